@@ -1,0 +1,140 @@
+"""The small interface every dynamical model exposes to the integrators and the analysis.
+
+A model is *state + rule + parameters*:
+
+* an ODE ``dy/dt = f(t, y; p)`` (:class:`ODESystem`) or a map ``x_{n+1} = g(n, x_n; p)``
+  (:class:`DiscreteMap`);
+* the rule is a compiled (``numba.njit``) kernel with a fixed calling convention, so the
+  integrators and the tangent-space (Lyapunov) code can call it from inside their own compiled
+  loops without Python overhead;
+* the parameters are a flat ``float64`` array ``p`` packed by the model's Python side.
+
+Kernel calling convention (all arrays ``float64``, C-contiguous):
+
+``rhs(t, y, p, out)``
+    writes ``f(t, y; p)`` into ``out`` (shape ``(dim,)``), returns nothing.
+``jac(t, y, p, out)``
+    writes the Jacobian ``df/dy`` into ``out`` (shape ``(dim, dim)``, ``out[i, j] = df_i/dy_j``).
+
+For a map the same convention holds with the step index ``n`` (a float) in place of ``t`` and
+``out`` receiving ``g``/``dg/dx``.
+
+Derived outputs (e.g. crosshead displacement from the clearance angle) are *not* part of the
+compiled rule: a model may implement :meth:`ODESystem.outputs` to turn a trajectory into named,
+unit-labelled signals. Nothing here knows about cranks; the compressor model
+(:mod:`recipdyn.model.compressor`) is one implementation, the Lorenz system in the tests another.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ODESystem", "DiscreteMap", "Signal"]
+
+
+@dataclass(frozen=True)
+class Signal:
+    """A derived output: values over the trajectory's samples plus metadata.
+
+    Attributes
+    ----------
+    values : ndarray
+        One value per sample.
+    units : str
+        SI units as a string understood by pint (``"m"``, ``"m/s**2"``, ``"rad"``, ``"N"``).
+    long_name : str
+        Human-readable name for axis labels.
+    """
+
+    values: np.ndarray
+    units: str
+    long_name: str
+
+
+@dataclass(frozen=True)
+class ODESystem:
+    """A first-order ODE ``dy/dt = f(t, y; p)`` with compiled kernels.
+
+    Parameters
+    ----------
+    rhs : numba dispatcher
+        ``rhs(t, y, p, out)``; see the module docstring.
+    params : ndarray
+        Packed ``float64`` parameter vector passed to the kernels unchanged.
+    state_names : tuple of str
+        One name per state component; ``dim`` is its length.
+    jac : numba dispatcher, optional
+        ``jac(t, y, p, out)``, the exact Jacobian ``df/dy``. Needed for Benettin's method.
+    period : float, optional
+        Period (in ``t``) of the explicit time dependence, if the system is periodically forced
+        (the compressor's crank period ``2*pi/omega``). Used for stroboscopic sections.
+    state_units : tuple of str, optional
+        Units of each state component.
+    name : str
+        Short identifier.
+    attrs : mapping
+        Extra metadata (every input parameter) copied into result attributes.
+    """
+
+    rhs: Callable[..., Any]
+    params: np.ndarray
+    state_names: tuple[str, ...]
+    jac: Callable[..., Any] | None = None
+    period: float | None = None
+    state_units: tuple[str, ...] | None = None
+    name: str = "ode"
+    attrs: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def dim(self) -> int:
+        return len(self.state_names)
+
+    def f(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Evaluate the right-hand side from Python (for tests and reference solvers)."""
+        out = np.empty(self.dim)
+        self.rhs(float(t), np.ascontiguousarray(y, dtype=np.float64), self.params, out)
+        return out
+
+    def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Evaluate the Jacobian from Python; raises if the model has none."""
+        if self.jac is None:
+            raise ValueError(f"model {self.name!r} provides no Jacobian")
+        out = np.empty((self.dim, self.dim))
+        self.jac(float(t), np.ascontiguousarray(y, dtype=np.float64), self.params, out)
+        return out
+
+    def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, Signal]:
+        """Derived signals over a trajectory ``y`` of shape ``(len(t), dim)``.
+
+        The generic system's outputs are its state components.
+        """
+        units = self.state_units or ("1",) * self.dim
+        return {
+            n: Signal(np.asarray(y[:, i]), units[i], n)
+            for i, n in enumerate(self.state_names)
+        }
+
+
+@dataclass(frozen=True)
+class DiscreteMap:
+    """A map ``x_{n+1} = g(n, x_n; p)`` with compiled kernels (same convention as ODESystem)."""
+
+    step: Callable[..., Any]
+    params: np.ndarray
+    state_names: tuple[str, ...]
+    jac: Callable[..., Any] | None = None
+    name: str = "map"
+    attrs: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def dim(self) -> int:
+        return len(self.state_names)
+
+    def g(self, n: int, x: np.ndarray) -> np.ndarray:
+        out = np.empty(self.dim)
+        self.step(float(n), np.ascontiguousarray(x, dtype=np.float64), self.params, out)
+        return out
