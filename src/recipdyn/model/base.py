@@ -16,6 +16,12 @@ Kernel calling convention (all arrays ``float64``, C-contiguous):
 ``jac(t, y, p, out)``
     writes the Jacobian ``df/dy`` into ``out`` (shape ``(dim, dim)``, ``out[i, j] = df_i/dy_j``).
 
+Kernels must be compiled with the explicit signatures :data:`RHS_SIGNATURE` /
+:data:`JAC_SIGNATURE` (``@numba.njit(RHS_SIGNATURE, cache=True)``): the integrators receive them
+as first-class function values (:data:`RHS_TYPE`), which keeps the integrators' own compiled code
+cacheable across processes (a lazily typed dispatcher argument would force a recompile in every
+new process).
+
 For a map the same convention holds with the step index ``n`` (a float) in place of ``t`` and
 ``out`` receiving ``g``/``dg/dx``.
 
@@ -32,8 +38,22 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import types as _nbt
 
-__all__ = ["ODESystem", "DiscreteMap", "Signal"]
+__all__ = [
+    "ODESystem", "DiscreteMap", "Signal", "RHS_SIGNATURE", "JAC_SIGNATURE", "EVENT_SIGNATURE",
+    "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE",
+]  # fmt: skip
+
+#: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
+RHS_SIGNATURE = _nbt.void(_nbt.float64, _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[::1])
+#: ``jac(t, y, p, out2d) -> None``.
+JAC_SIGNATURE = _nbt.void(_nbt.float64, _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[:, ::1])
+#: ``g(t, y, p) -> float`` (event functions for sections).
+EVENT_SIGNATURE = _nbt.float64(_nbt.float64, _nbt.float64[::1], _nbt.float64[::1])
+RHS_TYPE = _nbt.FunctionType(RHS_SIGNATURE)
+JAC_TYPE = _nbt.FunctionType(JAC_SIGNATURE)
+EVENT_TYPE = _nbt.FunctionType(EVENT_SIGNATURE)
 
 
 @dataclass(frozen=True)
@@ -113,10 +133,7 @@ class ODESystem:
         The generic system's outputs are its state components.
         """
         units = self.state_units or ("1",) * self.dim
-        return {
-            n: Signal(np.asarray(y[:, i]), units[i], n)
-            for i, n in enumerate(self.state_names)
-        }
+        return {n: Signal(np.asarray(y[:, i]), units[i], n) for i, n in enumerate(self.state_names)}
 
 
 @dataclass(frozen=True)

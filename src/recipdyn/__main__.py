@@ -1,0 +1,5 @@
+import sys
+
+from recipdyn.cli import main
+
+sys.exit(main())

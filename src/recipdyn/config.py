@@ -1,0 +1,97 @@
+"""Typed configuration (TOML) for simulations: parameters and settings with units.
+
+Example ``case.toml``::
+
+    [params]            # any CompressorParams field or alias, numbers in SI or quantities
+    rc = "1 mm"
+    d = "1 mm"
+    omega = "191 rpm"
+    load_sign = "physical"
+
+    [simulation]
+    revolutions = 20
+    transient = 5
+    fs = "10 kHz"
+    method = "dop853"
+    rtol = 1e-10
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from .model.parameters import CompressorParams, ParameterError, resolve_name
+from .units import to_si
+
+__all__ = ["SimulationConfig", "RunConfig", "load_config", "build_params"]
+
+_STRING_FIELDS = {"load_sign", "equations"}
+
+
+class SimulationConfig(BaseModel):
+    """Settings of :func:`recipdyn.simulate` (quantities allowed where units apply)."""
+
+    model_config = ConfigDict(extra="forbid")
+    revolutions: float | str = 10.0
+    transient: float | str = 0.0
+    fs: float | str = 10_000.0
+    method: Literal["dop853", "rk4"] = "dop853"
+    rtol: float = 1e-10
+    atol: float = 1e-12
+    h: float | str | None = None
+
+    def resolved(self) -> dict[str, Any]:
+        out = self.model_dump()
+        for k in ("revolutions", "transient", "fs", "h"):
+            if out[k] is not None:
+                out[k] = to_si(k, out[k])
+        return out
+
+
+class RunConfig(BaseModel):
+    """A whole config file: ``[params]`` and ``[simulation]`` tables."""
+
+    model_config = ConfigDict(extra="forbid")
+    params: dict[str, Any] = {}
+    simulation: SimulationConfig = SimulationConfig()
+
+
+def build_params(values: dict[str, Any], base: CompressorParams | None = None) -> CompressorParams:
+    """CompressorParams from ``{name_or_alias: number | quantity string}``, validated."""
+    kw: dict[str, Any] = {}
+    for k, v in values.items():
+        name = resolve_name(k)
+        if name in _STRING_FIELDS:
+            kw[name] = str(v)
+        elif name == "load_table":
+            from .model.load import read_load_table
+
+            kw[name] = read_load_table(v)
+        elif name == "theta_c0" and (v is None or str(v).lower() in ("default", "none")):
+            kw[name] = None
+        else:
+            kw[name] = to_si(name, v)
+    return dataclasses.replace(base or CompressorParams(), **kw)
+
+
+def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
+    """Read a TOML config; returns ``(params, simulation settings in SI)``."""
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ParameterError(f"config: file not found: {path}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"config {path}: malformed TOML ({exc})") from None
+    try:
+        cfg = RunConfig.model_validate(raw)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        loc = ".".join(str(x) for x in first["loc"])
+        raise ParameterError(f"config {path}: {loc}: {first['msg']}") from None
+    return build_params(cfg.params), cfg.simulation.resolved()

@@ -1,0 +1,368 @@
+"""Compiled integrator loops (numba). The Python front end is :mod:`recipdyn.integrate.solve`.
+
+Both loops call the model's compiled ``rhs(t, y, p, out)`` directly. The DOP853 loop follows
+SciPy's ``solve_ivp(method="DOP853")`` step for step (initial step selection, error norm, step
+control, dense output), so given the same inputs it takes the same steps; it adds optional
+event detection (root-finding on the 7th-order dense output).
+
+Status codes: 0 reached ``t1``; 1 stopped at max events; -1 step size underflow;
+-2 ``max_steps`` exceeded; -3 non-finite state.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from numba import types as T
+
+from ..model.base import EVENT_SIGNATURE, EVENT_TYPE, RHS_TYPE
+
+F8, I8 = T.float64, T.int64
+V1, V2 = T.float64[::1], T.float64[:, ::1]
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+
+
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def no_event(t, y, p):  # pragma: no cover - trivial
+    return 1.0
+
+
+@nb.njit(cache=True)
+def _rms(x):
+    s = 0.0
+    for v in x:
+        s += v * v
+    return math.sqrt(s / x.shape[0])
+
+
+@nb.njit(cache=True)
+def _dense_eval(x, y_old, F, out):
+    """SciPy's Dop853DenseOutput: nested Horner-like evaluation in x and (1 - x)."""
+    n = y_old.shape[0]
+    for j in range(n):
+        out[j] = 0.0
+    npow = F.shape[0]
+    for i in range(npow):
+        f = F[npow - 1 - i]
+        for j in range(n):
+            out[j] += f[j]
+            if i % 2 == 0:
+                out[j] *= x
+            else:
+                out[j] *= 1.0 - x
+    for j in range(n):
+        out[j] += y_old[j]
+
+
+@nb.njit(cache=True)
+def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp):
+    n = y.shape[0]
+    for j in range(n):
+        K[0, j] = f[j]
+    for s in range(1, n_stages):
+        for j in range(n):
+            acc = 0.0
+            for k in range(s):
+                acc += A[s, k] * K[k, j]
+            ytmp[j] = y[j] + h * acc
+        rhs(t + C[s] * h, ytmp, p, K[s])
+
+
+DOP853_SIG = I8(
+    RHS_TYPE, EVENT_TYPE, F8, V1, F8, V1, F8, F8, F8, F8, V1, I8,
+    V2, V1, V1, V1, V1, V2, T.boolean, I8, V2, V1, V2, T.int64[::1], V1,
+)  # fmt: skip
+
+
+@nb.njit(DOP853_SIG, cache=True)
+def dop853_kernel(
+    rhs, event, t0, y0, t1, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
+    A, B, C, E3, E5, D, use_event, event_dir, Y, ev_t, ev_y, stats, fstate,
+):  # fmt: skip
+    """Integrate from ``(t0, y0)`` to ``t1``; ``y0`` is updated in place to the final state.
+
+    Outputs: ``Y[i]`` at ``t_eval[i]``; events in ``ev_t``/``ev_y`` (capacity = their length);
+    ``stats = [nfev, nsteps, nreject, n_out, n_events]``; ``fstate = [t_final, h_abs_next]``.
+    Returns the status code.
+    """
+    n = y0.shape[0]
+    max_events = ev_t.shape[0]
+    n_stages = 12
+    K = np.empty((17, n))  # 12 stages + f_new + 3 extra dense stages (+1 spare)
+    ytmp = np.empty(n)
+    y = y0.copy()
+    f = np.empty(n)
+    rhs(t0, y, p, f)
+    nfev = 1
+    n_eval = t_eval.shape[0]
+    ie = 0
+    while ie < n_eval and t_eval[ie] <= t0:
+        Y[ie] = y
+        ie += 1
+    n_ev = 0
+    g_old = event(t0, y, p) if use_event else 0.0
+    direction = 1.0
+    interval = abs(t1 - t0)
+
+    # initial step (SciPy's select_initial_step with order 7)
+    if h_abs0 > 0.0:
+        h_abs = h_abs0
+    elif interval == 0.0:
+        h_abs = 0.0
+    else:
+        scale = np.empty(n)
+        for j in range(n):
+            scale[j] = atol + abs(y[j]) * rtol
+        d0 = _rms(y / scale)
+        d1 = _rms(f / scale)
+        h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+        h0 = min(h0, interval)
+        y1 = y + h0 * direction * f
+        f1 = np.empty(n)
+        rhs(t0 + h0 * direction, y1, p, f1)
+        nfev += 1
+        d2 = _rms((f1 - f) / scale) / h0
+        if d1 <= 1e-15 and d2 <= 1e-15:
+            h1 = max(1e-6, h0 * 1e-3)
+        else:
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+        h_abs = min(100.0 * h0, h1, interval, max_step)
+
+    t = t0
+    nsteps = 0
+    nrej = 0
+    status = 0
+    y_new = np.empty(n)
+    f_new = np.empty(n)
+    err5 = np.empty(n)
+    err3 = np.empty(n)
+    Fd = np.empty((7, n))
+    ydense = np.empty(n)
+    err_exp = -1.0 / 8.0
+    while t < t1:
+        if nsteps >= max_steps:
+            status = -2
+            break
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        if h_abs > max_step:
+            h_abs = max_step
+        elif h_abs < min_step:
+            h_abs = min_step
+        accepted = False
+        rejected = False
+        h = 0.0
+        t_new = t
+        while not accepted:
+            if h_abs < min_step:
+                status = -1
+                break
+            h = h_abs
+            t_new = t + h
+            if t_new - t1 > 0:
+                t_new = t1
+            h = t_new - t
+            h_abs = abs(h)
+            _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp)
+            for j in range(n):
+                acc = 0.0
+                for k in range(n_stages):
+                    acc += B[k] * K[k, j]
+                y_new[j] = y[j] + h * acc
+            rhs(t + h, y_new, p, f_new)
+            nfev += n_stages
+            for j in range(n):
+                K[n_stages, j] = f_new[j]
+            # error estimate
+            e5n = 0.0
+            e3n = 0.0
+            for j in range(n):
+                sc = atol + max(abs(y[j]), abs(y_new[j])) * rtol
+                a5 = 0.0
+                a3 = 0.0
+                for k in range(n_stages + 1):
+                    a5 += K[k, j] * E5[k]
+                    a3 += K[k, j] * E3[k]
+                err5[j] = a5 / sc
+                err3[j] = a3 / sc
+                e5n += err5[j] * err5[j]
+                e3n += err3[j] * err3[j]
+            if e5n == 0.0 and e3n == 0.0:
+                err_norm = 0.0
+            else:
+                err_norm = abs(h) * e5n / math.sqrt((e5n + 0.01 * e3n) * n)
+            if not math.isfinite(err_norm):
+                err_norm = 1e10  # treat as a failed step; shrink
+            if err_norm < 1.0:
+                if err_norm == 0.0:
+                    factor = MAX_FACTOR
+                else:
+                    factor = min(MAX_FACTOR, SAFETY * err_norm**err_exp)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_abs *= factor
+                accepted = True
+            else:
+                h_abs *= max(MIN_FACTOR, SAFETY * err_norm**err_exp)
+                rejected = True
+                nrej += 1
+        if status != 0:
+            break
+        finite = True
+        for j in range(n):
+            if not math.isfinite(y_new[j]):
+                finite = False
+        if not finite:
+            status = -3
+            break
+        nsteps += 1
+        # dense output, only when needed
+        need_dense = ie < n_eval and t_eval[ie] <= t_new
+        g_new = 0.0
+        crossing = False
+        if use_event:
+            g_new = event(t_new, y_new, p)
+            if (g_old < 0.0 <= g_new and event_dir >= 0) or (
+                g_old > 0.0 >= g_new and event_dir <= 0
+            ):
+                crossing = True
+                need_dense = True
+        if need_dense:
+            for s in range(3):
+                st = n_stages + 1 + s
+                for j in range(n):
+                    acc = 0.0
+                    for k in range(st):
+                        acc += A[st, k] * K[k, j]
+                    ytmp[j] = y[j] + h * acc
+                rhs(t + C[st] * h, ytmp, p, K[st])
+            nfev += 3
+            for j in range(n):
+                dy = y_new[j] - y[j]
+                Fd[0, j] = dy
+                Fd[1, j] = h * f[j] - dy
+                Fd[2, j] = 2.0 * dy - h * (f_new[j] + f[j])
+                for r in range(4):
+                    acc = 0.0
+                    for k in range(16):
+                        acc += D[r, k] * K[k, j]
+                    Fd[3 + r, j] = h * acc
+            while ie < n_eval and t_eval[ie] <= t_new:
+                if t_eval[ie] == t_new:
+                    Y[ie] = y_new
+                else:
+                    _dense_eval((t_eval[ie] - t) / h, y, Fd, ydense)
+                    Y[ie] = ydense
+                ie += 1
+            if crossing and n_ev < max_events:
+                # Illinois (modified regula falsi) on the dense output, in x = (t - t_old)/h
+                xa, xb = 0.0, 1.0
+                ga, gb = g_old, g_new
+                side = 0
+                for _ in range(100):
+                    xm = xb - gb * (xb - xa) / (gb - ga) if gb != ga else 0.5 * (xa + xb)
+                    _dense_eval(xm, y, Fd, ydense)
+                    gm = event(t + xm * h, ydense, p)
+                    if gm == 0.0 or abs(xb - xa) * abs(h) < 4e-16 * max(1.0, abs(t)):
+                        break
+                    if (gm > 0.0) == (gb > 0.0):
+                        xb, gb = xm, gm
+                        if side == -1:
+                            ga *= 0.5
+                        side = -1
+                    else:
+                        xa, ga = xm, gm
+                        if side == 1:
+                            gb *= 0.5
+                        side = 1
+                ev_t[n_ev] = t + xm * h
+                _dense_eval(xm, y, Fd, ydense)
+                ev_y[n_ev] = ydense
+                n_ev += 1
+        g_old = g_new
+        t = t_new
+        y[:] = y_new
+        f[:] = f_new
+        if use_event and n_ev >= max_events:
+            status = 1
+            break
+    y0[:] = y
+    stats[0] = nfev
+    stats[1] = nsteps
+    stats[2] = nrej
+    stats[3] = ie
+    stats[4] = n_ev
+    fstate[0] = t
+    fstate[1] = h_abs
+    return status
+
+
+@nb.njit(I8(RHS_TYPE, F8, V1, F8, V1, F8, V1, I8, V2, T.int64[::1], V1), cache=True)
+def rk4_kernel(rhs, t0, y0, t1, p, h_max, t_eval, max_steps, Y, stats, fstate):
+    """Classical RK4 that lands exactly on every output time.
+
+    Between consecutive stops (output times and ``t1``) it takes ``m = ceil(dt / h_max)`` equal
+    steps, so outputs are RK4 values, not interpolations. ``y0`` is updated in place;
+    ``stats = [nfev, nsteps, 0, n_out, 0]``, ``fstate = [t_final, h]``.
+    """
+    n = y0.shape[0]
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    yt = np.empty(n)
+    n_eval = t_eval.shape[0]
+    ie = 0
+    t = t0
+    nfev = 0
+    nsteps = 0
+    status = 0
+    while True:
+        while ie < n_eval and t_eval[ie] <= t:
+            Y[ie] = y
+            ie += 1
+        if t >= t1:
+            break
+        stop = t_eval[ie] if ie < n_eval and t_eval[ie] < t1 else t1
+        m = max(1, int(math.ceil((stop - t) / h_max - 1e-9)))
+        h = (stop - t) / m
+        ts = t
+        for i in range(m):
+            tc = ts + i * h
+            rhs(tc, y, p, k1)
+            for j in range(n):
+                yt[j] = y[j] + 0.5 * h * k1[j]
+            rhs(tc + 0.5 * h, yt, p, k2)
+            for j in range(n):
+                yt[j] = y[j] + 0.5 * h * k2[j]
+            rhs(tc + 0.5 * h, yt, p, k3)
+            for j in range(n):
+                yt[j] = y[j] + h * k3[j]
+            rhs(tc + h, yt, p, k4)
+            for j in range(n):
+                y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+            nfev += 4
+            nsteps += 1
+        t = stop
+        finite = True
+        for j in range(n):
+            if not math.isfinite(y[j]):
+                finite = False
+        if not finite:
+            status = -3
+            break
+        if nsteps > max_steps:
+            status = -2
+            break
+    y0[:] = y
+    stats[0] = nfev
+    stats[1] = nsteps
+    stats[3] = ie
+    fstate[0] = t
+    fstate[1] = h_max
+    return status

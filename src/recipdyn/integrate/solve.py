@@ -1,0 +1,238 @@
+"""Integrate any :class:`~recipdyn.model.base.ODESystem` with compiled Runge-Kutta loops.
+
+Methods (registry :data:`METHODS`):
+
+``"dop853"``
+    Dormand-Prince 8(5,3) with SciPy's error control and 7th-order dense output; outputs at
+    ``t_eval`` come from the dense output (exact sampling times, like a sensor); optional events
+    are root-found on the dense output. Counts ``nfev``, ``nsteps`` and ``nreject``.
+``"rk4"``
+    Classical fixed-step RK4 (the paper's method) with step ``h`` (at most), landing exactly on
+    every output time.
+
+Long runs are split into chunks so a progress bar can advance; the adaptive step size carries
+over between chunks, and the chunking depends only on the inputs, so results are reproducible.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.base import ODESystem
+from . import _kernels
+from .tableaus import DOP853
+
+__all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS"]
+
+METHODS = ("dop853", "rk4")
+_MESSAGES = {
+    0: "reached the end of the interval",
+    1: "stopped after the requested number of events",
+    -1: "step size fell below the resolution of t (the problem may be singular or stiff)",
+    -2: "max_steps exceeded",
+    -3: "the state became non-finite (NaN/inf)",
+}
+
+
+class IntegrationError(RuntimeError):
+    """The integrator failed; ``partial`` holds what was computed before the failure."""
+
+    def __init__(self, message: str, partial: Solution | None = None):
+        super().__init__(message)
+        self.partial = partial
+
+
+@dataclass
+class Solution:
+    """Result of :func:`integrate`.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Output times.
+    y : ndarray, shape (n, dim)
+        States at ``t``.
+    t_final, y_final : float, ndarray
+        Where the integration stopped.
+    nfev, nsteps, nreject : int
+        Right-hand-side evaluations, accepted and rejected steps.
+    status : int
+        0 success, 1 stopped at ``max_events``, < 0 failure (see ``message``).
+    t_events, y_events : ndarray
+        Event times and states (if an event function was given).
+    settings : dict
+        Method and tolerances, for result attributes.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    t_final: float
+    y_final: np.ndarray
+    nfev: int
+    nsteps: int
+    nreject: int
+    status: int
+    message: str
+    t_events: np.ndarray = field(default_factory=lambda: np.empty(0))
+    y_events: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status >= 0
+
+
+def _check_inputs(system, y0, t_span, method, rtol, atol, h):
+    if not isinstance(system, ODESystem):
+        raise TypeError(f"system must be an ODESystem, got {type(system).__name__}")
+    y0 = np.ascontiguousarray(y0, dtype=np.float64).reshape(-1)
+    if y0.shape[0] != system.dim:
+        raise ValueError(f"y0 has {y0.shape[0]} components, the system has {system.dim}")
+    if not np.all(np.isfinite(y0)):
+        raise ValueError(f"y0 must be finite, got {y0}")
+    t0, t1 = (float(x) for x in t_span)
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 < t0:
+        raise ValueError(f"t_span must be finite with t1 >= t0, got {t_span}")
+    if method not in METHODS:
+        raise ValueError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
+    if method == "dop853" and not (1e-14 <= rtol <= 1e-1 and 0.0 < atol <= 1.0):
+        raise ValueError(f"rtol = {rtol} must be in [1e-14, 0.1] and atol = {atol} in (0, 1]")
+    if method == "rk4" and (h is None or not (h > 0 and math.isfinite(h))):
+        raise ValueError(f"method 'rk4' needs a step h > 0, got h = {h}")
+    return y0, t0, t1
+
+
+def integrate(
+    system: ODESystem,
+    y0,
+    t_span: tuple[float, float],
+    *,
+    method: str = "dop853",
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    h: float | None = None,
+    t_eval=None,
+    max_step: float = math.inf,
+    max_steps: int = 100_000_000,
+    event: Callable | None = None,
+    event_direction: int = 0,
+    max_events: int = 0,
+    chunks: int = 1,
+    progress: Callable[[float], None] | None = None,
+    raise_on_failure: bool = True,
+) -> Solution:
+    """Integrate ``system`` from ``y0`` over ``t_span``.
+
+    Parameters
+    ----------
+    system : ODESystem
+    y0 : array_like, shape (dim,)
+    t_span : (t0, t1)
+    method : {"dop853", "rk4"}
+    rtol, atol : float
+        DOP853 tolerances (error per step below ``atol + rtol |y|``).
+    h : float
+        RK4 maximum step (required for ``"rk4"``).
+    t_eval : array_like, optional
+        Sorted output times within ``t_span``; default ``[t0, t1]``.
+    max_step : float
+        DOP853 maximum step.
+    event : numba function ``g(t, y, p) -> float``, optional
+        Record crossings of ``g = 0`` (DOP853 only), root-found on the dense output;
+        ``event_direction`` +1 rising, -1 falling, 0 both; ``max_events`` caps the count
+        (and stops the integration when reached; 0 = capacity only, default 100 000).
+    chunks : int
+        Split the run in this many pieces, calling ``progress(fraction)`` after each.
+    raise_on_failure : bool
+        Raise :class:`IntegrationError` (with the partial solution) on failure.
+    """
+    y0, t0, t1 = _check_inputs(system, y0, t_span, method, rtol, atol, h)
+    if t_eval is None:
+        t_eval = np.array([t0, t1])
+    t_eval = np.ascontiguousarray(t_eval, dtype=np.float64).reshape(-1)
+    if t_eval.size and (np.any(np.diff(t_eval) < 0) or t_eval[0] < t0 or t_eval[-1] > t1):
+        raise ValueError("t_eval must be sorted and lie within t_span")
+    use_event = event is not None
+    cap = max_events if max_events > 0 else 100_000
+    ev = event if use_event else _kernels.no_event
+    chunks = max(1, int(chunks))
+    edges = np.linspace(t0, t1, chunks + 1)
+    edges[-1] = t1
+    Ys = []
+    ev_t, ev_y = [], []
+    y = y0.copy()  # updated in place by the kernels
+    t = t0
+    h_abs = 0.0
+    nfev = nsteps = nrej = 0
+    status = 0
+    bounds = np.searchsorted(t_eval, edges[1:], side="right")
+    bounds[-1] = t_eval.size
+    lo = 0
+    for c in range(chunks):
+        hi = edges[c + 1]
+        sel = t_eval[lo : bounds[c]]
+        lo = bounds[c]
+        Y = np.empty((sel.size, system.dim))
+        stats = np.zeros(5, dtype=np.int64)
+        fstate = np.zeros(2)
+        if method == "dop853":
+            ev_cap = cap - len(ev_t) if use_event else 0
+            et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
+            status = _kernels.dop853_kernel(
+                system.rhs, ev, t, y, hi, system.params, rtol, atol, h_abs, max_step, sel,
+                max_steps - nsteps, DOP853.A, DOP853.B, DOP853.C, DOP853.E3, DOP853.E5,
+                DOP853.D, use_event, event_direction, Y, et, ey, stats, fstate,
+            )  # fmt: skip
+            ev_t.extend(et[: stats[4]])
+            ev_y.extend(ey[: stats[4]])
+        else:
+            status = _kernels.rk4_kernel(
+                system.rhs,
+                t,
+                y,
+                hi,
+                system.params,
+                float(h),
+                sel,
+                max_steps - nsteps,
+                Y,
+                stats,
+                fstate,
+            )
+        t, h_abs = float(fstate[0]), float(fstate[1])
+        nf, ns, nr, n_out = (int(x) for x in stats[:4])
+        Ys.append(Y[:n_out])
+        nfev += nf
+        nsteps += ns
+        nrej += nr
+        if progress is not None:
+            progress((t - t0) / (t1 - t0) if t1 > t0 else 1.0)
+        if status != 0:
+            break
+    Y = np.concatenate(Ys) if Ys else np.empty((0, system.dim))
+    sol = Solution(
+        t=t_eval[: Y.shape[0]].copy(),
+        y=Y,
+        t_final=float(t),
+        y_final=np.array(y),
+        nfev=int(nfev),
+        nsteps=int(nsteps),
+        nreject=int(nrej),
+        status=int(status),
+        message=_MESSAGES[int(status)],
+        t_events=np.array(ev_t, dtype=float),
+        y_events=np.array(ev_y, dtype=float).reshape(-1, system.dim),
+        settings=dict(method=method, rtol=rtol, atol=atol, h=h, max_step=max_step),
+    )
+    if status < 0 and raise_on_failure:
+        raise IntegrationError(f"integration failed at t = {t:.6g}: {sol.message}", sol)
+    return sol
+
+
+def propagate(system: ODESystem, y0, t0: float, t1: float, **kwargs) -> np.ndarray:
+    """State at ``t1`` starting from ``y0`` at ``t0`` (no stored trajectory)."""
+    return integrate(system, y0, (t0, t1), t_eval=np.empty(0), **kwargs).y_final

@@ -1,0 +1,212 @@
+r"""The single-cylinder compressor with a crank-pin clearance as an :class:`ODESystem`.
+
+State ``y = (theta_c, theta_c')``; time ``t`` in s; crank angle ``theta1 = theta1_0 + omega t``.
+The right-hand side is ``(theta_c', theta_c'')`` with ``theta_c''`` from
+
+* ``equations="exact"``: Lagrange's equation derived without approximation
+  (:mod:`.derivation`, compiled code in :mod:`._generated`), with an exact Jacobian;
+* ``equations="paper-printed"``: Eq. (43)-(47) as printed (:mod:`.paper_printed`), whose
+  Jacobian's ``d/d theta_c`` column is a central difference (the printed coefficients are a
+  comparison variant only).
+
+With ``rc = 0`` the clearance angle has no dynamics (the mechanism is ideal); the kernel then
+returns ``theta_c'' = 0`` and the outputs are the ideal slider-crank's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba as nb
+import numpy as np
+
+from ._generated import clearance_acceleration, clearance_acceleration_jac
+from .base import JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODESystem, Signal
+from .kinematics import joint_forces, kinematics
+from .load import gas_force, gas_force_kernel, pack_table
+from .paper_printed import paper_acceleration
+from .parameters import CompressorParams, ParameterError
+
+__all__ = ["CompressorModel", "compressor_model", "equilibrium_theta_c", "pack_params"]
+
+# Layout of the packed parameter vector.
+P_R, P_RS, P_L, P_LS, P_M1, P_M2, P_M3, P_J1, P_J2, P_G = range(10)
+P_RC, P_D, P_OMEGA, P_TH10, P_LOADKIND, P_LOADAMP, P_LOADSIGN, P_TABLE = range(10, 18)
+
+
+def pack_params(p: CompressorParams) -> np.ndarray:
+    """Flat float64 vector for the compiled kernels (layout: the ``P_*`` constants)."""
+    head = [p.r, p.rs, p.l, p.ls, p.m1, p.m2, p.m3, p.J1, p.J2, p.g, p.rc, p.d, p.omega]
+    head += [p.theta1_0, 0.0 if p.load_table is None else 1.0, p.load_amplitude]
+    head += [-1.0 if p.load_sign == "physical" else 1.0]
+    return np.concatenate([np.asarray(head, dtype=np.float64), pack_table(p.load_table)])
+
+
+@nb.njit(cache=True)
+def _force(t, p):
+    th1 = p[P_TH10] + p[P_OMEGA] * t
+    return th1, gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def rhs_exact(t, y, p, out):
+    out[0] = y[1]
+    if p[P_RC] == 0.0:
+        out[1] = 0.0
+        return
+    th1, F = _force(t, p)
+    out[1] = clearance_acceleration(
+        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
+        p[P_RC], p[P_D], p[P_OMEGA],
+    )  # fmt: skip
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def jac_exact(t, y, p, out):
+    out[0, 0] = 0.0
+    out[0, 1] = 1.0
+    if p[P_RC] == 0.0:
+        out[1, 0] = 0.0
+        out[1, 1] = 0.0
+        return
+    th1, F = _force(t, p)
+    _, da_dq, da_dqd = clearance_acceleration_jac(
+        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
+        p[P_RC], p[P_D], p[P_OMEGA],
+    )  # fmt: skip
+    out[1, 0] = da_dq
+    out[1, 1] = da_dqd
+
+
+@nb.njit(cache=True)
+def _paper_acc(t, q, qd, p):
+    th1, F = _force(t, p)
+    return paper_acceleration(
+        th1, q, qd, F, p[P_R], p[P_L], p[P_M2], p[P_M3], p[P_J2], p[P_RC], p[P_D], p[P_OMEGA]
+    )
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def rhs_paper(t, y, p, out):
+    out[0] = y[1]
+    out[1] = 0.0 if p[P_RC] == 0.0 else _paper_acc(t, y[0], y[1], p)
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def jac_paper(t, y, p, out):
+    out[0, 0] = 0.0
+    out[0, 1] = 1.0
+    if p[P_RC] == 0.0:
+        out[1, 0] = 0.0
+        out[1, 1] = 0.0
+        return
+    h = 1e-6
+    out[1, 0] = (_paper_acc(t, y[0] + h, y[1], p) - _paper_acc(t, y[0] - h, y[1], p)) / (2 * h)
+    hd = 1e-6 * max(1.0, abs(y[1]))
+    out[1, 1] = (_paper_acc(t, y[0], y[1] + hd, p) - _paper_acc(t, y[0], y[1] - hd, p)) / (2 * hd)
+
+
+@nb.njit(
+    nb.float64[::1](RHS_TYPE, nb.float64[::1], nb.float64[:, ::1], nb.float64[::1]), cache=True
+)
+def _accelerations(rhs, t, y, p):
+    out = np.empty(t.shape[0])
+    buf = np.empty(2)
+    yi = np.empty(2)
+    for i in range(t.shape[0]):
+        yi[0] = y[i, 0]
+        yi[1] = y[i, 1]
+        rhs(t[i], yi, p, buf)
+        out[i] = buf[1]
+    return out
+
+
+def equilibrium_theta_c(p: CompressorParams, t: float = 0.0) -> float:
+    r"""Clearance angle at which the link is aligned with the rod load at time ``t``.
+
+    The gas force on the crosshead is transmitted along the rod; the massless link is in
+    static equilibrium when it points along the rod, ``sin(theta_c - theta2) = 0``, i.e.
+    ``dx3/dtheta_c = 0``. The stable branch has the journal pushed away from the load:
+    ``theta_c = theta2 + pi`` when the force on the crosshead points toward the crank
+    (``F_x < 0``, physical sign, rod in compression) and ``theta_c = theta2`` when it points
+    away (``F_x > 0``, the paper's sign, rod in tension). theta2 depends weakly on theta_c
+    (``|d theta2/d theta_c| <= rc/(l cos theta2)``), so a fixed-point iteration converges.
+    """
+    th1 = p.theta1_0 + p.omega * t
+    F = float(gas_force(th1, p))
+    shift = math.pi if F <= 0.0 else 0.0
+    thc = shift
+    for _ in range(100):
+        s2 = -(p.d + p.r * math.sin(th1) + p.rc * math.sin(thc)) / p.l
+        new = math.asin(s2) + shift
+        if abs(new - thc) < 1e-15:
+            break
+        thc = new
+    return thc
+
+
+@dataclass(frozen=True)
+class CompressorModel(ODESystem):
+    """The compressor as a 2-state ODE with crosshead outputs (see module docstring)."""
+
+    cparams: CompressorParams = field(default_factory=CompressorParams)
+
+    def initial_state(self) -> np.ndarray:
+        """``(theta_c0, thetadot_c0)``; default theta_c0: :func:`equilibrium_theta_c` + offset."""
+        p = self.cparams
+        thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
+        return np.array([thc0 + p.theta_c_offset, p.thetadot_c0])
+
+    def accelerations(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Clearance-angle acceleration at each sample, from the equation of motion."""
+        return _accelerations(
+            self.rhs, np.ascontiguousarray(t, float), np.ascontiguousarray(y, float), self.params
+        )
+
+    def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, Signal]:
+        """Crosshead motion, rod angle, clearance state, gas force and joint forces."""
+        p = self.cparams
+        thc, thcd = y[:, 0], y[:, 1]
+        thcdd = self.accelerations(t, y)
+        k = kinematics(p, t, thc, thcd, thcdd)
+        fg = gas_force(k.theta1, p)
+        jf = joint_forces(p, k, thc, fg)
+        return {
+            "x": Signal(k.x3, "m", "crosshead displacement x3"),
+            "v": Signal(k.v3, "m/s", "crosshead velocity"),
+            "a": Signal(k.a3, "m/s**2", "crosshead acceleration"),
+            "theta1": Signal(k.theta1, "rad", "crank angle"),
+            "theta2": Signal(k.theta2, "rad", "connecting-rod angle"),
+            "theta_c": Signal(thc, "rad", "clearance angle"),
+            "thetadot_c": Signal(thcd, "rad/s", "clearance angular velocity"),
+            "thetaddot_c": Signal(thcdd, "rad/s**2", "clearance angular acceleration"),
+            "gas_force": Signal(fg, "N", "gas force on the crosshead along +x"),
+            "joint_force_x": Signal(jf.Fx, "N", "clearance-joint force on the rod, x"),
+            "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
+            "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
+            "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
+            "contact_force": Signal(
+                jf.contact, "N", "joint contact force (>0: permanent contact holds)"
+            ),
+            "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+        }
+
+
+def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
+    """Build the ODE model for ``p`` (default: the paper's base case)."""
+    p = CompressorParams() if p is None else p
+    if not isinstance(p, CompressorParams):
+        raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
+    exact = p.equations == "exact"
+    return CompressorModel(
+        rhs=rhs_exact if exact else rhs_paper,
+        jac=jac_exact if exact else jac_paper,
+        params=pack_params(p),
+        state_names=("theta_c", "thetadot_c"),
+        state_units=("rad", "rad/s"),
+        period=p.crank_period,
+        name=f"compressor-{p.equations}",
+        attrs=p.to_attrs(),
+        cparams=p,
+    )

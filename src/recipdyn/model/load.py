@@ -1,0 +1,118 @@
+r"""Cylinder load: the paper's piecewise pressure model (Eq. 1-2) or a user table.
+
+The force on the crosshead along +x is ``F_x(theta1) = s * P(theta1)`` with
+``P = load_amplitude * mu(theta1)`` (the paper's ``P = 200000 mu``, taken as a force in N) and
+
+* ``s = -1`` for ``load_sign="physical"``: the cylinder lies beyond the outer dead centre
+  (``theta1 = 0``, crosshead at ``x = r + l``), so the gas pushes the piston toward the crank;
+* ``s = +1`` for ``load_sign="paper"``: the sign with which P enters the paper's Eq. (46).
+
+Eq. (2), with ``phi = theta1 mod 2 pi``::
+
+    mu = sin(pi/2 - phi)        0       <= phi <= 7pi/16   expansion
+         sin(pi/16)             7pi/16  <= phi <= pi       suction
+         -sin(phi + pi/16)      pi      <= phi <= 23pi/16  compression
+         1                      23pi/16 <= phi <= 2pi      exhaust
+
+mu is continuous (the pieces meet at sin(pi/16) and 1) with kinks at the breakpoints; it is
+always positive, so the load never reverses.
+
+A table load (``CompressorParams.load_table``: rows of crank angle in degrees and force in N,
+already signed as the force on the crosshead along +x) is interpolated linearly and
+periodically; ``load_sign`` does not apply to it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+__all__ = ["mu_paper", "gas_force", "gas_force_kernel", "read_load_table"]
+
+_PI = math.pi
+
+
+@nb.njit(cache=True)
+def _mu_scalar(theta1: float) -> float:
+    phi = theta1 % (2.0 * _PI)
+    if phi <= 7.0 * _PI / 16.0:
+        return math.sin(0.5 * _PI - phi)
+    if phi <= _PI:
+        return math.sin(_PI / 16.0)
+    if phi <= 23.0 * _PI / 16.0:
+        return -math.sin(phi + _PI / 16.0)
+    return 1.0
+
+
+def mu_paper(theta1) -> np.ndarray:
+    """Cylinder pressure coefficient mu of Eq. (2) at crank angle(s) theta1 (rad)."""
+    th = np.asarray(theta1, dtype=np.float64)
+    return np.vectorize(_mu_scalar, otypes=[np.float64])(th)
+
+
+@nb.njit(cache=True)
+def gas_force_kernel(theta1: float, kind: float, amp: float, sign: float, table) -> float:
+    """Force on the crosshead along +x, N (compiled; see module docstring).
+
+    ``kind`` 0 = paper model, 1 = table; ``table`` is ``[n, angles_rad(n), forces_N(n)]``.
+    """
+    if kind == 0.0:
+        return sign * amp * _mu_scalar(theta1)
+    n = int(table[0])
+    ang = table[1 : 1 + n]
+    val = table[1 + n : 1 + 2 * n]
+    phi = theta1 % (2.0 * _PI)
+    j = np.searchsorted(ang, phi)  # ang[j-1] < phi <= ang[j]
+    if j == 0 or j == n:  # wrap-around segment between the last and the first node
+        a0, f0 = ang[n - 1], val[n - 1]
+        a1, f1 = ang[0] + 2.0 * _PI, val[0]
+        if phi < a0:
+            phi += 2.0 * _PI
+    else:
+        a0, f0, a1, f1 = ang[j - 1], val[j - 1], ang[j], val[j]
+    return f0 + (f1 - f0) * (phi - a0) / (a1 - a0)
+
+
+def pack_table(table) -> np.ndarray:
+    """Pack ``((deg, N), ...)`` rows as ``[n, angles_rad, forces]`` for the kernel."""
+    if table is None:
+        return np.zeros(1)
+    arr = np.asarray(table, dtype=np.float64)
+    return np.concatenate([[len(arr)], np.deg2rad(arr[:, 0]), arr[:, 1]])
+
+
+def gas_force(theta1, params) -> np.ndarray:
+    """Force on the crosshead along +x (N) at crank angle(s) theta1 for ``params``."""
+    kind = 0.0 if params.load_table is None else 1.0
+    sign = -1.0 if params.load_sign == "physical" else 1.0
+    tab = pack_table(params.load_table)
+    th = np.atleast_1d(np.asarray(theta1, dtype=np.float64))
+    out = np.array([gas_force_kernel(x, kind, params.load_amplitude, sign, tab) for x in th])
+    return out.reshape(np.shape(theta1))
+
+
+def read_load_table(path, *, area: float | None = None) -> tuple[tuple[float, float], ...]:
+    """Read a CSV load table: crank angle (deg) and force (N), or pressure (Pa) with ``area``.
+
+    Lines starting with ``#`` and a non-numeric header line are skipped. With ``area`` (m^2)
+    the second column is a pressure and the force is ``pressure * area``. Angles are wrapped
+    into [0, 360) and sorted.
+    """
+    from .parameters import ParameterError
+
+    try:
+        data = np.genfromtxt(path, delimiter=",", comments="#", dtype=float)
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"load table {path}: cannot read ({exc})") from None
+    data = np.atleast_2d(data)
+    data = data[~np.isnan(data).all(axis=1)]
+    if data.ndim != 2 or data.shape[1] < 2 or data.shape[0] < 2:
+        raise ParameterError(f"load table {path}: need >= 2 rows of 'angle_deg, value'")
+    if np.isnan(data[:, :2]).any():
+        raise ParameterError(f"load table {path}: non-numeric entries")
+    ang = np.mod(data[:, 0], 360.0)
+    val = data[:, 1] * (area if area is not None else 1.0)
+    order = np.argsort(ang)
+    return tuple((float(a), float(v)) for a, v in zip(ang[order], val[order], strict=True))

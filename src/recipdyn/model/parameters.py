@@ -1,0 +1,247 @@
+"""Immutable, validated parameters of the compressor model (SI units throughout).
+
+One frozen dataclass, :class:`CompressorParams`, holds geometry, inertia, faults, operation and
+the initial condition; vary it with :func:`dataclasses.replace` (validation runs again).
+:func:`paper_2d12` is the preset for the 2D12 compressor of Xiao et al. (2017).
+
+What the reference paper gives and what it does not
+----------------------------------------------------
+Table 1 of the paper (masses and moments of inertia of the 2D12 compressor) is garbled in the
+only copy we have and no other source was found. The crank radius (0.12 m) and the rod length
+(0.6 m) follow from the text ("480.6 mm at the low dead point" = l - r, and the table's "0.12");
+the centroids at mid-length are stated in Section 3. **Every other value is an assumption**,
+listed in :data:`ASSUMED` and recorded as such in every output file. They are plausible for a
+mid-size process compressor, not fitted to anything.
+
+Only ``m2``, ``m3``, ``J2`` (and ``g`` with ``m2``) enter the clearance-angle dynamics: the crank
+turns at a prescribed uniform speed, so ``m1``, ``J1`` and ``rs`` affect only the crank torque.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any, Literal
+
+__all__ = [
+    "CompressorParams",
+    "ParameterError",
+    "ASSUMED",
+    "PARAM_UNITS",
+    "PARAM_ALIASES",
+    "paper_2d12",
+    "resolve_name",
+]
+
+
+class ParameterError(ValueError):
+    """A parameter is out of its allowed range; the message names it and the range."""
+
+
+#: Parameters whose values are assumptions (the paper's Table 1 is illegible for them).
+ASSUMED: dict[str, str] = {
+    "m1": "assumed: Table 1 illegible (does not affect the clearance dynamics)",
+    "m2": "assumed: Table 1 illegible",
+    "m3": "assumed: Table 1 illegible",
+    "J1": "partly legible in Table 1 (0.0012); does not affect the clearance dynamics",
+    "J2": "assumed: slender uniform rod, m2*l**2/12",
+    "theta_c0": "not given in the paper: default = link aligned with the rod load, at rest",
+    "thetadot_c0": "not given in the paper: default 0",
+}
+
+PARAM_UNITS: dict[str, str] = {
+    "r": "m", "rs": "m", "l": "m", "ls": "m",
+    "m1": "kg", "m2": "kg", "m3": "kg", "J1": "kg*m**2", "J2": "kg*m**2", "g": "m/s**2",
+    "rc": "m", "d": "m", "omega": "rad/s", "theta1_0": "rad",
+    "theta_c0": "rad", "theta_c_offset": "rad", "thetadot_c0": "rad/s",
+    "load_amplitude": "N",
+}  # fmt: skip
+
+#: Friendly names accepted by the CLI, configs and sweeps.
+PARAM_ALIASES: dict[str, str] = {
+    "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
+    "crank_radius": "r", "rod_length": "l",
+}  # fmt: skip
+
+
+def resolve_name(name: str) -> str:
+    """Map an alias (``clearance``) to the field name (``rc``); raise on unknown names."""
+    name = PARAM_ALIASES.get(name, name)
+    if name not in {f.name for f in fields(CompressorParams)}:
+        known = sorted({f.name for f in fields(CompressorParams)} | set(PARAM_ALIASES))
+        raise ParameterError(f"unknown parameter {name!r}; known: {', '.join(known)}")
+    return name
+
+
+def _check(name: str, value: float, lo: float, hi: float, lo_open=False, hi_open=False):
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} must be finite, got {value!r}")
+    bad_lo = value <= lo if lo_open else value < lo
+    bad_hi = value >= hi if hi_open else value > hi
+    if bad_lo or bad_hi:
+        lb = "(" if lo_open else "["
+        rb = ")" if hi_open else "]"
+        unit = PARAM_UNITS.get(name, "")
+        raise ParameterError(
+            f"{name} = {value!r} {unit} is out of range; allowed: {lb}{lo:g}, {hi:g}{rb} {unit}"
+        )
+
+
+@dataclass(frozen=True)
+class CompressorParams:
+    """Parameters of the single-cylinder compressor with a clearance at the crank pin.
+
+    Attributes (SI units)
+    ---------------------
+    r : float
+        Crank radius A-B, m (paper: 0.12).
+    rs : float
+        Distance from the main bearing A to the crank's centroid, m (mid-length).
+    l : float
+        Connecting-rod length, m (paper: 0.6).
+    ls : float
+        Distance from the crank-pin end of the rod to its centroid, m (mid-length).
+    m1, m2, m3 : float
+        Masses of crank, rod and crosshead (with piston), kg. **Assumed** (see module doc).
+    J1, J2 : float
+        Moments of inertia of crank and rod about their centroids, kg m^2. **Assumed**.
+    g : float
+        Gravitational acceleration (acts along -y), m/s^2.
+    rc : float
+        Radial clearance of the crank-pin joint, m; the length of the massless virtual link.
+        ``0 <= rc < r``; ``rc = 0`` is the ideal mechanism.
+    d : float
+        Crosshead subsidence, m: the crosshead runs at ``y3 = -d``.
+    omega : float
+        Crank speed, rad/s (> 0); the crank angle is ``theta1 = theta1_0 + omega t``.
+    theta1_0 : float
+        Crank angle at t = 0, rad (0 = outer dead centre, crosshead at ``x = r + l``).
+    theta_c0 : float or None
+        Initial clearance angle, rad. ``None`` (default) = the link aligned with the force the
+        rod transmits at t = 0, i.e. the static equilibrium of the link under the gas load
+        (:func:`recipdyn.model.compressor.equilibrium_theta_c`), plus ``theta_c_offset``.
+    theta_c_offset : float
+        Offset added to the default initial clearance angle, rad. The motion is very sensitive
+        to it: offsets of ~0.2 rad and more excite large free oscillations of the link.
+    thetadot_c0 : float
+        Initial clearance angular velocity, rad/s (default 0).
+    load_amplitude : float
+        Peak cylinder force, N (the paper's ``P = 200000 mu``, Eq. 1).
+    load_sign : {"physical", "paper"}
+        Direction of the gas force on the crosshead. ``"physical"``: the gas pushes the piston
+        toward the crank, ``F_x = -P`` (the cylinder is on the +x side, beyond the outer dead
+        centre). ``"paper"``: ``F_x = +P``, the sign with which P enters the paper's Eq. (46)
+        (``d1 = P r_c`` multiplying ``dx3/dtheta_c``).
+    equations : {"exact", "paper-printed"}
+        ``"exact"``: our exact derivation. ``"paper-printed"``: Eq. (43)-(47) exactly as printed
+        (with their errata), for comparison only.
+    """
+
+    r: float = 0.12
+    rs: float = 0.06
+    l: float = 0.6
+    ls: float = 0.3
+    m1: float = 15.0
+    m2: float = 20.0
+    m3: float = 30.0
+    J1: float = 0.0012
+    J2: float = 0.6
+    g: float = 9.81
+    rc: float = 1.0e-3
+    d: float = 1.0e-3
+    omega: float = 20.0
+    theta1_0: float = 0.0
+    theta_c0: float | None = None
+    theta_c_offset: float = 0.0
+    thetadot_c0: float = 0.0
+    load_amplitude: float = 200000.0
+    load_sign: Literal["physical", "paper"] = "physical"
+    equations: Literal["exact", "paper-printed"] = "exact"
+    load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        _check("r", self.r, 0.0, math.inf, lo_open=True, hi_open=True)
+        _check("l", self.l, 0.0, math.inf, lo_open=True, hi_open=True)
+        _check("rs", self.rs, 0.0, self.r)
+        _check("ls", self.ls, 0.0, self.l)
+        for name in ("m1", "m2", "m3", "J1", "J2"):
+            _check(name, getattr(self, name), 0.0, math.inf, hi_open=True)
+        _check("g", self.g, 0.0, 100.0)
+        _check("rc", self.rc, 0.0, self.r, hi_open=True)
+        # |d + r sin(theta1) + rc sin(theta_c)| < l must hold for every crank and link angle.
+        dmax = self.l - self.r - self.rc
+        _check("d", self.d, -dmax, dmax, lo_open=True, hi_open=True)
+        _check("omega", self.omega, 0.0, 1.0e4, lo_open=True)
+        _check("theta1_0", self.theta1_0, -1e6, 1e6)
+        if self.theta_c0 is not None:
+            _check("theta_c0", self.theta_c0, -1e6, 1e6)
+        _check("theta_c_offset", self.theta_c_offset, -math.pi, math.pi)
+        _check("thetadot_c0", self.thetadot_c0, -1e7, 1e7)
+        _check("load_amplitude", self.load_amplitude, 0.0, 1e9)
+        if self.load_sign not in ("physical", "paper"):
+            raise ParameterError(f"load_sign = {self.load_sign!r}; allowed: 'physical' or 'paper'")
+        if self.equations not in ("exact", "paper-printed"):
+            raise ParameterError(
+                f"equations = {self.equations!r}; allowed: 'exact' or 'paper-printed'"
+            )
+        if self.m2 + self.m3 + self.J2 <= 0 and self.rc > 0:
+            raise ParameterError("m2, m3, J2: at least one must be > 0 when rc > 0")
+        if self.load_table is not None:
+            _validate_table(self.load_table)
+
+    @property
+    def crank_period(self) -> float:
+        """Duration of one crank revolution, s."""
+        return 2.0 * math.pi / self.omega
+
+    @property
+    def crank_frequency(self) -> float:
+        """Crank rotation frequency, Hz."""
+        return self.omega / (2.0 * math.pi)
+
+    def to_attrs(self) -> dict[str, Any]:
+        """Flat attributes for result files: every value, its unit and whether it is assumed."""
+        out: dict[str, Any] = {}
+        for k, v in asdict(self).items():
+            if k == "load_table":
+                out["load_model"] = "table" if v is not None else "paper Eq. (1)-(2)"
+                if v is not None:
+                    out["load_table_deg_N"] = [x for row in v for x in row]
+                continue
+            out[k] = "default" if v is None else v
+            if k in PARAM_UNITS:
+                out[f"{k}_units"] = PARAM_UNITS[k]
+        out["assumed_parameters"] = ", ".join(sorted(ASSUMED))
+        for k, why in ASSUMED.items():
+            out[f"{k}_note"] = why
+        return out
+
+
+def _validate_table(table) -> None:
+    if len(table) < 2:
+        raise ParameterError("load_table needs at least 2 rows of (crank angle deg, force N)")
+    prev = -math.inf
+    for i, row in enumerate(table):
+        if len(row) != 2:
+            raise ParameterError(f"load_table row {i} must be (angle_deg, force_N), got {row!r}")
+        a, f = row
+        for name, v in (("angle", a), ("force", f)):
+            if not math.isfinite(v):
+                raise ParameterError(f"load_table row {i}: {name} must be finite, got {v!r}")
+        if not (0.0 <= a < 360.0):
+            raise ParameterError(f"load_table row {i}: angle {a} deg out of range [0, 360)")
+        if a <= prev:
+            raise ParameterError(f"load_table row {i}: angles must increase strictly")
+        prev = a
+
+
+def paper_2d12(**overrides: Any) -> CompressorParams:
+    """The 2D12 compressor of Xiao et al. (2017), base case rc = d = 1 mm, omega = 20 rad/s.
+
+    Lengths are the paper's; masses and rod inertia are assumptions (:data:`ASSUMED`). Any
+    field can be overridden, e.g. ``paper_2d12(rc=0.5e-3, d=0.0)``.
+    """
+    names = {resolve_name(k): v for k, v in overrides.items()}
+    return CompressorParams(**names)

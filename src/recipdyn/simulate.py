@@ -1,0 +1,214 @@
+"""High-level simulation: parameters in, a labelled :class:`xarray.Dataset` out."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import time
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from .integrate import integrate
+from .model.compressor import compressor_model
+from .model.parameters import CompressorParams, ParameterError, resolve_name
+
+__all__ = ["simulate", "SimulationSettings", "DEFAULT_SETTINGS", "clean_attrs"]
+
+SIGN_CONVENTION = (
+    "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
+    "centre, x3 = r + l); y up, gravity along -y; crosshead at y3 = -d; gas_force is the force on "
+    "the crosshead along +x: -P (load_sign='physical', gas pushes the piston toward the crank) "
+    "or +P (load_sign='paper', the sign of Eq. 46)."
+)
+
+#: Defaults of :func:`simulate` (also recorded in every result).
+DEFAULT_SETTINGS: dict[str, Any] = dict(
+    revolutions=10.0,
+    transient=0.0,
+    fs=10_000.0,
+    method="dop853",
+    rtol=1e-10,
+    atol=1e-12,
+    h=None,
+)
+SimulationSettings = dict
+
+
+def clean_attrs(attrs: dict[str, Any]) -> dict[str, Any]:
+    """Make attributes storable in NetCDF/Zarr (no None, no bools, no nested dicts)."""
+    out = {}
+    for k, v in attrs.items():
+        if v is None:
+            v = "none"
+        elif isinstance(v, bool):
+            v = int(v)
+        elif isinstance(v, dict):
+            v = repr(v)
+        elif isinstance(v, (list, tuple)):
+            v = [float(x) for x in v] if all(isinstance(x, (int, float)) for x in v) else repr(v)
+        out[k] = v
+    return out
+
+
+def _coerce_params(params: CompressorParams | None, overrides: dict[str, Any]) -> CompressorParams:
+    base = CompressorParams() if params is None else params
+    if not overrides:
+        return base
+    import dataclasses
+
+    names = {resolve_name(k): v for k, v in overrides.items()}
+    return dataclasses.replace(base, **names)
+
+
+def simulate(
+    params: CompressorParams | None = None,
+    *,
+    revolutions: float = DEFAULT_SETTINGS["revolutions"],
+    transient: float = DEFAULT_SETTINGS["transient"],
+    fs: float = DEFAULT_SETTINGS["fs"],
+    method: str = DEFAULT_SETTINGS["method"],
+    rtol: float = DEFAULT_SETTINGS["rtol"],
+    atol: float = DEFAULT_SETTINGS["atol"],
+    h: float | None = DEFAULT_SETTINGS["h"],
+    progress: bool = False,
+    **overrides: Any,
+) -> xr.Dataset:
+    """Simulate the compressor and return the crosshead response as a Dataset.
+
+    Parameters
+    ----------
+    params : CompressorParams, optional
+        Model parameters (default: the paper's base case, :func:`~recipdyn.paper_2d12`).
+    revolutions : float
+        Crank revolutions to record (after the transient).
+    transient : float
+        Crank revolutions to integrate first and discard.
+    fs : float
+        Output sampling rate, Hz (samples come from the dense output at exact times, like a
+        sensor; the integrator's own steps are independent of it).
+    method : {"dop853", "rk4"}
+        Adaptive Dormand-Prince 8(5,3) (default) or the paper's fixed-step RK4.
+    rtol, atol : float
+        DOP853 tolerances.
+    h : float, optional
+        RK4 step, s (default: 1/20000 of a crank period).
+    progress : bool
+        Show a progress bar.
+    **overrides
+        Parameter overrides by name or alias, e.g. ``rc=0.5e-3``, ``clearance=0.5e-3``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time`` (s): ``x, v, a`` (crosshead), ``theta1, theta2, theta_c, thetadot_c,
+        thetaddot_c``, ``gas_force``, joint and guide forces; units in each variable's attrs;
+        all parameters, assumptions, initial conditions, solver settings and statistics, and the
+        package version in the Dataset's attrs.
+
+    Examples
+    --------
+    >>> import recipdyn
+    >>> ds = recipdyn.simulate(rc=1e-3, d=1e-3, omega=20.0, revolutions=2)  # doctest: +SKIP
+    >>> float(ds.a.max())  # doctest: +SKIP
+    """
+    p = _coerce_params(params, overrides)
+    for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
+        if not (isinstance(val, (int, float)) and math.isfinite(val) and val > lo):
+            raise ParameterError(f"{name} = {val!r} out of range; allowed: > {lo:g}")
+    if not (isinstance(transient, (int, float)) and math.isfinite(transient) and transient >= 0):
+        raise ParameterError(f"transient = {transient!r} out of range; allowed: >= 0")
+    model = compressor_model(p)
+    y0 = model.initial_state()
+    T = p.crank_period
+    t_start = transient * T
+    t_end = t_start + revolutions * T
+    n = int(math.floor(revolutions * T * fs + 1e-9)) + 1
+    t_eval = t_start + np.arange(n) / fs
+    if method == "rk4" and h is None:
+        h = T / 20000.0
+    bar = None
+    cb = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=100, unit="%", desc="simulate", leave=False)
+
+        def cb(frac, _bar=bar):
+            _bar.update(round(100 * frac) - _bar.n)
+
+    t0 = time.perf_counter()
+    sol = integrate(
+        model, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
+        chunks=max(1, min(200, int(math.ceil(transient + revolutions)))) if progress else 1,
+        progress=cb,
+    )  # fmt: skip
+    wall = time.perf_counter() - t0
+    if bar is not None:
+        bar.close()
+    outs = model.outputs(sol.t, sol.y)
+    data_vars = {
+        k: ("time", s.values, {"units": s.units, "long_name": s.long_name}) for k, s in outs.items()
+    }
+    ds = xr.Dataset(
+        data_vars,
+        coords={
+            "time": ("time", sol.t, {"units": "s", "long_name": "time"}),
+            "revolution": ("time", sol.t / T, {"units": "1", "long_name": "crank revolutions"}),
+        },
+    )
+    attrs: dict[str, Any] = {
+        "title": "recipdyn compressor simulation",
+        "recipdyn_version": __version__,
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "model": f"massless-link clearance at the crank pin, equations={p.equations}",
+        "sign_convention": SIGN_CONVENTION,
+        "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), doi:10.21595/jve.2017.18771",
+        "theta_c_initial": float(y0[0]),
+        "thetadot_c_initial": float(y0[1]),
+        "theta_c_initial_rule": (
+            "user-set theta_c0"
+            if p.theta_c0 is not None
+            else "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
+        ),  # fmt: skip
+        "solver_method": method,
+        "solver_rtol": rtol,
+        "solver_atol": atol,
+        "solver_h": h if h is not None else "adaptive",
+        "solver_nfev": sol.nfev,
+        "solver_nsteps": sol.nsteps,
+        "solver_nreject": sol.nreject,
+        "solver_status": sol.message,
+        "solver_wall_time_s": wall,
+        "revolutions": revolutions,
+        "transient_revolutions": transient,
+        "sampling_rate_hz": fs,
+        "crank_frequency_hz": p.crank_frequency,
+        "min_contact_force_N": float(np.min(outs["contact_force"].values)),
+    }
+    attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+    ds.attrs = clean_attrs(attrs)
+    return ds
+
+
+def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
+    """Rebuild the :class:`CompressorParams` recorded in a result's attributes."""
+    import dataclasses
+
+    kw: dict[str, Any] = {}
+    for f in dataclasses.fields(CompressorParams):
+        key = f"param_{f.name}"
+        if f.name == "load_table":
+            flat = attrs.get("param_load_table_deg_N")
+            if flat is not None:
+                arr = np.asarray(flat, dtype=float).reshape(-1, 2)
+                kw["load_table"] = tuple((float(a), float(b)) for a, b in arr)
+            continue
+        if key in attrs:
+            v = attrs[key]
+            if isinstance(v, np.generic):
+                v = v.item()
+            kw[f.name] = None if v == "default" else v
+    return CompressorParams(**kw)

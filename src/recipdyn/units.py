@@ -1,0 +1,65 @@
+"""Quantities with units for the CLI and config files (pint), converted to SI floats."""
+
+from __future__ import annotations
+
+import functools
+import math
+
+from .model.parameters import PARAM_UNITS, ParameterError
+
+__all__ = ["to_si", "parse_assignment"]
+
+#: SI unit each settings key is converted to (besides the model parameters' own units).
+SETTING_UNITS = {"fs": "Hz", "h": "s", "revolutions": "", "transient": ""}
+
+
+@functools.lru_cache(maxsize=1)
+def _ureg():
+    import pint
+
+    ureg = pint.UnitRegistry()
+    ureg.define("rev = 2 * pi * radian = revolution")
+    return ureg
+
+
+def to_si(name: str, value, unit: str | None = None) -> float:
+    """Convert ``value`` (number or string such as ``"1 mm"``, ``"191 rpm"``) to SI.
+
+    ``unit`` is the SI unit expected for ``name`` (default: from :data:`PARAM_UNITS`). A bare
+    number is taken to be in that unit already.
+    """
+    import pint
+
+    unit = PARAM_UNITS.get(name, SETTING_UNITS.get(name, "")) if unit is None else unit
+    if isinstance(value, bool):
+        raise ParameterError(f"{name}: expected a number or quantity, got {value!r}")
+    if isinstance(value, (int, float)):
+        out = float(value)
+    else:
+        text = str(value).strip()
+        try:
+            q = _ureg().Quantity(text)
+        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
+            raise ParameterError(f"{name}: unknown unit in {text!r} ({exc})") from None
+        except Exception as exc:  # pint raises assorted parse errors
+            raise ParameterError(f"{name}: cannot parse {text!r} as a quantity ({exc})") from None
+        target = unit.replace("**", "^") if unit else "dimensionless"
+        try:
+            out = float(q.to(target).magnitude)
+            if unit == "rad/s" and "hertz" in str(q.units):
+                out *= 2.0 * math.pi  # a crank speed in Hz means revolutions per second
+        except pint.errors.DimensionalityError:
+            raise ParameterError(
+                f"{name}: {text!r} cannot be converted to {unit or 'a plain number'}"
+            ) from None
+    if math.isnan(out):
+        raise ParameterError(f"{name} must not be NaN")
+    return out
+
+
+def parse_assignment(text: str) -> tuple[str, str]:
+    """Split ``"name=value"``; raise a clear error otherwise."""
+    if "=" not in text:
+        raise ParameterError(f"expected NAME=VALUE, got {text!r}")
+    k, v = text.split("=", 1)
+    return k.strip(), v.strip()
