@@ -38,6 +38,12 @@ def to_si(name: str, value, unit: str | None = None) -> float:
     else:
         text = str(value).strip()
         try:
+            bare = float(text)  # a bare number is already in SI
+        except ValueError:
+            bare = None
+        if bare is not None:
+            return _finite_or_nan_error(name, bare)
+        try:
             q = _ureg().Quantity(text)
         except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
             raise ParameterError(f"{name}: unknown unit in {text!r} ({exc})") from None
@@ -52,6 +58,10 @@ def to_si(name: str, value, unit: str | None = None) -> float:
             raise ParameterError(
                 f"{name}: {text!r} cannot be converted to {unit or 'a plain number'}"
             ) from None
+    return _finite_or_nan_error(name, out)
+
+
+def _finite_or_nan_error(name: str, out: float) -> float:
     if math.isnan(out):
         raise ParameterError(f"{name} must not be NaN")
     return out

@@ -7,10 +7,27 @@ retyped, so our compiled integrator takes exactly SciPy's steps (tests compare s
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _dop
+
+
+def _load_scipy_dop853():
+    """SciPy's ``dop853_coefficients`` module, loaded from its file: importing it the usual way
+    pulls in all of ``scipy.integrate`` (~0.2 s), which the CLI's start-up time cannot afford."""
+    from pathlib import Path
+
+    import scipy
+
+    path = Path(scipy.__file__).parent / "integrate" / "_ivp" / "dop853_coefficients.py"
+    spec = importlib.util.spec_from_file_location("_recipdyn_scipy_dop853", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+_dop = _load_scipy_dop853()
 
 __all__ = ["DOP853", "RK4", "Tableau"]
 

@@ -9,225 +9,145 @@ import math
 
 import numba as nb
 
-
-@nb.njit(cache=True, fastmath=False, error_model="numpy")
+@nb.njit(cache=True, fastmath=False, error_model='numpy')
 def clearance_acceleration(theta1, theta_c, thetadot_c, F, r, l, ls, m2, m3, J2, g, rc, d, omega):
     """Exact theta_c'' (rad/s^2) from Lagrange's equation, Eq. (38) without approximation."""
     x0 = math.cos(theta_c)
     x1 = x0**2
-    x2 = l ** (-2)
+    x2 = l**(-2)
     x3 = math.sin(theta1)
     x4 = math.sin(theta_c)
-    x5 = d + r * x3 + rc * x4
+    x5 = d + r*x3 + rc*x4
     x6 = x5**2
-    x7 = x2 * x6
+    x7 = x2*x6
     x8 = 1 - x7
-    x9 = 1 / x8
-    x10 = x2 * x9
-    x11 = J2 * x10
-    x12 = 1 / l
-    x13 = 1 / math.sqrt(x8)
-    x14 = x12 * x13
-    x15 = x0 * x5
-    x16 = x14 * x15 + x4
-    x17 = ls * x12
+    x9 = 1/x8
+    x10 = x2*x9
+    x11 = J2*x10
+    x12 = 1/l
+    x13 = 1/math.sqrt(x8)
+    x14 = x12*x13
+    x15 = x0*x5
+    x16 = x14*x15 + x4
+    x17 = ls*x12
     x18 = 1 - x17
     x19 = x18**2
-    x20 = ls * x13 * x2
-    x21 = x15 * x20 + x4
-    x22 = x0 * x18
+    x20 = ls*x13*x2
+    x21 = x15*x20 + x4
+    x22 = x0*x18
     x23 = math.cos(theta1)
-    x24 = l ** (-3)
-    x25 = m3 * x16
-    x26 = x13 * (x7 * x9 + 1)
-    x27 = r * x23**2
-    x28 = x10 * x5
-    x29 = x0 * x11
-    x30 = x6 / x8 ** (3 / 2)
-    x31 = x24 * x30
-    x32 = ls * x30 / l**4
-    x33 = rc * x1
-    return -(
-        F * x16
-        + g * m2 * x22
-        + omega**2
-        * r
-        * (
-            m2 * (-x0 * x19 * x3 + x21 * (x20 * x27 - x20 * x3 * x5 + x23 + x27 * x32))
-            + x25 * (x14 * x27 - x14 * x3 * x5 + x23 + x27 * x31)
-            - x29 * (-x27 * x28 + x3)
-        )
-        + 2
-        * omega
-        * r
-        * rc
-        * thetadot_c
-        * x0
-        * x12
-        * x23
-        * (J2 * x15 * x24 / x8**2 + m2 * x17 * x21 * x26 + x25 * x26)
-        + rc
-        * thetadot_c**2
-        * (
-            m2 * (-x18 * x22 * x4 - x21 * (ls * x13 * x2 * x4 * x5 - x0 - x20 * x33 - x32 * x33))
-            - x25 * (-x0 + x12 * x13 * x4 * x5 - x14 * x33 - x31 * x33)
-            - x29 * (-x28 * x33 + x4)
-        )
-    ) / (rc * (m2 * (x1 * x19 + x21**2) + m3 * x16**2 + x1 * x11))
+    x24 = l**(-3)
+    x25 = m3*x16
+    x26 = x13*(x7*x9 + 1)
+    x27 = r*x23**2
+    x28 = x10*x5
+    x29 = x0*x11
+    x30 = x6/x8**(3/2)
+    x31 = x24*x30
+    x32 = ls*x30/l**4
+    x33 = rc*x1
+    return -(F*x16 + g*m2*x22 + omega**2*r*(m2*(-x0*x19*x3 + x21*(x20*x27 - x20*x3*x5 + x23 + x27*x32)) + x25*(x14*x27 - x14*x3*x5 + x23 + x27*x31) - x29*(-x27*x28 + x3)) + 2*omega*r*rc*thetadot_c*x0*x12*x23*(J2*x15*x24/x8**2 + m2*x17*x21*x26 + x25*x26) + rc*thetadot_c**2*(m2*(-x18*x22*x4 - x21*(ls*x13*x2*x4*x5 - x0 - x20*x33 - x32*x33)) - x25*(-x0 + x12*x13*x4*x5 - x14*x33 - x31*x33) - x29*(-x28*x33 + x4)))/(rc*(m2*(x1*x19 + x21**2) + m3*x16**2 + x1*x11))
 
 
-@nb.njit(cache=True, fastmath=False, error_model="numpy")
-def clearance_acceleration_jac(
-    theta1, theta_c, thetadot_c, F, r, l, ls, m2, m3, J2, g, rc, d, omega
-):
+@nb.njit(cache=True, fastmath=False, error_model='numpy')
+def clearance_acceleration_jac(theta1, theta_c, thetadot_c, F, r, l, ls, m2, m3, J2, g, rc, d, omega):
     """theta_c'' and its partial derivatives with respect to theta_c and theta_c'."""
     x0 = math.sin(theta1)
     x1 = math.cos(theta1)
-    x2 = r * x1**2
+    x2 = r*x1**2
     x3 = math.sin(theta_c)
-    x4 = rc * x3
-    x5 = d + r * x0 + x4
-    x6 = l ** (-2)
+    x4 = rc*x3
+    x5 = d + r*x0 + x4
+    x6 = l**(-2)
     x7 = x5**2
-    x8 = x6 * x7
+    x8 = x6*x7
     x9 = 1 - x8
-    x10 = 1 / x9
-    x11 = x10 * x6
-    x12 = x11 * x5
-    x13 = x12 * x2
+    x10 = 1/x9
+    x11 = x10*x6
+    x12 = x11*x5
+    x13 = x12*x2
     x14 = x0 - x13
     x15 = math.cos(theta_c)
-    x16 = J2 * x11
-    x17 = x15 * x16
-    x18 = x14 * x17
-    x19 = 1 / l
-    x20 = 1 / math.sqrt(x9)
-    x21 = x19 * x20
-    x22 = x0 * x5
-    x23 = l ** (-3)
-    x24 = x9 ** (-3 / 2)
-    x25 = x24 * x7
-    x26 = x23 * x25
-    x27 = x1 + x2 * x21 + x2 * x26 - x21 * x22
-    x28 = x15 * x5
-    x29 = x21 * x28 + x3
-    x30 = m3 * x29
-    x31 = ls * x19
+    x16 = J2*x11
+    x17 = x15*x16
+    x18 = x14*x17
+    x19 = 1/l
+    x20 = 1/math.sqrt(x9)
+    x21 = x19*x20
+    x22 = x0*x5
+    x23 = l**(-3)
+    x24 = x9**(-3/2)
+    x25 = x24*x7
+    x26 = x23*x25
+    x27 = x1 + x2*x21 + x2*x26 - x21*x22
+    x28 = x15*x5
+    x29 = x21*x28 + x3
+    x30 = m3*x29
+    x31 = ls*x19
     x32 = 1 - x31
     x33 = x32**2
-    x34 = x15 * x33
-    x35 = ls * x20 * x6
-    x36 = x28 * x35 + x3
-    x37 = l ** (-4)
-    x38 = x2 * x37
-    x39 = ls * x25
-    x40 = x1 + x2 * x35 - x22 * x35 + x38 * x39
-    x41 = omega**2 * r
+    x34 = x15*x33
+    x35 = ls*x20*x6
+    x36 = x28*x35 + x3
+    x37 = l**(-4)
+    x38 = x2*x37
+    x39 = ls*x25
+    x40 = x1 + x2*x35 - x22*x35 + x38*x39
+    x41 = omega**2*r
     x42 = x15**2
-    x43 = rc * x42
-    x44 = x12 * x43
+    x43 = rc*x42
+    x44 = x12*x43
     x45 = x3 - x44
-    x46 = x15 - x19 * x20 * x3 * x5 + x21 * x43 + x26 * x43
+    x46 = x15 - x19*x20*x3*x5 + x21*x43 + x26*x43
     x47 = -x46
     x48 = -x32
-    x49 = x32 * x48
-    x50 = x15 * x49
-    x51 = x37 * x43
-    x52 = -ls * x20 * x3 * x5 * x6 + x15 + x35 * x43 + x39 * x51
+    x49 = x32*x48
+    x50 = x15*x49
+    x51 = x37*x43
+    x52 = -ls*x20*x3*x5*x6 + x15 + x35*x43 + x39*x51
     x53 = -x52
-    x54 = -m2 * (x3 * x50 - x36 * x53) + x17 * x45 + x30 * x47
+    x54 = -m2*(x3*x50 - x36*x53) + x17*x45 + x30*x47
     x55 = -x54
-    x56 = rc * thetadot_c**2
-    x57 = g * m2
-    x58 = x9 ** (-2)
-    x59 = J2 * x58
-    x60 = x23 * x28 * x59
-    x61 = x10 * x8
+    x56 = rc*thetadot_c**2
+    x57 = g*m2
+    x58 = x9**(-2)
+    x59 = J2*x58
+    x60 = x23*x28*x59
+    x61 = x10*x8
     x62 = x61 + 1
-    x63 = x20 * x30
-    x64 = x20 * x62
-    x65 = m2 * x31
-    x66 = x36 * x65
-    x67 = omega * r * x1 * x19
-    x68 = x15 * x67 * (x60 + x62 * x63 + x64 * x66)
-    x69 = 2 * rc * thetadot_c
-    x70 = F * x29 + x15 * x32 * x57 + x68 * x69
-    x71 = J2 * x42
-    x72 = 1 / (m2 * (x33 * x42 + x36**2) + m3 * x29**2 + x11 * x71)
-    x73 = x72 / rc
+    x63 = x20*x30
+    x64 = x20*x62
+    x65 = m2*x31
+    x66 = x36*x65
+    x67 = omega*r*x1*x19
+    x68 = x15*x67*(x60 + x62*x63 + x64*x66)
+    x69 = 2*rc*thetadot_c
+    x70 = F*x29 + x15*x32*x57 + x68*x69
+    x71 = J2*x42
+    x72 = 1/(m2*(x33*x42 + x36**2) + m3*x29**2 + x11*x71)
+    x73 = x72/rc
     x74 = x15**3
-    x75 = l ** (-5)
-    x76 = m3 * x47
-    x77 = x15 * x64
-    x78 = 3 * x5**3
-    x79 = x58 * x78
-    x80 = x3 * x61 + x3 - 3 * x44 - x51 * x79
-    x81 = x16 * x3
+    x75 = l**(-5)
+    x76 = m3*x47
+    x77 = x15*x64
+    x78 = 3*x5**3
+    x79 = x58*x78
+    x80 = x3*x61 + x3 - 3*x44 - x51*x79
+    x81 = x16*x3
     x82 = rc**2
-    x83 = x42 * x82
-    x84 = 3 * x4
-    x85 = x37 * x58
-    x86 = x74 * x82
-    x87 = x78 * x86 / x9 ** (5 / 2)
-    x88 = 3 * x24 * x5 * x86
-    x89 = x15 * x21
-    x90 = x15 * x84
+    x83 = x42*x82
+    x84 = 3*x4
+    x85 = x37*x58
+    x86 = x74*x82
+    x87 = x78*x86/x9**(5/2)
+    x88 = 3*x24*x5*x86
+    x89 = x15*x21
+    x90 = x15*x84
     x91 = x48**2
-    x92 = x15 * x35
-    x93 = rc * x71 * x85
-    x94 = rc * (x0 * x61 + x0 - 3 * x13 - x38 * x79)
+    x92 = x15*x35
+    x93 = rc*x71*x85
+    x94 = rc*(x0*x61 + x0 - 3*x13 - x38*x79)
     x95 = -x27
     x96 = -x40
-    x97 = 2 * x72
-    return (
-        -x73 * (x41 * (m2 * (-x0 * x34 + x36 * x40) - x18 + x27 * x30) + x55 * x56 + x70),
-        -x73
-        * (
-            -F * x47
-            + x3 * x48 * x57
-            + x41
-            * (
-                m2 * (x0 * x3 * x91 - x36 * x92 * x94 + x53 * x96)
-                - x14 * x5 * x93
-                + x14 * x81
-                - x30 * x89 * x94
-                + x76 * x95
-                - x93 * (x0 * x5 - 3 * x2 * x61 - x2)
-            )
-            - x56
-            * (
-                J2 * rc * x37 * x42 * x45 * x5 * x58
-                + J2 * x10 * x42 * x6 * (-x11 * x83 + x12 * x84 - 3 * x7 * x83 * x85 + 1)
-                - m2
-                * (
-                    x3**2 * x91
-                    - x36 * (-ls * x37 * x88 + x36 + x37 * x39 * x90 + x84 * x92 - ls * x87 / l**6)
-                    + x42 * x49
-                    + x53**2
-                )
-                + m3 * x29 * (-x23 * x88 + x26 * x90 + x29 - x75 * x87 + x84 * x89)
-                - m3 * x47**2
-                - x45 * x81
-            )
-            + x67
-            * x69
-            * (
-                J2 * rc * x23 * x58 * x74
-                + 4 * J2 * rc * x7 * x74 * x75 / x9**3
-                - x20 * x66 * x80
-                - 2 * x3 * x60
-                - x53 * x65 * x77
-                - x63 * x80
-                - x76 * x77
-            )
-            + x97
-            * (x41 * (m2 * (x0 * x50 - x36 * x96) - x18 - x30 * x95) - x54 * x56 + x70)
-            * (
-                J2 * x10 * x15 * x3 * x6
-                - m2 * (-x3 * x34 + x36 * x52)
-                - rc * x37 * x5 * x59 * x74
-                - x30 * x46
-            )
-        ),
-        -x97 * (thetadot_c * x55 + x68),
-    )
+    x97 = 2*x72
+    return -x73*(x41*(m2*(-x0*x34 + x36*x40) - x18 + x27*x30) + x55*x56 + x70), -x73*(-F*x47 + x3*x48*x57 + x41*(m2*(x0*x3*x91 - x36*x92*x94 + x53*x96) - x14*x5*x93 + x14*x81 - x30*x89*x94 + x76*x95 - x93*(x0*x5 - 3*x2*x61 - x2)) - x56*(J2*rc*x37*x42*x45*x5*x58 + J2*x10*x42*x6*(-x11*x83 + x12*x84 - 3*x7*x83*x85 + 1) - m2*(x3**2*x91 - x36*(-ls*x37*x88 + x36 + x37*x39*x90 + x84*x92 - ls*x87/l**6) + x42*x49 + x53**2) + m3*x29*(-x23*x88 + x26*x90 + x29 - x75*x87 + x84*x89) - m3*x47**2 - x45*x81) + x67*x69*(J2*rc*x23*x58*x74 + 4*J2*rc*x7*x74*x75/x9**3 - x20*x66*x80 - 2*x3*x60 - x53*x65*x77 - x63*x80 - x76*x77) + x97*(x41*(m2*(x0*x50 - x36*x96) - x18 - x30*x95) - x54*x56 + x70)*(J2*x10*x15*x3*x6 - m2*(-x3*x34 + x36*x52) - rc*x37*x5*x59*x74 - x30*x46)), -x97*(thetadot_c*x55 + x68)

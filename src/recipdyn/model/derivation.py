@@ -13,7 +13,8 @@ Two independent derivations of the same equation live here:
    :math:`B_q = J_2\theta_{2,c}\theta_{2,1c} + \sum_i m_i\,\mathbf p_{i,c}\cdot\mathbf p_{i,1c}`,
    :math:`C_q = J_2\theta_{2,c}\theta_{2,cc} + \sum_i m_i\,\mathbf p_{i,c}\cdot\mathbf p_{i,cc}`,
    :math:`D_q = J_2\theta_{2,c}\theta_{2,11} + \sum_i m_i\,\mathbf p_{i,c}\cdot\mathbf p_{i,11}`,
-   :math:`G = g\sum_i m_i\,\partial y_i/\partial\theta_c` and :math:`Q = F_x\,\partial x_3/\partial\theta_c`
+   :math:`G = g\sum_i m_i\,\partial y_i/\partial\theta_c` and
+   :math:`Q = F_x\,\partial x_3/\partial\theta_c`
    (subscripts after the comma are partial derivatives). No small-clearance approximation is
    made. The rod angle enters only through :math:`\sin\theta_2 = -(d + r\sin\theta_1 +
    r_c\sin\theta_c)/l` and :math:`\cos\theta_2 = +\sqrt{1-\sin^2\theta_2}` (crosshead on the

@@ -16,7 +16,8 @@ angle prescribed (``theta1' = omega``, ``theta1'' = 0``)::
 
 with exact partials (``n(a) = (-sin a, cos a)``)::
 
-    theta2_1  = -r cos(theta1) / (l cos(theta2))       theta2_c  = -r_c cos(theta_c) / (l cos(theta2))
+    theta2_1  = -r cos(theta1) / (l cos(theta2))
+    theta2_c  = -r_c cos(theta_c) / (l cos(theta2))
     theta2_11 = (r sin(theta1) + l sin(theta2) theta2_1^2) / (l cos(theta2))
     theta2_cc = (r_c sin(theta_c) + l sin(theta2) theta2_c^2) / (l cos(theta2))
     theta2_1c = tan(theta2) theta2_1 theta2_c

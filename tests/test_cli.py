@@ -1,0 +1,76 @@
+"""CLI: simulate writes a dataset and a figure; bad input exits with status 2 and names the
+parameter and its allowed range."""
+
+import math
+
+import pytest
+import xarray as xr
+
+from recipdyn.cli import main
+from recipdyn.model import CompressorParams, ParameterError
+
+
+def test_simulate_writes_dataset_and_figure(tmp_path, capsys):
+    out = tmp_path / "run.nc"
+    code = main(["simulate", "--rc", "0.5 mm", "--omega", "191 rpm", "-n", "1", "--fs", "2 kHz",
+                 "-o", str(out), "--no-progress"])  # fmt: skip
+    assert code == 0
+    ds = xr.open_dataset(out)
+    assert ds.attrs["param_rc"] == pytest.approx(5e-4)
+    assert ds.attrs["param_omega"] == pytest.approx(191 * 2 * math.pi / 60)
+    assert ds.a.attrs["units"] == "m/s**2"
+    assert "assumed" in ds.attrs["param_m2_note"]
+    assert ds.attrs["recipdyn_version"]
+    assert out.with_suffix(".png").stat().st_size > 10_000
+    assert "peak |a|" in capsys.readouterr().out
+
+
+def test_config_file(tmp_path):
+    cfg = tmp_path / "case.toml"
+    cfg.write_text('[params]\nclearance = "0.2 mm"\nd = 0\n[simulation]\nrevolutions = 0.5\n'
+                   'fs = "1 kHz"\n')  # fmt: skip
+    out = tmp_path / "c.nc"
+    assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
+    ds = xr.open_dataset(out)
+    assert ds.attrs["param_rc"] == pytest.approx(2e-4)
+    assert ds.sizes["time"] == 1 + int(0.5 * 2 * math.pi / 20 * 1000)
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--rc", "-1 mm"], ["rc", "allowed"]),
+        (["--rc", "0.2 m"], ["rc", "0.12"]),
+        (["--d", "0.5 m"], ["d =", "allowed"]),
+        (["--omega", "0 rad/s"], ["omega", "allowed"]),
+        (["--omega", "nan rad/s"], ["omega"]),
+        (["--rc", "1 furlongs_x"], ["rc", "unit"]),
+        (["--rc", "1 s"], ["rc", "cannot be converted"]),
+        (["--set", "l=-0.6"], ["l", "allowed"]),
+        (["--set", "bogus=1"], ["unknown parameter"]),
+        (["--method", "euler"], ["method"]),
+    ],
+)
+def test_bad_input_exit_2(tmp_path, capsys, args, words):
+    code = main(["simulate", *args, "-o", str(tmp_path / "x.nc"), "--no-figure", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "Traceback" not in err
+    for w in words:
+        assert w in err
+
+
+def test_malformed_config_exit_2(tmp_path, capsys):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text("[params\nrc = ")
+    assert main(["simulate", "-c", str(cfg), "--no-figure"]) == 2
+    assert "malformed" in capsys.readouterr().err
+    cfg.write_text("[simulation]\nwhatever = 1\n")
+    assert main(["simulate", "-c", str(cfg), "--no-figure"]) == 2
+
+
+def test_parameter_validation_messages():
+    for kw in (dict(r=0.0), dict(m2=-1.0), dict(omega=math.inf), dict(rc=math.nan),
+               dict(load_sign="up"), dict(equations="mine")):  # fmt: skip
+        with pytest.raises(ParameterError, match=next(iter(kw))):
+            CompressorParams(**kw)
