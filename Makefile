@@ -20,7 +20,7 @@ run: $(STAMP)
 	$(VENV)/bin/recipdyn run --out $(OUT)
 
 test: $(STAMP)
-	$(PY) -m pytest -q -m "slow or not slow" --timeout=1200
+	$(PY) -m pytest -q --timeout=1200
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -m "not slow" -x
