@@ -1,0 +1,159 @@
+"""Poincaré sections of any :class:`~recipdyn.model.base.ODESystem`.
+
+Two kinds:
+
+* :func:`stroboscopic_section` -- for a periodically forced system (``system.period`` set, e.g.
+  the compressor's crank period), the state exactly once per period at a chosen phase. The
+  samples come from the integrator's 7th-order dense output at the exact instants
+  ``t_k = t0 + (k + phase / 2 pi) T``, never from the nearest stored sample.
+* :func:`hyperplane_section` -- crossings of a hyperplane ``y[i] = value`` in a chosen
+  direction, root-found on the dense output inside the integrator.
+
+Both return an :class:`xarray.Dataset` over a ``section`` dimension with the state components
+and (optionally) the model's derived outputs at the section points, plus the settings in attrs.
+A period-1 orbit gives one distinct point, period-n n points, quasi-periodic motion a closed
+curve and chaotic motion a scattered set (see :func:`count_distinct_points`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba as nb
+import numpy as np
+import xarray as xr
+
+from ..integrate import integrate
+from ..model.base import EVENT_SIGNATURE, ODESystem
+
+__all__ = ["stroboscopic_section", "hyperplane_section", "count_distinct_points"]
+
+
+def _dataset(system: ODESystem, t, y, outputs: bool, attrs: dict[str, Any]) -> xr.Dataset:
+    data = {
+        name: ("section", y[:, i], {"units": (system.state_units or ("1",) * system.dim)[i]})
+        for i, name in enumerate(system.state_names)
+    }
+    if outputs and len(t):
+        for name, sig in system.outputs(t, y).items():
+            if name not in data:
+                data[name] = (
+                    "section",
+                    sig.values,
+                    {"units": sig.units, "long_name": sig.long_name},
+                )
+    ds = xr.Dataset(data, coords={"time": ("section", np.asarray(t), {"units": "s"})})
+    ds.attrs.update({k: v for k, v in attrs.items() if v is not None})
+    return ds
+
+
+def stroboscopic_section(
+    system: ODESystem,
+    y0,
+    n_points: int,
+    *,
+    transient_periods: float = 0.0,
+    phase: float = 0.0,
+    t0: float = 0.0,
+    outputs: bool = True,
+    **solver: Any,
+) -> xr.Dataset:
+    """State once per forcing period, exactly at phase ``phase`` (rad) of the period.
+
+    Parameters
+    ----------
+    system : ODESystem
+        Must have ``period`` (the forcing period, e.g. ``2 pi / omega``).
+    y0 : array_like
+        State at ``t0``.
+    n_points : int
+        Number of section points to record.
+    transient_periods : float
+        Periods integrated and discarded first.
+    phase : float
+        Forcing phase of the section in [0, 2 pi): for the compressor, the crank angle
+        ``theta1 - theta1_0`` at which the section is taken.
+    outputs : bool
+        Include the model's derived outputs (crosshead x, v, a, ...) at the section points.
+    **solver
+        Passed to :func:`recipdyn.integrate.integrate` (method, rtol, atol, ...).
+    """
+    if system.period is None:
+        raise ValueError(f"system {system.name!r} has no forcing period; use hyperplane_section")
+    if n_points < 1:
+        raise ValueError(f"n_points = {n_points}; allowed: >= 1")
+    if not (0.0 <= phase < 2 * math.pi):
+        raise ValueError(f"phase = {phase}; allowed: [0, 2 pi)")
+    T = system.period
+    k = np.arange(n_points) + transient_periods + phase / (2 * math.pi)
+    t_eval = t0 + k * T
+    sol = integrate(system, y0, (t0, float(t_eval[-1])), t_eval=t_eval, **solver)
+    attrs = dict(
+        section="stroboscopic", period=T, phase=phase, transient_periods=transient_periods,
+        nfev=sol.nfev, **{f"solver_{k}": v for k, v in sol.settings.items()},
+    )  # fmt: skip
+    return _dataset(system, sol.t, sol.y, outputs, attrs)
+
+
+def _plane_event(index: int, value: float):
+    @nb.njit(EVENT_SIGNATURE)
+    def event(t, y, p):
+        return y[index] - value
+
+    return event
+
+
+def hyperplane_section(
+    system: ODESystem,
+    y0,
+    t_span: tuple[float, float],
+    *,
+    index: int,
+    value: float = 0.0,
+    direction: int = 1,
+    outputs: bool = True,
+    max_points: int = 100_000,
+    **solver: Any,
+) -> xr.Dataset:
+    """Crossings of the hyperplane ``y[index] = value`` during ``t_span``.
+
+    ``direction`` +1 records upward crossings, -1 downward, 0 both. The crossing times are
+    found by regula falsi (Illinois) on the 7th-order dense output, to ~1e-15 relative in t.
+    """
+    if not (0 <= index < system.dim):
+        raise ValueError(f"index = {index}; allowed: 0..{system.dim - 1}")
+    if direction not in (-1, 0, 1):
+        raise ValueError(f"direction = {direction}; allowed: -1, 0, 1")
+    sol = integrate(
+        system, y0, t_span, t_eval=np.empty(0), event=_plane_event(index, float(value)),
+        event_direction=direction, max_events=max_points, **solver,
+    )  # fmt: skip
+    attrs = dict(
+        section="hyperplane", plane=f"{system.state_names[index]} = {value}", direction=direction,
+        nfev=sol.nfev, **{f"solver_{k}": v for k, v in sol.settings.items()},
+    )  # fmt: skip
+    return _dataset(system, sol.t_events, sol.y_events, outputs, attrs)
+
+
+def count_distinct_points(points, rtol: float = 1e-6, scale=None) -> int:
+    """Number of distinct points in a section: points closer than ``rtol * scale`` (per axis,
+    default scale = the largest magnitude on that axis) are the same point.
+
+    A period-n orbit gives n; quasi-periodic and chaotic motion give (nearly) as many as there
+    are points. KD-tree pairs + connected components (scipy).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    n = pts.shape[0]
+    if n == 0:
+        return 0
+    if scale is None:
+        scale = np.max(np.abs(pts), axis=0)
+    scale = np.where(np.asarray(scale, dtype=float) > 0, scale, 1.0)
+    pairs = cKDTree(pts / scale).query_pairs(rtol, p=np.inf, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    return int(connected_components(graph, directed=False)[0])
