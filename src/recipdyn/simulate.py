@@ -11,7 +11,7 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
-from .integrate import integrate
+from .integrate import IntegrationError, integrate
 from .model.compressor import compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 
@@ -108,6 +108,12 @@ def simulate(
         all parameters, assumptions, initial conditions, solver settings and statistics, and the
         package version in the Dataset's attrs.
 
+    Raises
+    ------
+    IntegrationError
+        If the integrator fails; its ``dataset`` attribute holds the samples computed before
+        the failure (nothing computed is lost) and ``partial`` the raw solution.
+
     Examples
     --------
     >>> import recipdyn
@@ -140,15 +146,23 @@ def simulate(
             _bar.update(round(100 * frac) - _bar.n)
 
     t0 = time.perf_counter()
-    sol = integrate(
-        model, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
-        chunks=max(1, min(200, int(math.ceil(transient + revolutions)))) if progress else 1,
-        progress=cb,
-    )  # fmt: skip
+    failure = None
+    try:
+        sol = integrate(
+            model, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
+            chunks=max(1, min(200, int(math.ceil(transient + revolutions)))) if progress else 1,
+            progress=cb,
+        )  # fmt: skip
+    except IntegrationError as exc:  # keep what was computed: the partial record
+        failure, sol = exc, exc.partial
+    finally:
+        if bar is not None:
+            bar.close()
     wall = time.perf_counter() - t0
-    if bar is not None:
-        bar.close()
-    outs = model.outputs(sol.t, sol.y)
+    try:
+        outs = model.outputs(sol.t, sol.y)
+    except ParameterError as exc:  # the state left the feasible geometry before failing
+        raise IntegrationError(f"{failure or ''} {exc}".strip(), sol) from None
     data_vars = {
         k: ("time", s.values, {"units": s.units, "long_name": s.long_name}) for k, s in outs.items()
     }
@@ -186,10 +200,15 @@ def simulate(
         "transient_revolutions": transient,
         "sampling_rate_hz": fs,
         "crank_frequency_hz": p.crank_frequency,
-        "min_contact_force_N": float(np.min(outs["contact_force"].values)),
+        "min_contact_force_N": (
+            float(np.min(outs["contact_force"].values)) if sol.t.size else float("nan")
+        ),
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
     ds.attrs = clean_attrs(attrs)
+    if failure is not None:
+        failure.dataset = ds  # the samples before the failure, with all attributes
+        raise failure
     return ds
 
 

@@ -44,6 +44,7 @@ class IntegrationError(RuntimeError):
     def __init__(self, message: str, partial: Solution | None = None):
         super().__init__(message)
         self.partial = partial
+        self.dataset = None  # set by recipdyn.simulate: the partial record as a Dataset
 
 
 @dataclass
