@@ -24,7 +24,7 @@ import numpy as np
 from ._generated import clearance_acceleration, clearance_acceleration_jac
 from .base import JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODESystem, Signal
 from .kinematics import joint_forces, kinematics
-from .load import gas_force, gas_force_kernel, pack_table
+from .load import gas_force, gas_force_kernel, mu_kernel, pack_table
 from .paper_printed import paper_acceleration
 from .parameters import CompressorParams, ParameterError
 
@@ -46,6 +46,8 @@ def pack_params(p: CompressorParams) -> np.ndarray:
 @nb.njit(cache=True)
 def _force(t, p):
     th1 = p[P_TH10] + p[P_OMEGA] * t
+    if p[P_LOADKIND] == 0.0:  # the paper's load: no table slice in the hot path
+        return th1, p[P_LOADSIGN] * p[P_LOADAMP] * mu_kernel(th1)
     return th1, gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 

@@ -29,13 +29,13 @@ import math
 import numba as nb
 import numpy as np
 
-__all__ = ["mu_paper", "gas_force", "gas_force_kernel", "read_load_table"]
+__all__ = ["mu_paper", "mu_kernel", "gas_force", "gas_force_kernel", "read_load_table"]
 
 _PI = math.pi
 
 
 @nb.njit(cache=True)
-def _mu_scalar(theta1: float) -> float:
+def mu_kernel(theta1: float) -> float:
     phi = theta1 % (2.0 * _PI)
     if phi <= 7.0 * _PI / 16.0:
         return math.sin(0.5 * _PI - phi)
@@ -49,7 +49,7 @@ def _mu_scalar(theta1: float) -> float:
 def mu_paper(theta1) -> np.ndarray:
     """Cylinder pressure coefficient mu of Eq. (2) at crank angle(s) theta1 (rad)."""
     th = np.asarray(theta1, dtype=np.float64)
-    return np.vectorize(_mu_scalar, otypes=[np.float64])(th)
+    return np.vectorize(mu_kernel, otypes=[np.float64])(th)
 
 
 @nb.njit(cache=True)
@@ -59,7 +59,7 @@ def gas_force_kernel(theta1: float, kind: float, amp: float, sign: float, table)
     ``kind`` 0 = paper model, 1 = table; ``table`` is ``[n, angles_rad(n), forces_N(n)]``.
     """
     if kind == 0.0:
-        return sign * amp * _mu_scalar(theta1)
+        return sign * amp * mu_kernel(theta1)
     n = int(table[0])
     ang = table[1 : 1 + n]
     val = table[1 + n : 1 + 2 * n]
