@@ -1,0 +1,120 @@
+"""Amplitude spectra with correct scaling, and labelled spectral peaks.
+
+A sine of amplitude A at a bin-centred frequency shows a peak of height A whatever the window:
+the one-sided FFT magnitude is divided by the window's coherent gain (its mean). Peaks are found
+with :func:`scipy.signal.find_peaks` and labelled as harmonics of a given fundamental (the crank
+frequency) when they fall within ``tol_bins`` bins of an integer multiple of it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.fft import rfft, rfftfreq
+from scipy.signal import find_peaks, get_window
+
+__all__ = ["Spectrum", "Peak", "amplitude_spectrum", "find_spectral_peaks", "order_spectrum"]
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """One-sided amplitude spectrum.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Hz.
+    amplitude : ndarray
+        Same units as the signal (peak amplitude of a sinusoid).
+    resolution : float
+        Bin width ``fs / n``, Hz.
+    window : str
+    fs : float
+        Sampling rate, Hz.
+    """
+
+    frequency: np.ndarray
+    amplitude: np.ndarray
+    resolution: float
+    window: str
+    fs: float
+
+
+@dataclass(frozen=True)
+class Peak:
+    """A spectral peak; ``order`` is the harmonic number of the fundamental (0 = not one)."""
+
+    frequency: float
+    amplitude: float
+    order: int
+
+
+def amplitude_spectrum(x, fs: float, window: str = "hann", detrend: bool = True) -> Spectrum:
+    """One-sided amplitude spectrum of a real signal.
+
+    Parameters
+    ----------
+    x : array_like
+        Uniformly sampled signal.
+    fs : float
+        Sampling rate, Hz (> 0).
+    window : str
+        Any :func:`scipy.signal.get_window` name ("hann", "hamming", "blackmanharris",
+        "flattop" for accurate amplitudes between bins, "boxcar" for none).
+    detrend : bool
+        Remove the mean first (the DC bin is then ~0).
+
+    Notes
+    -----
+    ``amplitude = 2 |X_k| / (n * mean(w))`` for ``0 < k < n/2``, half that at DC and Nyquist.
+    Frequency resolution ``fs / n``: a 10-revolution record at 20 rad/s resolves 0.32 Hz.
+    """
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 1 or x.size < 2:
+        raise ValueError("x must be a 1-D signal with at least 2 samples")
+    if not (fs > 0 and np.isfinite(fs)):
+        raise ValueError(f"fs = {fs}; allowed: > 0")
+    n = x.size
+    if detrend:
+        x = x - x.mean()
+    w = get_window(window, n, fftbins=True)
+    amp = np.abs(rfft(x * w)) * 2.0 / (n * w.mean())
+    amp[0] /= 2.0
+    if n % 2 == 0:
+        amp[-1] /= 2.0
+    return Spectrum(rfftfreq(n, 1.0 / fs), amp, fs / n, window, float(fs))
+
+
+def find_spectral_peaks(
+    spec: Spectrum,
+    n: int = 10,
+    *,
+    fundamental: float | None = None,
+    tol_bins: float = 1.5,
+    min_rel_height: float = 1e-3,
+) -> list[Peak]:
+    """The ``n`` largest local maxima, largest first, labelled as harmonics of ``fundamental``.
+
+    ``min_rel_height`` drops peaks below that fraction of the largest (numerical noise).
+    """
+    amp = spec.amplitude
+    if amp.size < 3 or amp.max() <= 0:
+        return []
+    idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
+    idx = idx[np.argsort(amp[idx])[::-1][:n]]
+    peaks = []
+    for i in idx:
+        f = float(spec.frequency[i])
+        order = 0
+        if fundamental:
+            k = round(f / fundamental)
+            if k >= 1 and abs(f - k * fundamental) <= tol_bins * spec.resolution:
+                order = int(k)
+        peaks.append(Peak(f, float(amp[i]), order))
+    return peaks
+
+
+def order_spectrum(spec: Spectrum, fundamental: float) -> tuple[np.ndarray, np.ndarray]:
+    """The spectrum over orders of ``fundamental`` (crank orders): ``(orders, amplitude)``."""
+    return spec.frequency / fundamental, spec.amplitude

@@ -1,0 +1,165 @@
+"""Reference dynamical systems with exact Jacobians (for tests, benchmarks and examples).
+
+Published Lyapunov exponents (Sprott, *Chaos and Time-Series Analysis*, 2003, Table A.1 and
+the accompanying tables): Lorenz (10, 28, 8/3): 0.9056, 0, -14.5723; Rossler (0.2, 0.2, 5.7):
+0.0714, 0, -5.3943; Henon (1.4, 0.3): 0.41922, -1.62319; Ueda x'' + 0.05 x' + x^3 = 7.5 cos t:
+0.1034 (sum -0.05).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ..model.base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
+
+__all__ = ["lorenz", "rossler", "ueda", "linear", "henon", "standard_map", "logistic_map"]
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _lorenz(t, y, p, out):
+    out[0] = p[0] * (y[1] - y[0])
+    out[1] = y[0] * (p[1] - y[2]) - y[1]
+    out[2] = y[0] * y[1] - p[2] * y[2]
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _lorenz_jac(t, y, p, J):
+    J[0, 0], J[0, 1], J[0, 2] = -p[0], p[0], 0.0
+    J[1, 0], J[1, 1], J[1, 2] = p[1] - y[2], -1.0, -y[0]
+    J[2, 0], J[2, 1], J[2, 2] = y[1], y[0], -p[2]
+
+
+def lorenz(sigma: float = 10.0, rho: float = 28.0, beta: float = 8.0 / 3.0) -> ODESystem:
+    return ODESystem(rhs=_lorenz, jac=_lorenz_jac, params=np.array([sigma, rho, beta]),
+                     state_names=("x", "y", "z"), name="lorenz")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _rossler(t, y, p, out):
+    out[0] = -y[1] - y[2]
+    out[1] = y[0] + p[0] * y[1]
+    out[2] = p[1] + y[2] * (y[0] - p[2])
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _rossler_jac(t, y, p, J):
+    J[0, 0], J[0, 1], J[0, 2] = 0.0, -1.0, -1.0
+    J[1, 0], J[1, 1], J[1, 2] = 1.0, p[0], 0.0
+    J[2, 0], J[2, 1], J[2, 2] = y[2], 0.0, y[0] - p[2]
+
+
+def rossler(a: float = 0.2, b: float = 0.2, c: float = 5.7) -> ODESystem:
+    return ODESystem(rhs=_rossler, jac=_rossler_jac, params=np.array([a, b, c]),
+                     state_names=("x", "y", "z"), name="rossler")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _ueda(t, y, p, out):
+    out[0] = y[1]
+    out[1] = -p[0] * y[1] - y[0] ** 3 + p[1] * math.cos(t)
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _ueda_jac(t, y, p, J):
+    J[0, 0], J[0, 1] = 0.0, 1.0
+    J[1, 0], J[1, 1] = -3.0 * y[0] ** 2, -p[0]
+
+
+def ueda(k: float = 0.05, B: float = 7.5) -> ODESystem:
+    """Ueda's oscillator ``x'' + k x' + x^3 = B cos t``: periodically forced, period 2 pi."""
+    return ODESystem(rhs=_ueda, jac=_ueda_jac, params=np.array([k, B]), state_names=("x", "v"),
+                     period=2 * math.pi, name="ueda")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _linear(t, y, p, out):
+    n = y.shape[0]
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += p[i * n + j] * y[j]
+        out[i] = s
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _linear_jac(t, y, p, J):
+    n = y.shape[0]
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = p[i * n + j]
+
+
+def linear(A) -> ODESystem:
+    """``y' = A y``: the Lyapunov exponents are the real parts of A's eigenvalues."""
+    A = np.asarray(A, dtype=float)
+    return ODESystem(rhs=_linear, jac=_linear_jac, params=A.ravel().copy(),
+                     state_names=tuple(f"y{i}" for i in range(A.shape[0])),
+                     name="linear")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _henon(n, x, p, out):
+    out[0] = 1.0 - p[0] * x[0] ** 2 + x[1]
+    out[1] = p[1] * x[0]
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _henon_jac(n, x, p, J):
+    J[0, 0], J[0, 1] = -2.0 * p[0] * x[0], 1.0
+    J[1, 0], J[1, 1] = p[1], 0.0
+
+
+def henon(a: float = 1.4, b: float = 0.3) -> DiscreteMap:
+    return DiscreteMap(step=_henon, jac=_henon_jac, params=np.array([a, b]),
+                       state_names=("x", "y"), name="henon")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _standard(n, x, p, out):
+    pn = x[1] + p[0] * math.sin(x[0])
+    out[0] = (x[0] + pn) % (2.0 * math.pi)
+    out[1] = pn
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _standard_jac(n, x, p, J):
+    c = p[0] * math.cos(x[0])
+    J[0, 0], J[0, 1] = 1.0 + c, 1.0
+    J[1, 0], J[1, 1] = c, 1.0
+
+
+def standard_map(K: float = 6.0) -> DiscreteMap:
+    """Chirikov's standard map (area-preserving: its exponents are symmetric)."""
+    return DiscreteMap(step=_standard, jac=_standard_jac, params=np.array([K]),
+                       state_names=("theta", "p"), name="standard")  # fmt: skip
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def _logistic(n, x, p, out):
+    out[0] = p[0] * x[0] * (1.0 - x[0])
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def _logistic_jac(n, x, p, J):
+    J[0, 0] = p[0] * (1.0 - 2.0 * x[0])
+
+
+def logistic_map(r: float = 4.0) -> DiscreteMap:
+    return DiscreteMap(step=_logistic, jac=_logistic_jac, params=np.array([r]),
+                       state_names=("x",), name="logistic")  # fmt: skip
+
+
+def iterate(dmap: DiscreteMap, x0, n: int, n_transient: int = 0) -> np.ndarray:
+    """Orbit of a map: array of shape (n, dim) after ``n_transient`` discarded iterations."""
+    x = np.asarray(x0, dtype=float).copy()
+    out = np.empty((n, dmap.dim))
+    buf = np.empty(dmap.dim)
+    for i in range(n_transient + n):
+        dmap.step(float(i), x, dmap.params, buf)
+        x[:] = buf
+        if i >= n_transient:
+            out[i - n_transient] = x
+    return out
