@@ -22,7 +22,8 @@ app = typer.Typer(
 
 
 def _register() -> None:
-    from . import simulate as _simulate  # noqa: F401  (commands register on import)
+    from . import reproduce as _reproduce  # noqa: F401  (commands register on import)
+    from . import simulate as _simulate  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
