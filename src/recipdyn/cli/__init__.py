@@ -22,7 +22,8 @@ app = typer.Typer(
 
 
 def _register() -> None:
-    from . import reproduce as _reproduce  # noqa: F401  (commands register on import)
+    from . import analyze as _analyze  # noqa: F401  (commands register on import)
+    from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
 
 
