@@ -25,6 +25,7 @@ def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
     from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
+    from . import sweep as _sweep  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:

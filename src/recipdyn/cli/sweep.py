@@ -1,0 +1,86 @@
+"""``recipdyn sweep`` and ``recipdyn plot``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from . import app
+
+DEFAULTS = dict(revolutions=5.0, transient=20.0, points=100, lyap_revolutions=50.0, fs=10_000.0,
+                rtol=1e-9, atol=1e-11)  # fmt: skip
+
+
+@app.command()
+def sweep(
+    params: list[str] = typer.Option(
+        ...,
+        "--param",
+        "-p",
+        help="NAME=start:stop:count[:log] or NAME=v1,v2 (units allowed); one or two.",
+    ),  # fmt: skip
+    measure: str = typer.Option(
+        "poincare,peak",
+        "--measure",
+        "-m",
+        help="Comma list of: poincare, peak, spectrum, lyapunov, verdict.",
+    ),
+    sets: list[str] = typer.Option(None, "--set", help="Base parameter NAME=VALUE (repeatable)."),
+    config: Path = typer.Option(None, "--config", "-c", help="TOML config for the base case."),
+    revolutions: float = typer.Option(
+        DEFAULTS["revolutions"], help="Revolutions for peak/spectrum."
+    ),
+    transient: float = typer.Option(DEFAULTS["transient"], help="Revolutions discarded first."),
+    points: int = typer.Option(DEFAULTS["points"], help="Stroboscopic points per value."),
+    lyap_revolutions: float = typer.Option(DEFAULTS["lyap_revolutions"]),
+    fs: str = typer.Option("10 kHz", help="Sampling rate for peak/spectrum."),
+    rtol: float = typer.Option(DEFAULTS["rtol"]),
+    backend: str = typer.Option("processes", help="serial, processes or dask."),
+    workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
+    dask_local: int = typer.Option(None, "--dask-local", help="Start a LocalCluster of N workers."),
+    scheduler: str = typer.Option(None, help="Existing Dask scheduler, tcp://HOST:PORT."),
+    continuation: bool = typer.Option(
+        False, help="Each point starts from the previous one's final state (sequential, 1-D)."
+    ),  # fmt: skip
+    resume: bool = typer.Option(False, help="Continue an interrupted sweep in OUT."),
+    force: bool = typer.Option(False, help="Overwrite an existing sweep in OUT."),
+    out: Path = typer.Option(Path("out/sweep"), "--out", "-o"),
+    progress: bool = typer.Option(True, "--progress/--no-progress"),
+) -> None:
+    """Sweep one or two parameters; write OUT/sweep.zarr and the figures."""
+    from ..model.parameters import ParameterError
+    from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
+    from ..units import to_si
+    from .simulate import _collect
+
+    base, _ = _collect(None, None, None, sets, config)
+    if dask_local is not None or scheduler is not None:
+        backend = "dask"
+    if workers is not None and workers < 1:
+        raise ParameterError(f"workers = {workers}; allowed: >= 1")
+    settings = dict(revolutions=revolutions, transient=transient, points=points,
+                    lyap_revolutions=lyap_revolutions, fs=to_si("fs", fs), rtol=rtol,
+                    atol=rtol / 100)  # fmt: skip
+    if transient < 0:
+        raise ParameterError(f"transient = {transient}; allowed: >= 0")
+    spec = SweepSpec(axes=tuple(parse_axis(p) for p in params),
+                     measures=tuple(m.strip() for m in measure.split(",") if m.strip()),
+                     base=base, settings=settings, continuation=continuation)  # fmt: skip
+    run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume)
+    store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)
+    for p in sweep_figures(open_sweep(store).load(), out):
+        typer.echo(f"wrote {p}")
+
+
+@app.command()
+def plot(
+    store: Path = typer.Argument(..., help="A sweep store (OUT/sweep.zarr)."),
+    out: Path = typer.Option(None, "--out", "-o", help="Folder (default: next to the store)."),
+) -> None:
+    """Regenerate a sweep's figures from its store."""
+    from ..sweep import open_sweep, sweep_figures
+
+    ds = open_sweep(store).load()
+    for p in sweep_figures(ds, out or store.parent):
+        typer.echo(f"wrote {p}")

@@ -1,0 +1,84 @@
+"""Sweep figures: bifurcation diagram, lambda1 vs parameter, fault-map heatmaps."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ..plotting import _mpl
+
+__all__ = ["sweep_figures"]
+
+_LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
+           "omega": ("crank speed omega", 1.0, "rad/s")}  # fmt: skip
+
+
+def _axis(ds, name):
+    label, k, unit = _LABELS.get(name, (name, 1.0, ds[name].attrs.get("units", "")))
+    return ds[name].values * k, f"{label} ({unit})"
+
+
+def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
+    """Write every figure the store supports; returns their paths."""
+    plt = _mpl()
+    out.mkdir(parents=True, exist_ok=True)
+    dims = ds.attrs["sweep_axes"].split(",")
+    done = ds.done.values.astype(bool)
+    paths = []
+    if len(dims) == 1:
+        x, xlabel = _axis(ds, dims[0])
+        if "poincare_v" in ds:
+            for var, ylab in (("poincare_v", "crosshead velocity v (m/s)"),
+                              ("poincare_theta_c", "clearance angle theta_c (rad)")):  # fmt: skip
+                fig, ax = plt.subplots(figsize=(9, 5), constrained_layout=True)
+                y = ds[var].values
+                xs = np.repeat(x[:, None], y.shape[1], axis=1)
+                ax.plot(xs[done].ravel(), y[done].ravel(), ",k", alpha=0.6)
+                ax.plot(xs[done].ravel(), y[done].ravel(), ".k", ms=1.0, alpha=0.5)
+                ax.set_xlabel(xlabel)
+                ax.set_ylabel(f"{ylab}, once per revolution")
+                ax.set_title(f"Bifurcation diagram ({y.shape[1]} stroboscopic points per value)")
+                ax.grid(alpha=0.3)
+                p = out / f"bifurcation_{var.split('_', 1)[1]}.png"
+                fig.savefig(p, dpi=130)
+                plt.close(fig)
+                paths.append(p)
+        for var, ylab in (("lambda1", "largest Lyapunov exponent (1/s)"),
+                          ("peak_a", "peak |a| (m/s$^2$)")):  # fmt: skip
+            if var in ds:
+                fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
+                ax.plot(x[done], ds[var].values[done], "o-", ms=3)
+                ax.set_xlabel(xlabel)
+                ax.set_ylabel(ylab)
+                ax.axhline(0, color="k", lw=0.5)
+                ax.grid(alpha=0.3)
+                p = out / f"{var}_vs_{dims[0]}.png"
+                fig.savefig(p, dpi=130)
+                plt.close(fig)
+                paths.append(p)
+    else:
+        x, xlabel = _axis(ds, dims[1])
+        y, ylabel = _axis(ds, dims[0])
+        for var, clabel in (("lambda1", "lambda1 (1/s)"), ("peak_a", "peak |a| (m/s$^2$)"),
+                            ("rms_a", "RMS a (m/s$^2$)"),
+                            ("poincare_distinct", "distinct section points")):  # fmt: skip
+            if var not in ds:
+                continue
+            z = np.where(done, ds[var].values.astype(float), np.nan)
+            fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
+            m = ax.pcolormesh(x, y, z, shading="nearest", cmap="viridis")
+            fig.colorbar(m, ax=ax, label=clabel)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
+            if ds[dims[1]].attrs.get("scale") == "log":
+                ax.set_xscale("log")
+            if ds[dims[0]].attrs.get("scale") == "log":
+                ax.set_yscale("log")
+            ax.set_title(f"Fault map: {clabel}")
+            p = out / f"map_{var}.png"
+            fig.savefig(p, dpi=130)
+            plt.close(fig)
+            paths.append(p)
+    return paths

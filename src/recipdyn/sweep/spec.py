@@ -1,0 +1,136 @@
+"""Sweep specifications: which parameters, which values, what to compute per point.
+
+``--param omega=10:150:281`` (start:stop:count, linear), ``--param clearance=0.1mm:5mm:50:log``
+(logarithmic), ``--param d=0,0.1mm,1mm`` (explicit list). One ``--param`` gives a 1-D sweep, two
+give the outer-product grid (fault map). Values carry units (pint) and are converted to SI;
+every grid point is validated as a :class:`~recipdyn.model.parameters.CompressorParams` before
+anything runs, so a value outside a parameter's range is reported up front.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..model.parameters import CompressorParams, ParameterError, resolve_name
+from ..units import to_si
+
+__all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
+
+#: Per-point work that can be requested.
+MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept parameter (SI values)."""
+
+    name: str
+    values: tuple[float, ...]
+    scale: str = "linear"
+
+
+def parse_axis(text: str) -> Axis:
+    """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units)."""
+    if "=" not in text:
+        raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
+    raw_name, rhs = (s.strip() for s in text.split("=", 1))
+    name = resolve_name(raw_name)
+    if name in ("load_sign", "equations", "load_table"):
+        raise ParameterError(f"--param {raw_name}: only numeric parameters can be swept")
+    if ":" in rhs:
+        parts = rhs.split(":")
+        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+            raise ParameterError(
+                f"--param {raw_name}: range must be start:stop:count or start:stop:count:log"
+            )
+        lo, hi = to_si(name, parts[0]), to_si(name, parts[1])
+        try:
+            count = int(parts[2])
+        except ValueError:
+            raise ParameterError(
+                f"--param {raw_name}: count {parts[2]!r} is not an integer"
+            ) from None
+        if count < 1:
+            raise ParameterError(f"--param {raw_name}: count = {count}; allowed: >= 1")
+        scale = "log" if len(parts) == 4 and parts[3] == "log" else "linear"
+        if scale == "log":
+            if lo <= 0 or hi <= 0:
+                raise ParameterError(
+                    f"--param {raw_name}: a log range needs start and stop > 0, got {lo:g}, {hi:g}"
+                )
+            vals = np.geomspace(lo, hi, count)
+        else:
+            vals = np.linspace(lo, hi, count)
+        return Axis(name, tuple(float(v) for v in vals), scale)
+    items = [s for s in rhs.split(",") if s.strip()]
+    if not items:
+        raise ParameterError(f"--param {raw_name}: no values given")
+    return Axis(name, tuple(to_si(name, s) for s in items), "list")
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Everything that defines a sweep's results (hashed to guard ``--resume``).
+
+    ``settings``: ``revolutions`` (recorded after the transient, for peak/spectrum),
+    ``transient`` (revolutions discarded), ``points`` (stroboscopic points for the
+    bifurcation diagram), ``lyap_revolutions``, ``fs`` (Hz), ``rtol``, ``atol``.
+    """
+
+    axes: tuple[Axis, ...]
+    measures: tuple[str, ...]
+    base: CompressorParams = field(default_factory=CompressorParams)
+    settings: dict[str, Any] = field(default_factory=dict)
+    continuation: bool = False
+
+    def __post_init__(self):
+        if not 1 <= len(self.axes) <= 2:
+            raise ParameterError(f"a sweep needs 1 or 2 --param axes, got {len(self.axes)}")
+        if len({a.name for a in self.axes}) != len(self.axes):
+            raise ParameterError("the same parameter is swept twice")
+        bad = [m for m in self.measures if m not in MEASURES]
+        if bad or not self.measures:
+            raise ParameterError(f"--measure {bad or '(none)'}; allowed: {', '.join(MEASURES)}")
+        if self.continuation and len(self.axes) != 1:
+            raise ParameterError("--continuation needs a 1-D sweep")
+        for key, lo in (("revolutions", 0), ("points", 0), ("lyap_revolutions", 0), ("fs", 0)):
+            v = self.settings.get(key)
+            if v is not None and not (v > lo):
+                raise ParameterError(f"{key} = {v}; allowed: > {lo}")
+        for point in self.grid():  # validate every point up front
+            self.point_params(point)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(a.values) for a in self.axes)
+
+    def grid(self):
+        """Iterate over ``(index_tuple, {name: value})``."""
+        for idx in itertools.product(*(range(n) for n in self.shape)):
+            yield idx, {a.name: a.values[i] for a, i in zip(self.axes, idx, strict=True)}
+
+    def point_params(self, point) -> CompressorParams:
+        values = point[1] if isinstance(point, tuple) else point
+        try:
+            return dataclasses.replace(self.base, **values)
+        except ParameterError as exc:
+            raise ParameterError(f"sweep point {values}: {exc}") from None
+
+    def to_json(self) -> str:
+        return json.dumps(
+            dict(axes=[dataclasses.asdict(a) for a in self.axes], measures=list(self.measures),
+                 base=dataclasses.asdict(self.base), settings=self.settings,
+                 continuation=self.continuation),
+            sort_keys=True, default=str,
+        )  # fmt: skip
+
+    @property
+    def digest(self) -> str:
+        return hashlib.sha256(self.to_json().encode()).hexdigest()[:16]
