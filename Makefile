@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml requirements/constraints.txt
 env: $(STAMP)
 
 run: $(STAMP)
-	$(VENV)/bin/recipdyn run --out $(OUT)
+	$(VENV)/bin/recipdyn reproduce --out $(OUT)
 
 test: $(STAMP)
 	$(PY) -m pytest -q --timeout=1200

@@ -179,13 +179,11 @@ def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
 
     @nb.njit(RHS_SIGNATURE)
     def trhs(t, z, p, out):
-        y = z[:n].copy()
-        f = np.empty(n)
-        rhs(t, y, p, f)
+        y = z[:n]
+        rhs(t, y, p, out[:n])
         J = np.empty((n, n))
         jac(t, y, p, J)
         for i in range(n):
-            out[i] = f[i]
             for j in range(k):
                 s = 0.0
                 for m in range(n):

@@ -1,0 +1,99 @@
+"""Benchmark (issue 3): signal Lyapunov estimators vs nolds, and Benettin on the compressor.
+
+Side by side in one run on the same Lorenz x-series (dt = 0.01, 20 000 points): recipdyn's
+Rosenstein and Wolf vs ``nolds.lyap_r`` (which builds an N x N distance matrix). Each estimator
+runs in a fresh subprocess so its peak memory (max RSS) is measured alone. Then the Benettin
+spectrum of the compressor base case over 1000 crank revolutions.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+
+LAMBDA = 0.9056
+
+_CHILD = r"""
+import json, resource, sys, time
+import numpy as np
+from recipdyn.analysis import systems as S
+from recipdyn.integrate import integrate
+n = int(sys.argv[2]); dt = 0.01
+sol = integrate(S.lorenz(), [1.0, 1.0, 1.0], (0, 50 + n * dt), t_eval=50 + np.arange(n) * dt,
+                rtol=1e-10)
+x = sol.y[:, 0]
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+which = sys.argv[1]
+t0 = time.perf_counter()
+if which == "nolds":
+    import nolds
+    lam = nolds.lyap_r(x, emb_dim=3, lag=16, min_tsep=155, trajectory_len=300) / dt
+else:
+    from recipdyn.analysis import lyap_rosenstein, lyap_wolf
+    if which == "rosenstein":
+        lyap_rosenstein(x[:200], dt)  # JIT-free, but warm imports
+        t0 = time.perf_counter()
+        lam = lyap_rosenstein(x, dt).exponent
+    else:
+        t0 = time.perf_counter()
+        lam = lyap_wolf(x, dt).exponent
+wall = time.perf_counter() - t0
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+out = dict(lam=float(lam), wall=wall, rss_mb=peak / 1024, rss_delta_mb=(peak - base) / 1024)
+print(json.dumps(out))
+"""
+
+
+def _child(which: str, n: int) -> dict:
+    r = subprocess.run([sys.executable, "-c", _CHILD, which, str(n)], capture_output=True,
+                       text=True, timeout=3600)  # fmt: skip
+    if r.returncode != 0:
+        return {"error": (r.stderr.strip().splitlines() or ["failed"])[-1]}
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def main(argv: list[str] | None = None) -> dict:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true", help="5000 points, 100 revolutions")
+    args, _ = ap.parse_known_args(argv)
+    n = 5000 if args.quick else 20_000
+    res: dict = {"n": n}
+    for which in ("rosenstein", "wolf", "nolds"):
+        res[which] = _child(which, n)
+    print(f"signal Lyapunov, Lorenz x, N = {n} (reference {LAMBDA})")
+    for which in ("rosenstein", "wolf", "nolds"):
+        r = res[which]
+        if "error" in r:
+            print(f"  {which:11s} unavailable: {r['error']}")
+            continue
+        err = 100 * (r["lam"] / LAMBDA - 1)
+        print(f"  {which:11s} lambda1 {r['lam']:.4f} ({err:+.1f} %)  {r['wall']:7.2f} s  "
+              f"peak RSS {r['rss_mb']:.0f} MB (+{r['rss_delta_mb']:.0f} MB)")  # fmt: skip
+    if "error" not in res["nolds"]:
+        res["speedup_rosenstein_vs_nolds"] = res["nolds"]["wall"] / res["rosenstein"]["wall"]
+        res["memory_ratio_nolds_vs_rosenstein"] = max(res["nolds"]["rss_delta_mb"], 1) / max(
+            res["rosenstein"]["rss_delta_mb"], 1
+        )
+        print(f"  speed-up Rosenstein vs nolds.lyap_r: {res['speedup_rosenstein_vs_nolds']:.1f}x,"
+              f" extra memory ratio {res['memory_ratio_nolds_vs_rosenstein']:.1f}x")  # fmt: skip
+    from recipdyn.analysis import lyapunov_spectrum
+    from recipdyn.model import CompressorParams, compressor_model
+
+    revs = 100 if args.quick else 1000
+    m = compressor_model(CompressorParams())
+    lyapunov_spectrum(m, m.initial_state(), m.period, rtol=1e-8, atol=1e-9)  # warm-up
+    t0 = time.perf_counter()
+    r = lyapunov_spectrum(m, m.initial_state(), revs * m.period, rtol=1e-8, atol=1e-9)
+    res["benettin_compressor"] = dict(revolutions=revs, seconds=time.perf_counter() - t0,
+                                      exponents=r.exponents.tolist(), sum=r.sum)  # fmt: skip
+    b = res["benettin_compressor"]
+    print(f"Benettin, compressor base case, {revs} revolutions (rtol 1e-8): {b['seconds']:.2f} s,"
+          f" exponents {b['exponents']}, sum {b['sum']:.2e}")  # fmt: skip
+    return res
+
+
+if __name__ == "__main__":
+    main()
