@@ -63,8 +63,10 @@ def main(argv: list[str] | None = None) -> dict:
         pts = 10 if args.quick else args.points
         revs = 30 if args.quick else args.revs
         bif_settings = dict(SETTINGS, transient=revs // 3, points=revs - revs // 3)
-        bif = SweepSpec(axes=(parse_axis(f"omega=10:150:{pts}"),), measures=("poincare",),
-                        base=CompressorParams(theta_c_offset=0.1), settings=bif_settings)  # fmt: skip
+        bif = SweepSpec(
+            axes=(parse_axis(f"omega=10:150:{pts}"),), measures=("poincare",),
+            base=CompressorParams(theta_c_offset=0.1), settings=bif_settings,
+        )  # fmt: skip
         t0 = time.perf_counter()
         run_sweep(bif, f"{tmp}/bif", backend="processes", progress=False)
         wall = time.perf_counter() - t0
