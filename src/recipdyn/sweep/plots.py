@@ -34,6 +34,8 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                               ("poincare_theta_c", "clearance angle theta_c (rad)")):  # fmt: skip
                 fig, ax = plt.subplots(figsize=(9, 5), constrained_layout=True)
                 y = ds[var].values
+                if var == "poincare_theta_c":  # the link may turn over: wrap to (-pi, pi]
+                    y = np.angle(np.exp(1j * y))
                 xs = np.repeat(x[:, None], y.shape[1], axis=1)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ",k", alpha=0.6)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ".k", ms=1.0, alpha=0.5)
