@@ -117,19 +117,27 @@ def _fmt(x: Any) -> str:
     return str(x)
 
 
-def _md_table(rows, variants) -> str:
+def _table(rows, variants) -> tuple[list[str], list[list[str]]]:
+    """Header and formatted cells of the comparison table (shared by Markdown and HTML)."""
     head = ["where", "case", "quantity", "paper"]
     for v in variants:
         head += [f"ours [{v}]", f"diff [{v}]"]
-    head += ["reason"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    head.append("reason")
+    body = []
     for r in rows:
         cells = [r["where"], r["case"], f"{r['quantity']} ({r['unit']})", _fmt(r["paper"])]
         for v in variants:
             rel = r[f"rel_{v}"]
             cells += [_fmt(r[f"ours_{v}"]), f"{100 * rel:+.1f} %" if np.isfinite(rel) else "n/a"]
         cells.append(r["reason"])
-        lines.append("| " + " | ".join(cells) + " |")
+        body.append(cells)
+    return head, body
+
+
+def _md_table(rows, variants) -> str:
+    head, body = _table(rows, variants)
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += ["| " + " | ".join(cells) + " |" for cells in body]
     return "\n".join(lines)
 
 
@@ -204,17 +212,9 @@ def write_html(
     for k, v in settings.items():
         parts.append(f"<tr><td>{e(k)}</td><td>{e(str(v))}</td></tr>")
     parts.append("</table><h2>Every number the paper reports</h2><table><tr>")
-    head = ["where", "case", "quantity", "paper"]
-    for v in variants:
-        head += [f"ours [{v}]", f"diff [{v}]"]
-    head.append("reason")
+    head, body = _table(rows, variants)
     parts.append("".join(f"<th>{e(h)}</th>" for h in head) + "</tr>")
-    for r in rows:
-        cells = [r["where"], r["case"], f"{r['quantity']} ({r['unit']})", _fmt(r["paper"])]
-        for v in variants:
-            rel = r[f"rel_{v}"]
-            cells += [_fmt(r[f"ours_{v}"]), f"{100 * rel:+.1f} %" if np.isfinite(rel) else "n/a"]
-        cells.append(r["reason"])
+    for cells in body:
         parts.append("<tr>" + "".join(f"<td>{e(c)}</td>" for c in cells) + "</tr>")
     parts.append("</table><h2>Figures</h2>")
     for stem in sorted(figures):
