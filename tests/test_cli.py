@@ -74,3 +74,19 @@ def test_parameter_validation_messages():
                dict(load_sign="up"), dict(equations="mine")):  # fmt: skip
         with pytest.raises(ParameterError, match=next(iter(kw))):
             CompressorParams(**kw)
+
+
+def test_load_table_from_csv(tmp_path):
+    """A user load table (crank angle deg, force N) is used and recorded in the result."""
+    csv = tmp_path / "load.csv"
+    csv.write_text("angle_deg,force_N\n0,-150000\n90,-40000\n180,-40000\n270,-150000\n")
+    out = tmp_path / "t.nc"
+    code = main(["simulate", "--set", f"load_table={csv}", "-n", "0.5", "--fs", "1 kHz",
+                 "-o", str(out), "--no-figure", "--no-progress"])  # fmt: skip
+    assert code == 0
+    ds = xr.open_dataset(out)
+    assert ds.attrs["param_load_model"] == "table"
+    assert float(ds.gas_force[0]) == pytest.approx(-150000.0)
+    from recipdyn.simulate import params_from_attrs
+
+    assert params_from_attrs(ds.attrs).load_table[1] == (90.0, -40000.0)
