@@ -64,3 +64,16 @@ def test_jacobian_matches_finite_differences(rng):
             am[idx] -= h
             fd = (clearance_acceleration(*ap) - clearance_acceleration(*am)) / (2 * h)
             assert deriv == pytest.approx(fd, rel=1e-5, abs=1e-6 * abs(acc) + 1e-9)
+
+
+def test_combined_rhs_jac_equals_separate_kernels(rng):
+    """The model's rhs_jac gives rhs and jac to rounding (used by the tangent integration)."""
+    from recipdyn.model import CompressorParams, compressor_model
+
+    m = compressor_model(CompressorParams(rc=2e-3, d=1e-3))
+    for _ in range(20):
+        t, y = rng.uniform(0, 1), np.array([rng.uniform(-3, 3), rng.normal(0, 200)])
+        f, J = np.empty(2), np.empty((2, 2))
+        m.rhs_jac(t, y, m.params, f, J)
+        np.testing.assert_allclose(f, m.f(t, y), rtol=1e-12)
+        np.testing.assert_allclose(J, m.jacobian(t, y), rtol=1e-12)

@@ -35,7 +35,15 @@ import numpy as np
 from ..integrate import IntegrationError, propagate
 from ..integrate import _kernels as _ik
 from ..integrate.tableaus import DOP853 as _DOP
-from ..model.base import EVENT_TYPE, JAC_TYPE, RHS_SIGNATURE, RHS_TYPE, DiscreteMap, ODESystem
+from ..model.base import (
+    EVENT_TYPE,
+    JAC_TYPE,
+    RHS_JAC_SIGNATURE,
+    RHS_SIGNATURE,
+    RHS_TYPE,
+    DiscreteMap,
+    ODESystem,
+)
 
 __all__ = ["LyapunovResult", "lyapunov_spectrum", "lyapunov_spectrum_map", "tangent_system"]
 
@@ -175,14 +183,26 @@ def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
         raise ValueError(f"system {system.name!r} has no Jacobian; Benettin's method needs one")
     n = system.dim
     k = n if k is None else int(k)
-    rhs, jac = system.rhs, system.jac
+    rhs, jac, both = system.rhs, system.jac, system.rhs_jac
+
+    if both is not None:  # right-hand side and Jacobian share work: one call
+
+        @nb.njit(RHS_JAC_SIGNATURE)
+        def f_and_j(t, y, p, f, J):
+            both(t, y, p, f, J)
+
+    else:
+
+        @nb.njit(RHS_JAC_SIGNATURE)
+        def f_and_j(t, y, p, f, J):
+            rhs(t, y, p, f)
+            jac(t, y, p, J)
 
     @nb.njit(RHS_SIGNATURE)
     def trhs(t, z, p, out):
         y = z[:n]
-        rhs(t, y, p, out[:n])
         J = np.empty((n, n))
-        jac(t, y, p, J)
+        f_and_j(t, y, p, out[:n], J)
         for i in range(n):
             for j in range(k):
                 s = 0.0

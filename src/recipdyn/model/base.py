@@ -42,7 +42,7 @@ from numba import types as _nbt
 
 __all__ = [
     "ODESystem", "DiscreteMap", "Signal", "RHS_SIGNATURE", "JAC_SIGNATURE", "EVENT_SIGNATURE",
-    "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE",
+    "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE",
 ]  # fmt: skip
 
 #: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
@@ -54,6 +54,11 @@ EVENT_SIGNATURE = _nbt.float64(_nbt.float64, _nbt.float64[::1], _nbt.float64[::1
 RHS_TYPE = _nbt.FunctionType(RHS_SIGNATURE)
 JAC_TYPE = _nbt.FunctionType(JAC_SIGNATURE)
 EVENT_TYPE = _nbt.FunctionType(EVENT_SIGNATURE)
+#: ``rhs_jac(t, y, p, out, out2d) -> None``: both at once (optional; saves shared work in
+#: tangent-space integration).
+RHS_JAC_SIGNATURE = _nbt.void(
+    _nbt.float64, _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[:, ::1]
+)
 
 
 @dataclass(frozen=True)
@@ -89,6 +94,9 @@ class ODESystem:
         One name per state component; ``dim`` is its length.
     jac : numba dispatcher, optional
         ``jac(t, y, p, out)``, the exact Jacobian ``df/dy``. Needed for Benettin's method.
+    rhs_jac : numba dispatcher, optional
+        ``rhs_jac(t, y, p, out, out2d)``: right-hand side and Jacobian in one call, when they
+        share work (used by the tangent-space integration instead of ``rhs`` + ``jac``).
     period : float, optional
         Period (in ``t``) of the explicit time dependence, if the system is periodically forced
         (the compressor's crank period ``2*pi/omega``). Used for stroboscopic sections.
@@ -105,6 +113,7 @@ class ODESystem:
     state_names: tuple[str, ...]
     jac: Callable[..., Any] | None = None
     period: float | None = None
+    rhs_jac: Callable[..., Any] | None = None
     state_units: tuple[str, ...] | None = None
     name: str = "ode"
     attrs: Mapping[str, Any] = field(default_factory=dict)

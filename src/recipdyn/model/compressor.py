@@ -22,7 +22,7 @@ import numba as nb
 import numpy as np
 
 from ._generated import clearance_acceleration, clearance_acceleration_jac
-from .base import JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODESystem, Signal
+from .base import JAC_SIGNATURE, RHS_JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODESystem, Signal
 from .kinematics import joint_forces, kinematics
 from .load import gas_force, gas_force_kernel, mu_kernel, pack_table
 from .paper_printed import paper_acceleration
@@ -79,6 +79,23 @@ def jac_exact(t, y, p, out):
     )  # fmt: skip
     out[1, 0] = da_dq
     out[1, 1] = da_dqd
+
+
+@nb.njit(RHS_JAC_SIGNATURE, cache=True)
+def rhs_jac_exact(t, y, p, out, J):
+    out[0] = y[1]
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    if p[P_RC] == 0.0:
+        out[1] = 0.0
+        J[1, 0] = 0.0
+        J[1, 1] = 0.0
+        return
+    th1, F = _force(t, p)
+    out[1], J[1, 0], J[1, 1] = clearance_acceleration_jac(
+        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
+        p[P_RC], p[P_D], p[P_OMEGA],
+    )  # fmt: skip
 
 
 @nb.njit(cache=True)
@@ -204,6 +221,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
     return CompressorModel(
         rhs=rhs_exact if exact else rhs_paper,
         jac=jac_exact if exact else jac_paper,
+        rhs_jac=rhs_jac_exact if exact else None,
         params=pack_params(p),
         state_names=("theta_c", "thetadot_c"),
         state_units=("rad", "rad/s"),
