@@ -64,23 +64,6 @@ def rhs_exact(t, y, p, out):
     )  # fmt: skip
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
-def jac_exact(t, y, p, out):
-    out[0, 0] = 0.0
-    out[0, 1] = 1.0
-    if p[P_RC] == 0.0:
-        out[1, 0] = 0.0
-        out[1, 1] = 0.0
-        return
-    th1, F = _force(t, p)
-    _, da_dq, da_dqd = clearance_acceleration_jac(
-        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
-        p[P_RC], p[P_D], p[P_OMEGA],
-    )  # fmt: skip
-    out[1, 0] = da_dq
-    out[1, 1] = da_dqd
-
-
 @nb.njit(RHS_JAC_SIGNATURE, cache=True)
 def rhs_jac_exact(t, y, p, out, J):
     out[0] = y[1]
@@ -96,6 +79,12 @@ def rhs_jac_exact(t, y, p, out, J):
         th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
         p[P_RC], p[P_D], p[P_OMEGA],
     )  # fmt: skip
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def jac_exact(t, y, p, out):
+    f = np.empty(2)
+    rhs_jac_exact(t, y, p, f, out)
 
 
 @nb.njit(cache=True)
