@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..model.parameters import ASSUMED, CompressorParams
+from ..model.parameters import ASSUMED, PARAM_UNITS, CompressorParams
 from .cases import PAPER_VALUES, PaperValue, case_by_id
 
 __all__ = ["comparison_rows", "write_tables", "write_html", "REASONS"]
@@ -203,12 +203,13 @@ def write_html(
         "</ul><h2>Variants</h2><ul>",
         *(f"<li><b>{e(v)}</b>: {e(variant_labels[v])}</li>" for v in variants),
         "</ul><h2>Parameters and assumptions</h2><table><tr><th>parameter</th><th>value</th>"
-        "<th>note</th></tr>",
+        "<th>unit</th><th>note</th></tr>",
     ]
     for k, v in p0.to_attrs().items():
         if k.endswith("_units") or k.endswith("_note") or k == "assumed_parameters":
             continue
-        parts.append(f"<tr><td>{e(k)}</td><td>{e(str(v))}</td>"
+        unit = PARAM_UNITS.get(k, "")
+        parts.append(f"<tr><td>{e(k)}</td><td>{e(str(v))}</td><td>{e(unit)}</td>"
                      f"<td>{e(ASSUMED.get(k, ''))}</td></tr>")  # fmt: skip
     parts.append("</table><h2>Settings</h2><table>")
     for k, v in settings.items():
