@@ -25,6 +25,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+from .defaults import SIMULATION
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
@@ -37,13 +38,13 @@ class SimulationConfig(BaseModel):
     """Settings of :func:`recipdyn.simulate` (quantities allowed where units apply)."""
 
     model_config = ConfigDict(extra="forbid")
-    revolutions: float | str = 10.0
-    transient: float | str = 0.0
-    fs: float | str = 10_000.0
-    method: Literal["dop853", "rk4"] = "dop853"
-    rtol: float = 1e-10
-    atol: float = 1e-12
-    h: float | str | None = None
+    revolutions: float | str = SIMULATION["revolutions"]
+    transient: float | str = SIMULATION["transient"]
+    fs: float | str = SIMULATION["fs"]
+    method: Literal["dop853", "rk4"] = SIMULATION["method"]
+    rtol: float = SIMULATION["rtol"]
+    atol: float = SIMULATION["atol"]
+    h: float | str | None = SIMULATION["h"]
 
     def resolved(self) -> dict[str, Any]:
         out = self.model_dump()
@@ -83,9 +84,16 @@ def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
     """Read a TOML config; returns ``(params, simulation settings in SI)``."""
     path = Path(path)
     try:
-        raw = tomllib.loads(path.read_text())
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ParameterError(f"config: file not found: {path}") from None
+    except IsADirectoryError:
+        raise ParameterError(f"config {path}: is a folder, expected a TOML file") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"config {path}: not UTF-8 text (byte {exc.start}); TOML files "
+                             "must be UTF-8") from None  # fmt: skip
+    except PermissionError:
+        raise ParameterError(f"config {path}: permission denied") from None
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"config {path}: malformed TOML ({exc})") from None
     try:

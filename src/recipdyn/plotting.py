@@ -54,10 +54,17 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
         ax.set_xlabel("time (s)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
+    ax = axes[1, 1]
+    if t.size < 4:  # too short for a spectrum: say so instead of failing
+        ax.text(0.5, 0.5, f"{t.size} sample(s): too short for a spectrum", ha="center",
+                va="center", transform=ax.transAxes)  # fmt: skip
+        ax.set_axis_off()
+        fig.suptitle(title or "Crosshead response")
+        fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+        return fig
     fs = 1.0 / float(np.median(np.diff(t)))
     # 'spectrum' scaling corrects for the window's coherent gain: sqrt(2 P) is the amplitude
     freq, pxx = periodogram(ds["a"].values, fs, window="hann", scaling="spectrum")
-    ax = axes[1, 1]
     ax.plot(freq, np.sqrt(2.0 * pxx), lw=0.7)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("d) amplitude of a (m/s$^2$)")

@@ -95,7 +95,7 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
     while t < t_end - 1e-12 * max(1.0, abs(t_end)):
         t1 = min(t + dt, t_end)
         status = _ik.dop853_kernel(
-            trhs, no_event, t, z, t1, p, rtol, atol, h_abs, np.inf, empty1, 1 << 40,
+            trhs, no_event, t, z, t1, t1, p, rtol, atol, h_abs, np.inf, empty1, 1 << 40,
             A, B, C, E3, E5, D, False, 0, Yd, empty1, empty2, stats, fstate,
         )  # fmt: skip
         if status < 0:

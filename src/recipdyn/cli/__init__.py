@@ -1,17 +1,25 @@
-"""Command-line interface: ``recipdyn simulate | run | ...``.
+"""Command-line interface: ``recipdyn simulate | analyze | sweep | plot | reproduce | ...``.
 
-Each command parses its options, calls one library function and writes files. Bad input
-(out-of-range parameters, unknown units, malformed configs) prints one clear line naming the
-parameter and its allowed range and exits with status 2, without a traceback.
+Each command parses its options, calls one library function and writes files. The exit
+statuses are the contract of ``docs/reliability.md``:
+
+* 0 success;
+* 1 the computation failed (the integrator; the partial record is kept and named);
+* 2 bad input (usage errors, out-of-range parameters or settings, unknown units, unreadable or
+  wrong files, unwritable outputs): one line naming the parameter and its allowed range;
+* 130 / 143 interrupted by SIGINT / SIGTERM, after saying what was kept and how to resume.
+
+No traceback reaches the user unless ``--debug`` (or ``RECIPDYN_DEBUG=1``) asks for it.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 
 import typer
 
-from ..model.parameters import ParameterError
+from ..errors import Interrupted, ParameterError, raise_on_signals
 
 app = typer.Typer(
     add_completion=False,
@@ -21,6 +29,26 @@ app = typer.Typer(
 )
 
 
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        typer.echo(f"recipdyn {__version__}")
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+    debug: bool = typer.Option(False, "--debug", help="Show tracebacks of unexpected errors."),
+) -> None:
+    """Nonlinear dynamics of reciprocating compressors with joint clearance and subsidence."""
+    if debug:
+        os.environ["RECIPDYN_DEBUG"] = "1"
+
+
 def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
     from . import reproduce as _reproduce  # noqa: F401
@@ -28,31 +56,65 @@ def _register() -> None:
     from . import sweep as _sweep  # noqa: F401
 
 
+def _click_exception_types() -> list[tuple[type, type]]:
+    """(ClickException, UsageError) classes: typer bundles its own copy of click
+    (``typer._click``), and a plain ``click`` may also be installed; catch both."""
+    types = []
+    for modname in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            mod = __import__(modname, fromlist=["ClickException"])
+        except ImportError:
+            continue
+        types.append((mod.ClickException, mod.UsageError))
+    return types
+
+
+def _err(msg: str) -> None:
+    typer.echo(msg, err=True)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point; returns the exit status (0 ok, 1 run failure, 2 bad input)."""
+    """Entry point; returns the exit status (see the module docstring)."""
     _register()
+    raise_on_signals()
+    from ..integrate import IntegrationError
+
+    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
         app(args=argv, standalone_mode=False)
     except ParameterError as exc:
-        typer.echo(f"error: {exc}", err=True)
+        _err(f"error: {exc}")
         return 2
-    except (typer.Abort, KeyboardInterrupt):
-        typer.echo("aborted", err=True)
-        return 130
+    except IntegrationError as exc:
+        _err(f"error: {exc}")
+        return 1
+    except KeyboardInterrupt as exc:
+        intr = Interrupted.wrap(exc)
+        for line in intr.kept:
+            _err(f"kept: {line}")
+        if not intr.kept:
+            _err("nothing finished was pending; no output written")
+        _err(f"interrupted ({intr})")
+        return intr.exit_code
+    except OSError as exc:  # an output that cannot be written, a full disk, ...
+        if debug or os.environ.get("RECIPDYN_DEBUG"):
+            raise
+        _err(f"error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
+        return 2
     except typer.Exit as exc:
         return exc.exit_code or 0
-    except Exception as exc:  # click usage errors carry their own exit code
-        import click
-
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            return exc.exit_code or 0
-        from ..integrate import IntegrationError
-
-        if isinstance(exc, IntegrationError):
-            typer.echo(f"error: {exc}", err=True)
-            return 1
-        raise
+    except typer.Abort:
+        _err("aborted")
+        return 130
+    except Exception as exc:
+        for click_exc, usage in _click_exception_types():
+            if isinstance(exc, click_exc):
+                exc.show()
+                return 2 if isinstance(exc, usage) else (exc.exit_code or 1)
+        if debug or os.environ.get("RECIPDYN_DEBUG"):
+            raise
+        _err(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)")
+        return 1
     return 0
 
 

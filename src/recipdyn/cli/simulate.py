@@ -9,6 +9,8 @@ import typer
 from . import app
 
 _SET_HELP = "Set any parameter: NAME=VALUE with units, e.g. --set m3='40 kg' (repeatable)."
+_MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (default: half " \
+    "of the available memory)."  # fmt: skip
 
 
 def _collect(rc, d, omega, sets, config):
@@ -32,6 +34,26 @@ def _collect(rc, d, omega, sets, config):
     return build_params(values, params), settings
 
 
+def max_memory_bytes(text: str | None) -> float | None:
+    """``--max-memory`` in bytes (a quantity such as '4 GB', or a number of bytes)."""
+    if text is None:
+        return None
+    from ..units import to_si
+
+    return to_si("max_memory", text, unit="byte")
+
+
+def keep_partial(exc, out: Path) -> Path | None:
+    """Write the partial record an interrupted or failed simulation carries, next to ``out``."""
+    from ..io import write_dataset
+
+    ds = getattr(exc, "dataset", None)
+    if ds is None or ds.sizes.get("time", 0) == 0:
+        return None
+    path = out.with_name(out.stem + ".partial" + out.suffix)
+    return write_dataset(ds, path)
+
+
 @app.command()
 def simulate(
     rc: str = typer.Option(None, "--rc", "--clearance", help="Radial clearance, e.g. '1 mm'."),
@@ -39,45 +61,61 @@ def simulate(
     omega: str = typer.Option(None, "--omega", help="Crank speed, e.g. '20 rad/s', '191 rpm'."),
     sets: list[str] = typer.Option(None, "--set", help=_SET_HELP),
     config: Path = typer.Option(
-        None, "--config", "-c", help="TOML config ([params], [simulation])."
+        None, "--config", "-c", help="TOML config with [params] and [simulation] tables."
     ),
     revolutions: str = typer.Option(None, "--revolutions", "-n", help="Revolutions to record."),
     transient: str = typer.Option(None, "--transient", help="Revolutions to discard first."),
     fs: str = typer.Option(None, "--fs", help="Sampling rate, e.g. '10 kHz'."),
     method: str = typer.Option(None, "--method", help="dop853 (default) or rk4."),
     rtol: float = typer.Option(None, "--rtol", help="Relative tolerance (dop853)."),
-    out: Path = typer.Option(Path("out/simulation.nc"), "--out", "-o", help="NetCDF output."),
+    atol: float = typer.Option(None, "--atol", help="Absolute tolerance (dop853)."),
+    h: str = typer.Option(None, "--h", help="RK4 step, e.g. '1e-5 s'."),
+    out: Path = typer.Option(
+        Path("out/simulation.nc"), "--out", "-o", help="Output: .nc (NetCDF), .csv or .zarr."
+    ),
     figure: bool = typer.Option(True, "--figure/--no-figure", help="Also write a PNG figure."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
+    max_memory: str = typer.Option(None, "--max-memory", help=_MEM_HELP),
 ) -> None:
-    """Simulate the compressor; write a NetCDF dataset and a figure (x, v, a, spectrum)."""
+    """Simulate the compressor; write the record (.nc, .csv or .zarr) and a figure."""
+    from ..errors import Interrupted
+    from ..integrate import IntegrationError
+    from ..io import check_output, save_figure, write_dataset
     from ..simulate import DEFAULT_SETTINGS
     from ..simulate import simulate as run_sim
     from ..units import to_si
 
+    out = check_output(out)  # before any work: a bad path is reported at once
     params, settings = _collect(rc, d, omega, sets, config)
     kw = {**DEFAULT_SETTINGS, **settings}
-    for name, val in (("revolutions", revolutions), ("transient", transient), ("fs", fs)):
+    for name, val in (("revolutions", revolutions), ("transient", transient), ("fs", fs),
+                      ("h", h)):  # fmt: skip
         if val is not None:
             kw[name] = to_si(name, val)
-    if method is not None:
-        kw["method"] = method
-    if rtol is not None:
-        kw["rtol"] = rtol
-    from ..model.parameters import ParameterError
-
-    if kw["method"] not in ("dop853", "rk4"):
-        raise ParameterError(f"method = {kw['method']!r}; allowed: dop853, rk4")
-    ds = run_sim(params, progress=progress, **kw)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ds.to_netcdf(out)
+    for name, val in (("method", method), ("rtol", rtol), ("atol", atol)):
+        if val is not None:
+            kw[name] = val
+    try:
+        ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory), **kw)
+    except (IntegrationError, Interrupted) as exc:
+        kept = keep_partial(exc, out)
+        if kept is not None:
+            n = exc.dataset.sizes["time"]
+            msg = f"partial record ({n} samples up to t = {exc.dataset.time.values[-1]:.6g} s) " \
+                f"in {kept}"  # fmt: skip
+            if isinstance(exc, Interrupted):
+                exc.kept.append(msg + "; rerun the command to compute it all")
+            else:
+                typer.echo(f"kept: {msg}", err=True)
+        raise
+    write_dataset(ds, out)
     typer.echo(f"wrote {out}  ({ds.sizes['time']} samples, nfev={ds.attrs['solver_nfev']})")
     if figure:
-        from ..plotting import response_figure
+        from ..plotting import _mpl, response_figure
 
         fig = response_figure(ds)
-        png = out.with_suffix(".png")
-        fig.savefig(png, dpi=130)
+        png = save_figure(fig, out.with_suffix(".png"), dpi=130)
+        _mpl().close(fig)
         typer.echo(f"wrote {png}")
     a = ds["a"].values
     typer.echo(
@@ -90,15 +128,15 @@ def simulate(
 def run(
     out: Path = typer.Option(Path("out"), "--out", "-o", help="Output folder."),
 ) -> None:
-    """The main job with embedded defaults: the paper's base case (rc = d = 1 mm, 20 rad/s)."""
+    """The paper's base case (rc = d = 1 mm, 20 rad/s, 10 revolutions) -> OUT/base_case.nc/.png."""
+    from ..io import check_output, save_figure, write_dataset
     from ..model.parameters import paper_2d12
     from ..plotting import response_figure
     from ..simulate import simulate as run_sim
 
-    out.mkdir(parents=True, exist_ok=True)
+    check_output(out / "base_case.nc")
     ds = run_sim(paper_2d12(), revolutions=10, transient=0, progress=True)
-    ds.to_netcdf(out / "base_case.nc")
-    response_figure(ds, title="Base case: rc = 1 mm, d = 1 mm, omega = 20 rad/s").savefig(
-        out / "base_case.png", dpi=130
-    )
+    write_dataset(ds, out / "base_case.nc")
+    fig = response_figure(ds, title="Base case: rc = 1 mm, d = 1 mm, omega = 20 rad/s")
+    save_figure(fig, out / "base_case.png", dpi=130)
     typer.echo(f"wrote {out / 'base_case.nc'} and {out / 'base_case.png'}")

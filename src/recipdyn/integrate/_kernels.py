@@ -74,17 +74,22 @@ def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp):
 
 
 DOP853_SIG = I8(
-    RHS_TYPE, EVENT_TYPE, F8, V1, F8, V1, F8, F8, F8, F8, V1, I8,
+    RHS_TYPE, EVENT_TYPE, F8, V1, F8, F8, V1, F8, F8, F8, F8, V1, I8,
     V2, V1, V1, V1, V1, V2, T.boolean, I8, V2, V1, V2, T.int64[::1], V1,
 )  # fmt: skip
 
 
 @nb.njit(DOP853_SIG, cache=True)
 def dop853_kernel(
-    rhs, event, t0, y0, t1, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
+    rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
     A, B, C, E3, E5, D, use_event, event_dir, Y, ev_t, ev_y, stats, fstate,
 ):  # fmt: skip
-    """Integrate from ``(t0, y0)`` to ``t1``; ``y0`` is updated in place to the final state.
+    """Integrate from ``(t0, y0)`` toward ``t1``; ``y0`` is updated in place to the final state.
+
+    Steps are clipped at ``t1`` only. ``t_stop <= t1`` ends the call after the first step that
+    reaches it (without clipping that step), so a run split into several calls with
+    ``t_stop`` at the split points (for a progress bar) takes exactly the steps of one call:
+    the results are bit-identical (given ``h_abs0`` = the previous call's ``fstate[1]``).
 
     Outputs: ``Y[i]`` at ``t_eval[i]``; events in ``ev_t``/``ev_y`` (capacity = their length);
     ``stats = [nfev, nsteps, nreject, n_out, n_events]``; ``fstate = [t_final, h_abs_next]``.
@@ -144,7 +149,7 @@ def dop853_kernel(
     Fd = np.empty((7, n))
     ydense = np.empty(n)
     err_exp = -1.0 / 8.0
-    while t < t1:
+    while t < t_stop:
         if nsteps >= max_steps:
             status = -2
             break
@@ -301,13 +306,15 @@ def dop853_kernel(
     return status
 
 
-@nb.njit(I8(RHS_TYPE, F8, V1, F8, V1, F8, V1, I8, V2, T.int64[::1], V1), cache=True)
-def rk4_kernel(rhs, t0, y0, t1, p, h_max, t_eval, max_steps, Y, stats, fstate):
+@nb.njit(I8(RHS_TYPE, F8, V1, F8, F8, V1, F8, V1, I8, V2, T.int64[::1], V1), cache=True)
+def rk4_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate):
     """Classical RK4 that lands exactly on every output time.
 
     Between consecutive stops (output times and ``t1``) it takes ``m = ceil(dt / h_max)`` equal
-    steps, so outputs are RK4 values, not interpolations. ``y0`` is updated in place;
-    ``stats = [nfev, nsteps, 0, n_out, 0]``, ``fstate = [t_final, h]``.
+    steps, so outputs are RK4 values, not interpolations. The call returns after the first
+    stop at or beyond ``t_stop`` (so splitting a run for a progress bar does not add stops).
+    ``y0`` is updated in place; ``stats = [nfev, nsteps, 0, n_out, 0]``,
+    ``fstate = [t_final, h]``.
     """
     n = y0.shape[0]
     y = y0.copy()
@@ -326,7 +333,7 @@ def rk4_kernel(rhs, t0, y0, t1, p, h_max, t_eval, max_steps, Y, stats, fstate):
         while ie < n_eval and t_eval[ie] <= t:
             Y[ie] = y
             ie += 1
-        if t >= t1:
+        if t >= t1 or t >= t_stop:
             break
         stop = t_eval[ie] if ie < n_eval and t_eval[ie] < t1 else t1
         m = max(1, int(math.ceil((stop - t) / h_max - 1e-9)))

@@ -10,8 +10,9 @@ Methods (registry :data:`METHODS`):
     Classical fixed-step RK4 (the paper's method) with step ``h`` (at most), landing exactly on
     every output time.
 
-Long runs are split into chunks so a progress bar can advance; the adaptive step size carries
-over between chunks, and the chunking depends only on the inputs, so results are reproducible.
+Long runs can be split into chunks so a progress bar can advance; a chunk ends after the first
+step that reaches its boundary (the step is not shortened), so the results are bit-identical
+whatever the number of chunks.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
+from ..errors import Interrupted, ParameterError, deferred_signals
 from ..model.base import ODESystem
 from . import _kernels
 from .tableaus import DOP853
@@ -35,6 +38,7 @@ _MESSAGES = {
     -1: "step size fell below the resolution of t (the problem may be singular or stiff)",
     -2: "max_steps exceeded",
     -3: "the state became non-finite (NaN/inf)",
+    -4: "interrupted",
 }
 
 
@@ -92,19 +96,29 @@ def _check_inputs(system, y0, t_span, method, rtol, atol, h):
         raise TypeError(f"system must be an ODESystem, got {type(system).__name__}")
     y0 = np.ascontiguousarray(y0, dtype=np.float64).reshape(-1)
     if y0.shape[0] != system.dim:
-        raise ValueError(f"y0 has {y0.shape[0]} components, the system has {system.dim}")
+        raise ParameterError(f"y0 has {y0.shape[0]} components, the system has {system.dim}")
     if not np.all(np.isfinite(y0)):
-        raise ValueError(f"y0 must be finite, got {y0}")
+        raise ParameterError(f"y0 must be finite, got {y0}")
     t0, t1 = (float(x) for x in t_span)
     if not (math.isfinite(t0) and math.isfinite(t1)) or t1 < t0:
-        raise ValueError(f"t_span must be finite with t1 >= t0, got {t_span}")
+        raise ParameterError(f"t_span must be finite with t1 >= t0, got {t_span}")
     if method not in METHODS:
-        raise ValueError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
-    if method == "dop853" and not (1e-14 <= rtol <= 1e-1 and 0.0 < atol <= 1.0):
-        raise ValueError(f"rtol = {rtol} must be in [1e-14, 0.1] and atol = {atol} in (0, 1]")
-    if method == "rk4" and (h is None or not (h > 0 and math.isfinite(h))):
-        raise ValueError(f"method 'rk4' needs a step h > 0, got h = {h}")
+        raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
+    check_tolerances(rtol, atol)
+    if method == "rk4" and (h is None or not (_is_number(h) and h > 0 and math.isfinite(h))):
+        raise ParameterError(f"h = {h!r}: method 'rk4' needs a step h > 0 s (finite)")
     return y0, t0, t1
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
+
+
+def check_tolerances(rtol, atol) -> None:
+    """Raise :class:`ParameterError` unless ``rtol`` and ``atol`` are in their ranges."""
+    for name, v, (lo, hi) in (("rtol", rtol, RTOL_RANGE), ("atol", atol, ATOL_RANGE)):
+        if not (_is_number(v) and math.isfinite(v) and lo <= v <= hi):
+            raise ParameterError(f"{name} = {v!r} out of range; allowed: [{lo:g}, {hi:g}]")
 
 
 def integrate(
@@ -113,8 +127,8 @@ def integrate(
     t_span: tuple[float, float],
     *,
     method: str = "dop853",
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     h: float | None = None,
     t_eval=None,
     max_step: float = math.inf,
@@ -152,69 +166,66 @@ def integrate(
         Raise :class:`IntegrationError` (with the partial solution) on failure.
     """
     y0, t0, t1 = _check_inputs(system, y0, t_span, method, rtol, atol, h)
+    rtol, atol, max_step, max_steps = float(rtol), float(atol), float(max_step), int(max_steps)
     if t_eval is None:
         t_eval = np.array([t0, t1])
     t_eval = np.ascontiguousarray(t_eval, dtype=np.float64).reshape(-1)
     if t_eval.size and (np.any(np.diff(t_eval) < 0) or t_eval[0] < t0 or t_eval[-1] > t1):
-        raise ValueError("t_eval must be sorted and lie within t_span")
+        raise ParameterError("t_eval must be sorted and lie within t_span")
     use_event = event is not None
     cap = max_events if max_events > 0 else 100_000
     ev = event if use_event else _kernels.no_event
     chunks = max(1, int(chunks))
-    edges = np.linspace(t0, t1, chunks + 1)
-    edges[-1] = t1
-    Ys = []
+    # Progress stops: each kernel call returns after the first step that reaches the next one,
+    # without clipping that step, so the step sequence (and every number) is the same for any
+    # number of chunks: progress observes the integration, it never changes it.
+    stops = np.linspace(t0, t1, chunks + 1)[1:]
+    stops[-1] = t1
+    Y = np.empty((t_eval.size, system.dim))
     ev_t, ev_y = [], []
     y = y0.copy()  # updated in place by the kernels
     t = t0
     h_abs = 0.0
     nfev = nsteps = nrej = 0
     status = 0
-    bounds = np.searchsorted(t_eval, edges[1:], side="right")
-    bounds[-1] = t_eval.size
-    lo = 0
-    for c in range(chunks):
-        hi = edges[c + 1]
-        sel = t_eval[lo : bounds[c]]
-        lo = bounds[c]
-        Y = np.empty((sel.size, system.dim))
-        stats = np.zeros(5, dtype=np.int64)
-        fstate = np.zeros(2)
-        if method == "dop853":
-            ev_cap = cap - len(ev_t) if use_event else 0
-            et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
-            status = _kernels.dop853_kernel(
-                system.rhs, ev, t, y, hi, system.params, rtol, atol, h_abs, max_step, sel,
-                max_steps - nsteps, DOP853.A, DOP853.B, DOP853.C, DOP853.E3, DOP853.E5,
-                DOP853.D, use_event, event_direction, Y, et, ey, stats, fstate,
-            )  # fmt: skip
-            ev_t.extend(et[: stats[4]])
-            ev_y.extend(ey[: stats[4]])
-        else:
-            status = _kernels.rk4_kernel(
-                system.rhs,
-                t,
-                y,
-                hi,
-                system.params,
-                float(h),
-                sel,
-                max_steps - nsteps,
-                Y,
-                stats,
-                fstate,
-            )
-        t, h_abs = float(fstate[0]), float(fstate[1])
-        nf, ns, nr, n_out = (int(x) for x in stats[:4])
-        Ys.append(Y[:n_out])
-        nfev += nf
-        nsteps += ns
-        nrej += nr
-        if progress is not None:
-            progress((t - t0) / (t1 - t0) if t1 > t0 else 1.0)
-        if status != 0:
-            break
-    Y = np.concatenate(Ys) if Ys else np.empty((0, system.dim))
+    n_out = 0
+    interrupted = 0
+    with deferred_signals() as pending:
+        for t_stop in stops:
+            if t >= t_stop and t_stop < t1:
+                continue  # the previous call already stepped past this stop
+            if pending.signum:  # everything before t is recorded: stop here and keep it
+                interrupted, status = pending.signum, -4
+                break
+            stats = np.zeros(5, dtype=np.int64)
+            fstate = np.zeros(2)
+            if method == "dop853":
+                ev_cap = cap - len(ev_t) if use_event else 0
+                et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
+                status = _kernels.dop853_kernel(
+                    system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
+                    max_step, t_eval[n_out:], max_steps - nsteps, DOP853.A, DOP853.B, DOP853.C,
+                    DOP853.E3, DOP853.E5, DOP853.D, use_event, event_direction, Y[n_out:], et, ey,
+                    stats, fstate,
+                )  # fmt: skip
+                ev_t.extend(et[: stats[4]])
+                ev_y.extend(ey[: stats[4]])
+            else:
+                status = _kernels.rk4_kernel(
+                    system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
+                    max_steps - nsteps, Y[n_out:], stats, fstate,
+                )  # fmt: skip
+            t, h_abs = float(fstate[0]), float(fstate[1])
+            nf, ns, nr, k_out = (int(x) for x in stats[:4])
+            n_out += k_out
+            nfev += nf
+            nsteps += ns
+            nrej += nr
+            if progress is not None:
+                progress(min(1.0, (t - t0) / (t1 - t0)) if t1 > t0 else 1.0)
+            if status != 0 or t >= t1:
+                break
+    Y = Y[:n_out]
     sol = Solution(
         t=t_eval[: Y.shape[0]].copy(),
         y=Y,
@@ -229,6 +240,10 @@ def integrate(
         y_events=np.array(ev_y, dtype=float).reshape(-1, system.dim),
         settings=dict(method=method, rtol=rtol, atol=atol, h=h, max_step=max_step),
     )
+    if interrupted:
+        exc = Interrupted(interrupted)
+        exc.partial = sol
+        raise exc
     if status < 0 and raise_on_failure:
         raise IntegrationError(f"integration failed at t = {t:.6g}: {sol.message}", sol)
     return sol

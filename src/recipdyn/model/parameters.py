@@ -23,6 +23,9 @@ import math
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any, Literal
 
+from ..defaults import RC_MIN
+from ..errors import ParameterError
+
 __all__ = [
     "CompressorParams",
     "ParameterError",
@@ -32,10 +35,6 @@ __all__ = [
     "paper_2d12",
     "resolve_name",
 ]
-
-
-class ParameterError(ValueError):
-    """A parameter is out of its allowed range; the message names it and the range."""
 
 
 #: Parameters whose values are assumptions (the paper's Table 1 is illegible for them).
@@ -170,6 +169,12 @@ class CompressorParams:
             _check(name, getattr(self, name), 0.0, math.inf, hi_open=True)
         _check("g", self.g, 0.0, 100.0)
         _check("rc", self.rc, 0.0, self.r, hi_open=True)
+        if 0.0 < self.rc < RC_MIN:
+            raise ParameterError(
+                f"rc = {self.rc!r} m is out of range; allowed: 0 (ideal joint) or "
+                f"[{RC_MIN:g}, {self.r:g}) m (below {RC_MIN:g} m the free link oscillation "
+                "needs millions of steps per revolution)"
+            )
         # |d + r sin(theta1) + rc sin(theta_c)| < l must hold for every crank and link angle.
         dmax = self.l - self.r - self.rc
         _check("d", self.d, -dmax, dmax, lo_open=True, hi_open=True)

@@ -1,0 +1,100 @@
+"""Exceptions shared by every layer (the bottom of the package: imports nothing of recipdyn).
+
+The command line maps them to exit statuses (``docs/reliability.md``):
+
+* :class:`ParameterError` (bad input: a parameter, setting, path or file) -> 2;
+* :class:`~recipdyn.integrate.IntegrationError` (the integrator failed) -> 1;
+* :class:`Interrupted` (SIGINT / SIGTERM) -> 128 + signal number (130 / 143).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from typing import Any
+
+__all__ = ["ParameterError", "Interrupted", "raise_on_signals", "deferred_signals"]
+
+
+class ParameterError(ValueError):
+    """Bad input; the message names the parameter (or file) and the allowed range."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Work was stopped by a signal.
+
+    Layers that catch it on the way up add what they kept (``kept``: one line each, e.g. "12 of
+    40 sweep points in out/sweep.zarr; rerun with --resume") and re-raise it; ``partial`` may
+    carry a partial result (an integrator :class:`~recipdyn.integrate.Solution` or a Dataset).
+    """
+
+    def __init__(self, signum: int = signal.SIGINT, message: str = ""):
+        super().__init__(message or f"interrupted by {signal.Signals(signum).name}")
+        self.signum = int(signum)
+        self.kept: list[str] = []
+        self.partial: Any = None  # raw partial result (an integrator Solution)
+        self.dataset: Any = None  # the partial record as a Dataset, where one was built
+
+    @property
+    def exit_code(self) -> int:
+        return 128 + self.signum
+
+    @classmethod
+    def wrap(cls, exc: BaseException) -> Interrupted:
+        """``exc`` itself if it is an :class:`Interrupted`, else one for SIGINT."""
+        return exc if isinstance(exc, Interrupted) else cls(signal.SIGINT)
+
+
+def _raise(signum, _frame):
+    raise Interrupted(signum)
+
+
+def raise_on_signals() -> None:
+    """Turn SIGINT and SIGTERM into :class:`Interrupted` in this (main) thread."""
+    signal.signal(signal.SIGINT, _raise)
+    signal.signal(signal.SIGTERM, _raise)
+
+
+class _Pending:
+    """The first signal received inside :func:`deferred_signals` (0 = none)."""
+
+    signum: int = 0
+
+    def check(self) -> None:
+        """Raise :class:`Interrupted` if a signal arrived."""
+        if self.signum:
+            raise Interrupted(self.signum)
+
+
+@contextlib.contextmanager
+def deferred_signals() -> Iterator[_Pending]:
+    """Hold SIGINT/SIGTERM while a block runs; the block polls ``pending.signum``.
+
+    A Python signal handler raises between any two bytecodes, e.g. between an integrator chunk
+    and the bookkeeping that records it. Inside this context a signal only sets a flag, which
+    the code checks at points where everything finished is consistent and can be kept. Signals
+    whose handler is the operating system's default (SIGTERM in a plain Python program) are
+    left alone. Outside the main thread this does nothing (Python delivers signals there).
+    """
+    pending = _Pending()
+    if threading.current_thread() is not threading.main_thread():
+        yield pending
+        return
+    saved = {}
+
+    def _flag(signum, _frame):
+        if not pending.signum:
+            pending.signum = signum
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        old = signal.getsignal(sig)
+        if callable(old):
+            saved[sig] = old
+            signal.signal(sig, _flag)
+    try:
+        yield pending
+    finally:
+        for sig, old in saved.items():
+            signal.signal(sig, old)

@@ -1,0 +1,155 @@
+"""Reading and writing result files safely.
+
+* Outputs are checked *before* any work (:func:`check_output`): a known format from the file
+  extension, a folder that exists or can be made, and permission to write there.
+* Every file is written to a temporary name in the same folder and renamed when complete
+  (:func:`atomic_path`): an interrupted or failed write never destroys the previous file and
+  never leaves a half-written one under the final name.
+* Inputs are read with clear refusals (:func:`read_dataset`): missing, empty, not the expected
+  format, or missing variables -> :class:`~recipdyn.errors.ParameterError` naming what is wrong.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+from .errors import ParameterError
+
+__all__ = ["DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
+           "save_figure"]  # fmt: skip
+
+#: File extension -> format of a simulated record.
+DATASET_FORMATS = {".nc": "NetCDF", ".csv": "CSV", ".zarr": "Zarr"}
+
+
+def check_output(path: str | Path, formats: dict[str, str] | None = DATASET_FORMATS,
+                 what: str = "output") -> Path:  # fmt: skip
+    """Check that ``path`` can be written (before computing anything); returns it as a Path.
+
+    ``formats`` maps allowed extensions to names (``None``: any extension, e.g. a folder).
+    """
+    path = Path(path)
+    if formats is not None and path.suffix.lower() not in formats:
+        allowed = ", ".join(f"{k} ({v})" for k, v in formats.items())
+        raise ParameterError(
+            f"{what} {path}: unknown extension {path.suffix or '(none)'!r}; allowed: {allowed}"
+        )
+    folder = path.parent if formats is not None else path
+    try:  # made now, so that an impossible path is reported before any work
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ParameterError(f"{what} {path}: cannot create folder {folder} "
+                             f"({exc.strerror or exc})") from None  # fmt: skip
+    if not folder.is_dir():
+        raise ParameterError(f"{what} {path}: {folder} is not a folder")
+    try:  # permissions can lie (root, read-only mounts): try it
+        fd, probe = tempfile.mkstemp(dir=folder, prefix=".recipdyn-probe-")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ParameterError(f"{what} {path}: folder {folder} is not writable "
+                             f"({exc.strerror or exc})") from None  # fmt: skip
+    if formats is not None and path.suffix.lower() != ".zarr" and path.is_dir():
+        raise ParameterError(f"{what} {path}: is a folder, expected a file name")
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it to ``path`` if the block succeeds.
+
+    On any exception (including an interruption) the temporary file is removed and the
+    previous content of ``path``, if any, is untouched.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.tmp-"))
+    target = tmp / path.name if not directory else tmp / "data"
+    try:
+        yield target
+        if directory:
+            old = None
+            if path.exists():
+                old = path.with_name(f".{path.name}.old-{os.getpid()}")
+                os.replace(path, old)
+            os.replace(target, path)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(target, path)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def write_dataset(ds, path: str | Path) -> Path:
+    """Write a Dataset in the format its extension names (.nc, .csv, .zarr), atomically.
+
+    CSV: one column per variable over the first dimension, ``name [units]`` headers, and the
+    attributes as ``# key = value`` comment lines above the table.
+    """
+    path = check_output(path)
+    fmt = DATASET_FORMATS[path.suffix.lower()]
+    if fmt == "Zarr":
+        with atomic_path(path, directory=True) as tmp:
+            ds.to_zarr(str(tmp), mode="w", consolidated=False)
+        return path
+    with atomic_path(path) as tmp:
+        if fmt == "NetCDF":
+            ds.to_netcdf(tmp)
+        else:
+            _write_csv(ds, tmp)
+    return path
+
+
+def _write_csv(ds, path: Path) -> None:
+    import numpy as np
+
+    names = [k for k in ds.data_vars if ds[k].ndim == 1]
+    dim = ds[names[0]].dims[0] if names else next(iter(ds.dims))
+    cols = [dim, *names]
+    head = [f"{c} [{ds[c].attrs.get('units', '')}]" for c in cols]
+    with open(path, "w", encoding="utf-8") as fh:
+        for k, v in ds.attrs.items():
+            fh.write(f"# {k} = {str(v).replace(chr(10), ' ')}\n")
+        fh.write(",".join(head) + "\n")
+        np.savetxt(fh, np.column_stack([ds[c].values for c in cols]), delimiter=",", fmt="%.17g")
+
+
+def save_figure(fig, path: str | Path, **kw) -> Path:
+    """``fig.savefig`` to ``path`` atomically."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kw)
+    return path
+
+
+def read_dataset(path: str | Path, *, required: Sequence[str] = (), what: str = "input",
+                 expected: str = "a recipdyn run (NetCDF from 'recipdyn simulate')"):  # fmt: skip
+    """Open a NetCDF file as a loaded Dataset, refusing clearly when it is not what is needed."""
+    import xarray as xr
+
+    path = Path(path)
+    if not path.exists():
+        raise ParameterError(f"{what} {path}: file not found")
+    if path.is_dir():
+        raise ParameterError(f"{what} {path}: is a folder; expected {expected}")
+    if path.stat().st_size == 0:
+        raise ParameterError(f"{what} {path}: file is empty; expected {expected}")
+    try:
+        with xr.open_dataset(path) as ds:
+            ds = ds.load()
+    except Exception as exc:  # netCDF4/h5netcdf/xarray raise assorted errors on foreign files
+        raise ParameterError(f"{what} {path}: cannot be read as NetCDF "
+                             f"({type(exc).__name__}); expected {expected}") from None  # fmt: skip
+    missing = [v for v in required if v not in ds.variables]
+    if missing:
+        raise ParameterError(f"{what} {path}: variable(s) {', '.join(missing)} missing; "
+                             f"expected {expected}")  # fmt: skip
+    if required and ds.sizes.get(ds[required[0]].dims[0] if ds[required[0]].dims else "", 0) == 0:
+        raise ParameterError(f"{what} {path}: holds no samples")
+    return ds
