@@ -24,6 +24,7 @@ from .analysis import (
     zero_one_test,
 )
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
+from .defaults import ATOL, LYAP_TOL, RTOL
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
 from .plotting import _mpl
@@ -34,7 +35,7 @@ __all__ = ["analyze_run"]
 
 def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                 lyap_revolutions: float = 100.0, max_signal_samples: int = 40_000,
-                rtol: float = 1e-9) -> dict[str, Any]:  # fmt: skip
+                rtol: float = RTOL, atol: float = ATOL) -> dict[str, Any]:  # fmt: skip
     """Analyse ``path`` (a NetCDF file from ``recipdyn simulate``) into folder ``out``.
 
     Equation-based results (stroboscopic section over ``section_points`` revolutions, Benettin
@@ -100,7 +101,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         model = compressor_model(p)
         y0 = np.array([float(ds.theta_c.values[0]), float(ds.thetadot_c.values[0])])
         t0 = float(t[0])
-        sec = stroboscopic_section(model, y0, section_points, t0=t0, rtol=rtol, atol=rtol / 10)
+        sec = stroboscopic_section(model, y0, section_points, t0=t0, rtol=rtol, atol=atol)
         section = np.c_[sec.v.values, sec.a.values]
         title = f"Poincaré section, once per revolution ({section_points} points)"
         fig = plot_phase(sec.v, sec.a, "v (m/s)", "a (m/s$^2$)", points=True, title=title)
@@ -110,7 +111,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
             k01 = zero_one_test(sec.thetadot_c.values)
         if p.rc > 0:
             res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
-                                    rtol=rtol, atol=rtol / 10)  # fmt: skip
+                                    rtol=rtol, atol=atol)  # fmt: skip
             lam = float(res.exponents[0])
             tail = res.history[len(res.history) // 2 :, 0]
             lam_err = float(np.std(tail)) if tail.size > 1 else 0.0
@@ -127,7 +128,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         summary["poincare"] = {"points": section_points}
         summary["zero_one_K"] = k01
     verdict = classify(lambda1=lam, lambda1_err=lam_err, k01=k01, section=section, spectrum=spec,
-                       lyap_tol=0.02)  # fmt: skip
+                       lyap_tol=LYAP_TOL)  # fmt: skip
     summary["verdict"] = verdict.to_dict()
     (out / "summary.json").write_text(json.dumps(_plain(summary), indent=2))
     (out / "summary.md").write_text(_markdown(summary))

@@ -22,8 +22,13 @@ class ParameterError(ValueError):
     """Bad input; the message names the parameter (or file) and the allowed range."""
 
 
-class Interrupted(KeyboardInterrupt):
+class Interrupted(BaseException):
     """Work was stopped by a signal.
+
+    Like :class:`KeyboardInterrupt` it derives from :class:`BaseException`, so ``except
+    Exception`` does not swallow it; it is not a KeyboardInterrupt subclass, so that command
+    frameworks that turn KeyboardInterrupt into a bare exit status (click, typer) let it reach
+    recipdyn's own handler, which reports what was kept.
 
     Layers that catch it on the way up add what they kept (``kept``: one line each, e.g. "12 of
     40 sweep points in out/sweep.zarr; rerun with --resume") and re-raise it; ``partial`` may
@@ -43,7 +48,8 @@ class Interrupted(KeyboardInterrupt):
 
     @classmethod
     def wrap(cls, exc: BaseException) -> Interrupted:
-        """``exc`` itself if it is an :class:`Interrupted`, else one for SIGINT."""
+        """``exc`` itself if it is an :class:`Interrupted`, else one for SIGINT (for a plain
+        :class:`KeyboardInterrupt`)."""
         return exc if isinstance(exc, Interrupted) else cls(signal.SIGINT)
 
 

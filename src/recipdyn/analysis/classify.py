@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS
 from .poincare import count_distinct_points
 from .spectrum import Spectrum, find_spectral_peaks
 
@@ -57,8 +58,8 @@ def _line_structure(spec: Spectrum, n: int = 12) -> dict[str, Any]:
 
 
 def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: float | None = None,
-             section=None, spectrum: Spectrum | None = None, lyap_tol: float = 0.01,
-             max_periodic_points: int = 16) -> Verdict:  # fmt: skip
+             section=None, spectrum: Spectrum | None = None, lyap_tol: float = LYAP_TOL,
+             max_periodic_points: int = MAX_PERIODIC_POINTS) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum. ``lyap_tol`` is in the exponent's units."""
     ev: dict[str, Any] = {}

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numba as nb
 import numpy as np
 
+from ..defaults import ATOL, RTOL
 from ..integrate import IntegrationError, propagate
 from ..integrate import _kernels as _ik
 from ..integrate.tableaus import DOP853 as _DOP
@@ -224,8 +225,8 @@ def lyapunov_spectrum(
     dt: float | None = None,
     t_transient: float = 0.0,
     t0: float = 0.0,
-    rtol: float = 1e-9,
-    atol: float = 1e-10,
+    rtol: float = RTOL,
+    atol: float = ATOL,
     method: str = "dop853",
     h: float | None = None,
     max_log_spread: float = 5.0,

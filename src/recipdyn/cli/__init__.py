@@ -81,14 +81,14 @@ def main(argv: list[str] | None = None) -> int:
 
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
-        app(args=argv, standalone_mode=False)
+        rv = app(args=argv, standalone_mode=False)
     except ParameterError as exc:
         _err(f"error: {exc}")
         return 2
     except IntegrationError as exc:
         _err(f"error: {exc}")
         return 1
-    except KeyboardInterrupt as exc:
+    except (Interrupted, KeyboardInterrupt) as exc:
         intr = Interrupted.wrap(exc)
         for line in intr.kept:
             _err(f"kept: {line}")
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         _err(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)")
         return 1
-    return 0
+    return rv if isinstance(rv, int) else 0
 
 
 def cli_entry() -> None:

@@ -6,10 +6,8 @@ from pathlib import Path
 
 import typer
 
+from ..defaults import SWEEP as DEFAULTS
 from . import app
-
-DEFAULTS = dict(revolutions=5.0, transient=20.0, points=100, lyap_revolutions=50.0, fs=10_000.0,
-                rtol=1e-9, atol=1e-11)  # fmt: skip
 
 
 @app.command()
@@ -35,7 +33,8 @@ def sweep(
     points: int = typer.Option(DEFAULTS["points"], help="Stroboscopic points per value."),
     lyap_revolutions: float = typer.Option(DEFAULTS["lyap_revolutions"]),
     fs: str = typer.Option("10 kHz", help="Sampling rate for peak/spectrum."),
-    rtol: float = typer.Option(DEFAULTS["rtol"]),
+    rtol: float = typer.Option(DEFAULTS["rtol"], help="Relative tolerance (dop853)."),
+    atol: float = typer.Option(DEFAULTS["atol"], help="Absolute tolerance (dop853)."),
     backend: str = typer.Option("processes", help="serial, processes or dask."),
     workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
     dask_local: int = typer.Option(None, "--dask-local", help="Start a LocalCluster of N workers."),
@@ -47,27 +46,31 @@ def sweep(
     force: bool = typer.Option(False, help="Overwrite an existing sweep in OUT."),
     out: Path = typer.Option(Path("out/sweep"), "--out", "-o"),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
+    max_memory: str = typer.Option(None, "--max-memory", help="Memory limit, e.g. '4 GB'."),
 ) -> None:
     """Sweep one or two parameters; write OUT/sweep.zarr and the figures."""
     from ..model.parameters import ParameterError
     from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
     from ..units import to_si
-    from .simulate import _collect
+    from .simulate import _collect, max_memory_bytes
 
     base, _ = _collect(None, None, None, sets, config)
     if dask_local is not None or scheduler is not None:
         backend = "dask"
     if workers is not None and workers < 1:
         raise ParameterError(f"workers = {workers}; allowed: >= 1")
+    if dask_local is not None and dask_local < 1:
+        raise ParameterError(f"dask_local = {dask_local}; allowed: >= 1")
+    if points < 1:
+        raise ParameterError(f"points = {points}; allowed: >= 1")
     settings = dict(revolutions=revolutions, transient=transient, points=points,
                     lyap_revolutions=lyap_revolutions, fs=to_si("fs", fs), rtol=rtol,
-                    atol=rtol / 100)  # fmt: skip
-    if transient < 0:
-        raise ParameterError(f"transient = {transient}; allowed: >= 0")
+                    atol=atol)  # fmt: skip
     spec = SweepSpec(axes=tuple(parse_axis(p) for p in params),
                      measures=tuple(m.strip() for m in measure.split(",") if m.strip()),
                      base=base, settings=settings, continuation=continuation)  # fmt: skip
-    run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume)
+    run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,
+                  max_memory=max_memory_bytes(max_memory))  # fmt: skip
     store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)
     for p in sweep_figures(open_sweep(store).load(), out):
         typer.echo(f"wrote {p}")

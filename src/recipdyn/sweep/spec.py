@@ -18,13 +18,24 @@ from typing import Any
 
 import numpy as np
 
-from ..model.parameters import CompressorParams, ParameterError, resolve_name
+from ..defaults import ATOL, RTOL
+from ..errors import ParameterError
+from ..model.parameters import CompressorParams, resolve_name
 from ..units import to_si
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
 
 #: Per-point work that can be requested.
 MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict")
+#: Most points one sweep store holds (one chunk file per point and variable).
+MAX_POINTS = 10_000_000
+
+
+def _finite(v) -> bool:
+    import math
+
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) \
+        and math.isfinite(v)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -57,8 +68,8 @@ def parse_axis(text: str) -> Axis:
             raise ParameterError(
                 f"--param {raw_name}: count {parts[2]!r} is not an integer"
             ) from None
-        if count < 1:
-            raise ParameterError(f"--param {raw_name}: count = {count}; allowed: >= 1")
+        if not 1 <= count <= MAX_POINTS:
+            raise ParameterError(f"--param {raw_name}: count = {count}; allowed: 1..{MAX_POINTS}")
         scale = "log" if len(parts) == 4 and parts[3] == "log" else "linear"
         if scale == "log":
             if lo <= 0 or hi <= 0:
@@ -102,10 +113,36 @@ class SweepSpec:
             raise ParameterError("--continuation needs a 1-D sweep")
         for key, lo in (("revolutions", 0), ("points", 0), ("lyap_revolutions", 0), ("fs", 0)):
             v = self.settings.get(key)
-            if v is not None and not (v > lo):
-                raise ParameterError(f"{key} = {v}; allowed: > {lo}")
+            if v is not None and not (_finite(v) and v > lo):
+                raise ParameterError(f"{key} = {v!r}; allowed: > {lo} (finite)")
+        tr = self.settings.get("transient")
+        if tr is not None and not (_finite(tr) and tr >= 0):
+            raise ParameterError(f"transient = {tr!r}; allowed: >= 0 (finite)")
+        if self.continuation and tr is not None and tr != int(tr):
+            raise ParameterError(
+                f"transient = {tr!r}: --continuation needs a whole number of "
+                "revolutions (each point hands on its state at crank angle 0)"
+            )
+        if self.settings.get("points") is not None and self.settings["points"] != int(
+            self.settings["points"]
+        ):
+            raise ParameterError(f"points = {self.settings['points']!r}; allowed: an integer >= 1")
+        if "rtol" in self.settings or "atol" in self.settings:
+            from ..integrate.solve import check_tolerances
+
+            check_tolerances(self.settings.get("rtol", RTOL), self.settings.get("atol", ATOL))
+        n = self.n_points
+        if n > MAX_POINTS:
+            raise ParameterError(
+                f"a sweep of {n:.3g} points is more than one store holds "
+                f"(limit {MAX_POINTS:.0e}); split it into several sweeps"
+            )
         for point in self.grid():  # validate every point up front
             self.point_params(point)
+
+    @property
+    def n_points(self) -> int:
+        return int(np.prod([len(a.values) for a in self.axes], dtype=float))
 
     @property
     def shape(self) -> tuple[int, ...]:

@@ -18,6 +18,7 @@ from ..analysis import (
     find_spectral_peaks,
     lyapunov_spectrum,
 )
+from ..defaults import LYAP_TOL
 from ..integrate import IntegrationError, integrate
 from ..model.compressor import compressor_model
 from ..model.parameters import CompressorParams, ParameterError
@@ -89,7 +90,7 @@ def _compute(p: CompressorParams, measures, s, y0) -> dict[str, Any]:
         else:
             res["lambda1"], res["lambda_sum"] = 0.0, 0.0
     if "verdict" in measures:
-        v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", 0.05),
+        v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL),
                      section=np.c_[res["poincare_v"], res["poincare_a"]])  # fmt: skip
         res["verdict"] = v.verdict
     # final state, for continuation: integrate to a whole number of periods after t_end

@@ -1,0 +1,72 @@
+"""Process pools that stop cleanly: the execution helpers under sweeps and the reproduction.
+
+* Workers ignore SIGINT: Ctrl-C reaches the whole foreground process group, and only the
+  coordinating process decides what to keep; it then cancels pending work and terminates the
+  workers (:func:`stop_pool`).
+* Workers notice when their parent dies, even by ``kill -9``: on Linux the kernel sends them
+  SIGKILL (``prctl(PR_SET_PDEATHSIG)``), and everywhere a watchdog thread exits the worker when
+  its parent process id changes.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+__all__ = ["process_pool", "stop_pool", "worker_init"]
+
+_WATCH_INTERVAL = 0.5  # s between parent checks of the watchdog
+
+
+def _die_with_parent_linux() -> None:
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except Exception:  # pragma: no cover - not Linux or no libc: the watchdog remains
+        pass
+
+
+def _watch_parent(parent: int) -> None:
+    while True:
+        time.sleep(_WATCH_INTERVAL)
+        if os.getppid() != parent:
+            os._exit(1)  # the coordinator is gone: nobody will collect our result
+
+
+def worker_init(parent: int | None = None) -> None:
+    """Initializer of every worker process (see the module docstring)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = os.getppid() if parent is None else parent
+    if sys.platform.startswith("linux"):
+        _die_with_parent_linux()
+    if os.getppid() != parent:  # the parent died before we got here
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A ``ProcessPoolExecutor`` whose workers run :func:`worker_init`."""
+    return ProcessPoolExecutor(max_workers=workers, initializer=worker_init,
+                               initargs=(os.getpid(),))  # fmt: skip
+
+
+def stop_pool(pool: ProcessPoolExecutor, timeout: float = 5.0) -> None:
+    """Cancel pending work and end the workers now (running tasks are abandoned)."""
+    procs = list(getattr(pool, "_processes", {}).values())  # no public handle in Python 3.11
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    deadline = time.monotonic() + timeout
+    for p in procs:
+        p.join(max(0.0, deadline - time.monotonic()))
+        if p.is_alive():  # pragma: no cover - a worker stuck in compiled code ignoring SIGTERM
+            p.kill()
+            p.join(1.0)
