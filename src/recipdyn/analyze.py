@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import xarray as xr
 
 from .analysis import (
     amplitude_spectrum,
@@ -25,12 +24,16 @@ from .analysis import (
 )
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
 from .defaults import ATOL, LYAP_TOL, RTOL
+from .io import save_figure, write_text
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
 from .plotting import _mpl
 from .simulate import params_from_attrs
 
-__all__ = ["analyze_run"]
+__all__ = ["analyze_run", "MIN_SAMPLES"]
+
+#: Fewest samples analyze accepts (a spectrum with a few lines and a phase portrait).
+MIN_SAMPLES = 64
 
 
 def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
@@ -43,17 +46,21 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     signal-based ones (spectrum, Wolf, Rosenstein on the crosshead acceleration) always.
     Returns the summary dict (also written as ``summary.json`` and ``summary.md``).
     """
+    from .io import check_output, read_dataset
+
     path, out = Path(path), Path(out)
-    try:
-        ds = xr.open_dataset(path).load()
-    except (OSError, ValueError) as exc:
-        raise ParameterError(f"cannot read {path} as a NetCDF dataset ({exc})") from None
-    for var in ("a", "v", "x"):
-        if var not in ds:
-            raise ParameterError(f"{path}: variable {var!r} missing; expected a recipdyn run")
-    out.mkdir(parents=True, exist_ok=True)
-    plt = _mpl()
+    ds = read_dataset(path, required=("a", "v", "x", "time"))
+    if ds.sizes["time"] < MIN_SAMPLES:
+        raise ParameterError(
+            f"{path}: {ds.sizes['time']} samples; analyze needs at least {MIN_SAMPLES} "
+            "(simulate more revolutions or a higher --fs)"
+        )
     t = ds.time.values
+    dt = np.diff(t)
+    if not (np.all(dt > 0) and np.ptp(dt) <= 1e-6 * np.median(dt)):
+        raise ParameterError(f"{path}: time samples must be uniformly spaced and increasing")
+    check_output(out, formats=None, what="analysis folder")
+    plt = _mpl()
     fs = 1.0 / float(np.median(np.diff(t)))
     fc = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
     a = ds.a.values
@@ -68,7 +75,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     }  # fmt: skip
     fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
     fig = plot_spectrum(spec, peaks, fmax=fmax, title="spectrum of the crosshead acceleration")
-    fig.savefig(out / "spectrum.png", dpi=110)
+    save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
     plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
@@ -76,7 +83,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     if "theta_c" in ds:
         plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)", ax=axes[2],
                    title="clearance angle")  # fmt: skip
-    fig.savefig(out / "phase_portraits.png", dpi=110)
+    save_figure(fig, out / "phase_portraits.png", dpi=110)
     plt.close(fig)
 
     n = min(a.size, max_signal_samples)
@@ -86,7 +93,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
             r = fn(a[:n], 1.0 / fs)
             sig[name] = {"exponent_per_s": r.exponent, "params": _plain(r.params)}
             fig = plot_divergence(r)
-            fig.savefig(out / f"lyapunov_{name}.png", dpi=110)
+            save_figure(fig, out / f"lyapunov_{name}.png", dpi=110)
             plt.close(fig)
         except ValueError as exc:
             sig[name] = {"error": str(exc)}
@@ -97,7 +104,12 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     section = None
     k01 = None
     if "param_rc" in ds.attrs:
-        p = params_from_attrs(ds.attrs)
+        try:
+            p = params_from_attrs(ds.attrs)
+        except (ParameterError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{path}: the recorded parameters are not valid ({exc})") from None
+        if "theta_c" not in ds or "thetadot_c" not in ds:
+            raise ParameterError(f"{path}: records parameters but not theta_c/thetadot_c")
         model = compressor_model(p)
         y0 = np.array([float(ds.theta_c.values[0]), float(ds.thetadot_c.values[0])])
         t0 = float(t[0])
@@ -105,7 +117,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         section = np.c_[sec.v.values, sec.a.values]
         title = f"Poincaré section, once per revolution ({section_points} points)"
         fig = plot_phase(sec.v, sec.a, "v (m/s)", "a (m/s$^2$)", points=True, title=title)
-        fig.savefig(out / "poincare.png", dpi=110)
+        save_figure(fig, out / "poincare.png", dpi=110)
         plt.close(fig)
         if section_points >= 100:
             k01 = zero_one_test(sec.thetadot_c.values)
@@ -123,15 +135,15 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                 "revolutions": lyap_revolutions,
             }
             fig = plot_lyapunov_history(res)
-            fig.savefig(out / "lyapunov_benettin.png", dpi=110)
+            save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
             plt.close(fig)
         summary["poincare"] = {"points": section_points}
         summary["zero_one_K"] = k01
     verdict = classify(lambda1=lam, lambda1_err=lam_err, k01=k01, section=section, spectrum=spec,
                        lyap_tol=LYAP_TOL)  # fmt: skip
     summary["verdict"] = verdict.to_dict()
-    (out / "summary.json").write_text(json.dumps(_plain(summary), indent=2))
-    (out / "summary.md").write_text(_markdown(summary))
+    write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
+    write_text(out / "summary.md", _markdown(summary))
     return summary
 
 

@@ -20,8 +20,10 @@ from pathlib import Path
 
 from .errors import ParameterError
 
-__all__ = ["DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
-           "save_figure"]  # fmt: skip
+__all__ = [
+    "DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
+    "write_text", "save_figure",
+]  # fmt: skip
 
 #: File extension -> format of a simulated record.
 DATASET_FORMATS = {".nc": "NetCDF", ".csv": "CSV", ".zarr": "Zarr"}
@@ -153,3 +155,11 @@ def read_dataset(path: str | Path, *, required: Sequence[str] = (), what: str = 
     if required and ds.sizes.get(ds[required[0]].dims[0] if ds[required[0]].dims else "", 0) == 0:
         raise ParameterError(f"{what} {path}: holds no samples")
     return ds
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write UTF-8 text to ``path`` atomically."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path

@@ -50,6 +50,8 @@ def calibrate(
     names = tuple(n.strip() for n in free.split(",") if n.strip())
     if maxiter < 1 or popsize < 1:
         raise ParameterError("maxiter and popsize must be >= 1")
+    if jobs == 0 or jobs < -1:
+        raise ParameterError(f"jobs = {jobs}; allowed: -1 (all cores) or >= 1")
     results = [fit(names, maxiter=maxiter, popsize=popsize, workers=jobs)]
     if with_offset and "theta_c_offset" not in names:
         results.append(fit((*names, "theta_c_offset"), maxiter=maxiter, popsize=popsize,

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..io import write_text
 from ..model.kinematics import ideal_slider_crank
 from ..model.parameters import CompressorParams
 from ..simulate import simulate
@@ -87,11 +88,20 @@ def reproduce(
     jobs : int, optional
         Worker processes (default: all cores).
     """
+    from ..io import check_output
+    from ..locking import RunLock
+
+    t0 = time.perf_counter()
+    out = check_output(out, formats=None, what="output folder")
+    with RunLock(out, "reproduce"):
+        return _reproduce(out, t0, quick, force, jobs, progress)
+
+
+def _reproduce(out: Path, t0: float, quick: bool, force: bool, jobs: int | None,
+               progress: bool) -> Path:  # fmt: skip
     from .figures import make_all_figures, save_figures
     from .report import comparison_rows, write_html, write_tables
 
-    t0 = time.perf_counter()
-    out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     settings = Settings().quick() if quick else Settings()
     specs = [RunSpec(c, v, settings) for c in CASES for v in VARIANTS]
@@ -133,7 +143,7 @@ def reproduce(
     write_html(out, rows=rows, variants=variants,
                variant_labels={v.id: v.label for v in VARIANTS}, figures=figures, notes=notes,
                settings=sdict, runtime_s=runtime, findings=findings)  # fmt: skip
-    (out / "investigation.json").write_text(json.dumps(inv_table, indent=1))
+    write_text(out / "investigation.json", json.dumps(inv_table, indent=1))
     return out / "report.html"
 
 

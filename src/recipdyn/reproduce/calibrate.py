@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..integrate import IntegrationError
+from ..io import write_text
 from ..model.parameters import CompressorParams
 from ..simulate import simulate
 from .cases import PAPER_VALUES, case_by_id
@@ -88,7 +89,7 @@ def calibrate(free=("m2", "m3", "J2"), *, fixed: dict[str, float] | None = None,
 
 def write_calibration(results: list[dict[str, Any]], out: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
-    (out / "calibration.json").write_text(json.dumps(results, indent=1, default=float))
+    write_text(out / "calibration.json", json.dumps(results, indent=1, default=float))
     lines = ["# Calibration of the unknown parameters to the paper's peak accelerations", ""]
     for r in results:
         lines += [f"## free: {', '.join(r['free'])}; fixed: {r['fixed'] or 'none'}", "",
@@ -99,7 +100,7 @@ def write_calibration(results: list[dict[str, Any]], out: Path) -> Path:
                   for t in r["targets"]]  # fmt: skip
         lines.append("")
     path = out / "calibration.md"
-    path.write_text("\n".join(lines))
+    write_text(path, "\n".join(lines))
     return path
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io import save_figure
 from ..model.load import mu_paper
 from ..plotting import _mpl
 from .cases import case_by_id
@@ -220,7 +221,7 @@ def save_figures(figs: dict, folder: Path, dpi: int = 100) -> dict[str, Path]:
     paths = {}
     for stem, fig in figs.items():
         paths[stem] = folder / f"{stem}.png"
-        fig.savefig(paths[stem], dpi=dpi)
+        save_figure(fig, paths[stem], dpi=dpi)
         plt.close(fig)
     return paths
 

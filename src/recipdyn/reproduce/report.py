@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import csv
 import html
+import io
 import platform
 from pathlib import Path
 from typing import Any
@@ -12,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..io import write_text
 from ..model.parameters import ASSUMED, PARAM_UNITS, CompressorParams
 from .cases import PAPER_VALUES, PaperValue, case_by_id
 
@@ -145,12 +147,13 @@ def _md_table(rows, variants) -> str:
 
 def write_tables(rows, variants, out: Path) -> tuple[Path, Path]:
     csv_path = out / "comparison.csv"
-    with csv_path.open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
+    buf = io.StringIO(newline="")
+    w = csv.DictWriter(buf, fieldnames=list(rows[0].keys()))
+    w.writeheader()
+    w.writerows(rows)
+    write_text(csv_path, buf.getvalue())
     md_path = out / "comparison.md"
-    md_path.write_text("# Paper vs recipdyn: every reported number\n\n" + _md_table(rows, variants)
+    write_text(md_path, "# Paper vs recipdyn: every reported number\n\n" + _md_table(rows, variants)
                        + "\n")  # fmt: skip
     return csv_path, md_path
 
@@ -226,5 +229,5 @@ def write_html(
                      f"<figcaption>{e(stem)}</figcaption></figure>")  # fmt: skip
     parts.append("</body></html>")
     path = out / "report.html"
-    path.write_text("\n".join(parts))
+    write_text(path, "\n".join(parts))
     return path

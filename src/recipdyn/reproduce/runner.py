@@ -13,7 +13,6 @@ import hashlib
 import json
 import os
 from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,7 +21,9 @@ import numpy as np
 import xarray as xr
 
 from .. import __version__
+from ..errors import Interrupted, deferred_signals
 from ..model.parameters import CompressorParams
+from ..parallel import process_pool, stop_pool
 from .cases import Case
 
 __all__ = ["Variant", "VARIANTS", "RunSpec", "run_all", "Settings"]
@@ -94,15 +95,25 @@ class RunSpec:
 
 
 def _compute(spec: RunSpec, path: str) -> str:
-    """Worker: simulate, measure, write the result file; returns its path."""
+    """Worker: simulate, measure, write the result file atomically; returns its path."""
+    from ..io import atomic_path
     from .measures import measure_run
 
     ds = measure_run(spec)
-    tmp = path + ".part"
     enc = {k: {"zlib": True, "complevel": 4} for k in ds.data_vars}
-    ds.to_netcdf(tmp, encoding=enc)
-    os.replace(tmp, path)  # atomic: an interrupted run never leaves a half-written result
+    with atomic_path(path) as tmp:  # an interrupted run never leaves a half-written result
+        ds.to_netcdf(tmp, encoding=enc)
     return path
+
+
+def _load(path: Path) -> xr.Dataset | None:
+    """A cached run, fully read; ``None`` if the file is unreadable (truncated, corrupted)."""
+    try:
+        with xr.open_dataset(path) as ds:
+            out = ds.load()
+    except Exception:
+        return None
+    return out if "m_peak_a" in out.attrs or out.attrs else None
 
 
 def run_all(
@@ -115,36 +126,66 @@ def run_all(
 ) -> dict[tuple[str, str], xr.Dataset]:
     """Compute (or load from ``cache``) every run; returns ``{(case_id, variant_id): ds}``.
 
-    ``progress(key, cached)`` is called as each run completes.
+    ``progress(key, cached)`` is called as each run completes. A cache file that cannot be read
+    back (truncated by a crash, corrupted) is recomputed, never used. On SIGINT/SIGTERM the runs
+    finished so far stay in the cache and :class:`~recipdyn.errors.Interrupted` says so.
     """
     cache.mkdir(parents=True, exist_ok=True)
     specs = list(specs)
     todo = []
-    for s in specs:
-        path = cache / f"{s.key}.nc"
-        if force or not path.exists():
-            todo.append((s, str(path)))
-        elif progress is not None:
-            progress(s.key, True)
-    jobs = jobs or os.cpu_count() or 1
-    if todo:
-        if jobs == 1:
-            for s, p in todo:
-                _compute(s, p)
-                if progress is not None:
-                    progress(s.key, False)
-        else:
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
-                futs = {pool.submit(_compute, s, p): s for s, p in todo}
-                for fut in as_completed(futs):
-                    fut.result()
-                    if progress is not None:
-                        progress(futs[fut].key, False)
     out: dict[tuple[str, str], xr.Dataset] = {}
     for s in specs:
-        with xr.open_dataset(cache / f"{s.key}.nc") as ds:
-            out[(s.case.id, s.variant.id)] = ds.load()
-    return out
+        path = cache / f"{s.key}.nc"
+        ds = None if (force or not path.exists()) else _load(path)
+        if ds is None:
+            todo.append((s, str(path)))
+        else:
+            out[(s.case.id, s.variant.id)] = ds
+            if progress is not None:
+                progress(s.key, True)
+    jobs = jobs or os.cpu_count() or 1
+    done = 0
+    try:
+        with deferred_signals() as pending:
+            if jobs == 1:
+                for s, p in todo:
+                    pending.check()
+                    _compute(s, p)
+                    done += 1
+                    if progress is not None:
+                        progress(s.key, False)
+                pending.check()
+            elif todo:
+                from concurrent.futures import FIRST_COMPLETED, wait
+
+                pool = process_pool(jobs)
+                try:
+                    futs = {pool.submit(_compute, s, p): s for s, p in todo}
+                    waiting = set(futs)
+                    while waiting:
+                        finished, waiting = wait(waiting, timeout=0.2,
+                                                 return_when=FIRST_COMPLETED)  # fmt: skip
+                        for fut in finished:
+                            fut.result()
+                            done += 1
+                            if progress is not None:
+                                progress(futs[fut].key, False)
+                        pending.check()
+                except BaseException:
+                    stop_pool(pool)
+                    raise
+                pool.shutdown(wait=True)
+    except (KeyboardInterrupt, Interrupted) as exc:
+        intr = Interrupted.wrap(exc)
+        intr.kept.append(f"{len(specs) - len(todo) + done} of {len(specs)} runs in {cache} "
+                         "(rerun the same command: cached runs are reused)")  # fmt: skip
+        raise intr from None
+    for s, p in todo:
+        ds = _load(Path(p))
+        if ds is None:
+            raise OSError(f"run {s.key} did not read back from {p}")
+        out[(s.case.id, s.variant.id)] = ds
+    return {(s.case.id, s.variant.id): out[(s.case.id, s.variant.id)] for s in specs}
 
 
 def summary_of(ds: xr.Dataset) -> dict[str, Any]:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ..io import save_figure
 from ..plotting import _mpl
 
 __all__ = ["sweep_figures"]
@@ -44,7 +45,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.set_title(f"Bifurcation diagram ({y.shape[1]} stroboscopic points per value)")
                 ax.grid(alpha=0.3)
                 p = out / f"bifurcation_{var.split('_', 1)[1]}.png"
-                fig.savefig(p, dpi=130)
+                save_figure(fig, p, dpi=130)
                 plt.close(fig)
                 paths.append(p)
         for var, ylab in (("lambda1", "largest Lyapunov exponent (1/s)"),
@@ -57,7 +58,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.axhline(0, color="k", lw=0.5)
                 ax.grid(alpha=0.3)
                 p = out / f"{var}_vs_{dims[0]}.png"
-                fig.savefig(p, dpi=130)
+                save_figure(fig, p, dpi=130)
                 plt.close(fig)
                 paths.append(p)
     else:
@@ -80,7 +81,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.set_yscale("log")
             ax.set_title(f"Fault map: {clabel}")
             p = out / f"map_{var}.png"
-            fig.savefig(p, dpi=130)
+            save_figure(fig, p, dpi=130)
             plt.close(fig)
             paths.append(p)
     return paths
