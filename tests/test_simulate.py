@@ -1,6 +1,7 @@
 """simulate(): labelled output, recorded inputs, partial results on failure."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -16,7 +17,12 @@ def test_dataset_records_every_input_and_units(tmp_path):
         if f.name != "load_table":
             assert f"param_{f.name}" in ds.attrs
     assert params_from_attrs(ds.attrs) == p
-    assert ds.attrs["theta_c_initial"] == pytest.approx(ds.attrs["theta_c_initial"])
+    # the default start: the link aligned with the rod at t = 0 (checked from the closure
+    # equation, independently of equilibrium_theta_c), plus the offset
+    thc_eq = ds.attrs["theta_c_initial"] - p.theta_c_offset
+    th2 = math.asin(-(p.d + p.r * math.sin(p.theta1_0) + p.rc * math.sin(thc_eq)) / p.l)
+    assert math.sin(thc_eq - th2) == pytest.approx(0.0, abs=1e-12)
+    assert math.cos(thc_eq - th2) == pytest.approx(-1.0)  # gas force toward the crank at t = 0
     assert ds.time.values[0] == pytest.approx(0.5 * p.crank_period)
     assert ds.time.attrs["units"] == "s" and ds.x.attrs["units"] == "m"
     np.testing.assert_allclose(np.diff(ds.time.values), 1 / 4000, rtol=1e-9)

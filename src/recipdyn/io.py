@@ -96,16 +96,33 @@ def write_dataset(ds, path: str | Path) -> Path:
     """
     path = check_output(path)
     fmt = DATASET_FORMATS[path.suffix.lower()]
-    if fmt == "Zarr":
-        with atomic_path(path, directory=True) as tmp:
-            ds.to_zarr(str(tmp), mode="w", consolidated=False)
-        return path
-    with atomic_path(path) as tmp:
-        if fmt == "NetCDF":
-            ds.to_netcdf(tmp)
-        else:
-            _write_csv(ds, tmp)
+    try:
+        if fmt == "Zarr":
+            with atomic_path(path, directory=True) as tmp:
+                ds.to_zarr(str(tmp), mode="w", consolidated=False)
+            return path
+        with atomic_path(path) as tmp:
+            if fmt == "NetCDF":
+                ds.to_netcdf(tmp)
+            else:
+                _write_csv(ds, tmp)
+    except Exception as exc:  # HDF5/netCDF report a full disk as RuntimeError, zarr variously
+        raise write_error(path, exc) from None
     return path
+
+
+def write_error(path: Path, exc: BaseException) -> OSError:
+    """An OSError naming the output, the cause and the free space left (a full disk?)."""
+    if isinstance(exc, OSError) and exc.filename:
+        reason = exc.strerror or str(exc)
+    else:
+        reason = str(exc) or type(exc).__name__
+    try:
+        free = shutil.disk_usage(path.parent).free
+        reason += f"; {free / 1e6:.3g} MB free in {path.parent}"
+    except OSError:
+        pass
+    return OSError(f"cannot write {path}: {reason}")
 
 
 def _write_csv(ds, path: Path) -> None:
@@ -125,8 +142,11 @@ def _write_csv(ds, path: Path) -> None:
 def save_figure(fig, path: str | Path, **kw) -> Path:
     """``fig.savefig`` to ``path`` atomically."""
     path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kw)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kw)
+    except Exception as exc:
+        raise write_error(path, exc) from None
     return path
 
 
@@ -160,6 +180,9 @@ def read_dataset(path: str | Path, *, required: Sequence[str] = (), what: str = 
 def write_text(path: str | Path, text: str) -> Path:
     """Write UTF-8 text to ``path`` atomically."""
     path = Path(path)
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    except Exception as exc:
+        raise write_error(path, exc) from None
     return path

@@ -154,6 +154,10 @@ class LyapunovResult:
     per_period : ndarray or None
         ``exponents * period`` for periodically forced systems.
     settings : dict
+    t_start, y_start, t_final, y_final : float, ndarray
+        Where the averaging began (after the transient) and where it ended, so that invariants
+        along the computed trajectory can be checked (e.g. the exponent sum of a Lagrangian
+        system, ``-ln(M(t_final, y_final) / M(t_start, y_start)) / t_total``).
     """
 
     exponents: np.ndarray
@@ -161,6 +165,10 @@ class LyapunovResult:
     history: np.ndarray
     per_period: np.ndarray | None = None
     settings: dict = field(default_factory=dict)
+    t_start: float = float("nan")
+    y_start: np.ndarray | None = None
+    t_final: float = float("nan")
+    y_final: np.ndarray | None = None
 
     @property
     def sum(self) -> float:
@@ -266,6 +274,7 @@ def lyapunov_spectrum(
         y = propagate(system, y, t, t + t_transient, **solver)
         t += t_transient
     tsys = tangent_system(system, k)
+    t_start, y_start = t, y.copy()
     z = np.concatenate([y, _initial_basis(n, k).ravel()])
     n_hist = max(1, int(n_history))
     hist = np.zeros((n_hist, k))
@@ -286,7 +295,8 @@ def lyapunov_spectrum(
         per = ex * system.period if system.period else None
         return LyapunovResult(ex.copy(), times[:filled].copy(), hist[:filled].copy(), per,
                               dict(method="benettin", dt_final=dt, t_total=t_total,
-                                   t_transient=t_transient, rtol=rtol, atol=atol, k=k))  # fmt: skip
+                                   t_transient=t_transient, rtol=rtol, atol=atol, k=k),
+                              t_start, y_start, float(info[0]), z[:n].copy())  # fmt: skip
     # fixed-step RK4 path (the paper's integrator): plain Python loop over intervals
     t_start, t_end = t, t + t_total
     sums = np.zeros(k)
@@ -306,7 +316,8 @@ def lyapunov_spectrum(
     per = ex * system.period if system.period else None
     return LyapunovResult(ex, np.array(times), np.array(hist), per,
                           dict(method="benettin", dt_final=dt, t_total=t_total,
-                               t_transient=t_transient, rtol=rtol, atol=atol, k=k))  # fmt: skip
+                               t_transient=t_transient, rtol=rtol, atol=atol, k=k),
+                          t_start, y_start, float(t), z[:n].copy())  # fmt: skip
 
 
 def _map_kernel(step, jac, x0, p, n_iter, n_transient, k, n_hist, q0):

@@ -99,7 +99,8 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:  # an output that cannot be written, a full disk, ...
         if debug or os.environ.get("RECIPDYN_DEBUG"):
             raise
-        _err(f"error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
+        where = f": {exc.filename}" if exc.filename else ""
+        _err(f"error: {exc.strerror or exc}{where}")
         return 2
     except typer.Exit as exc:
         return exc.exit_code or 0
