@@ -10,8 +10,8 @@ def test_analyze_a_simulated_run(tmp_path, capsys):
     revolutions, 250x the verdict threshold; 0-1 K ~1), so the verdict must say so; the exponent
     sum of this Lagrangian system is a boundary term bounded by ln(A_max/A_min)/T."""
     import numpy as np
-    from conftest import generalized_mass
 
+    from conftest import generalized_mass
     from recipdyn.model import CompressorParams
 
     run = tmp_path / "run.nc"

@@ -38,14 +38,25 @@ def _env(tag: str) -> dict[str, str]:
 
 
 def spawn(args, cwd, tag="") -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "recipdyn", *args], cwd=cwd,
-                            env=_env(tag or uuid.uuid4().hex), stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    return subprocess.Popen(
+        [sys.executable, "-m", "recipdyn", *args],
+        cwd=cwd,
+        env=_env(tag or uuid.uuid4().hex),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def run_cli(args, cwd, timeout=300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "recipdyn", *args], cwd=cwd, env=_env("x"),
-                          capture_output=True, text=True, timeout=timeout)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "recipdyn", *args],
+        cwd=cwd,
+        env=_env("x"),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 def tagged_processes(tag: str) -> list[int]:
@@ -86,8 +97,20 @@ def no_traceback(*texts):
 
 needs_proc = pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc")
 
-SWEEP = ["sweep", "-p", "omega=15:25:16", "-m", "poincare,peak", "--points", "30",
-         "--transient", "5", "--revolutions", "2", "--no-progress"]  # fmt: skip
+SWEEP = [
+    "sweep",
+    "-p",
+    "omega=15:25:16",
+    "-m",
+    "poincare,peak",
+    "--points",
+    "30",
+    "--transient",
+    "5",
+    "--revolutions",
+    "2",
+    "--no-progress",
+]
 
 
 def load_store(path: Path) -> dict[str, np.ndarray]:
@@ -141,7 +164,7 @@ USAGE = [
     (["reproduce", "-j", "0"], "jobs"),
     (["analyze", "missing.nc"], "not found"),
     (["plot", "missing.zarr"], "not found"),
-]  # fmt: skip
+]
 
 
 @pytest.mark.parametrize("args,word", USAGE, ids=[" ".join(a)[:40] for a, _ in USAGE])
@@ -173,8 +196,14 @@ def test_version(capsys):
 
 
 def _write_inputs(d: Path) -> dict[str, Path]:
-    files = {"text": d / "t.txt", "empty": d / "e.nc", "foreign": d / "foreign.nc",
-             "folder": d / "folder", "bad_toml": d / "bad.toml", "latin1": d / "latin1.toml"}  # fmt: skip
+    files = {
+        "text": d / "t.txt",
+        "empty": d / "e.nc",
+        "foreign": d / "foreign.nc",
+        "folder": d / "folder",
+        "bad_toml": d / "bad.toml",
+        "latin1": d / "latin1.toml",
+    }
     files["text"].write_text("hello\n")
     files["empty"].write_bytes(b"")
     xr.Dataset({"foo": ("t", np.arange(5.0))}).to_netcdf(files["foreign"])
@@ -184,14 +213,22 @@ def _write_inputs(d: Path) -> dict[str, Path]:
     return files
 
 
-@pytest.mark.parametrize("command,kind,word", [
-    ("analyze", "text", "cannot be read"), ("analyze", "empty", "empty"),
-    ("analyze", "foreign", "missing"), ("analyze", "folder", "folder"),
-    ("plot", "text", "sweep store"), ("plot", "foreign", "sweep store"),
-    ("plot", "folder", "sweep store"),
-    ("simulate -c", "bad_toml", "malformed"), ("simulate -c", "latin1", "UTF-8"),
-    ("simulate -c", "folder", "folder"), ("simulate -c", "empty", ""),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "command,kind,word",
+    [
+        ("analyze", "text", "cannot be read"),
+        ("analyze", "empty", "empty"),
+        ("analyze", "foreign", "missing"),
+        ("analyze", "folder", "folder"),
+        ("plot", "text", "sweep store"),
+        ("plot", "foreign", "sweep store"),
+        ("plot", "folder", "sweep store"),
+        ("simulate -c", "bad_toml", "malformed"),
+        ("simulate -c", "latin1", "UTF-8"),
+        ("simulate -c", "folder", "folder"),
+        ("simulate -c", "empty", ""),
+    ],
+)
 def test_wrong_input_files(tmp_path, monkeypatch, capsys, command, kind, word):
     monkeypatch.chdir(tmp_path)
     files = _write_inputs(tmp_path)
@@ -226,8 +263,10 @@ def test_bad_output_path_is_reported_before_any_work(tmp_path, capsys, monkeypat
     blocker = tmp_path / "file"
     blocker.write_text("x")
     assert main(["simulate", "-o", str(blocker / "run.nc")]) == 2
-    assert main(["sweep", "-p", "omega=10:20:2", "-o", str(blocker / "sw"), "--backend",
-                 "serial"]) == 2  # fmt: skip
+    assert (
+        main(["sweep", "-p", "omega=10:20:2", "-o", str(blocker / "sw"), "--backend", "serial"])
+        == 2
+    )
     assert not called
     assert "cannot create folder" in capsys.readouterr().err
 
@@ -235,8 +274,22 @@ def test_bad_output_path_is_reported_before_any_work(tmp_path, capsys, monkeypat
 @pytest.mark.parametrize("ext", [".nc", ".csv", ".zarr"])
 def test_output_format_follows_the_extension(tmp_path, ext):
     out = tmp_path / f"run{ext}"
-    assert main(["simulate", "-n", "0.2", "--fs", "2 kHz", "-o", str(out), "--no-figure",
-                 "--no-progress"]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "simulate",
+                "-n",
+                "0.2",
+                "--fs",
+                "2 kHz",
+                "-o",
+                str(out),
+                "--no-figure",
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     if ext == ".nc":
         assert xr.open_dataset(out).a.attrs["units"] == "m/s**2"
     elif ext == ".zarr":
@@ -254,8 +307,17 @@ def test_failed_write_keeps_the_previous_file(tmp_path, monkeypatch, capsys):
     """A write that fails halfway (disk full, simulated) leaves the old file intact, no
     temporary file behind, and exits 2 with the reason."""
     out = tmp_path / "run.nc"
-    args = ["simulate", "-n", "0.2", "--fs", "2 kHz", "-o", str(out), "--no-figure",
-            "--no-progress"]  # fmt: skip
+    args = [
+        "simulate",
+        "-n",
+        "0.2",
+        "--fs",
+        "2 kHz",
+        "-o",
+        str(out),
+        "--no-figure",
+        "--no-progress",
+    ]
     assert main(args) == 0
     before = out.read_bytes()
 
@@ -264,8 +326,7 @@ def test_failed_write_keeps_the_previous_file(tmp_path, monkeypatch, capsys):
         raise OSError(28, "No space left on device", str(path))
 
     monkeypatch.setattr(xr.Dataset, "to_netcdf", full_disk)
-    assert main([*args[:-4], "--rc", "2 mm", "-o", str(out), "--no-figure",
-                 "--no-progress"]) == 2  # fmt: skip
+    assert main([*args[:-4], "--rc", "2 mm", "-o", str(out), "--no-figure", "--no-progress"]) == 2
     assert "No space left" in capsys.readouterr().err
     assert out.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
@@ -276,14 +337,16 @@ def test_real_full_disk_on_a_small_tmpfs(tmp_path):
     no traceback, no partial file under the final name."""
     mnt = tmp_path / "small"
     mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(mnt)],
-                       capture_output=True)  # fmt: skip
+    r = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(mnt)], capture_output=True
+    )
     if r.returncode != 0:
         pytest.skip("cannot mount a tmpfs here")
     try:
         out = mnt / "run.nc"
-        res = run_cli(["simulate", "-n", "3", "-o", str(out), "--no-figure", "--no-progress"],
-                      tmp_path)  # fmt: skip
+        res = run_cli(
+            ["simulate", "-n", "3", "-o", str(out), "--no-figure", "--no-progress"], tmp_path
+        )
         assert res.returncode == 2, res.stderr
         no_traceback(res.stderr)
         assert "cannot write" in res.stderr and "MB free" in res.stderr
@@ -326,8 +389,24 @@ def test_cli_progress_flag_same_file_content(tmp_path):
     outs = []
     for flag in ("--progress", "--no-progress"):
         out = tmp_path / f"r{flag}.nc"
-        assert main(["simulate", "--omega", "150", "--set", "theta_c_offset=0.2", "-n", "5",
-                     "-o", str(out), "--no-figure", flag]) == 0  # fmt: skip
+        assert (
+            main(
+                [
+                    "simulate",
+                    "--omega",
+                    "150",
+                    "--set",
+                    "theta_c_offset=0.2",
+                    "-n",
+                    "5",
+                    "-o",
+                    str(out),
+                    "--no-figure",
+                    flag,
+                ]
+            )
+            == 0
+        )
         outs.append(xr.open_dataset(out))
     for k in ("a", "theta_c", "contact_force"):
         assert np.array_equal(outs[0][k].values, outs[1][k].values)
@@ -342,8 +421,21 @@ def test_cli_progress_flag_same_file_content(tmp_path):
 def test_simulate_interrupted_keeps_partial_record(tmp_path, sig):
     tag = uuid.uuid4().hex
     out = tmp_path / "long.nc"
-    p = spawn(["simulate", "--set", "theta_c_offset=0.3", "-n", "2000", "-o", str(out),
-               "--no-figure", "--no-progress"], tmp_path, tag)  # fmt: skip
+    p = spawn(
+        [
+            "simulate",
+            "--set",
+            "theta_c_offset=0.3",
+            "-n",
+            "2000",
+            "-o",
+            str(out),
+            "--no-figure",
+            "--no-progress",
+        ],
+        tmp_path,
+        tag,
+    )
     time.sleep(6.0)  # imports + compiled-code load, then integrating
     p.send_signal(sig)
     _, err = p.communicate(timeout=60)
@@ -370,8 +462,10 @@ def test_sweep_interrupted_at_random_moment_then_resumed_equals_uninterrupted(tm
     out = tmp_path / "a"
     p = spawn([*SWEEP, "-o", str(out), "--workers", "2"], tmp_path, tag)
     k = int(rng.integers(1, 5))
-    wait_for(lambda: done_chunks(out / "sweep.zarr") >= k or p.poll() is not None,
-             what="first stored points")  # fmt: skip
+    wait_for(
+        lambda: done_chunks(out / "sweep.zarr") >= k or p.poll() is not None,
+        what="first stored points",
+    )
     time.sleep(float(rng.uniform(0, 0.3)))
     p.send_signal(sig)
     _, err = p.communicate(timeout=60)
@@ -393,8 +487,9 @@ def test_workers_exit_when_the_parent_is_killed(tmp_path):
     tag = uuid.uuid4().hex
     out = tmp_path / "k"
     p = spawn([*SWEEP, "-o", str(out), "--workers", "2"], tmp_path, tag)
-    wait_for(lambda: len(tagged_processes(tag)) >= 3 or p.poll() is not None,
-             what="workers to start")  # fmt: skip
+    wait_for(
+        lambda: len(tagged_processes(tag)) >= 3 or p.poll() is not None, what="workers to start"
+    )
     if p.poll() is not None:
         pytest.skip("the sweep finished before it could be killed")
     p.kill()
@@ -406,13 +501,28 @@ def test_workers_exit_when_the_parent_is_killed(tmp_path):
 def test_continuation_resume_after_kill9_equals_uninterrupted(tmp_path):
     """kill -9 in the middle of a continuation sweep; --resume restarts from the recorded
     final state of the last stored point and recomputes everything after it."""
-    args = ["sweep", "-p", "omega=18:22:8", "-m", "poincare", "--points", "40", "--transient",
-            "3", "--continuation", "--set", "theta_c_offset=0.2", "--no-progress"]  # fmt: skip
+    args = [
+        "sweep",
+        "-p",
+        "omega=18:22:8",
+        "-m",
+        "poincare",
+        "--points",
+        "40",
+        "--transient",
+        "3",
+        "--continuation",
+        "--set",
+        "theta_c_offset=0.2",
+        "--no-progress",
+    ]
     out = tmp_path / "c"
     tag = uuid.uuid4().hex
     p = spawn([*args, "-o", str(out)], tmp_path, tag)
-    wait_for(lambda: done_chunks(out / "sweep.zarr") >= 2 or p.poll() is not None,
-             what="two stored points")  # fmt: skip
+    wait_for(
+        lambda: done_chunks(out / "sweep.zarr") >= 2 or p.poll() is not None,
+        what="two stored points",
+    )
     if p.poll() is not None:
         pytest.skip("the sweep finished before it could be killed")
     p.kill()
@@ -430,8 +540,11 @@ def test_reproduce_interrupted_keeps_cache(tmp_path):
     out = tmp_path / "rep"
     p = spawn(["reproduce", "--quick", "-o", str(out), "-j", "2", "--no-progress"], tmp_path, tag)
     cache = out / "cache"
-    wait_for(lambda: (cache.exists() and any(cache.glob("*.nc"))) or p.poll() is not None,
-             timeout=180, what="a cached run")  # fmt: skip
+    wait_for(
+        lambda: (cache.exists() and any(cache.glob("*.nc"))) or p.poll() is not None,
+        timeout=180,
+        what="a cached run",
+    )
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=60)
     if p.returncode == 0:
@@ -453,9 +566,19 @@ def test_reproduce_interrupted_keeps_cache(tmp_path):
 def _small_sweep(out, **kw):
     from recipdyn.sweep import SweepSpec, parse_axis, run_sweep
 
-    spec = SweepSpec(axes=(parse_axis("omega=15:25:4"),), measures=("poincare", "peak"),
-                     settings=dict(revolutions=1.0, transient=2.0, points=10,
-                                   lyap_revolutions=5.0, fs=2000.0, rtol=1e-9, atol=1e-11))  # fmt: skip
+    spec = SweepSpec(
+        axes=(parse_axis("omega=15:25:4"),),
+        measures=("poincare", "peak"),
+        settings=dict(
+            revolutions=1.0,
+            transient=2.0,
+            points=10,
+            lyap_revolutions=5.0,
+            fs=2000.0,
+            rtol=1e-9,
+            atol=1e-11,
+        ),
+    )
     return run_sweep(spec, out, backend="serial", progress=False, **kw)
 
 
@@ -484,8 +607,22 @@ def test_missing_data_chunk_is_not_counted_as_done(tmp_path):
 
 def test_resume_refuses_a_different_spec_and_a_broken_store(tmp_path, capsys):
     _small_sweep(tmp_path / "s")
-    assert main(["sweep", "-p", "omega=15:25:5", "-o", str(tmp_path / "s"), "--resume",
-                 "--backend", "serial", "--no-progress"]) == 2  # fmt: skip
+    assert (
+        main(
+            [
+                "sweep",
+                "-p",
+                "omega=15:25:5",
+                "-o",
+                str(tmp_path / "s"),
+                "--resume",
+                "--backend",
+                "serial",
+                "--no-progress",
+            ]
+        )
+        == 2
+    )
     assert "different sweep spec" in capsys.readouterr().err
     (tmp_path / "s" / "sweep.zarr" / "zarr.json").write_text("{not json")
     with pytest.raises(ParameterError, match="cannot be opened"):
@@ -517,8 +654,14 @@ def test_second_sweep_on_the_same_folder_refuses(tmp_path):
     out = tmp_path / "busy"
     p = spawn([*SWEEP, "-o", str(out), "--workers", "1"], tmp_path)
     try:
-        wait_for(lambda: (out / ".recipdyn.lock").exists() and (out / ".recipdyn.lock")
-                 .read_text().startswith("{") or p.poll() is not None, what="the lock")  # fmt: skip
+        wait_for(
+            lambda: (
+                (out / ".recipdyn.lock").exists()
+                and (out / ".recipdyn.lock").read_text().startswith("{")
+                or p.poll() is not None
+            ),
+            what="the lock",
+        )
         r = run_cli([*SWEEP, "-o", str(out), "--force"], tmp_path, timeout=120)
         if p.poll() is None:
             assert r.returncode == 2, r.stderr
@@ -544,9 +687,25 @@ def test_stale_lock_from_a_killed_run_is_taken_over(tmp_path):
 
 def test_integrator_failure_keeps_partial_record_and_exits_1(tmp_path, capsys):
     out = tmp_path / "blow.nc"
-    code = main(["simulate", "--set", "equations=paper-printed", "--set", "load_sign=paper",
-                 "--set", "theta_c_offset=1.0", "-n", "2", "--fs", "5 kHz", "-o", str(out),
-                 "--no-figure", "--no-progress"])  # fmt: skip
+    code = main(
+        [
+            "simulate",
+            "--set",
+            "equations=paper-printed",
+            "--set",
+            "load_sign=paper",
+            "--set",
+            "theta_c_offset=1.0",
+            "-n",
+            "2",
+            "--fs",
+            "5 kHz",
+            "-o",
+            str(out),
+            "--no-figure",
+            "--no-progress",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 1 and "integration failed" in err and "kept:" in err
     ds = xr.open_dataset(tmp_path / "blow.partial.nc")
@@ -591,8 +750,10 @@ def test_axis_parsing_fuzz(text):
 
 
 @settings(max_examples=150, deadline=None)
-@given(st.sampled_from(["rc", "omega", "d", "m3", "fs", "revolutions"]),
-       st.one_of(st.text(max_size=20), st.floats(allow_nan=True, allow_infinity=True)))  # fmt: skip
+@given(
+    st.sampled_from(["rc", "omega", "d", "m3", "fs", "revolutions"]),
+    st.one_of(st.text(max_size=20), st.floats(allow_nan=True, allow_infinity=True)),
+)
 def test_quantity_parsing_fuzz(name, value):
     from recipdyn.units import to_si
 
@@ -605,9 +766,27 @@ def test_quantity_parsing_fuzz(name, value):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.dictionaries(st.sampled_from(["r", "l", "rc", "d", "omega", "m2", "m3", "J2",
-                                        "theta_c_offset", "load_amplitude", "g"]),
-                       st.floats(allow_nan=True, allow_infinity=True, width=64), max_size=4))  # fmt: skip
+@given(
+    st.dictionaries(
+        st.sampled_from(
+            [
+                "r",
+                "l",
+                "rc",
+                "d",
+                "omega",
+                "m2",
+                "m3",
+                "J2",
+                "theta_c_offset",
+                "load_amplitude",
+                "g",
+            ]
+        ),
+        st.floats(allow_nan=True, allow_infinity=True, width=64),
+        max_size=4,
+    )
+)
 def test_parameters_fuzz(values):
     """Any combination of values either builds valid parameters or raises a ParameterError
     that names one of the given parameters."""
