@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from ..defaults import ANALYZE
 from . import app
 
 
@@ -13,8 +14,12 @@ from . import app
 def analyze(
     run: Path = typer.Argument(..., help="NetCDF file written by 'recipdyn simulate'."),
     out: Path = typer.Option(None, "--out", "-o", help="Output folder (default: RUN_analysis)."),
-    section_points: int = typer.Option(200, "--section-points", help="Poincaré points."),
-    lyap_revolutions: float = typer.Option(100.0, "--lyap-revolutions"),
+    section_points: int = typer.Option(
+        ANALYZE["section_points"], "--section-points", help="Poincaré points."
+    ),
+    lyap_revolutions: float = typer.Option(
+        ANALYZE["lyap_revolutions"], "--lyap-revolutions", help="Benettin averaging length."
+    ),
 ) -> None:
     """Spectrum, phase portraits, Poincaré section, Lyapunov exponents, 0-1 test, verdict."""
     from ..analyze import analyze_run

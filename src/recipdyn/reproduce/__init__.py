@@ -45,7 +45,7 @@ def investigate(quick: bool = False) -> tuple[dict[str, Any], Any]:
                 p = CompressorParams(rc=rc, d=0.0, theta_c_offset=off, equations=eq,
                                      load_sign=sign)  # fmt: skip
                 try:
-                    ds = simulate(p, revolutions=revs, fs=20_000, rtol=1e-9)
+                    ds = simulate(p, revolutions=revs, fs=20_000)
                     peaks.append(float(np.abs(ds.a).max()))
                 except Exception:  # the printed equations can blow up: record it
                     peaks.append(float("nan"))

@@ -10,7 +10,6 @@ numbers are reachable by this model at all; it never changes the package's defau
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ..defaults import CALIBRATION_ATOL, CALIBRATION_RTOL
 from ..integrate import IntegrationError
 from ..io import write_text
 from ..model.parameters import CompressorParams
@@ -39,7 +39,13 @@ def _peaks(values: dict[str, float], revolutions: float) -> list[float]:
         c = case_by_id(cid)
         p = CompressorParams(rc=c.rc, d=c.d, omega=c.omega, **values)
         try:
-            ds = simulate(p, revolutions=revolutions, fs=20_000.0, rtol=1e-8, atol=1e-10)
+            ds = simulate(
+                p,
+                revolutions=revolutions,
+                fs=20_000.0,
+                rtol=CALIBRATION_RTOL,
+                atol=CALIBRATION_ATOL,
+            )
             out.append(float(np.abs(ds.a).max()))
         except IntegrationError:
             out.append(float("nan"))
@@ -102,8 +108,3 @@ def write_calibration(results: list[dict[str, Any]], out: Path) -> Path:
     path = out / "calibration.md"
     write_text(path, "\n".join(lines))
     return path
-
-
-def replace_defaults(p: CompressorParams, best: dict[str, float]) -> CompressorParams:
-    """``p`` with the calibrated values (for users who want to adopt them explicitly)."""
-    return dataclasses.replace(p, **best)

@@ -27,7 +27,6 @@ stop the sweep after the points already finished are written; the workers are en
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import time
@@ -440,10 +439,3 @@ def _run_dask(tasks, dask_local, scheduler, workers, accept, pending) -> None:
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-def spec_from_store(path: str | Path) -> dict[str, Any]:
-    """The JSON spec recorded in a store."""
-    import zarr
-
-    return json.loads(zarr.open_group(str(path), mode="r").attrs["spec_json"])
