@@ -419,6 +419,9 @@ def test_cli_progress_flag_same_file_content(tmp_path):
 @needs_proc
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_simulate_interrupted_keeps_partial_record(tmp_path, sig):
+    import re
+    import threading
+
     tag = uuid.uuid4().hex
     out = tmp_path / "long.nc"
     p = spawn(
@@ -431,14 +434,24 @@ def test_simulate_interrupted_keeps_partial_record(tmp_path, sig):
             "-o",
             str(out),
             "--no-figure",
-            "--no-progress",
+            "--progress",
         ],
         tmp_path,
         tag,
     )
-    time.sleep(6.0)  # imports + compiled-code load, then integrating
+    chunks: list[str] = []
+    reader = threading.Thread(target=lambda: chunks.extend(iter(lambda: p.stderr.read(64), "")))
+    reader.start()
+
+    def integrating():  # the progress bar has advanced: compiled code loaded, samples exist
+        m = re.findall(r"(\d+)%\|", "".join(chunks))
+        return (m and int(m[-1]) >= 1) or p.poll() is not None
+
+    wait_for(integrating, timeout=180, what="the integration to advance")
     p.send_signal(sig)
-    _, err = p.communicate(timeout=60)
+    p.wait(timeout=60)
+    reader.join(timeout=10)
+    err = "".join(chunks)
     assert p.returncode == 128 + sig, err
     no_traceback(err)
     assert "kept:" in err and "partial record" in err

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from recipdyn.cli import main
+from recipdyn.errors import Interrupted
 from recipdyn.model import CompressorParams, ParameterError
 from recipdyn.sweep import SweepSpec, open_sweep, parse_axis, run_sweep
 
@@ -47,8 +48,9 @@ def test_resume_does_not_recompute(tmp_path):
         if len(seen) == 2:
             raise KeyboardInterrupt
 
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(Interrupted) as info:  # a KeyboardInterrupt comes out as Interrupted
         run_sweep(spec, tmp_path / "r", backend="serial", progress=False, on_point=interrupt)
+    assert info.value.exit_code == 130 and "2 of 6 sweep points" in info.value.kept[0]
     assert open_sweep(tmp_path / "r" / "sweep.zarr").done.values.sum() == 2
     second = []
     run_sweep(spec, tmp_path / "r", backend="serial", resume=True, progress=False,

@@ -120,10 +120,10 @@ def _unit(name: str) -> str:
 _FILL = {"f8": np.nan, "i8": -1, "str": ""}
 
 
-def _canonical(name: str, dtype: str, value) -> bytes:
+def _canonical(name: str, dtype: str, shape: tuple[int, ...], value) -> bytes:
     if dtype == "str":
         return f"{name}={value}".encode()
-    a = np.asarray(value, dtype=dtype)
+    a = np.broadcast_to(np.asarray(value, dtype=dtype), shape)  # a fill scalar fills it all
     if dtype == "f8":
         a = np.where(np.isnan(a), np.nan, a)  # one NaN bit pattern
     return name.encode() + np.ascontiguousarray(a).tobytes()
@@ -132,8 +132,9 @@ def _canonical(name: str, dtype: str, value) -> bytes:
 def _checksum(spec: SweepSpec, values: dict[str, Any]) -> int:
     """CRC-32 of a point's values as the store holds them (fill values where absent)."""
     crc = 0
-    for name, (dtype, _extra, _size, _u) in _variables(spec).items():
-        crc = zlib.crc32(_canonical(name, dtype, values.get(name, _FILL[dtype])), crc)
+    for name, (dtype, extra, size, _u) in _variables(spec).items():
+        shape = (size,) if extra else ()
+        crc = zlib.crc32(_canonical(name, dtype, shape, values.get(name, _FILL[dtype])), crc)
     return zlib.crc32(f"error={values.get('error', '')}".encode(), crc)
 
 
