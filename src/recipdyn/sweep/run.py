@@ -159,31 +159,23 @@ def _write(g, spec: SweepSpec, res: dict[str, Any]) -> None:
 
 def _verified_done(g, spec: SweepSpec) -> tuple[np.ndarray, int]:
     """``done`` after re-checking every point marked done; returns (done, n_rejected)."""
-    try:
-        done = np.asarray(g["done"][...], dtype=bool)
-    except Exception:  # a torn 'done' chunk: read point by point
-        done = np.zeros(spec.shape, dtype=bool)
-        for idx, _ in spec.grid():
-            try:
-                done[idx] = bool(g["done"][idx])
-            except Exception:
-                done[idx] = False
-    try:
-        sums = np.asarray(g["checksum"][...])
-    except Exception:
-        sums = None
+    done = np.zeros(spec.shape, dtype=bool)
     rejected = 0
-    for idx in zip(*np.nonzero(done), strict=True):
-        idx = tuple(int(i) for i in idx)
-        try:
-            ok = (sums is not None and sums[idx] >= 0
-                  and _checksum(spec, _read_point(g, spec, idx)) == int(sums[idx]))  # fmt: skip
-            if sums is None:
-                ok = _checksum(spec, _read_point(g, spec, idx)) == int(g["checksum"][idx])
-        except Exception:  # unreadable chunk
+    try:
+        marked = np.asarray(g["done"][...], dtype=bool)
+    except Exception:  # a torn 'done' chunk: look at every point
+        marked = None
+    for idx, _ in spec.grid():
+        if marked is not None and not marked[idx]:
+            continue
+        try:  # point by point: one torn chunk must not hide the others
+            if not bool(g["done"][idx]):
+                continue
+            ok = _checksum(spec, _read_point(g, spec, idx)) == int(g["checksum"][idx])
+        except Exception:  # unreadable (truncated, corrupted) chunk
             ok = False
+        done[idx] = ok
         if not ok:
-            done[idx] = False
             rejected += 1
             try:
                 g["done"][idx] = False
