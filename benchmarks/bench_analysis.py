@@ -19,7 +19,7 @@ LAMBDA = 0.9056
 _CHILD = r"""
 import json, resource, sys, time
 import numpy as np
-from recipdyn.analysis import systems as S
+from recipdyn.model.reference import systems as S
 from recipdyn.integrate import integrate
 n = int(sys.argv[2]); dt = 0.01
 sol = integrate(S.lorenz(), [1.0, 1.0, 1.0], (0, 50 + n * dt), t_eval=50 + np.arange(n) * dt,

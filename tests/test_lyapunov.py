@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from recipdyn.analysis import lyapunov_spectrum, lyapunov_spectrum_map
-from recipdyn.analysis import systems as S
 from recipdyn.model import CompressorParams, compressor_model
+from recipdyn.model.reference import systems as S
 
 
 def test_lorenz():

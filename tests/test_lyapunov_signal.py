@@ -11,8 +11,8 @@ from recipdyn.analysis import (
     lyap_rosenstein,
     lyap_wolf,
 )
-from recipdyn.analysis import systems as S
 from recipdyn.integrate import integrate
+from recipdyn.model.reference import systems as S
 
 LAMBDA_LORENZ = 0.9056
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from recipdyn.analysis import amplitude_spectrum, classify, zero_one_test
-from recipdyn.analysis.systems import iterate, logistic_map
+from recipdyn.model.reference.systems import iterate, logistic_map
 
 
 @pytest.mark.parametrize("r, chaotic", [(3.97, True), (4.0, True), (3.5, False), (3.83, False)])

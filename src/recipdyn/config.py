@@ -29,7 +29,8 @@ from .defaults import SIMULATION
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
-__all__ = ["SimulationConfig", "RunConfig", "load_config", "build_params"]
+__all__ = ["SimulationConfig", "RunConfig", "load_config", "read_config", "build_params",
+           "model_values"]  # fmt: skip
 
 _STRING_FIELDS = {"load_sign", "equations"}
 
@@ -55,9 +56,10 @@ class SimulationConfig(BaseModel):
 
 
 class RunConfig(BaseModel):
-    """A whole config file: ``[params]`` and ``[simulation]`` tables."""
+    """A whole config file: an optional ``model`` name and ``[params]``, ``[simulation]``."""
 
     model_config = ConfigDict(extra="forbid")
+    model: str | None = None
     params: dict[str, Any] = {}
     simulation: SimulationConfig = SimulationConfig()
 
@@ -80,8 +82,8 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
     return dataclasses.replace(base or CompressorParams(), **kw)
 
 
-def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
-    """Read a TOML config; returns ``(params, simulation settings in SI)``."""
+def read_config(path: str | Path) -> RunConfig:
+    """Read and validate a TOML config file (clear errors, exit status 2 at the CLI)."""
     path = Path(path)
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -97,9 +99,26 @@ def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"config {path}: malformed TOML ({exc})") from None
     try:
-        cfg = RunConfig.model_validate(raw)
+        return RunConfig.model_validate(raw)
     except ValidationError as exc:
         first = exc.errors()[0]
         loc = ".".join(str(x) for x in first["loc"])
         raise ParameterError(f"config {path}: {loc}: {first['msg']}") from None
+
+
+def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
+    """Read a TOML config of the compressor; returns ``(params, simulation settings in SI)``."""
+    cfg = read_config(path)
+    if cfg.model not in (None, "compressor"):
+        raise ParameterError(f"config {path}: model {cfg.model!r}; this command needs the "
+                             "compressor (or pass --model)")  # fmt: skip
     return build_params(cfg.params), cfg.simulation.resolved()
+
+
+def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
+    """Validated values of any model's schema from ``{name: number | quantity string}``."""
+    out: dict[str, Any] = {}
+    for k, v in values.items():
+        p = model.schema[model.schema.resolve(k)]
+        out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
+    return model.parameters(out)

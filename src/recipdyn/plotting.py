@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-__all__ = ["response_figure", "provenance_footer"]
+__all__ = ["response_figure", "provenance_footer", "model_figure"]
 
 
 def _mpl():
@@ -75,4 +75,38 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
     ax.grid(alpha=0.3)
     fig.suptitle(title or "Crosshead response")
     fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+    return fig
+
+
+def model_figure(ds: xr.Dataset, *, title: str | None = None):
+    """Any model's record: up to three signals over time (or iteration) and a phase portrait
+    of the first two (points for a map)."""
+    plt = _mpl()
+    names = [k for k in ds.data_vars if ds[k].ndim == 1][:3]
+    dim = ds[names[0]].dims[0]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    t = ds[dim].values
+    is_map = dim == "iteration"
+    for k in names:
+        u = ds[k].attrs.get("units", "")
+        label = f"{k} ({u})" if u not in ("", "1") else k
+        if is_map:
+            axes[0].plot(t, ds[k].values, ".", ms=2, label=label)
+        else:
+            axes[0].plot(t, ds[k].values, lw=0.7, label=label)
+    tu = ds[dim].attrs.get("units", "")
+    axes[0].set_xlabel(f"{dim} ({tu})" if tu not in ("", "1") else dim)
+    axes[0].legend(fontsize=8, loc="upper right")
+    axes[0].grid(alpha=0.3)
+    if len(names) >= 2:
+        a, b = ds[names[0]], ds[names[1]]
+        style = dict(ls="none", marker=".", ms=1.5) if is_map else dict(lw=0.5)
+        axes[1].plot(a.values, b.values, **style)
+        axes[1].set_xlabel(f"{names[0]} ({a.attrs.get('units', '')})")
+        axes[1].set_ylabel(f"{names[1]} ({b.attrs.get('units', '')})")
+        axes[1].set_title("phase portrait")
+        axes[1].grid(alpha=0.3)
+    else:
+        axes[1].set_axis_off()
+    fig.suptitle(title or f"{ds.attrs.get('model', 'model')}: {ds.attrs.get('title', '')}")
     return fig

@@ -15,8 +15,10 @@ from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted
 from .integrate import IntegrationError, integrate
 from .integrate.solve import check_tolerances
-from .model.compressor import compressor_model
+from .model.compressor import COMPRESSOR, compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
+from .model.protocol import Model
+from .model.registry import get_model
 from .resources import check_memory
 
 __all__ = ["simulate", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
@@ -81,6 +83,7 @@ def simulate(
     h: float | None = DEFAULT_SETTINGS["h"],
     progress: bool = False,
     max_memory: float | None = None,
+    model: str | Model | None = None,
     **overrides: Any,
 ) -> xr.Dataset:
     """Simulate the compressor and return the crosshead response as a Dataset.
@@ -107,6 +110,12 @@ def simulate(
     max_memory : float, optional
         Refuse runs estimated to need more memory than this, bytes (default: half of the memory
         available at the start).
+    model : str or Model, optional
+        A registered model (:func:`recipdyn.model.registry.get_model`: a name such as
+        ``"duffing"`` or a ``module:object`` path); default the paper's compressor. For other
+        models ``params`` is a mapping of their schema's parameters, ``revolutions`` and
+        ``transient`` count forcing periods (time units for an autonomous system, iterations
+        for a map) and the outputs are the model's.
     **overrides
         Parameter overrides by name or alias, e.g. ``rc=0.5e-3``, ``clearance=0.5e-3``.
 
@@ -135,6 +144,12 @@ def simulate(
     >>> ds = recipdyn.simulate(rc=1e-3, d=1e-3, omega=20.0, revolutions=2)  # doctest: +SKIP
     >>> float(ds.a.max())  # doctest: +SKIP
     """
+    if model is not None and get_model(model).name != COMPRESSOR.name:
+        return _simulate_model(
+            get_model(model), params, overrides, revolutions=revolutions, transient=transient,
+            fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
+            max_memory=max_memory,
+        )  # fmt: skip
     p = _coerce_params(params, overrides)
     for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
         if not (_is_number(val) and math.isfinite(val) and val > lo):
@@ -266,3 +281,79 @@ def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
                 v = v.item()
             kw[f.name] = None if v == "default" else v
     return CompressorParams(**kw)
+
+
+def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
+    for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
+        if not (_is_number(val) and math.isfinite(val) and val > lo):
+            raise ParameterError(f"{name} = {val!r} out of range; allowed: > {lo:g}")
+    if not (_is_number(transient) and math.isfinite(transient) and transient >= 0):
+        raise ParameterError(f"transient = {transient!r} out of range; allowed: >= 0")
+    if method not in ("dop853", "rk4"):
+        raise ParameterError(f"method = {method!r}; allowed: dop853, rk4")
+    check_tolerances(rtol, atol)
+
+
+def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, method, rtol,
+                    atol, h, progress, max_memory) -> xr.Dataset:  # fmt: skip
+    """:func:`simulate` for any registered model other than the compressor."""
+    values = m.parameters(dict(params or {}), **overrides)
+    _check_run_settings(revolutions, transient, fs, method, rtol, atol)
+    period = m.period(values)
+    T = float(period) if period else 1.0  # one "revolution" = one forcing period
+    system = m.system(values)
+    y0 = m.initial_state(values)
+    attrs: dict[str, Any] = {
+        "title": f"recipdyn simulation: {m.name}", "recipdyn_version": __version__,
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "model": m.name, "model_description": m.description,
+        "revolutions": revolutions, "transient_revolutions": transient,
+        "period": period if period else "none (autonomous: revolutions count time units)",
+        "state_initial": [float(x) for x in y0],
+        **m.schema.to_attrs(values),
+    }  # fmt: skip
+    if m.kind == "map":
+        n0, n = int(round(transient)), max(1, int(round(revolutions)))
+        check_memory(estimate_memory(n), f"simulate ({n} iterations)", "fewer iterations",
+                     max_memory)  # fmt: skip
+        from .model.reference.systems import iterate
+
+        y = iterate(system, y0, n, n_transient=n0)
+        t = np.arange(n0 + 1, n0 + n + 1, dtype=float)
+        attrs.update(solver_method="map iteration", solver_status="reached the end")
+        return _dataset(m, values, t, y, "iteration", "1", attrs)
+    n_float = revolutions * T * fs
+    check_memory(estimate_memory(n_float), f"simulate ({n_float:.3g} samples)",
+                 "reduce --revolutions or --fs", max_memory)  # fmt: skip
+    if method == "rk4" and h is None:
+        h = T / RK4_STEPS_PER_REVOLUTION
+    t_start = transient * T
+    t_eval = t_start + np.arange(int(math.floor(n_float + 1e-9)) + 1) / fs
+    failure = None
+    t0 = time.perf_counter()
+    try:
+        sol = integrate(
+            system, y0, (0.0, t_eval[-1]), method=method, rtol=rtol, atol=atol, h=h,
+            t_eval=t_eval, chunks=max(1, min(1000, int(transient + revolutions))),
+        )  # fmt: skip
+    except (IntegrationError, Interrupted) as exc:
+        failure, sol = exc, exc.partial
+    attrs.update(solver_method=method, solver_rtol=rtol, solver_atol=atol,
+                 solver_h=h if h is not None else "adaptive", solver_nfev=sol.nfev,
+                 solver_nsteps=sol.nsteps, solver_nreject=sol.nreject,
+                 solver_status=sol.message, solver_wall_time_s=time.perf_counter() - t0,
+                 sampling_rate_hz=fs)  # fmt: skip
+    ds = _dataset(m, values, sol.t, sol.y, "time", m.time_unit, attrs)
+    if failure is not None:
+        failure.dataset = ds
+        raise failure
+    return ds
+
+
+def _dataset(m: Model, values, t, y, dim: str, t_units: str, attrs) -> xr.Dataset:
+    outs = m.outputs(values, t, y)
+    data_vars = {k: (dim, s.values, {"units": s.units, "long_name": s.long_name})
+                 for k, s in outs.items()}  # fmt: skip
+    ds = xr.Dataset(data_vars, coords={dim: (dim, t, {"units": t_units, "long_name": dim})})
+    ds.attrs = clean_attrs(attrs)
+    return ds

@@ -51,6 +51,7 @@ def _root(
 
 def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
+    from . import models as _models  # noqa: F401
     from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
     from . import sweep as _sweep  # noqa: F401

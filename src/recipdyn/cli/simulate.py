@@ -34,6 +34,31 @@ def _collect(rc, d, omega, sets, config):
     return build_params(values, params), settings
 
 
+def _collect_model(model, rc, d, omega, sets, config):
+    """(model, parameters, simulation settings) from the options and an optional config."""
+    from ..config import model_values, read_config
+    from ..model.registry import get_model
+    from ..units import parse_assignment
+
+    cfg = read_config(config) if config is not None else None
+    m = get_model(model or (cfg.model if cfg is not None else None))
+    if m.name == "compressor":
+        params, settings = _collect(rc, d, omega, sets, config)
+        return m, params, settings
+    given = [f"--{n}" for n, v in (("rc", rc), ("d", d), ("omega", omega)) if v is not None]
+    if given:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"{', '.join(given)}: compressor options; for model {m.name!r} use "
+                             "--set NAME=VALUE (see 'recipdyn models " + m.name + "')")  # fmt: skip
+    values = dict(cfg.params) if cfg is not None else {}
+    for item in sets or []:
+        k, v = parse_assignment(item)
+        values[k] = v
+    settings = cfg.simulation.resolved() if cfg is not None else {}
+    return m, model_values(m, values), settings
+
+
 def max_memory_bytes(text: str | None) -> float | None:
     """``--max-memory`` in bytes (a quantity such as '4 GB', or a number of bytes)."""
     if text is None:
@@ -76,8 +101,15 @@ def simulate(
     figure: bool = typer.Option(True, "--figure/--no-figure", help="Also write a PNG figure."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
     max_memory: str = typer.Option(None, "--max-memory", help=_MEM_HELP),
+    model: str = typer.Option(
+        None,
+        "--model",
+        help="A registered model (see 'recipdyn models') or module:object; "
+        "default: the paper's compressor.",
+    ),  # fmt: skip
 ) -> None:
-    """Simulate the compressor; write the record (.nc, .csv or .zarr) and a figure."""
+    """Simulate a model (default: the compressor); write the record (.nc, .csv or .zarr) and a
+    figure."""
     from ..errors import Interrupted
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset
@@ -86,7 +118,7 @@ def simulate(
     from ..units import to_si
 
     out = check_output(out)  # before any work: a bad path is reported at once
-    params, settings = _collect(rc, d, omega, sets, config)
+    m, params, settings = _collect_model(model, rc, d, omega, sets, config)
     kw = {**DEFAULT_SETTINGS, **settings}
     for name, val in (("revolutions", revolutions), ("transient", transient), ("fs", fs),
                       ("h", h)):  # fmt: skip
@@ -96,7 +128,8 @@ def simulate(
         if val is not None:
             kw[name] = val
     try:
-        ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory), **kw)
+        ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
+                     model=m, **kw)  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
         kept = keep_partial(exc, out)
         if kept is not None:
@@ -109,6 +142,15 @@ def simulate(
                 typer.echo(f"kept: {msg}", err=True)
         raise
     write_dataset(ds, out)
+    if m.name != "compressor":
+        typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
+        if figure:
+            from ..plotting import _mpl, model_figure
+
+            fig = model_figure(ds)
+            typer.echo(f"wrote {save_figure(fig, out.with_suffix('.png'), dpi=130)}")
+            _mpl().close(fig)
+        return
     typer.echo(f"wrote {out}  ({ds.sizes['time']} samples, nfev={ds.attrs['solver_nfev']})")
     if figure:
         from ..plotting import _mpl, response_figure

@@ -16,7 +16,9 @@ returns ``theta_c'' = 0`` and the outputs are the ideal slider-crank's.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numba as nb
 import numpy as np
@@ -26,9 +28,13 @@ from .base import JAC_SIGNATURE, RHS_JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODE
 from .kinematics import joint_forces, kinematics
 from .load import gas_force, gas_force_kernel, mu_kernel, pack_table
 from .paper_printed import paper_acceleration
-from .parameters import CompressorParams, ParameterError
+from .parameters import SCHEMA, CompressorParams, ParameterError
+from .protocol import Model
 
-__all__ = ["CompressorModel", "compressor_model", "equilibrium_theta_c", "pack_params"]
+__all__ = [
+    "CompressorModel", "compressor_model", "equilibrium_theta_c", "pack_params", "Compressor",
+    "COMPRESSOR",
+]  # fmt: skip
 
 # Layout of the packed parameter vector.
 P_R, P_RS, P_L, P_LS, P_M1, P_M2, P_M3, P_J1, P_J2, P_G = range(10)
@@ -219,3 +225,43 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         attrs=p.to_attrs(),
         cparams=p,
     )
+
+
+class Compressor(Model):
+    """The paper's compressor as a registered model (schema: :data:`parameters.SCHEMA`).
+
+    ``equations`` selects the exact derivation or the paper's printed Eq. (43)-(47).
+    """
+
+    name = "compressor"
+    description = (
+        "single-cylinder reciprocating compressor, massless-link clearance at the crank pin and "
+        "crosshead subsidence (Xiao et al. 2017)"
+    )
+    state_names = ("theta_c", "thetadot_c")
+    state_units = ("rad", "rad/s")
+    schema = SCHEMA
+
+    @staticmethod
+    def params(values: Mapping[str, Any]) -> CompressorParams:
+        return CompressorParams(**values)
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        self.params(values)  # the ranges that depend on other parameters
+
+    def system(self, values: Mapping[str, Any]) -> CompressorModel:
+        return compressor_model(self.params(values))
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        return self.system(values).initial_state()
+
+    def period(self, values: Mapping[str, Any]) -> float:
+        return 2.0 * math.pi / float(values["omega"])
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        return self.system(values).outputs(t, y)
+
+
+#: The registered instance (``recipdyn --model compressor``, the default).
+COMPRESSOR = Compressor()

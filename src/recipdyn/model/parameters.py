@@ -25,6 +25,7 @@ from typing import Any, Literal
 
 from ..defaults import RC_MIN
 from ..errors import ParameterError
+from .protocol import Param, Schema
 
 __all__ = [
     "CompressorParams",
@@ -34,6 +35,7 @@ __all__ = [
     "PARAM_ALIASES",
     "paper_2d12",
     "resolve_name",
+    "SCHEMA",
 ]
 
 
@@ -48,19 +50,59 @@ ASSUMED: dict[str, str] = {
     "thetadot_c0": "not given in the paper: default 0",
 }
 
-PARAM_UNITS: dict[str, str] = {
-    "r": "m", "rs": "m", "l": "m", "ls": "m",
-    "m1": "kg", "m2": "kg", "m3": "kg", "J1": "kg*m**2", "J2": "kg*m**2", "g": "m/s**2",
-    "rc": "m", "d": "m", "omega": "rad/s", "theta1_0": "rad",
-    "theta_c0": "rad", "theta_c_offset": "rad", "thetadot_c0": "rad/s",
-    "load_amplitude": "N",
-}  # fmt: skip
+_INF = math.inf
 
-#: Friendly names accepted by the CLI, configs and sweeps.
-PARAM_ALIASES: dict[str, str] = {
+#: The compressor's parameter schema: units, static ranges, groups, assumptions. Ranges that
+#: depend on other parameters (rs <= r, ls <= l, rc < r, |d| < l - r - rc) are checked in
+#: :meth:`CompressorParams.__post_init__`.
+SCHEMA = Schema((
+    Param("r", "m", 0.12, "crank radius A-B (paper)", 0.0, _INF, True, True, group="mechanism"),
+    Param("rs", "m", 0.06, "main bearing to crank centroid (mid-length)", 0.0, _INF,
+          group="mechanism"),
+    Param("l", "m", 0.6, "connecting-rod length (paper)", 0.0, _INF, True, True,
+          group="mechanism"),
+    Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (mid-length)", 0.0, _INF,
+          group="mechanism"),
+    Param("m1", "kg", 15.0, "crank mass", 0.0, _INF, high_open=True, assumed=ASSUMED["m1"],
+          group="mechanism"),
+    Param("m2", "kg", 20.0, "connecting-rod mass", 0.0, _INF, high_open=True,
+          assumed=ASSUMED["m2"], group="mechanism"),
+    Param("m3", "kg", 30.0, "crosshead + piston mass", 0.0, _INF, high_open=True,
+          assumed=ASSUMED["m3"], group="mechanism"),
+    Param("J1", "kg*m**2", 0.0012, "crank moment of inertia about its centroid", 0.0, _INF,
+          high_open=True, assumed=ASSUMED["J1"], group="mechanism"),
+    Param("J2", "kg*m**2", 0.6, "rod moment of inertia about its centroid", 0.0, _INF,
+          high_open=True, assumed=ASSUMED["J2"], group="mechanism"),
+    Param("g", "m/s**2", 9.81, "gravitational acceleration (along -y)", 0.0, 100.0,
+          group="mechanism"),
+    Param("rc", "m", 1.0e-3, "radial clearance of the crank-pin joint (massless link length); "
+          "0 = ideal joint", 0.0, _INF, group="joint"),
+    Param("d", "m", 1.0e-3, "crosshead subsidence (crosshead runs at y = -d)", -_INF, _INF,
+          group="joint"),
+    Param("omega", "rad/s", 20.0, "crank speed", 0.0, 1.0e4, low_open=True, group="operation"),
+    Param("theta1_0", "rad", 0.0, "crank angle at t = 0 (0 = outer dead centre)", -1e6, 1e6,
+          group="operation"),
+    Param("theta_c0", "rad", None, "initial clearance angle (default: link aligned with the "
+          "rod load)", -1e6, 1e6, assumed=ASSUMED["theta_c0"], group="initial", optional=True),
+    Param("theta_c_offset", "rad", 0.0, "offset added to the initial clearance angle",
+          -math.pi, math.pi, group="initial"),
+    Param("thetadot_c0", "rad/s", 0.0, "initial clearance angular velocity", -1e7, 1e7,
+          assumed=ASSUMED["thetadot_c0"], group="initial"),
+    Param("load_amplitude", "N", 200000.0, "peak cylinder force (paper Eq. 1: P = 200000 mu)",
+          0.0, 1e9, group="load"),
+    Param("load_sign", "", "physical", "direction of the gas force: 'physical' (toward the "
+          "crank) or 'paper' (as in Eq. 46)", choices=("physical", "paper"), group="load"),
+    Param("equations", "", "exact", "'exact' derivation or the paper's printed Eq. 43-47",
+          choices=("exact", "paper-printed"), group="joint"),
+), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
-}  # fmt: skip
+})  # fmt: skip
+
+PARAM_UNITS: dict[str, str] = {p.name: p.unit for p in SCHEMA if p.unit}
+
+#: Friendly names accepted by the CLI, configs and sweeps.
+PARAM_ALIASES: dict[str, str] = dict(SCHEMA.aliases)
 
 
 def resolve_name(name: str) -> str:
@@ -161,13 +203,10 @@ class CompressorParams:
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        _check("r", self.r, 0.0, math.inf, lo_open=True, hi_open=True)
-        _check("l", self.l, 0.0, math.inf, lo_open=True, hi_open=True)
+        for p in SCHEMA:  # the static ranges, declared once in the schema
+            p.check(getattr(self, p.name))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
-        for name in ("m1", "m2", "m3", "J1", "J2"):
-            _check(name, getattr(self, name), 0.0, math.inf, hi_open=True)
-        _check("g", self.g, 0.0, 100.0)
         _check("rc", self.rc, 0.0, self.r, hi_open=True)
         if 0.0 < self.rc < RC_MIN:
             raise ParameterError(
@@ -178,19 +217,6 @@ class CompressorParams:
         # |d + r sin(theta1) + rc sin(theta_c)| < l must hold for every crank and link angle.
         dmax = self.l - self.r - self.rc
         _check("d", self.d, -dmax, dmax, lo_open=True, hi_open=True)
-        _check("omega", self.omega, 0.0, 1.0e4, lo_open=True)
-        _check("theta1_0", self.theta1_0, -1e6, 1e6)
-        if self.theta_c0 is not None:
-            _check("theta_c0", self.theta_c0, -1e6, 1e6)
-        _check("theta_c_offset", self.theta_c_offset, -math.pi, math.pi)
-        _check("thetadot_c0", self.thetadot_c0, -1e7, 1e7)
-        _check("load_amplitude", self.load_amplitude, 0.0, 1e9)
-        if self.load_sign not in ("physical", "paper"):
-            raise ParameterError(f"load_sign = {self.load_sign!r}; allowed: 'physical' or 'paper'")
-        if self.equations not in ("exact", "paper-printed"):
-            raise ParameterError(
-                f"equations = {self.equations!r}; allowed: 'exact' or 'paper-printed'"
-            )
         if self.m2 + self.m3 + self.J2 <= 0 and self.rc > 0:
             raise ParameterError("m2, m3, J2: at least one must be > 0 when rc > 0")
         if self.load_table is not None:

@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ..model.base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
+from ..base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
 
 __all__ = ["lorenz", "rossler", "ueda", "linear", "henon", "standard_map", "logistic_map"]
 

@@ -1,0 +1,251 @@
+"""The model protocol: what a model declares so that every layer above can use it.
+
+A *model* is a family of dynamical systems with a typed parameter schema:
+
+* ``name`` and a one-line ``description``;
+* ``state_names`` and ``state_units``;
+* ``schema``: a :class:`Schema` of :class:`Param` (name, unit, default, allowed range or
+  choices, description, whether the value is an assumption, group);
+* :meth:`Model.system`: the compiled system (:class:`~recipdyn.model.base.ODESystem` or
+  :class:`~recipdyn.model.base.DiscreteMap`) for validated parameter values — its kernels follow
+  the calling convention of :mod:`recipdyn.model.base`;
+* :meth:`Model.initial_state`, :meth:`Model.period` (the forcing period, for stroboscopic
+  sections and orders; ``None`` for autonomous systems), :meth:`Model.outputs` (named signals
+  with units, default: the state components) and :meth:`Model.check` (validity checks across
+  parameters).
+
+Models are found by name through :mod:`recipdyn.model.registry`. The layers above the model talk
+to a model only through this class; see ``docs/architecture.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .base import DiscreteMap, ODESystem, Signal
+
+__all__ = ["Param", "Schema", "Model"]
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a model.
+
+    Attributes
+    ----------
+    name : str
+        Identifier (also the CLI/config key).
+    unit : str
+        SI unit understood by pint (``"m"``, ``"rad/s"``, ``"kg*m**2"``); ``""`` if
+        dimensionless. Values are always stored in this unit.
+    default : float, str or None
+        Default value (``None`` only if ``optional``).
+    description : str
+        One line, shown by ``recipdyn models NAME``.
+    low, high : float
+        Allowed range (``low_open``/``high_open`` exclude the end points).
+    choices : tuple of str, optional
+        For string-valued parameters: the allowed values.
+    assumed : str
+        Why the default is an assumption (empty if it is not), recorded in every output.
+    group : str
+        The part of the model it belongs to (e.g. ``mechanism``, ``joint``, ``load``,
+        ``initial``, ``operation``).
+    optional : bool
+        ``None`` is allowed (meaning "derived by the model", e.g. an initial angle).
+    """
+
+    name: str
+    unit: str
+    default: Any
+    description: str
+    low: float = -math.inf
+    high: float = math.inf
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple[str, ...] | None = None
+    assumed: str = ""
+    group: str = "model"
+    optional: bool = False
+
+    @property
+    def kind(self) -> str:
+        return "choice" if self.choices is not None else "number"
+
+    def range_text(self) -> str:
+        if self.choices is not None:
+            return ", ".join(repr(c) for c in self.choices)
+        lb = "(" if self.low_open else "["
+        rb = ")" if self.high_open else "]"
+        return f"{lb}{self.low:g}, {self.high:g}{rb}" + (f" {self.unit}" if self.unit else "")
+
+    def check(self, value: Any) -> Any:
+        """``value`` validated (numbers as float); :class:`ParameterError` names the range."""
+        if value is None and self.optional:
+            return None
+        if self.choices is not None:
+            if value not in self.choices:
+                raise ParameterError(f"{self.name} = {value!r}; allowed: {self.range_text()}")
+            return value
+        if not _is_number(value):
+            raise ParameterError(f"{self.name} must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ParameterError(f"{self.name} must be finite, got {value!r}")
+        bad_lo = value <= self.low if self.low_open else value < self.low
+        bad_hi = value >= self.high if self.high_open else value > self.high
+        if bad_lo or bad_hi:
+            unit = f" {self.unit}" if self.unit else ""
+            raise ParameterError(
+                f"{self.name} = {value!r}{unit} is out of range; allowed: {self.range_text()}"
+            )
+        return value
+
+
+@dataclass(frozen=True)
+class Schema:
+    """An ordered set of :class:`Param` with validation and round trips."""
+
+    params: tuple[Param, ...]
+    aliases: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        names = [p.name for p in self.params]
+        if len(set(names)) != len(names):
+            raise ValueError(f"duplicate parameter names in schema: {names}")
+
+    def __iter__(self) -> Iterator[Param]:
+        return iter(self.params)
+
+    def __len__(self) -> int:
+        return len(self.params)
+
+    def __contains__(self, name: str) -> bool:
+        return any(p.name == name for p in self.params)
+
+    def __getitem__(self, name: str) -> Param:
+        name = self.resolve(name)
+        return next(p for p in self.params if p.name == name)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.params)
+
+    def resolve(self, name: str) -> str:
+        """The parameter's name for ``name`` or an alias; raise on unknown names."""
+        name = self.aliases.get(name, name)
+        if name not in self:
+            known = sorted({*self.names, *self.aliases})
+            raise ParameterError(f"unknown parameter {name!r}; known: {', '.join(known)}")
+        return name
+
+    def defaults(self) -> dict[str, Any]:
+        return {p.name: p.default for p in self.params}
+
+    def validate(self, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        """Defaults updated with ``values`` (names or aliases), each checked against its range."""
+        out = self.defaults()
+        for k, v in (values or {}).items():
+            out[self.resolve(k)] = v
+        return {p.name: p.check(out[p.name]) for p in self.params}
+
+    def units(self) -> dict[str, str]:
+        return {p.name: p.unit for p in self.params}
+
+    def to_attrs(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """Flat attributes for result files: ``param_NAME``, its units, and assumption notes."""
+        out: dict[str, Any] = {}
+        for p in self.params:
+            v = values[p.name]
+            out[f"param_{p.name}"] = "default" if v is None else v
+            if p.unit:
+                out[f"param_{p.name}_units"] = p.unit
+            if p.assumed:
+                out[f"param_{p.name}_note"] = p.assumed
+        return out
+
+    def from_attrs(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """Values recorded by :meth:`to_attrs` (unknown keys ignored)."""
+        out: dict[str, Any] = {}
+        for p in self.params:
+            key = f"param_{p.name}"
+            if key in attrs:
+                v = attrs[key]
+                if isinstance(v, np.generic):
+                    v = v.item()
+                out[p.name] = None if v == "default" else v
+        return self.validate(out)
+
+    def table(self) -> list[dict[str, str]]:
+        """Rows for display: name, default, unit, range, group, assumed, description."""
+        return [dict(name=p.name, default="derived" if p.default is None else f"{p.default:g}"
+                     if _is_number(p.default) else str(p.default), unit=p.unit or "-",
+                     range=p.range_text(), group=p.group, assumed="yes" if p.assumed else "",
+                     description=p.description) for p in self.params]  # fmt: skip
+
+
+class Model(ABC):
+    """Base class of registered models (see the module docstring).
+
+    Subclasses set ``name``, ``description``, ``state_names``, ``state_units``, ``schema`` and
+    implement :meth:`system` and :meth:`initial_state`; the rest has generic defaults.
+    """
+
+    name: str = ""
+    description: str = ""
+    state_names: tuple[str, ...] = ()
+    state_units: tuple[str, ...] = ()
+    time_unit: str = "s"
+    schema: Schema = Schema(())
+
+    @property
+    def kind(self) -> str:
+        """``"ode"`` or ``"map"``."""
+        return "ode"
+
+    @property
+    def dim(self) -> int:
+        return len(self.state_names)
+
+    def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
+        """Validated parameter values: defaults updated with ``values`` and ``kw``."""
+        out = self.schema.validate({**(values or {}), **kw})
+        self.check(out)
+        return out
+
+    def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
+        """Validity checks across parameters; raise :class:`ParameterError`."""
+
+    @abstractmethod
+    def system(self, values: Mapping[str, Any]) -> ODESystem | DiscreteMap:
+        """The compiled system for validated ``values``."""
+
+    @abstractmethod
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The initial state for validated ``values``."""
+
+    def period(self, values: Mapping[str, Any]) -> float | None:
+        """Forcing period in ``time_unit`` (None for an autonomous system)."""
+        sys_ = self.system(values)
+        return getattr(sys_, "period", None)
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """Named signals over a trajectory (default: the state components)."""
+        return {n: Signal(np.asarray(y[:, i]), u, n)
+                for i, (n, u) in enumerate(zip(self.state_names, self.state_units,
+                                               strict=True))}  # fmt: skip
+
+    def __repr__(self) -> str:
+        return f"<model {self.name!r}: {self.description}>"

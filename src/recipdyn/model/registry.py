@@ -1,0 +1,105 @@
+"""Find models by name: the built-in ones, Python entry points, or a ``module:object`` path.
+
+* Built-in: ``compressor`` (the default), ``duffing``, ``lorenz``, ``henon``.
+* Entry points: another package registers ``name = "pkg.module:object"`` in the group
+  ``recipdyn.models`` of its ``pyproject.toml``; ``recipdyn models`` then lists it.
+* A path: ``"my_models:PENDULUM"`` (an importable module) or ``"path/to/file.py:PENDULUM"``
+  (a file of the user's own), naming a :class:`~recipdyn.model.protocol.Model` instance or
+  class.
+
+Modules are imported only when a model is asked for, so listing names costs nothing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.util
+import sys
+from pathlib import Path
+
+from ..errors import ParameterError
+from .protocol import Model
+
+__all__ = ["get_model", "model_names", "register", "DEFAULT_MODEL", "ENTRY_POINT_GROUP"]
+
+DEFAULT_MODEL = "compressor"
+ENTRY_POINT_GROUP = "recipdyn.models"
+
+_BUILTIN = {
+    "compressor": "recipdyn.model.compressor:COMPRESSOR",
+    "duffing": "recipdyn.model.reference:DUFFING",
+    "lorenz": "recipdyn.model.reference:LORENZ",
+    "henon": "recipdyn.model.reference:HENON",
+}
+_REGISTERED: dict[str, Model] = {}
+
+
+def register(model: Model) -> Model:
+    """Register ``model`` under ``model.name`` for this process (returns it)."""
+    if not isinstance(model, Model) or not model.name:
+        raise ParameterError(f"cannot register {model!r}: not a named recipdyn Model")
+    _REGISTERED[model.name] = model
+    return model
+
+
+def _entry_points() -> dict[str, str]:
+    from importlib.metadata import entry_points
+
+    return {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def model_names() -> list[str]:
+    """Every model name that :func:`get_model` accepts (paths aside)."""
+    return sorted({*_BUILTIN, *_entry_points(), *_REGISTERED})
+
+
+def _load_path(spec: str) -> object:
+    module_name, _, attr = spec.rpartition(":")
+    if not module_name or not attr:
+        raise ParameterError(f"model {spec!r}: expected NAME or module:object")
+    try:
+        if module_name.endswith(".py") or "/" in module_name or "\\" in module_name:
+            path = Path(module_name)
+            if not path.is_file():
+                raise ParameterError(f"model {spec!r}: file {path} not found")
+            # a stable name (numba's on-disk cache records it; hash() would change per process)
+            digest = hashlib.sha1(str(path.resolve()).encode()).hexdigest()[:12]
+            mod_id = f"recipdyn_user_model_{path.stem}_{digest}"
+            mspec = importlib.util.spec_from_file_location(mod_id, path)
+            module = importlib.util.module_from_spec(mspec)
+            sys.modules[mod_id] = module  # picklable by reference in worker processes
+            mspec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(module_name)
+    except ParameterError:
+        raise
+    except Exception as exc:
+        raise ParameterError(f"model {spec!r}: cannot import {module_name} "
+                             f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+    try:
+        return getattr(module, attr)
+    except AttributeError:
+        raise ParameterError(f"model {spec!r}: {module_name} has no {attr!r}") from None
+
+
+def get_model(spec: str | Model | None = None) -> Model:
+    """The model named ``spec`` (default :data:`DEFAULT_MODEL`); see the module docstring."""
+    if isinstance(spec, Model):
+        return spec
+    spec = DEFAULT_MODEL if spec is None else str(spec).strip()
+    if spec in _REGISTERED:
+        return _REGISTERED[spec]
+    target = _BUILTIN.get(spec)
+    if target is None:
+        target = _entry_points().get(spec)
+    if target is None and ":" not in spec:
+        raise ParameterError(f"unknown model {spec!r}; known: {', '.join(model_names())} "
+                             "(or module:object)")  # fmt: skip
+    obj = _load_path(target or spec)
+    if isinstance(obj, type) and issubclass(obj, Model):
+        obj = obj()
+    if not isinstance(obj, Model):
+        raise ParameterError(f"model {spec!r} is a {type(obj).__name__}, not a recipdyn Model "
+                             "(subclass recipdyn.model.protocol.Model)")  # fmt: skip
+    return obj

@@ -1,0 +1,165 @@
+"""The interface test every model passes (in the spirit of DynamicalSystemsBase.jl's
+test_system_function): every registered model plus the example in examples/, the same way.
+
+A new model that is registered is picked up by ``model_names()`` and has to pass all of this.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import recipdyn
+from recipdyn.cli import main
+from recipdyn.errors import ParameterError
+from recipdyn.model.base import DiscreteMap, ODESystem
+from recipdyn.model.registry import get_model, model_names
+
+EXAMPLE = str(Path(__file__).parents[1] / "examples" / "pendulum.py") + ":PENDULUM"
+MODELS = [*model_names(), EXAMPLE]
+
+
+def _ids(x):
+    return Path(x.split(":")[0]).stem if ":" in x else x
+
+
+@pytest.fixture(params=MODELS, ids=_ids)
+def model(request):
+    return get_model(request.param)
+
+
+def test_registry_knows_the_builtin_models():
+    assert {"compressor", "duffing", "lorenz", "henon"} <= set(model_names())
+    assert get_model(None).name == "compressor"
+    with pytest.raises(ParameterError, match="unknown model"):
+        get_model("no-such-model")
+    with pytest.raises(ParameterError, match="not a recipdyn Model"):
+        get_model("math:pi")
+
+
+def test_schema_is_complete_and_defaults_valid(model):
+    from recipdyn.units import to_si
+
+    values = model.parameters()
+    assert set(values) == set(model.schema.names)
+    for p in model.schema:
+        assert p.description and p.group
+        if p.choices is None and p.default is not None:
+            assert p.check(p.default) == p.default
+            assert to_si(p.name, f"{p.default} {p.unit}".strip(), unit=p.unit) == pytest.approx(
+                p.default
+            )  # the unit string is one pint understands
+        with pytest.raises(ParameterError, match=p.name):
+            model.parameters({p.name: "not a value" if p.choices is None else "nope"})
+    assert len(model.state_names) == len(model.state_units)
+
+
+def test_parameter_round_trips(model, tmp_path):
+    """dict -> NetCDF attrs -> dict and dict -> TOML -> dict give the same values."""
+    import json
+
+    from recipdyn.config import model_values, read_config
+
+    values = model.parameters()
+    back = model.schema.from_attrs(model.schema.to_attrs(values))
+    assert back == values
+    cfg = tmp_path / "c.toml"
+    lines = [f"model = {json.dumps(model.name)}", "[params]"]
+    lines += [f"{k} = {json.dumps(v)}" for k, v in values.items() if v is not None]
+    cfg.write_text("\n".join(lines) + "\n")
+    assert model_values(model, read_config(cfg).params) == values
+
+
+def test_kernels_deterministic_and_jacobian_exact(model, rng):
+    """rhs is deterministic (bit for bit); the Jacobian equals central differences within the
+    difference's own error: truncation ~h^2 |f'''| (h = 1e-6 scaled, < 1e-6 relative for
+    these smooth kernels; we allow 1e-5) plus rounding ~eps |f| / h (large for the stiff
+    compressor, whose theta_c'' reaches ~1e6 rad/s^2 off equilibrium; we allow 10 eps |f| / h).
+    """
+    values = model.parameters()
+    s = model.system(values)
+    assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == model.dim
+    y0 = model.initial_state(values)
+    fn = s.f if isinstance(s, ODESystem) else s.g
+    for _ in range(5):
+        y = y0 + 0.05 * rng.standard_normal(s.dim) * np.maximum(1.0, np.abs(y0))
+        t = float(rng.uniform(0, 3))
+        assert np.array_equal(fn(t, y), fn(t, y))
+        J = np.empty((s.dim, s.dim))
+        s.jac(t, np.ascontiguousarray(y), s.params, J)
+        for j in range(s.dim):
+            h = 1e-6 * max(1.0, abs(y[j]))
+            e = np.zeros(s.dim)
+            e[j] = h
+            fp, fm = fn(t, y + e), fn(t, y - e)
+            fd = (fp - fm) / (2 * h)
+            rounding = 10 * np.finfo(float).eps * np.maximum(np.abs(fp), np.abs(fm)) / h
+            tol = 1e-5 * np.maximum(1.0, np.abs(J[:, j])) + rounding
+            assert np.all(np.abs(fd - J[:, j]) <= tol), (model.name, j, fd, J[:, j])
+
+
+def test_simulate_records_outputs_with_units_and_inputs(model, tmp_path):
+    ds = recipdyn.simulate(model=model, revolutions=2, fs=200.0)
+    for k in ds.data_vars:
+        assert isinstance(ds[k].attrs.get("units"), str), k
+        assert np.all(np.isfinite(ds[k].values)), k
+    for name in model.schema.names:
+        assert f"param_{name}" in ds.attrs
+    path = tmp_path / "r.nc"
+    ds.to_netcdf(path)
+    assert model.schema.from_attrs(xr.open_dataset(path).attrs) == model.parameters()
+
+
+def test_cli_simulate_and_models(model, tmp_path, capsys):
+    spec = EXAMPLE if model.name == "pendulum" else model.name
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--model", spec, "-n", "2", "--fs", "100 Hz", "-o", str(out),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert out.exists() and out.with_suffix(".png").stat().st_size > 5000
+    assert main(["models", spec]) == 0
+    shown = capsys.readouterr().out
+    assert all(n in shown for n in model.schema.names)
+
+
+@pytest.mark.parametrize("name,expected", [
+    ("duffing", lambda v: -v["delta"]),
+    ("lorenz", lambda v: -(v["sigma"] + 1 + v["beta"])),
+])  # fmt: skip
+def test_exponent_sums_are_exact(name, expected):
+    """Constant Jacobian traces: the Benettin sum equals the trace for any trajectory."""
+    from recipdyn.analysis import lyapunov_spectrum
+
+    m = get_model(name)
+    v = m.parameters()
+    r = lyapunov_spectrum(m.system(v), m.initial_state(v), 200.0)
+    assert r.sum == pytest.approx(expected(v), abs=1e-6)
+
+
+def test_henon_exponents_from_the_registry():
+    """Published: 0.41922, -1.62319 (Sprott 2003); the sum is ln b exactly."""
+    from recipdyn.analysis import lyapunov_spectrum_map
+
+    m = get_model("henon")
+    v = m.parameters()
+    r = lyapunov_spectrum_map(m.system(v), m.initial_state(v), 200_000)
+    assert r.exponents[0] == pytest.approx(0.41922, abs=5e-3)
+    assert r.sum == pytest.approx(math.log(v["b"]), abs=1e-9)
+
+
+def test_compressor_through_the_registry_is_bit_identical():
+    """The registered compressor and the direct API give the same numbers."""
+    a = recipdyn.simulate(revolutions=1, theta_c_offset=0.2)
+    b = recipdyn.simulate(model="compressor", revolutions=1, theta_c_offset=0.2)
+    assert np.array_equal(a.a.values, b.a.values)
+
+
+def test_model_options_are_checked(capsys):
+    assert main(["simulate", "--model", "duffing", "--rc", "1 mm"]) == 2
+    assert "compressor options" in capsys.readouterr().err
+    assert main(["simulate", "--model", "nope"]) == 2
+    assert main(["simulate", "--model", "duffing", "--set", "w=-1"]) == 2
+    assert "w = -1" in capsys.readouterr().err
