@@ -163,3 +163,40 @@ def test_model_options_are_checked(capsys):
     assert main(["simulate", "--model", "nope"]) == 2
     assert main(["simulate", "--model", "duffing", "--set", "w=-1"]) == 2
     assert "w = -1" in capsys.readouterr().err
+
+
+def test_sweep_any_model(model, tmp_path):
+    """A short 1-D sweep over the model's first numeric parameter completes with every measure,
+    records the model and units, and draws its figures."""
+    from recipdyn.sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
+
+    spec_name = EXAMPLE if model.name == "pendulum" else model.name
+    p = next(p for p in model.schema if p.choices is None and p.default not in (None, 0.0))
+    lo, hi = sorted((p.default, p.default * 1.01))
+    axis = parse_axis(f"{p.name}={lo}:{hi}:2", spec_name)
+    measures = ("poincare", "peak", "lyapunov", "verdict")
+    settings = dict(revolutions=2.0, transient=2.0, points=8, lyap_revolutions=5.0, fs=200.0,
+                    rtol=1e-9, atol=1e-11)  # fmt: skip
+    spec = SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name)
+    ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False)).load()
+    assert ds.done.values.all() and not any(ds.error.values), ds.error.values
+    assert ds.attrs["model"] == model.name
+    assert np.isfinite(ds.lambda1.values).all()
+    sig = model.vibration()[0]
+    assert np.isfinite(ds[f"peak_{sig}"].values).all()
+    assert ds[p.name].attrs["units"] == (p.unit or "1")
+    assert any(f.name.startswith("bifurcation_") for f in sweep_figures(ds, tmp_path))
+
+
+def test_sweep_of_a_file_model_on_the_process_pool(tmp_path):
+    """A model from a user's file reaches the worker processes (by its module:object path)."""
+    args = ["sweep", "--model", EXAMPLE, "-p", "A=1.0:1.2:4", "-m", "poincare,lyapunov",
+            "--points", "10", "--transient", "5", "--lyap-revolutions", "10", "--workers", "2",
+            "-o", str(tmp_path), "--no-progress"]  # fmt: skip
+    assert main(args) == 0
+    ds = xr.open_zarr(str(tmp_path / "sweep.zarr"), consolidated=False).load()
+    assert ds.done.values.all() and not any(ds.error.values)
+    serial = tmp_path / "serial"
+    assert main([*args[:-3], "-o", str(serial), "--backend", "serial", "--no-progress"]) == 0
+    ref = xr.open_zarr(str(serial / "sweep.zarr"), consolidated=False).load()
+    assert np.array_equal(ds.lambda1.values, ref.lambda1.values)

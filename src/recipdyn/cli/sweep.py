@@ -47,14 +47,17 @@ def sweep(
     out: Path = typer.Option(Path("out/sweep"), "--out", "-o"),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
     max_memory: str = typer.Option(None, "--max-memory", help="Memory limit, e.g. '4 GB'."),
+    model: str = typer.Option(
+        None, "--model", help="A registered model or module:object (default: the compressor)."
+    ),
 ) -> None:
     """Sweep one or two parameters; write OUT/sweep.zarr and the figures."""
     from ..model.parameters import ParameterError
     from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
     from ..units import to_si
-    from .simulate import _collect, max_memory_bytes
+    from .simulate import _collect_model, max_memory_bytes
 
-    base, _ = _collect(None, None, None, sets, config)
+    m, base, _ = _collect_model(model, None, None, None, sets, config)
     if dask_local is not None or scheduler is not None:
         backend = "dask"
     if workers is not None and workers < 1:
@@ -66,9 +69,10 @@ def sweep(
     settings = dict(revolutions=revolutions, transient=transient, points=points,
                     lyap_revolutions=lyap_revolutions, fs=to_si("fs", fs), rtol=rtol,
                     atol=atol)  # fmt: skip
-    spec = SweepSpec(axes=tuple(parse_axis(p) for p in params),
-                     measures=tuple(m.strip() for m in measure.split(",") if m.strip()),
-                     base=base, settings=settings, continuation=continuation)  # fmt: skip
+    spec = SweepSpec(axes=tuple(parse_axis(p, m) for p in params),
+                     measures=tuple(x.strip() for x in measure.split(",") if x.strip()),
+                     base=base, settings=settings, continuation=continuation,
+                     model=model or m.name)  # fmt: skip
     run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,
                   max_memory=max_memory_bytes(max_memory))  # fmt: skip
     store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)

@@ -241,6 +241,12 @@ class Compressor(Model):
     state_names = ("theta_c", "thetadot_c")
     state_units = ("rad", "rad/s")
     schema = SCHEMA
+    section_signals = (("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
+                       ("a", "m/s**2"))  # fmt: skip
+    vibration_signal = ("a", "m/s**2")
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics
 
     @staticmethod
     def params(values: Mapping[str, Any]) -> CompressorParams:

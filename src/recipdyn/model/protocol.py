@@ -208,6 +208,24 @@ class Model(ABC):
     state_units: tuple[str, ...] = ()
     time_unit: str = "s"
     schema: Schema = Schema(())
+    #: Signals recorded at each stroboscopic (or map) section point by sweeps: (name, unit);
+    #: empty = the state components.
+    section_signals: tuple[tuple[str, str], ...] = ()
+    #: The measured vibration signal (peak, RMS and spectrum in sweeps): (name, unit); empty =
+    #: the first state component.
+    vibration_signal: tuple[str, str] = ()
+
+    def sections(self) -> tuple[tuple[str, str], ...]:
+        return self.section_signals or tuple(zip(self.state_names, self.state_units,
+                                                 strict=True))  # fmt: skip
+
+    def vibration(self) -> tuple[str, str]:
+        return self.vibration_signal or (self.state_names[0], self.state_units[0])
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov
+        exponents are then reported as 0 without integrating."""
+        return True
 
     @property
     def kind(self) -> str:

@@ -21,6 +21,11 @@ def _axis(ds, name):
     return ds[name].values * k, f"{label} ({unit})"
 
 
+def _label(name: str, da) -> str:
+    u = da.attrs.get("units", "")
+    return f"{name} ({u})" if u not in ("", "1") else name
+
+
 def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
     """Write every figure the store supports; returns their paths."""
     plt = _mpl()
@@ -30,9 +35,15 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
     paths = []
     if len(dims) == 1:
         x, xlabel = _axis(ds, dims[0])
-        if "poincare_v" in ds:
-            for var, ylab in (("poincare_v", "crosshead velocity v (m/s)"),
-                              ("poincare_theta_c", "clearance angle theta_c (rad)")):  # fmt: skip
+        if "poincare_v" in ds and "poincare_theta_c" in ds:  # the compressor
+            pairs = (("poincare_v", "crosshead velocity v (m/s)"),
+                     ("poincare_theta_c", "clearance angle theta_c (rad)"))  # fmt: skip
+        else:  # any other model: every recorded section signal
+            pairs = tuple((k, _label(k.removeprefix("poincare_"), ds[k]))
+                          for k in ds.data_vars if k.startswith("poincare_")
+                          and k != "poincare_distinct")  # fmt: skip
+        if pairs:
+            for var, ylab in pairs:
                 fig, ax = plt.subplots(figsize=(9, 5), constrained_layout=True)
                 y = ds[var].values
                 if var == "poincare_theta_c":  # the link may turn over: wrap to (-pi, pi]
@@ -41,15 +52,20 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.plot(xs[done].ravel(), y[done].ravel(), ",k", alpha=0.6)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ".k", ms=1.0, alpha=0.5)
                 ax.set_xlabel(xlabel)
-                ax.set_ylabel(f"{ylab}, once per revolution")
-                ax.set_title(f"Bifurcation diagram ({y.shape[1]} stroboscopic points per value)")
+                compressor = ds.attrs.get("model", "compressor") == "compressor"
+                ax.set_ylabel(f"{ylab}, " + ("once per revolution" if compressor else
+                                             "at the section points"))  # fmt: skip
+                ax.set_title(f"Bifurcation diagram ({y.shape[1]} section points per value)")
                 ax.grid(alpha=0.3)
                 p = out / f"bifurcation_{var.split('_', 1)[1]}.png"
                 save_figure(fig, p, dpi=130)
                 plt.close(fig)
                 paths.append(p)
-        for var, ylab in (("lambda1", "largest Lyapunov exponent (1/s)"),
-                          ("peak_a", "peak |a| (m/s$^2$)")):  # fmt: skip
+        peaks = [(k, f"peak |{k.removeprefix('peak_')}| ({ds[k].attrs.get('units', '')})")
+                 for k in ds.data_vars if k.startswith("peak_") and ds[k].ndim == 1]  # fmt: skip
+        lam = ("lambda1", f"largest Lyapunov exponent ({ds['lambda1'].attrs.get('units', '1/s')})"
+               if "lambda1" in ds else "")  # fmt: skip
+        for var, ylab in (lam, *peaks):
             if var in ds:
                 fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
                 ax.plot(x[done], ds[var].values[done], "o-", ms=3)
@@ -64,9 +80,14 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
     else:
         x, xlabel = _axis(ds, dims[1])
         y, ylabel = _axis(ds, dims[0])
-        for var, clabel in (("lambda1", "lambda1 (1/s)"), ("peak_a", "peak |a| (m/s$^2$)"),
-                            ("rms_a", "RMS a (m/s$^2$)"),
-                            ("poincare_distinct", "distinct section points")):  # fmt: skip
+        maps = [("lambda1", "lambda1 (1/s)")]
+        for k in ds.data_vars:
+            if (k.startswith("peak_") or k.startswith("rms_")) and ds[k].ndim == 2:
+                what, sig = k.split("_", 1)
+                maps.append((k, f"{'peak |' + sig + '|' if what == 'peak' else 'RMS ' + sig} "
+                                f"({ds[k].attrs.get('units', '')})"))  # fmt: skip
+        maps.append(("poincare_distinct", "distinct section points"))
+        for var, clabel in maps:
             if var not in ds:
                 continue
             z = np.where(done, ds[var].values.astype(float), np.nan)

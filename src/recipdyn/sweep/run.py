@@ -54,24 +54,27 @@ BACKENDS = ("serial", "processes", "dask")
 def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | None, str]]:
     """name -> (dtype, extra dims, extra size, units) for the requested measures."""
     v: dict[str, tuple[str, tuple[str, ...], int | None, str]] = {}
+    m = spec.get_model()
     n = int(spec.settings["points"])
+    per_time = "Hz" if m.time_unit == "s" else f"1/{m.time_unit}"
     if "poincare" in spec.measures or "verdict" in spec.measures:
-        for k, u in (("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
-                     ("a", "m/s**2")):  # fmt: skip
+        for k, u in m.sections():
             v[f"poincare_{k}"] = ("f8", ("section",), n, u)
         v["poincare_distinct"] = ("i8", (), None, "1")
+    sig, sig_unit = m.vibration()
     if "peak" in spec.measures or "spectrum" in spec.measures:
-        v["peak_a"] = ("f8", (), None, "m/s**2")
-        v["rms_a"] = ("f8", (), None, "m/s**2")
+        v[f"peak_{sig}"] = ("f8", (), None, sig_unit)
+        v[f"rms_{sig}"] = ("f8", (), None, sig_unit)
     if "spectrum" in spec.measures:
-        v["peak_freq"] = ("f8", ("peak",), N_PEAKS, "Hz")
-        v["peak_amp"] = ("f8", ("peak",), N_PEAKS, "m/s**2")
+        v["peak_freq"] = ("f8", ("peak",), N_PEAKS, per_time)
+        v["peak_amp"] = ("f8", ("peak",), N_PEAKS, sig_unit)
     if "lyapunov" in spec.measures or "verdict" in spec.measures:
-        v["lambda1"] = ("f8", (), None, "1/s")
-        v["lambda_sum"] = ("f8", (), None, "1/s")
+        lam_unit = "1" if m.kind == "map" else ("1/s" if m.time_unit == "s" else per_time)
+        v["lambda1"] = ("f8", (), None, lam_unit)
+        v["lambda_sum"] = ("f8", (), None, lam_unit)
     if "verdict" in spec.measures:
         v["verdict"] = ("str", (), None, "")
-    v["y_final"] = ("f8", ("state",), 2, "")
+    v["y_final"] = ("f8", ("state",), m.dim, "")
     return v
 
 
@@ -83,7 +86,8 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
     for a in spec.axes:
         arr = g.create_array(a.name, shape=(len(a.values),), dtype="f8", dimension_names=[a.name])
         arr[:] = np.asarray(a.values)
-        arr.attrs.update({"units": _unit(a.name), "scale": a.scale})
+        arr.attrs.update({"units": spec.get_model().schema[a.name].unit or "1",
+                          "scale": a.scale})  # fmt: skip
     one = (1,) * len(dims)
     for name, (dtype, extra, size, units) in _variables(spec).items():
         shape = spec.shape + ((size,) if extra else ())
@@ -100,21 +104,16 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
     g.create_array("error", shape=spec.shape, chunks=one, dtype=str, dimension_names=list(dims))
     g.create_array("checksum", shape=spec.shape, chunks=one, dtype="i8", fill_value=-1,
                    dimension_names=list(dims))  # fmt: skip
-    attrs = dict(spec.base.to_attrs())
+    attrs = spec.base_attrs()
     g.attrs.update(clean_attrs({
         "title": "recipdyn sweep", "recipdyn_version": __version__, "spec_digest": spec.digest,
+        "model": spec.get_model().name, "model_spec": spec.model,
         "spec_json": spec.to_json(), "measures": ",".join(spec.measures),
         "sweep_axes": ",".join(dims), "continuation": int(spec.continuation),
         "mode": "sequential continuation" if spec.continuation else "independent points",
         **{f"setting_{k}": v for k, v in spec.settings.items()},
         **{f"param_{k}": v for k, v in attrs.items()},
     }))  # fmt: skip
-
-
-def _unit(name: str) -> str:
-    from ..model.parameters import PARAM_UNITS
-
-    return PARAM_UNITS.get(name, "1")
 
 
 _FILL = {"f8": np.nan, "i8": -1, "str": ""}
@@ -205,7 +204,7 @@ def open_sweep(path: str | Path) -> xr.Dataset:
 def _tasks(spec: SweepSpec, todo: Iterable) -> Iterable[dict[str, Any]]:
     for idx, values in todo:
         yield dict(index=idx, params=spec.point_params(values), measures=spec.measures,
-                   settings=spec.settings)  # fmt: skip
+                   settings=spec.settings, model=spec.model)  # fmt: skip
 
 
 def run_sweep(
@@ -258,8 +257,12 @@ def _check_resources(spec: SweepSpec, out: Path, backend, workers, dask_local,
 
     s = spec.settings
     if "peak" in spec.measures or "spectrum" in spec.measures:
-        omega_min = min(spec.point_params(p).omega for _, p in _corners(spec))
-        samples = s.get("revolutions", 5.0) * 2 * np.pi / omega_min * s.get("fs", 1e4)
+        m = spec.get_model()
+        periods = []
+        for _, p in _corners(spec):
+            pp = spec.point_params(p)
+            periods.append(pp.crank_period if hasattr(pp, "crank_period") else m.period(pp) or 1.0)
+        samples = s.get("revolutions", 5.0) * max(periods) * s.get("fs", 1e4)
         n_par = 1 if backend == "serial" or spec.continuation else (
             dask_local or workers or os.cpu_count() or 1)  # fmt: skip
         check_memory(n_par * estimate_memory(samples),

@@ -13,6 +13,7 @@ import dataclasses
 import hashlib
 import itertools
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,6 +22,8 @@ import numpy as np
 from ..defaults import ATOL, RTOL
 from ..errors import ParameterError
 from ..model.parameters import CompressorParams, resolve_name
+from ..model.protocol import Model
+from ..model.registry import get_model
 from ..units import to_si
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
@@ -47,21 +50,24 @@ class Axis:
     scale: str = "linear"
 
 
-def parse_axis(text: str) -> Axis:
-    """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units)."""
+def parse_axis(text: str, model: str | Model | None = None) -> Axis:
+    """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units,
+    converted to the unit of the parameter in ``model``'s schema; default the compressor)."""
     if "=" not in text:
         raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
     raw_name, rhs = (s.strip() for s in text.split("=", 1))
-    name = resolve_name(raw_name)
-    if name in ("load_sign", "equations", "load_table"):
+    m = get_model(model)
+    name = resolve_name(raw_name) if m.name == "compressor" else m.schema.resolve(raw_name)
+    if name not in m.schema or m.schema[name].choices is not None:
         raise ParameterError(f"--param {raw_name}: only numeric parameters can be swept")
+    unit = m.schema[name].unit
     if ":" in rhs:
         parts = rhs.split(":")
         if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
             raise ParameterError(
                 f"--param {raw_name}: range must be start:stop:count or start:stop:count:log"
             )
-        lo, hi = to_si(name, parts[0]), to_si(name, parts[1])
+        lo, hi = to_si(name, parts[0], unit=unit), to_si(name, parts[1], unit=unit)
         try:
             count = int(parts[2])
         except ValueError:
@@ -83,7 +89,7 @@ def parse_axis(text: str) -> Axis:
     items = [s for s in rhs.split(",") if s.strip()]
     if not items:
         raise ParameterError(f"--param {raw_name}: no values given")
-    return Axis(name, tuple(to_si(name, s) for s in items), "list")
+    return Axis(name, tuple(to_si(name, s, unit=unit) for s in items), "list")
 
 
 @dataclass(frozen=True)
@@ -97,11 +103,19 @@ class SweepSpec:
 
     axes: tuple[Axis, ...]
     measures: tuple[str, ...]
-    base: CompressorParams = field(default_factory=CompressorParams)
+    #: The base case: CompressorParams for the compressor, else a mapping of the model's values.
+    base: Any = field(default_factory=CompressorParams)
     settings: dict[str, Any] = field(default_factory=dict)
     continuation: bool = False
+    #: A registered model name or module:object path (see recipdyn.model.registry).
+    model: str = "compressor"
 
     def __post_init__(self):
+        m = self.get_model()
+        if m.name != "compressor" and not isinstance(self.base, Mapping):
+            object.__setattr__(self, "base", m.parameters())
+        elif m.name != "compressor":
+            object.__setattr__(self, "base", m.parameters(dict(self.base)))
         if not 1 <= len(self.axes) <= 2:
             raise ParameterError(f"a sweep needs 1 or 2 --param axes, got {len(self.axes)}")
         if len({a.name for a in self.axes}) != len(self.axes):
@@ -153,18 +167,33 @@ class SweepSpec:
         for idx in itertools.product(*(range(n) for n in self.shape)):
             yield idx, {a.name: a.values[i] for a, i in zip(self.axes, idx, strict=True)}
 
-    def point_params(self, point) -> CompressorParams:
+    def get_model(self) -> Model:
+        return get_model(self.model)
+
+    def point_params(self, point) -> Any:
+        """The point's parameters: CompressorParams for the compressor, else a dict."""
         values = point[1] if isinstance(point, tuple) else point
         try:
-            return dataclasses.replace(self.base, **values)
+            if isinstance(self.base, CompressorParams):
+                return dataclasses.replace(self.base, **values)
+            return self.get_model().parameters({**self.base, **values})
         except ParameterError as exc:
             raise ParameterError(f"sweep point {values}: {exc}") from None
+
+    def base_attrs(self) -> dict[str, Any]:
+        """The base case's parameters as result attributes."""
+        if isinstance(self.base, CompressorParams):
+            return self.base.to_attrs()
+        return {
+            k[len("param_") :]: v for k, v in self.get_model().schema.to_attrs(self.base).items()
+        }
 
     def to_json(self) -> str:
         return json.dumps(
             dict(axes=[dataclasses.asdict(a) for a in self.axes], measures=list(self.measures),
-                 base=dataclasses.asdict(self.base), settings=self.settings,
-                 continuation=self.continuation),
+                 base=dataclasses.asdict(self.base) if isinstance(self.base, CompressorParams)
+                 else dict(self.base), settings=self.settings, continuation=self.continuation,
+                 **({} if self.model == "compressor" else {"model": self.model})),
             sort_keys=True, default=str,
         )  # fmt: skip
 

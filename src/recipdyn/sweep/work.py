@@ -22,6 +22,7 @@ from ..defaults import LYAP_TOL
 from ..integrate import IntegrationError, integrate
 from ..model.compressor import compressor_model
 from ..model.parameters import CompressorParams, ParameterError
+from ..model.registry import get_model
 
 __all__ = ["run_point", "N_PEAKS"]
 
@@ -31,13 +32,15 @@ N_PEAKS = 3
 def run_point(task: dict[str, Any]) -> dict[str, Any]:
     """Compute the requested measures for one point.
 
-    ``task``: ``index`` (tuple), ``params`` (CompressorParams), ``measures``, ``settings``,
-    optional ``y0`` (continuation). Returns ``{"index", "error", "y_final", <measure arrays>}``;
-    failures (integrator, infeasible geometry) are caught and returned as ``error``.
+    ``task``: ``index`` (tuple), ``model`` (a registered name or module:object, default the
+    compressor), ``params`` (CompressorParams for the compressor, else a dict of the model's
+    values), ``measures``, ``settings``, optional ``y0`` (continuation). Returns ``{"index",
+    "error", "y_final", <measure arrays>}``; failures (integrator, infeasible geometry) are
+    caught and returned as ``error``.
     """
     out: dict[str, Any] = {"index": task["index"], "error": ""}
     try:
-        out.update(_compute(task["params"], task["measures"], task["settings"], task.get("y0")))
+        out.update(_compute(task))
     except (IntegrationError, ParameterError, FloatingPointError, ValueError) as exc:
         out["error"] = f"{type(exc).__name__}: {exc}"
     except Exception as exc:  # record anything else too; the sweep goes on
@@ -45,10 +48,43 @@ def run_point(task: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _compute(p: CompressorParams, measures, s, y0) -> dict[str, Any]:
-    m = compressor_model(p)
-    T = p.crank_period
-    y = m.initial_state() if y0 is None else np.asarray(y0, dtype=float)
+class _Point:
+    """One point's system, period, initial state and outputs, for any registered model.
+
+    The compressor keeps the exact calls it always had (``compressor_model(p)``), so its
+    results are bit-identical to before the model interface.
+    """
+
+    def __init__(self, model_spec: str, p: Any):
+        m = get_model(model_spec)
+        self.model = m
+        if isinstance(p, CompressorParams):
+            self.system = compressor_model(p)
+            self.T = p.crank_period
+            self.y_init = self.system.initial_state()
+            self.outputs = self.system.outputs
+            self.fc = p.crank_frequency
+            self.dynamic = p.rc > 0
+        else:
+            self.system = m.system(p)
+            period = m.period(p)
+            self.T = float(period) if period else 1.0
+            self.y_init = m.initial_state(p)
+            self.outputs = lambda t, y, _m=m, _p=p: _m.outputs(_p, t, y)
+            self.fc = 1.0 / period if period else None
+            self.dynamic = m.has_dynamics(p)
+        self.sections = [k for k, _ in m.sections()]
+        self.vib = m.vibration()[0]
+
+
+def _compute(task: dict[str, Any]) -> dict[str, Any]:
+    pt = _Point(task.get("model", "compressor"), task["params"])
+    measures, s, y0 = task["measures"], task["settings"], task.get("y0")
+    if pt.model.kind == "map":
+        return _compute_map(pt, measures, s, y0)
+    m = pt.system
+    T = pt.T
+    y = pt.y_init if y0 is None else np.asarray(y0, dtype=float)
     solver = dict(rtol=s["rtol"], atol=s["atol"])
     res: dict[str, Any] = {}
     t0 = s["transient"] * T
@@ -57,11 +93,11 @@ def _compute(p: CompressorParams, measures, s, y0) -> dict[str, Any]:
     if need_section:
         te = t0 + np.arange(n_pts) * T
         sol = integrate(m, y, (0.0, te[-1]), t_eval=te, **solver)
-        outs = m.outputs(sol.t, sol.y)
-        for k in ("theta_c", "thetadot_c", "x", "v", "a"):
+        outs = pt.outputs(sol.t, sol.y)
+        for k in pt.sections:
             res[f"poincare_{k}"] = outs[k].values
-        res["poincare_distinct"] = count_distinct_points(np.c_[outs["v"].values,
-                                                              outs["a"].values])  # fmt: skip
+        pair = pt.sections[-2:] if pt.model.name == "compressor" else pt.sections[:2]
+        res["poincare_distinct"] = count_distinct_points(np.c_[tuple(outs[k].values for k in pair)])
         y_end, t_end = sol.y_final, sol.t_final
     else:
         y_end, t_end = y, 0.0
@@ -70,12 +106,11 @@ def _compute(p: CompressorParams, measures, s, y0) -> dict[str, Any]:
         n = int(s["revolutions"] * T * fs) + 1
         te = t0 + np.arange(n) / fs
         sol = integrate(m, y, (0.0, te[-1]), t_eval=te, **solver)
-        a = m.outputs(sol.t, sol.y)["a"].values
-        res["peak_a"] = float(np.max(np.abs(a)))
-        res["rms_a"] = float(np.sqrt(np.mean(a**2)))
+        a = pt.outputs(sol.t, sol.y)[pt.vib].values
+        res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
+        res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
         if "spectrum" in measures:
-            peaks = find_spectral_peaks(amplitude_spectrum(a, fs), n=N_PEAKS,
-                                        fundamental=p.crank_frequency)  # fmt: skip
+            peaks = find_spectral_peaks(amplitude_spectrum(a, fs), n=N_PEAKS, fundamental=pt.fc)
             f = np.full(N_PEAKS, np.nan)
             amp = np.full(N_PEAKS, np.nan)
             for i, pk in enumerate(peaks):
@@ -84,16 +119,58 @@ def _compute(p: CompressorParams, measures, s, y0) -> dict[str, Any]:
         if not need_section:
             y_end, t_end = sol.y_final, sol.t_final
     if "lyapunov" in measures or "verdict" in measures:
-        if p.rc > 0:
+        if pt.dynamic:
             r = lyapunov_spectrum(m, y, s["lyap_revolutions"] * T, t_transient=t0, **solver)
             res["lambda1"], res["lambda_sum"] = float(r.exponents[0]), float(r.sum)
         else:
             res["lambda1"], res["lambda_sum"] = 0.0, 0.0
     if "verdict" in measures:
+        pair = pt.sections[-2:] if pt.model.name == "compressor" else pt.sections[:2]
         v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL),
-                     section=np.c_[res["poincare_v"], res["poincare_a"]])  # fmt: skip
+                     section=np.c_[tuple(res[f"poincare_{k}"] for k in pair)])  # fmt: skip
         res["verdict"] = v.verdict
     # final state, for continuation: integrate to a whole number of periods after t_end
     res["y_final"] = np.asarray(y_end, dtype=float)
     res["t_final"] = float(t_end)
+    return res
+
+
+def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
+    """A map: section points are the iterates after the transient; exponents per iteration."""
+    from ..analysis import lyapunov_spectrum_map
+    from ..model.reference.systems import iterate
+
+    y = pt.y_init if y0 is None else np.asarray(y0, dtype=float)
+    n0 = int(s["transient"])
+    n = max(int(s["points"]), int(s.get("revolutions", 0)))
+    orbit = iterate(pt.system, y, n, n_transient=n0)
+    outs = pt.outputs(np.arange(n0 + 1, n0 + n + 1, dtype=float), orbit)
+    res: dict[str, Any] = {}
+    k_pts = int(s["points"])
+    for k in pt.sections:
+        res[f"poincare_{k}"] = outs[k].values[:k_pts]
+    res["poincare_distinct"] = count_distinct_points(
+        np.c_[tuple(outs[k].values[:k_pts] for k in pt.sections[:2])]
+    )
+    a = outs[pt.vib].values
+    if "peak" in measures or "spectrum" in measures:
+        res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
+        res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
+    if "spectrum" in measures:
+        peaks = find_spectral_peaks(amplitude_spectrum(a, 1.0), n=N_PEAKS)
+        f = np.full(N_PEAKS, np.nan)
+        amp = np.full(N_PEAKS, np.nan)
+        for i, pk in enumerate(peaks):
+            f[i], amp[i] = pk.frequency, pk.amplitude
+        res["peak_freq"], res["peak_amp"] = f, amp
+    if "lyapunov" in measures or "verdict" in measures:
+        r = lyapunov_spectrum_map(pt.system, y, max(1, int(s["lyap_revolutions"])),
+                                  n_transient=n0)  # fmt: skip
+        res["lambda1"], res["lambda_sum"] = float(r.exponents[0]), float(r.sum)
+    if "verdict" in measures:
+        sec = np.c_[tuple(res[f"poincare_{k}"] for k in pt.sections[:2])]
+        v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL), section=sec)
+        res["verdict"] = v.verdict
+    res["y_final"] = np.asarray(orbit[-1], dtype=float)
+    res["t_final"] = float(n0 + n)
     return res
