@@ -200,3 +200,33 @@ def test_sweep_of_a_file_model_on_the_process_pool(tmp_path):
     assert main([*args[:-3], "-o", str(serial), "--backend", "serial", "--no-progress"]) == 0
     ref = xr.open_zarr(str(serial / "sweep.zarr"), consolidated=False).load()
     assert np.array_equal(ds.lambda1.values, ref.lambda1.values)
+
+
+@pytest.mark.parametrize("name,args,check", [
+    # the Duffing exponents sum to -delta exactly (constant trace)
+    ("duffing", ["-n", "30", "--fs", "50 Hz"],
+     lambda s: abs(s["lyapunov_equations"]["sum_per_s"] + 0.3) < 1e-6),
+    # Lorenz lambda1 = 0.9056 (Sprott 2003); 200 time units from (1, 1, 1): finite-time
+    # fluctuations of a few hundredths, so 0.12 is a safe bound on any CPU
+    ("lorenz", ["-n", "200", "--fs", "50 Hz"],
+     lambda s: abs(s["lyapunov_equations"]["exponents_per_s"][0] - 0.9056) < 0.12),
+    # Henon lambda1 = 0.41922 per iteration; 10 000 iterations: +-0.01
+    ("henon", ["-n", "3000"],
+     lambda s: abs(s["lyapunov_equations"]["exponents_per_s"][0] - 0.41922) < 0.01),
+])  # fmt: skip
+def test_analyze_any_model(tmp_path, name, args, check):
+    """simulate -> analyze from the CLI for the reference models; all three are chaotic at
+    their defaults, and the equation-based exponents match their known values."""
+    import json
+
+    run = tmp_path / "r.nc"
+    assert main(["simulate", "--model", name, *args, "-o", str(run), "--no-figure",
+                 "--no-progress"]) == 0  # fmt: skip
+    out = tmp_path / "an"
+    assert main(["analyze", str(run), "-o", str(out), "--section-points", "100",
+                 "--lyap-revolutions", "10000" if name == "henon" else "200"]) == 0  # fmt: skip
+    s = json.loads((out / "summary.json").read_text())
+    assert s["model"] == name
+    assert s["verdict"]["verdict"] == "chaotic", s["verdict"]
+    assert check(s), s["lyapunov_equations"]
+    assert (out / "phase_portraits.png").stat().st_size > 5000

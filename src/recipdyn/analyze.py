@@ -49,22 +49,37 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     from .io import check_output, read_dataset
 
     path, out = Path(path), Path(out)
-    ds = read_dataset(path, required=("a", "v", "x", "time"))
-    if ds.sizes["time"] < MIN_SAMPLES:
+    ds = read_dataset(path)
+    m = _record_model(ds, path)
+    compressor = m is None or m.name == "compressor"
+    dim = "iteration" if "iteration" in ds.dims else "time"
+    vib = "a" if compressor else m.vibration()[0]
+    need = ("a", "v", "x", "time") if compressor else (vib, dim)
+    missing = [v for v in need if v not in ds.variables]
+    if missing:
+        raise ParameterError(f"input {path}: variable(s) {', '.join(missing)} missing; expected "
+                             "a recipdyn run (NetCDF from 'recipdyn simulate')")  # fmt: skip
+    if ds.sizes[dim] < MIN_SAMPLES:
         raise ParameterError(
-            f"{path}: {ds.sizes['time']} samples; analyze needs at least {MIN_SAMPLES} "
+            f"{path}: {ds.sizes[dim]} samples; analyze needs at least {MIN_SAMPLES} "
             "(simulate more revolutions or a higher --fs)"
         )
-    t = ds.time.values
+    t = ds[dim].values
     dt = np.diff(t)
     if not (np.all(dt > 0) and np.ptp(dt) <= 1e-6 * np.median(dt)):
         raise ParameterError(f"{path}: time samples must be uniformly spaced and increasing")
     check_output(out, formats=None, what="analysis folder")
     plt = _mpl()
     fs = 1.0 / float(np.median(np.diff(t)))
-    fc = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
-    a = ds.a.values
-    summary: dict[str, Any] = {"input": path.name, "samples": int(t.size), "fs_hz": fs}
+    if compressor:
+        fc = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
+    else:
+        period = ds.attrs.get("period")
+        fc = 1.0 / float(period) if isinstance(period, (int, float, np.floating)) else None
+    a = ds[vib].values
+    summary: dict[str, Any] = {"input": path.name, "samples": int(t.size), "fs_hz": fs,
+                               "model": m.name if m is not None else "unknown",
+                               "signal": vib}  # fmt: skip
 
     spec = amplitude_spectrum(a, fs)
     peaks = find_spectral_peaks(spec, n=8, fundamental=fc)
@@ -74,15 +89,26 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                   for p in peaks],
     }  # fmt: skip
     fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
-    fig = plot_spectrum(spec, peaks, fmax=fmax, title="spectrum of the crosshead acceleration")
+    what = "the crosshead acceleration" if compressor else vib
+    fig = plot_spectrum(spec, peaks, fmax=fmax, title=f"spectrum of {what}")
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
-    plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
-    plot_phase(ds.v, ds.a, "v (m/s)", "a (m/s$^2$)", ax=axes[1], title="velocity-acceleration")
-    if "theta_c" in ds:
-        plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)", ax=axes[2],
-                   title="clearance angle")  # fmt: skip
+    if compressor:
+        fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
+        plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
+        plot_phase(ds.v, ds.a, "v (m/s)", "a (m/s$^2$)", ax=axes[1],
+                   title="velocity-acceleration")  # fmt: skip
+        if "theta_c" in ds:
+            plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)",
+                       ax=axes[2], title="clearance angle")  # fmt: skip
+    else:
+        names = [s for s in m.state_names if s in ds]
+        pairs = list(zip(names, names[1:], strict=False))[:3] or [(names[0], names[0])]
+        fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
+                                 constrained_layout=True, squeeze=False)  # fmt: skip
+        for ax, (u, w) in zip(axes[0], pairs, strict=True):
+            plot_phase(ds[u], ds[w], _lab(ds[u], u), _lab(ds[w], w), ax=ax, points=dim ==
+                       "iteration", title=f"{u}-{w}")  # fmt: skip
     save_figure(fig, out / "phase_portraits.png", dpi=110)
     plt.close(fig)
 
@@ -103,7 +129,11 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     lam_err = 0.0
     section = None
     k01 = None
-    if "param_rc" in ds.attrs:
+    if not compressor:
+        lam, lam_err, section, k01 = _equations_any_model(
+            m, ds, dim, out, summary, section_points, lyap_revolutions, rtol, atol, plt, path
+        )
+    elif "param_rc" in ds.attrs:
         try:
             p = params_from_attrs(ds.attrs)
         except (ParameterError, TypeError, ValueError) as exc:
@@ -145,6 +175,77 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
+
+
+def _lab(da, name: str) -> str:
+    u = da.attrs.get("units", "")
+    return f"{name} ({u})" if u not in ("", "1") else name
+
+
+def _record_model(ds, path):
+    """The model a record was made with (None for a file that does not say)."""
+    from .model.registry import get_model
+
+    spec = ds.attrs.get("model_spec") or ds.attrs.get("model_name")
+    if spec is None:
+        return get_model("compressor") if "param_rc" in ds.attrs else None
+    try:
+        return get_model(str(spec))
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: made with model {spec!r}, which is not available here "
+                             f"({exc})") from None  # fmt: skip
+
+
+def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revolutions, rtol,
+                         atol, plt, path):  # fmt: skip
+    """Section, Benettin exponents and 0-1 test of any registered model's record."""
+    from .analysis import lyapunov_spectrum_map
+
+    try:
+        values = m.schema.from_attrs(ds.attrs)
+        m.check(values)
+    except (ParameterError, TypeError, ValueError) as exc:
+        raise ParameterError(f"{path}: the recorded parameters are not valid ({exc})") from None
+    missing = [s for s in m.state_names if s not in ds]
+    if missing:
+        raise ParameterError(f"{path}: state variable(s) {', '.join(missing)} missing")
+    system = m.system(values)
+    y0 = np.array([float(ds[s].values[0]) for s in m.state_names])
+    t0 = float(ds[dim].values[0])
+    pair = m.state_names[:2] if m.dim >= 2 else m.state_names * 2
+    lam, lam_err, section, k01 = None, 0.0, None, None
+    if m.kind == "map":
+        section = np.c_[tuple(ds[s].values for s in pair)]
+        res = lyapunov_spectrum_map(system, y0, max(1000, int(lyap_revolutions)), n_transient=0)
+        unit = "per iteration"
+    else:
+        period = m.period(values)
+        if period:
+            sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol, atol=atol)
+            section = np.c_[tuple(sec[s].values for s in pair)]
+            title = f"Poincaré section, once per period ({section_points})"
+            fig = plot_phase(sec[pair[0]], sec[pair[1]], pair[0], pair[1], points=True,
+                             title=title)  # fmt: skip
+            save_figure(fig, out / "poincare.png", dpi=110)
+            plt.close(fig)
+            if section_points >= 100:
+                k01 = zero_one_test(sec[m.state_names[0]].values)
+            summary["poincare"] = {"points": section_points}
+        res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
+                                rtol=rtol, atol=atol)  # fmt: skip
+        unit = f"per {m.time_unit}"
+    lam = float(res.exponents[0])
+    tail = res.history[len(res.history) // 2 :, 0]
+    lam_err = float(np.std(tail)) if tail.size > 1 else 0.0
+    summary["lyapunov_equations"] = {
+        "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
+        "spread_second_half": lam_err, "revolutions": lyap_revolutions,
+    }  # fmt: skip
+    fig = plot_lyapunov_history(res)
+    save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
+    plt.close(fig)
+    summary["zero_one_K"] = k01
+    return lam, lam_err, section, k01
 
 
 def _plain(obj):

@@ -148,7 +148,7 @@ def simulate(
         return _simulate_model(
             get_model(model), params, overrides, revolutions=revolutions, transient=transient,
             fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
-            max_memory=max_memory,
+            max_memory=max_memory, spec=model if isinstance(model, str) else get_model(model).name,
         )  # fmt: skip
     p = _coerce_params(params, overrides)
     for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
@@ -224,6 +224,8 @@ def simulate(
         "recipdyn_version": __version__,
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "model": f"massless-link clearance at the crank pin, equations={p.equations}",
+        "model_name": COMPRESSOR.name,
+        "model_spec": COMPRESSOR.name,
         "sign_convention": SIGN_CONVENTION,
         "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), doi:10.21595/jve.2017.18771",
         "theta_c_initial": float(y0[0]),
@@ -295,7 +297,7 @@ def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
 
 
 def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, method, rtol,
-                    atol, h, progress, max_memory) -> xr.Dataset:  # fmt: skip
+                    atol, h, progress, max_memory, spec) -> xr.Dataset:  # fmt: skip
     """:func:`simulate` for any registered model other than the compressor."""
     values = m.parameters(dict(params or {}), **overrides)
     _check_run_settings(revolutions, transient, fs, method, rtol, atol)
@@ -306,7 +308,8 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     attrs: dict[str, Any] = {
         "title": f"recipdyn simulation: {m.name}", "recipdyn_version": __version__,
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-        "model": m.name, "model_description": m.description,
+        "model": m.name, "model_name": m.name, "model_spec": spec,
+        "model_description": m.description,
         "revolutions": revolutions, "transient_revolutions": transient,
         "period": period if period else "none (autonomous: revolutions count time units)",
         "state_initial": [float(x) for x in y0],
