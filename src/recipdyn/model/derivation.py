@@ -39,7 +39,8 @@ from functools import lru_cache
 from pathlib import Path
 
 import sympy as sp
-from sympy.printing.pycode import PythonCodePrinter
+
+from .derive import KernelPrinter
 
 __all__ = ["SYMBOLS", "structured_equations", "brute_force_lagrangian", "generate_code"]
 
@@ -171,21 +172,6 @@ import numba as nb
 '''
 
 
-class _KernelPrinter(PythonCodePrinter):
-    """Prints half-integer powers with ``math.sqrt`` (no ``pow`` calls in the hot loop)."""
-
-    def _print_Pow(self, expr, rational=False):
-        b, e = expr.as_base_exp()
-        if e.is_Rational and e.q == 2 and abs(e.p) <= 7:
-            base = f"math.sqrt({self._print(b)})"
-            mag = f"{base}**{abs(e.p)}" if abs(e.p) != 1 else base
-            return f"(1.0/({mag}))" if e.p < 0 else f"({mag})"
-        if e.is_Integer and e < 0:
-            inner = self._print(b) if e == -1 else f"{self.parenthesize(b, 100)}**{-int(e)}"
-            return f"(1.0/({inner}))"
-        return super()._print_Pow(expr, rational=rational)
-
-
 def _kernel(name: str, exprs: list[sp.Expr], outs: list[str], doc: str) -> str:
     repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), optimizations="basic")
     lines = [
@@ -193,7 +179,7 @@ def _kernel(name: str, exprs: list[sp.Expr], outs: list[str], doc: str) -> str:
         f"def {name}(theta1, theta_c, thetadot_c, F, r, l, ls, m2, m3, J2, g, rc, d, omega):",
         f'    """{doc}"""',
     ]
-    printer = _KernelPrinter({"standard": "python3"})
+    printer = KernelPrinter({"standard": "python3"})
     code = printer.doprint
 
     for sym, e in repl:

@@ -1,6 +1,7 @@
 """Find models by name: the built-in ones, Python entry points, or a ``module:object`` path.
 
-* Built-in: ``compressor`` (the default), ``duffing``, ``lorenz``, ``henon``.
+* Built-in: ``compressor`` (the default), ``duffing``, ``lorenz``, ``henon``,
+  ``double-pendulum``.
 * Entry points: another package registers ``name = "pkg.module:object"`` in the group
   ``recipdyn.models`` of its ``pyproject.toml``; ``recipdyn models`` then lists it.
 * A path: ``"my_models:PENDULUM"`` (an importable module) or ``"path/to/file.py:PENDULUM"``
@@ -31,6 +32,7 @@ _BUILTIN = {
     "duffing": "recipdyn.model.reference:DUFFING",
     "lorenz": "recipdyn.model.reference:LORENZ",
     "henon": "recipdyn.model.reference:HENON",
+    "double-pendulum": "recipdyn.model.reference.double_pendulum:DOUBLE_PENDULUM",
 }
 _REGISTERED: dict[str, Model] = {}
 

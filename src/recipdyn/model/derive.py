@@ -1,0 +1,198 @@
+r"""Euler–Lagrange equations for N generalized coordinates, compiled kernels from sympy.
+
+Given the kinetic energy :math:`T(q, \dot q, t)`, the potential :math:`V(q, t)` and generalized
+forces :math:`Q(q, \dot q, t)` (contact forces, gas pressure, damping — anything not in
+:math:`V`), with :math:`L = T - V`:
+
+.. math:: M(q, \dot q, t)\,\ddot q = b(q, \dot q, t),\qquad
+          M_{ij} = \frac{\partial^2 L}{\partial \dot q_i \partial \dot q_j},\quad
+          b_i = Q_i + \frac{\partial L}{\partial q_i}
+                - \sum_j \frac{\partial^2 L}{\partial \dot q_i \partial q_j}\dot q_j
+                - \frac{\partial^2 L}{\partial \dot q_i \partial t}.
+
+The state is :math:`y = (q, \dot q)`. The right-hand side solves :math:`M \ddot q = b`; the exact
+Jacobian uses :math:`\partial \ddot q/\partial y_k = M^{-1}(\partial b/\partial y_k -
+(\partial M/\partial y_k)\,\ddot q)`, with every partial derivative taken symbolically. For one
+coordinate the solve is a division; for more, ``numpy.linalg.solve`` inside the compiled kernel.
+
+:func:`kernel_source` prints both kernels (numba, the calling convention of
+:mod:`recipdyn.model.base`, common subexpressions eliminated) as Python source that is checked
+in; a test regenerates it and fails if the committed file is stale.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.printing.pycode import PythonCodePrinter
+
+__all__ = ["Lagrangian", "derive", "kernel_source", "KernelPrinter"]
+
+
+class KernelPrinter(PythonCodePrinter):
+    """Prints half-integer powers with ``math.sqrt`` (no ``pow`` calls in the hot loop)."""
+
+    def _print_Pow(self, expr, rational=False):
+        b, e = expr.as_base_exp()
+        if e.is_Rational and e.q == 2 and abs(e.p) <= 7:
+            base = f"math.sqrt({self._print(b)})"
+            mag = f"{base}**{abs(e.p)}" if abs(e.p) != 1 else base
+            return f"(1.0/({mag}))" if e.p < 0 else f"({mag})"
+        if e.is_Integer and e < 0:
+            inner = self._print(b) if e == -1 else f"{self.parenthesize(b, 100)}**{-int(e)}"
+            return f"(1.0/({inner}))"
+        return super()._print_Pow(expr, rational=rational)
+
+
+@dataclass(frozen=True)
+class Lagrangian:
+    """The derived equations ``M qdd = b`` and their partial derivatives.
+
+    Attributes
+    ----------
+    q, qd : tuple of Symbol
+        Coordinates and velocities (the state is ``(q, qd)``).
+    t : Symbol
+        Time.
+    params : tuple of Symbol
+        Parameters, in the order of the packed vector ``p``.
+    M : Matrix (N x N)
+    b : Matrix (N x 1)
+    dM : list of Matrix
+        ``dM[k] = dM/dy_k`` for each of the 2N state components.
+    db : list of Matrix
+        ``db[k] = db/dy_k``.
+    """
+
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    t: sp.Symbol
+    params: tuple[sp.Symbol, ...]
+    M: sp.Matrix
+    b: sp.Matrix
+    dM: tuple[sp.Matrix, ...]
+    db: tuple[sp.Matrix, ...]
+
+    @property
+    def n(self) -> int:
+        return len(self.q)
+
+    def accelerations(self) -> sp.Matrix:
+        """``M^-1 b`` symbolically (for tests and small N)."""
+        return self.M.LUsolve(self.b)
+
+
+def derive(T: sp.Expr, V: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+           t: sp.Symbol, params: Sequence[sp.Symbol],
+           Q: Sequence[sp.Expr] | None = None) -> Lagrangian:  # fmt: skip
+    """Euler–Lagrange equations of ``L = T - V`` with generalized forces ``Q`` (module doc).
+
+    ``T``, ``V`` and ``Q`` are expressions in the symbols ``q``, ``qd``, ``t`` and ``params``;
+    any other free symbol is an error (it would have no value in the compiled kernel).
+    """
+    q, qd, params = tuple(q), tuple(qd), tuple(params)
+    n = len(q)
+    if len(qd) != n:
+        raise ValueError(f"{n} coordinates but {len(qd)} velocities")
+    Q = [sp.S.Zero] * n if Q is None else [sp.sympify(x) for x in Q]
+    if len(Q) != n:
+        raise ValueError(f"{n} coordinates but {len(Q)} generalized forces")
+    L = sp.sympify(T) - sp.sympify(V)
+    allowed = {*q, *qd, t, *params}
+    stray = (L.free_symbols | set().union(*(x.free_symbols for x in Q))) - allowed
+    if stray:
+        raise ValueError(f"symbols without a value: {sorted(map(str, stray))}")
+    dL_dqd = [sp.diff(L, v) for v in qd]
+    M = sp.Matrix(n, n, lambda i, j: sp.diff(dL_dqd[i], qd[j]))
+    b = sp.Matrix(n, 1, lambda i, _: Q[i] + sp.diff(L, q[i])
+                  - sum(sp.diff(dL_dqd[i], q[j]) * qd[j] for j in range(n))
+                  - sp.diff(dL_dqd[i], t))  # fmt: skip
+    y = (*q, *qd)
+    dM = tuple(M.diff(v) for v in y)
+    db = tuple(b.diff(v) for v in y)
+    return Lagrangian(q, qd, t, params, M, b, dM, db)
+
+
+def _names(lag: Lagrangian) -> dict[sp.Symbol, sp.Symbol]:
+    sub = {}
+    for i, s in enumerate(lag.q):
+        sub[s] = sp.Symbol(f"_q{i}")
+    for i, s in enumerate(lag.qd):
+        sub[s] = sp.Symbol(f"_qd{i}")
+    sub[lag.t] = sp.Symbol("t")
+    for i, s in enumerate(lag.params):
+        sub[s] = sp.Symbol(f"_p{i}")
+    return sub
+
+
+def _body(lag: Lagrangian, exprs: list[sp.Expr]) -> tuple[list[str], list[str]]:
+    sub = _names(lag)
+    repl, reduced = sp.cse([e.subs(sub) for e in exprs], symbols=sp.numbered_symbols("x"),
+                           optimizations="basic")  # fmt: skip
+    printer = KernelPrinter({"standard": "python3"})
+    n = lag.n
+    head = [f"    _q{i} = y[{i}]" for i in range(n)]
+    head += [f"    _qd{i} = y[{n + i}]" for i in range(n)]
+    head += [f"    _p{i} = p[{i}]" for i in range(len(lag.params))]
+    head += [f"    {s} = {printer.doprint(e)}" for s, e in repl]
+    return head, [printer.doprint(e) for e in reduced]
+
+
+def kernel_source(lag: Lagrangian, name: str, doc: str) -> str:
+    """Python source of ``{name}_rhs(t, y, p, out)`` and ``{name}_jac(t, y, p, J)``."""
+    n = lag.n
+    m_exprs = [lag.M[i, j] for i in range(n) for j in range(n)]
+    b_exprs = [lag.b[i] for i in range(n)]
+    lines = [f'"""Generated by recipdyn.model.derive -- do not edit by hand.\n\n{doc}\n"""', "",
+             "import math", "", "import numba as nb", "import numpy as np", "",
+             "from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE", "", "",
+             "@nb.njit(cache=True)",
+             f"def {name}_system(t, y, p, M, b):",
+             '    """Fill M (N x N) and b (N) of M qdd = b."""']  # fmt: skip
+    head, vals = _body(lag, m_exprs + b_exprs)
+    lines += head
+    for i in range(n):
+        for j in range(n):
+            lines.append(f"    M[{i}, {j}] = {vals[i * n + j]}")
+    for i in range(n):
+        lines.append(f"    b[{i}] = {vals[n * n + i]}")
+    lines += ["", "", "@nb.njit(cache=True)", f"def {name}_partials(t, y, p, dM, db):",
+              '    """dM[k] = dM/dy_k (2N x N x N), db[k] = db/dy_k (2N x N)."""']  # fmt: skip
+    d_exprs = [lag.dM[k][i, j] for k in range(2 * n) for i in range(n) for j in range(n)]
+    d_exprs += [lag.db[k][i] for k in range(2 * n) for i in range(n)]
+    head, vals = _body(lag, d_exprs)
+    lines += head
+    for k in range(2 * n):
+        for i in range(n):
+            for j in range(n):
+                lines.append(f"    dM[{k}, {i}, {j}] = {vals[k * n * n + i * n + j]}")
+    off = 2 * n * n * n
+    for k in range(2 * n):
+        for i in range(n):
+            lines.append(f"    db[{k}, {i}] = {vals[off + k * n + i]}")
+    solve = "    acc[0] = b[0] / M[0, 0]" if n == 1 else "    acc[:] = np.linalg.solve(M, b)"
+    lines += ["", "", "@nb.njit(RHS_SIGNATURE, cache=True)", f"def {name}_rhs(t, y, p, out):",
+              '    """(qd, qdd) with M qdd = b."""',
+              f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})", f"    acc = np.empty({n})",
+              f"    {name}_system(t, y, p, M, b)", solve,
+              f"    for i in range({n}):", "        out[i] = y[" + str(n) + " + i]",
+              f"        out[{n} + i] = acc[i]",
+              "", "", "@nb.njit(JAC_SIGNATURE, cache=True)", f"def {name}_jac(t, y, p, J):",
+              '    """Exact Jacobian: dqdd/dy_k = M^-1 (db/dy_k - dM/dy_k qdd)."""',
+              f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})", f"    acc = np.empty({n})",
+              f"    dM = np.empty(({2 * n}, {n}, {n}))", f"    db = np.empty(({2 * n}, {n}))",
+              f"    {name}_system(t, y, p, M, b)", solve,
+              f"    {name}_partials(t, y, p, dM, db)",
+              f"    for i in range({2 * n}):", f"        for k in range({2 * n}):",
+              "            J[i, k] = 0.0",
+              f"    for i in range({n}):", f"        J[i, {n} + i] = 1.0",
+              f"    r = np.empty({n})", f"    for k in range({2 * n}):",
+              f"        for i in range({n}):", "            s = db[k, i]",
+              f"            for j in range({n}):", "                s -= dM[k, i, j] * acc[j]",
+              "            r[i] = s",
+              ("        col = r / M[0, 0]" if n == 1 else "        col = np.linalg.solve(M, r)"),
+              f"        for i in range({n}):", f"            J[{n} + i, k] = col[i]",
+              ""]  # fmt: skip
+    return "\n".join(lines)
