@@ -35,7 +35,7 @@ import numpy as np
 from ..defaults import ATOL, RTOL
 from ..integrate import IntegrationError, propagate
 from ..integrate import _kernels as _ik
-from ..integrate.tableaus import DOP853 as _DOP
+from ..integrate.tableaus import dop853
 from ..model.base import (
     EVENT_TYPE,
     JAC_TYPE,
@@ -281,6 +281,7 @@ def lyapunov_spectrum(
     times = np.zeros(n_hist)
     info = np.zeros(3)  # [t_reached, dt_final, n_hist_filled]
     if method == "dop853":
+        _DOP = dop853()
         status = _benettin_dop853(
             tsys.rhs, z, system.params, n, k, t, t_total, dt, rtol, atol, max_log_spread,
             hist, times, info, _ik.no_event, _DOP.A, _DOP.B, _DOP.C, _DOP.E3, _DOP.E5, _DOP.D,

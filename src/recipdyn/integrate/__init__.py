@@ -1,8 +1,16 @@
 """Compiled integrators for any :class:`~recipdyn.model.base.ODESystem`."""
 
 from .solve import METHODS, IntegrationError, Solution, integrate, propagate
-from .tableaus import DOP853, RK4, Tableau
+from .tableaus import RK4, Tableau, dop853
 
+# DOP853 (the tableau) is built on first access (module __getattr__ below).
 __all__ = [
-    "integrate", "propagate", "Solution", "IntegrationError", "METHODS", "DOP853", "RK4", "Tableau",
+    "integrate", "propagate", "Solution", "IntegrationError", "METHODS", "RK4", "Tableau",
+    "dop853",
 ]  # fmt: skip
+
+
+def __getattr__(name: str):
+    if name == "DOP853":
+        return dop853()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

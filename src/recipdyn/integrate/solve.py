@@ -27,7 +27,7 @@ from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
 from ..errors import Interrupted, ParameterError, deferred_signals
 from ..model.base import ODESystem
 from . import _kernels
-from .tableaus import DOP853
+from .tableaus import dop853
 
 __all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS"]
 
@@ -190,6 +190,7 @@ def integrate(
     status = 0
     n_out = 0
     interrupted = 0
+    tab = dop853() if method == "dop853" else None
     with deferred_signals() as pending:
         for t_stop in stops:
             if t >= t_stop and t_stop < t1:
@@ -204,8 +205,8 @@ def integrate(
                 et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
                 status = _kernels.dop853_kernel(
                     system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
-                    max_step, t_eval[n_out:], max_steps - nsteps, DOP853.A, DOP853.B, DOP853.C,
-                    DOP853.E3, DOP853.E5, DOP853.D, use_event, event_direction, Y[n_out:], et, ey,
+                    max_step, t_eval[n_out:], max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
+                    tab.E5, tab.D, use_event, event_direction, Y[n_out:], et, ey,
                     stats, fstate,
                 )  # fmt: skip
                 ev_t.extend(et[: stats[4]])
