@@ -97,7 +97,7 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
         t1 = min(t + dt, t_end)
         status = _ik.dop853_kernel(
             trhs, no_event, t, z, t1, t1, p, rtol, atol, h_abs, np.inf, empty1, 1 << 40,
-            A, B, C, E3, E5, D, False, 0, Yd, empty1, empty2, stats, fstate,
+            A, B, C, E3, E5, D, False, 0, 0, trhs, Yd, empty1, empty2, empty2, stats, fstate,
         )  # fmt: skip
         if status < 0:
             info[0] = t

@@ -17,12 +17,15 @@ import numba as nb
 import numpy as np
 from numba import types as T
 
-from ..model.base import EVENT_SIGNATURE, EVENT_TYPE, RHS_TYPE
+from ..model.base import EVENT_SIGNATURE, EVENT_TYPE, RHS_SIGNATURE, RHS_TYPE
 
 F8, I8 = T.float64, T.int64
 V1, V2 = T.float64[::1], T.float64[:, ::1]
 
 SAFETY = 0.9
+#: Events are looked for at this many equally spaced points inside each step (on the dense
+#: output), so two crossings within one step are both seen unless they are closer than h/4.
+EVENT_SUBSTEPS = 4
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 
@@ -73,16 +76,72 @@ def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp):
         rhs(t + C[s] * h, ytmp, p, K[s])
 
 
+@nb.njit(cache=True)
+def _dense_coefficients(rhs, t, y, f, y_new, f_new, h, A, C, D, n_stages, K, p, ytmp, Fd):
+    """The three extra stages and the 7th-order dense-output coefficients of one step."""
+    n = y.shape[0]
+    for s in range(3):
+        st = n_stages + 1 + s
+        for j in range(n):
+            acc = 0.0
+            for k in range(st):
+                acc += A[st, k] * K[k, j]
+            ytmp[j] = y[j] + h * acc
+        rhs(t + C[st] * h, ytmp, p, K[st])
+    for j in range(n):
+        dy = y_new[j] - y[j]
+        Fd[0, j] = dy
+        Fd[1, j] = h * f[j] - dy
+        Fd[2, j] = 2.0 * dy - h * (f_new[j] + f[j])
+        for r in range(4):
+            acc = 0.0
+            for k in range(16):
+                acc += D[r, k] * K[k, j]
+            Fd[3 + r, j] = h * acc
+
+
+@nb.njit(cache=True)
+def _locate_event(event, t, y, h, xa, xb, ga, gb, Fd, p, ydense):
+    """Illinois (modified regula falsi) on the dense output between ``x = xa`` and ``xb``
+    (``x = (t - t_step) / h``, a sign change of ``g`` between them); returns the root's x."""
+    side = 0
+    xm = xb
+    for _ in range(100):
+        xm = xb - gb * (xb - xa) / (gb - ga) if gb != ga else 0.5 * (xa + xb)
+        _dense_eval(xm, y, Fd, ydense)
+        gm = event(t + xm * h, ydense, p)
+        if gm == 0.0 or abs(xb - xa) * abs(h) < 4e-16 * max(1.0, abs(t)):
+            break
+        if (gm > 0.0) == (gb > 0.0):
+            xb, gb = xm, gm
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            xa, ga = xm, gm
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return xm
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def no_reset(t, y, p, out):  # pragma: no cover - trivial
+    for j in range(y.shape[0]):
+        out[j] = y[j]
+
+
 DOP853_SIG = I8(
     RHS_TYPE, EVENT_TYPE, F8, V1, F8, F8, V1, F8, F8, F8, F8, V1, I8,
-    V2, V1, V1, V1, V1, V2, T.boolean, I8, V2, V1, V2, T.int64[::1], V1,
+    V2, V1, V1, V1, V1, V2, T.boolean, I8, I8, RHS_TYPE, V2, V1, V2, V2, T.int64[::1], V1,
 )  # fmt: skip
 
 
 @nb.njit(DOP853_SIG, cache=True)
 def dop853_kernel(
     rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
-    A, B, C, E3, E5, D, use_event, event_dir, Y, ev_t, ev_y, stats, fstate,
+    A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2, stats,
+    fstate,
 ):  # fmt: skip
     """Integrate from ``(t0, y0)`` toward ``t1``; ``y0`` is updated in place to the final state.
 
@@ -91,7 +150,15 @@ def dop853_kernel(
     ``t_stop`` at the split points (for a progress bar) takes exactly the steps of one call:
     the results are bit-identical (given ``h_abs0`` = the previous call's ``fstate[1]``).
 
-    Outputs: ``Y[i]`` at ``t_eval[i]``; events in ``ev_t``/``ev_y`` (capacity = their length);
+    Events (``use_event``): crossings of ``event(t, y, p) = 0`` in direction ``event_dir``
+    (+1 rising, -1 falling, 0 both) are located on the dense output and recorded in ``ev_t``,
+    ``ev_y`` (state at the event) and ``ev_y2`` (state after the event's action; capacity =
+    their length). ``event_action``: 0 record only; 1 terminal (stop at the event, status 1);
+    2 reset (``reset(t, y_event, p, y_after)`` sets the state, the integration continues from
+    the event). Outputs after an acting event within its step are never taken from the
+    pre-event trajectory.
+
+    Outputs: ``Y[i]`` at ``t_eval[i]``;
     ``stats = [nfev, nsteps, nreject, n_out, n_events]``; ``fstate = [t_final, h_abs_next]``.
     Returns the status code.
     """
@@ -225,74 +292,67 @@ def dop853_kernel(
             status = -3
             break
         nsteps += 1
-        # dense output, only when needed
+        # dense output, only when needed (always with events: they are looked for inside
+        # the step on it, so a step that contains two crossings does not hide them)
         need_dense = ie < n_eval and t_eval[ie] <= t_new
         g_new = 0.0
-        crossing = False
         if use_event:
             g_new = event(t_new, y_new, p)
-            if (g_old < 0.0 <= g_new and event_dir >= 0) or (
-                g_old > 0.0 >= g_new and event_dir <= 0
-            ):
-                crossing = True
-                need_dense = True
+            need_dense = True
         if need_dense:
-            for s in range(3):
-                st = n_stages + 1 + s
-                for j in range(n):
-                    acc = 0.0
-                    for k in range(st):
-                        acc += A[st, k] * K[k, j]
-                    ytmp[j] = y[j] + h * acc
-                rhs(t + C[st] * h, ytmp, p, K[st])
+            _dense_coefficients(rhs, t, y, f, y_new, f_new, h, A, C, D, n_stages, K, p, ytmp, Fd)
             nfev += 3
-            for j in range(n):
-                dy = y_new[j] - y[j]
-                Fd[0, j] = dy
-                Fd[1, j] = h * f[j] - dy
-                Fd[2, j] = 2.0 * dy - h * (f_new[j] + f[j])
-                for r in range(4):
-                    acc = 0.0
-                    for k in range(16):
-                        acc += D[r, k] * K[k, j]
-                    Fd[3 + r, j] = h * acc
-            while ie < n_eval and t_eval[ie] <= t_new:
+            t_cut = t_new  # outputs up to here belong to this step's trajectory
+            acting = False
+            if use_event:
+                xa, ga = 0.0, g_old
+                for q in range(1, EVENT_SUBSTEPS + 1):
+                    if n_ev >= max_events or acting:
+                        break
+                    xb = q / EVENT_SUBSTEPS
+                    if q == EVENT_SUBSTEPS:
+                        gb = g_new
+                    else:
+                        _dense_eval(xb, y, Fd, ydense)
+                        gb = event(t + xb * h, ydense, p)
+                    if (ga < 0.0 <= gb and event_dir >= 0) or (ga > 0.0 >= gb and event_dir <= 0):
+                        xm = _locate_event(event, t, y, h, xa, xb, ga, gb, Fd, p, ydense)
+                        ev_t[n_ev] = t + xm * h
+                        _dense_eval(xm, y, Fd, ydense)
+                        ev_y[n_ev] = ydense
+                        ev_y2[n_ev] = ydense
+                        if event_action != 0:  # terminal or reset: the step ends here
+                            acting = True
+                            t_cut = ev_t[n_ev]
+                        else:
+                            n_ev += 1
+                    xa, ga = xb, gb
+            while ie < n_eval and t_eval[ie] <= t_cut:
                 if t_eval[ie] == t_new:
                     Y[ie] = y_new
+                elif acting and t_eval[ie] == t_cut:
+                    Y[ie] = ev_y[n_ev]
                 else:
                     _dense_eval((t_eval[ie] - t) / h, y, Fd, ydense)
                     Y[ie] = ydense
                 ie += 1
-            if crossing and n_ev < max_events:
-                # Illinois (modified regula falsi) on the dense output, in x = (t - t_old)/h
-                xa, xb = 0.0, 1.0
-                ga, gb = g_old, g_new
-                side = 0
-                for _ in range(100):
-                    xm = xb - gb * (xb - xa) / (gb - ga) if gb != ga else 0.5 * (xa + xb)
-                    _dense_eval(xm, y, Fd, ydense)
-                    gm = event(t + xm * h, ydense, p)
-                    if gm == 0.0 or abs(xb - xa) * abs(h) < 4e-16 * max(1.0, abs(t)):
-                        break
-                    if (gm > 0.0) == (gb > 0.0):
-                        xb, gb = xm, gm
-                        if side == -1:
-                            ga *= 0.5
-                        side = -1
-                    else:
-                        xa, ga = xm, gm
-                        if side == 1:
-                            gb *= 0.5
-                        side = 1
-                ev_t[n_ev] = t + xm * h
-                _dense_eval(xm, y, Fd, ydense)
-                ev_y[n_ev] = ydense
+            if acting:
+                t_new = ev_t[n_ev]
+                if event_action == 2:  # reset the state, continue from the event
+                    reset(t_new, ev_y[n_ev], p, y_new)
+                    ev_y2[n_ev] = y_new
+                else:
+                    y_new[:] = ev_y[n_ev]
+                    status = 1
+                rhs(t_new, y_new, p, f_new)
+                nfev += 1
+                g_new = event(t_new, y_new, p)
                 n_ev += 1
         g_old = g_new
         t = t_new
         y[:] = y_new
         f[:] = f_new
-        if use_event and n_ev >= max_events:
+        if status == 1 or (use_event and n_ev >= max_events):
             status = 1
             break
     y0[:] = y

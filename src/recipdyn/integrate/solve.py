@@ -34,7 +34,7 @@ __all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS"]
 METHODS = ("dop853", "rk4")
 _MESSAGES = {
     0: "reached the end of the interval",
-    1: "stopped after the requested number of events",
+    1: "stopped at an event (terminal event or the requested number of events)",
     -1: "step size fell below the resolution of t (the problem may be singular or stiff)",
     -2: "max_steps exceeded",
     -3: "the state became non-finite (NaN/inf)",
@@ -68,7 +68,9 @@ class Solution:
     status : int
         0 success, 1 stopped at ``max_events``, < 0 failure (see ``message``).
     t_events, y_events : ndarray
-        Event times and states (if an event function was given).
+        Event times and states at the events (if an event function was given).
+    y_events_after : ndarray
+        States after each event's action (equal to ``y_events`` unless the event resets).
     settings : dict
         Method and tolerances, for result attributes.
     """
@@ -84,6 +86,7 @@ class Solution:
     message: str
     t_events: np.ndarray = field(default_factory=lambda: np.empty(0))
     y_events: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
+    y_events_after: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
     settings: dict = field(default_factory=dict)
 
     @property
@@ -136,6 +139,8 @@ def integrate(
     event: Callable | None = None,
     event_direction: int = 0,
     max_events: int = 0,
+    event_action: str = "record",
+    reset: Callable | None = None,
     chunks: int = 1,
     progress: Callable[[float], None] | None = None,
     raise_on_failure: bool = True,
@@ -160,6 +165,13 @@ def integrate(
         Record crossings of ``g = 0`` (DOP853 only), root-found on the dense output;
         ``event_direction`` +1 rising, -1 falling, 0 both; ``max_events`` caps the count
         (and stops the integration when reached; 0 = capacity only, default 100 000).
+    event_action : {"record", "terminal", "reset"}
+        What an event does: only recorded (default); ends the integration at the event
+        (status 1); or applies ``reset`` and continues from the event.
+    reset : numba function ``reset(t, y, p, out)``, optional
+        The state after a ``"reset"`` event (e.g. an impact law with restitution), compiled
+        with :data:`~recipdyn.model.base.RHS_SIGNATURE`. States before and after each event are
+        in ``y_events`` and ``y_events_after``.
     chunks : int
         Split the run in this many pieces, calling ``progress(fraction)`` after each.
     raise_on_failure : bool
@@ -173,6 +185,17 @@ def integrate(
     if t_eval.size and (np.any(np.diff(t_eval) < 0) or t_eval[0] < t0 or t_eval[-1] > t1):
         raise ParameterError("t_eval must be sorted and lie within t_span")
     use_event = event is not None
+    actions = {"record": 0, "terminal": 1, "reset": 2}
+    if event_action not in actions:
+        raise ParameterError(f"event_action = {event_action!r}; allowed: {', '.join(actions)}")
+    if event_action == "reset" and reset is None:
+        raise ParameterError("event_action 'reset' needs a reset function")
+    if event_action != "record" and not use_event:
+        raise ParameterError(f"event_action {event_action!r} needs an event function")
+    if use_event and method != "dop853":
+        raise ParameterError("events need method 'dop853' (located on its dense output)")
+    action = actions[event_action]
+    reset_fn = reset if reset is not None else _kernels.no_reset
     cap = max_events if max_events > 0 else 100_000
     ev = event if use_event else _kernels.no_event
     chunks = max(1, int(chunks))
@@ -182,7 +205,7 @@ def integrate(
     stops = np.linspace(t0, t1, chunks + 1)[1:]
     stops[-1] = t1
     Y = np.empty((t_eval.size, system.dim))
-    ev_t, ev_y = [], []
+    ev_t, ev_y, ev_y2 = [], [], []
     y = y0.copy()  # updated in place by the kernels
     t = t0
     h_abs = 0.0
@@ -203,14 +226,16 @@ def integrate(
             if method == "dop853":
                 ev_cap = cap - len(ev_t) if use_event else 0
                 et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
+                ey2 = np.empty((ev_cap, system.dim))
                 status = _kernels.dop853_kernel(
                     system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
                     max_step, t_eval[n_out:], max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
-                    tab.E5, tab.D, use_event, event_direction, Y[n_out:], et, ey,
-                    stats, fstate,
+                    tab.E5, tab.D, use_event, event_direction, action, reset_fn, Y[n_out:], et,
+                    ey, ey2, stats, fstate,
                 )  # fmt: skip
                 ev_t.extend(et[: stats[4]])
                 ev_y.extend(ey[: stats[4]])
+                ev_y2.extend(ey2[: stats[4]])
             else:
                 status = _kernels.rk4_kernel(
                     system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
@@ -239,6 +264,7 @@ def integrate(
         message=_MESSAGES[int(status)],
         t_events=np.array(ev_t, dtype=float),
         y_events=np.array(ev_y, dtype=float).reshape(-1, system.dim),
+        y_events_after=np.array(ev_y2, dtype=float).reshape(-1, system.dim),
         settings=dict(method=method, rtol=rtol, atol=atol, h=h, max_step=max_step),
     )
     if interrupted:
