@@ -110,3 +110,13 @@ def test_needs_jacobian():
     with pytest.raises(ValueError, match="Jacobian"):
         lyapunov_spectrum(ODESystem(rhs=S.lorenz().rhs, params=np.ones(3),
                                     state_names=("x", "y", "z")), [1, 1, 1], 1.0)  # fmt: skip
+
+
+def test_tangent_kernels_are_compiled_once_per_process():
+    """Benettin at every sweep point must not recompile the tangent system (~0.5 s each)."""
+    from recipdyn.analysis import tangent_system
+
+    a = tangent_system(compressor_model(CompressorParams(omega=20.0)))
+    b = tangent_system(compressor_model(CompressorParams(omega=35.0, rc=2e-3)))
+    assert a.rhs is b.rhs and not np.array_equal(a.params, b.params)
+    assert tangent_system(S.lorenz()).rhs is not a.rhs

@@ -186,13 +186,17 @@ def _initial_basis(n: int, k: int) -> np.ndarray:
     return np.ascontiguousarray(q)
 
 
-def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
-    """The system augmented with ``k`` tangent vectors (state ``[y, W.ravel()]``, W n x k)."""
-    if system.jac is None:
-        raise ValueError(f"system {system.name!r} has no Jacobian; Benettin's method needs one")
-    n = system.dim
-    k = n if k is None else int(k)
-    rhs, jac, both = system.rhs, system.jac, system.rhs_jac
+#: Compiled tangent right-hand sides by (rhs, jac, rhs_jac, n, k): numba compiles a closure on
+#: its first call (~0.5 s), so a sweep that asks for exponents at every point compiles once per
+#: worker process instead of once per point.
+_TANGENT_CACHE: dict[tuple, object] = {}
+
+
+def _tangent_rhs(rhs, jac, both, n: int, k: int):
+    key = (rhs, jac, both, n, k)
+    cached = _TANGENT_CACHE.get(key)
+    if cached is not None:
+        return cached
 
     if both is not None:  # right-hand side and Jacobian share work: one call
 
@@ -219,6 +223,17 @@ def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
                     s += J[i, m] * z[n + m * k + j]
                 out[n + i * k + j] = s
 
+    _TANGENT_CACHE[key] = trhs
+    return trhs
+
+
+def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
+    """The system augmented with ``k`` tangent vectors (state ``[y, W.ravel()]``, W n x k)."""
+    if system.jac is None:
+        raise ValueError(f"system {system.name!r} has no Jacobian; Benettin's method needs one")
+    n = system.dim
+    k = n if k is None else int(k)
+    trhs = _tangent_rhs(system.rhs, system.jac, system.rhs_jac, n, k)
     names = system.state_names + tuple(f"w{i}{j}" for i in range(n) for j in range(k))
     return ODESystem(rhs=trhs, params=system.params, state_names=names, period=system.period,
                      name=f"{system.name}-tangent")  # fmt: skip
