@@ -27,7 +27,7 @@ from .defaults import ATOL, LYAP_TOL, RTOL
 from .io import save_figure, write_text
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
-from .plotting import _mpl
+from .plotting import _mpl, axis_label
 from .simulate import params_from_attrs
 
 __all__ = ["analyze_run", "MIN_SAMPLES"]
@@ -107,8 +107,8 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
                                  constrained_layout=True, squeeze=False)  # fmt: skip
         for ax, (u, w) in zip(axes[0], pairs, strict=True):
-            plot_phase(ds[u], ds[w], _lab(ds[u], u), _lab(ds[w], w), ax=ax, points=dim ==
-                       "iteration", title=f"{u}-{w}")  # fmt: skip
+            plot_phase(ds[u], ds[w], axis_label(u, ds[u]), axis_label(w, ds[w]), ax=ax,
+                       points=dim == "iteration", title=f"{u}-{w}")  # fmt: skip
     save_figure(fig, out / "phase_portraits.png", dpi=110)
     plt.close(fig)
 
@@ -175,11 +175,6 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
-
-
-def _lab(da, name: str) -> str:
-    u = da.attrs.get("units", "")
-    return f"{name} ({u})" if u not in ("", "1") else name
 
 
 def _record_model(ds, path):

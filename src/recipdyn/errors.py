@@ -15,7 +15,15 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
-__all__ = ["ParameterError", "Interrupted", "raise_on_signals", "deferred_signals"]
+__all__ = ["ParameterError", "Interrupted", "raise_on_signals", "deferred_signals",
+           "is_number"]  # fmt: skip
+
+
+def is_number(x: Any) -> bool:
+    """A real number (Python or NumPy int/float), not a bool."""
+    import numbers
+
+    return isinstance(x, numbers.Real) and not isinstance(x, bool)
 
 
 class ParameterError(ValueError):

@@ -15,9 +15,11 @@ import signal
 import sys
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Iterable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Any
 
-__all__ = ["process_pool", "stop_pool", "worker_init"]
+__all__ = ["process_pool", "stop_pool", "worker_init", "run_unordered"]
 
 _WATCH_INTERVAL = 0.5  # s between parent checks of the watchdog
 
@@ -70,3 +72,39 @@ def stop_pool(pool: ProcessPoolExecutor, timeout: float = 5.0) -> None:
         if p.is_alive():  # pragma: no cover - a worker stuck in compiled code ignoring SIGTERM
             p.kill()
             p.join(1.0)
+
+
+#: How often (s) the coordinator looks for a signal while waiting for workers.
+POLL = 0.2
+
+
+def run_unordered(fn: Callable[[Any], Any], tasks: Iterable, workers: int,
+                  on_result: Callable[[Any], None], pending) -> None:  # fmt: skip
+    """``fn(task)`` for every task on a pool of ``workers`` processes.
+
+    ``on_result`` runs in this process as each result arrives (any order); at most two tasks
+    per worker are queued (bounded memory for huge task lists); ``pending.check()`` (from
+    :func:`recipdyn.errors.deferred_signals`) runs between results, so a signal stops the work
+    promptly. On any exception or interruption the pool is stopped (:func:`stop_pool`).
+    """
+    pool = process_pool(workers)
+    try:
+        it = iter(tasks)
+        in_flight: set = set()
+        exhausted = False
+        while True:
+            while not exhausted and len(in_flight) < 2 * workers:
+                try:
+                    in_flight.add(pool.submit(fn, next(it)))
+                except StopIteration:
+                    exhausted = True
+            if not in_flight:
+                break
+            finished, in_flight = wait(in_flight, timeout=POLL, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                on_result(fut.result())
+            pending.check()
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)

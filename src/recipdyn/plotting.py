@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-__all__ = ["response_figure", "provenance_footer", "model_figure"]
+__all__ = ["response_figure", "provenance_footer", "model_figure", "axis_label"]
 
 
 def _mpl():
@@ -20,6 +20,12 @@ def _mpl():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def axis_label(name: str, da) -> str:
+    """``name (units)`` from a DataArray's ``units`` attribute (no unit for dimensionless)."""
+    u = da.attrs.get("units", "")
+    return f"{name} ({u})" if u not in ("", "1") else name
 
 
 def provenance_footer(ds: xr.Dataset) -> str:

@@ -12,7 +12,7 @@ import xarray as xr
 
 from . import __version__
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
-from .errors import Interrupted
+from .errors import Interrupted, is_number
 from .integrate import IntegrationError, integrate
 from .integrate.solve import check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
@@ -151,18 +151,11 @@ def simulate(
             max_memory=max_memory, spec=model if isinstance(model, str) else get_model(model).name,
         )  # fmt: skip
     p = _coerce_params(params, overrides)
-    for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
-        if not (_is_number(val) and math.isfinite(val) and val > lo):
-            raise ParameterError(f"{name} = {val!r} out of range; allowed: > {lo:g}")
-    if not (_is_number(transient) and math.isfinite(transient) and transient >= 0):
-        raise ParameterError(f"transient = {transient!r} out of range; allowed: >= 0")
-    if method not in ("dop853", "rk4"):
-        raise ParameterError(f"method = {method!r}; allowed: dop853, rk4")
-    check_tolerances(rtol, atol)
+    _check_run_settings(revolutions, transient, fs, method, rtol, atol)
     T = p.crank_period
     if method == "rk4" and h is None:
         h = T / RK4_STEPS_PER_REVOLUTION
-    if h is not None and not (_is_number(h) and math.isfinite(h) and 0 < h <= T):
+    if h is not None and not (is_number(h) and math.isfinite(h) and 0 < h <= T):
         raise ParameterError(f"h = {h!r} s out of range; allowed: (0, {T:g}] (one revolution)")
     n_float = revolutions * T * fs
     check_memory(
@@ -260,10 +253,6 @@ def simulate(
     return ds
 
 
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
-
-
 def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
     """Rebuild the :class:`CompressorParams` recorded in a result's attributes."""
     import dataclasses
@@ -287,9 +276,9 @@ def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
 
 def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
     for name, val, lo in (("revolutions", revolutions, 0.0), ("fs", fs, 0.0)):
-        if not (_is_number(val) and math.isfinite(val) and val > lo):
+        if not (is_number(val) and math.isfinite(val) and val > lo):
             raise ParameterError(f"{name} = {val!r} out of range; allowed: > {lo:g}")
-    if not (_is_number(transient) and math.isfinite(transient) and transient >= 0):
+    if not (is_number(transient) and math.isfinite(transient) and transient >= 0):
         raise ParameterError(f"transient = {transient!r} out of range; allowed: >= 0")
     if method not in ("dop853", "rk4"):
         raise ParameterError(f"method = {method!r}; allowed: dop853, rk4")

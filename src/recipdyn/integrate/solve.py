@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
-from ..errors import Interrupted, ParameterError, deferred_signals
+from ..errors import Interrupted, ParameterError, deferred_signals, is_number
 from ..model.base import ODESystem
 from . import _kernels
 from .tableaus import dop853
@@ -108,19 +108,15 @@ def _check_inputs(system, y0, t_span, method, rtol, atol, h):
     if method not in METHODS:
         raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
     check_tolerances(rtol, atol)
-    if method == "rk4" and (h is None or not (_is_number(h) and h > 0 and math.isfinite(h))):
+    if method == "rk4" and (h is None or not (is_number(h) and h > 0 and math.isfinite(h))):
         raise ParameterError(f"h = {h!r}: method 'rk4' needs a step h > 0 s (finite)")
     return y0, t0, t1
-
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
 
 
 def check_tolerances(rtol, atol) -> None:
     """Raise :class:`ParameterError` unless ``rtol`` and ``atol`` are in their ranges."""
     for name, v, (lo, hi) in (("rtol", rtol, RTOL_RANGE), ("atol", atol, ATOL_RANGE)):
-        if not (_is_number(v) and math.isfinite(v) and lo <= v <= hi):
+        if not (is_number(v) and math.isfinite(v) and lo <= v <= hi):
             raise ParameterError(f"{name} = {v!r} out of range; allowed: [{lo:g}, {hi:g}]")
 
 

@@ -28,14 +28,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, is_number
 from .base import DiscreteMap, ODESystem, Signal
 
 __all__ = ["Param", "Schema", "Model"]
-
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
 
 
 @dataclass(frozen=True)
@@ -98,7 +94,7 @@ class Param:
             if value not in self.choices:
                 raise ParameterError(f"{self.name} = {value!r}; allowed: {self.range_text()}")
             return value
-        if not _is_number(value):
+        if not is_number(value):
             raise ParameterError(f"{self.name} must be a number, got {value!r}")
         value = float(value)
         if not math.isfinite(value):
@@ -190,7 +186,7 @@ class Schema:
     def table(self) -> list[dict[str, str]]:
         """Rows for display: name, default, unit, range, group, assumed, description."""
         return [dict(name=p.name, default="derived" if p.default is None else f"{p.default:g}"
-                     if _is_number(p.default) else str(p.default), unit=p.unit or "-",
+                     if is_number(p.default) else str(p.default), unit=p.unit or "-",
                      range=p.range_text(), group=p.group, assumed="yes" if p.assumed else "",
                      description=p.description) for p in self.params]  # fmt: skip
 

@@ -22,7 +22,7 @@ from .. import __version__
 from ..defaults import ATOL, RTOL
 from ..errors import Interrupted, deferred_signals
 from ..model.parameters import CompressorParams
-from ..parallel import process_pool, stop_pool
+from ..parallel import run_unordered
 from .cases import Case
 
 __all__ = ["Variant", "VARIANTS", "RunSpec", "run_all", "Settings"]
@@ -105,6 +105,13 @@ def _compute(spec: RunSpec, path: str) -> str:
     return path
 
 
+def _compute_task(task: tuple[RunSpec, str]) -> str:
+    """Pool entry point: compute one run; returns its key."""
+    spec, path = task
+    _compute(spec, path)
+    return spec.key
+
+
 def _load(path: Path) -> xr.Dataset | None:
     """A cached run, fully read; ``None`` if the file is unreadable (truncated, corrupted)."""
     try:
@@ -144,36 +151,22 @@ def run_all(
                 progress(s.key, True)
     jobs = jobs or os.cpu_count() or 1
     done = 0
+
+    def finished(key: str) -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(key, False)
+
     try:
         with deferred_signals() as pending:
             if jobs == 1:
-                for s, p in todo:
+                for task in todo:
                     pending.check()
-                    _compute(s, p)
-                    done += 1
-                    if progress is not None:
-                        progress(s.key, False)
+                    finished(_compute_task(task))
                 pending.check()
             elif todo:
-                from concurrent.futures import FIRST_COMPLETED, wait
-
-                pool = process_pool(jobs)
-                try:
-                    futs = {pool.submit(_compute, s, p): s for s, p in todo}
-                    waiting = set(futs)
-                    while waiting:
-                        finished, waiting = wait(waiting, timeout=0.2,
-                                                 return_when=FIRST_COMPLETED)  # fmt: skip
-                        for fut in finished:
-                            fut.result()
-                            done += 1
-                            if progress is not None:
-                                progress(futs[fut].key, False)
-                        pending.check()
-                except BaseException:
-                    stop_pool(pool)
-                    raise
-                pool.shutdown(wait=True)
+                run_unordered(_compute_task, todo, jobs, finished, pending)
     except (KeyboardInterrupt, Interrupted) as exc:
         intr = Interrupted.wrap(exc)
         intr.kept.append(f"{len(specs) - len(todo) + done} of {len(specs)} runs in {cache} "

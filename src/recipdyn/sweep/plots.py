@@ -8,7 +8,7 @@ import numpy as np
 import xarray as xr
 
 from ..io import save_figure
-from ..plotting import _mpl
+from ..plotting import _mpl, axis_label
 
 __all__ = ["sweep_figures"]
 
@@ -19,11 +19,6 @@ _LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
 def _axis(ds, name):
     label, k, unit = _LABELS.get(name, (name, 1.0, ds[name].attrs.get("units", "")))
     return ds[name].values * k, f"{label} ({unit})"
-
-
-def _label(name: str, da) -> str:
-    u = da.attrs.get("units", "")
-    return f"{name} ({u})" if u not in ("", "1") else name
 
 
 def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
@@ -39,7 +34,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
             pairs = (("poincare_v", "crosshead velocity v (m/s)"),
                      ("poincare_theta_c", "clearance angle theta_c (rad)"))  # fmt: skip
         else:  # any other model: every recorded section signal
-            pairs = tuple((k, _label(k.removeprefix("poincare_"), ds[k]))
+            pairs = tuple((k, axis_label(k.removeprefix("poincare_"), ds[k]))
                           for k in ds.data_vars if k.startswith("poincare_")
                           and k != "poincare_distinct")  # fmt: skip
         if pairs:

@@ -41,7 +41,7 @@ import xarray as xr
 from .. import __version__
 from ..errors import Interrupted, ParameterError, deferred_signals
 from ..locking import RunLock
-from ..parallel import process_pool, stop_pool
+from ..parallel import run_unordered
 from ..simulate import clean_attrs
 from .spec import SweepSpec
 from .work import N_PEAKS, run_point
@@ -376,35 +376,8 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
     return store
 
 
-_POLL = 0.2  # s: how often the coordinator looks for a signal while waiting for workers
-
-
 def _run_processes(tasks, workers, accept, pending) -> None:
-    from concurrent.futures import FIRST_COMPLETED, wait
-
-    workers = workers or os.cpu_count() or 1
-    tasks = iter(tasks)
-    pool = process_pool(workers)
-    try:
-        pending_f: set = set()
-        exhausted = False
-        while True:
-            while not exhausted and len(pending_f) < 2 * workers:  # bounded queue
-                task = next(tasks, None)
-                if task is None:
-                    exhausted = True
-                    break
-                pending_f.add(pool.submit(run_point, task))
-            if not pending_f:
-                break
-            finished, pending_f = wait(pending_f, timeout=_POLL, return_when=FIRST_COMPLETED)
-            for f in finished:
-                accept(f.result())
-            pending.check()
-    except BaseException:
-        stop_pool(pool)
-        raise
-    pool.shutdown(wait=True)
+    run_unordered(run_point, tasks, workers or os.cpu_count() or 1, accept, pending)
 
 
 def _run_dask(tasks, dask_local, scheduler, workers, accept, pending) -> None:

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..defaults import ATOL, RTOL
-from ..errors import ParameterError
+from ..errors import ParameterError, is_number
 from ..model.parameters import CompressorParams, resolve_name
 from ..model.protocol import Model
 from ..model.registry import get_model
@@ -37,8 +37,7 @@ MAX_POINTS = 10_000_000
 def _finite(v) -> bool:
     import math
 
-    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) \
-        and math.isfinite(v)  # fmt: skip
+    return is_number(v) and math.isfinite(v)
 
 
 @dataclass(frozen=True)
