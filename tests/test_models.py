@@ -230,3 +230,68 @@ def test_analyze_any_model(tmp_path, name, args, check):
     assert s["verdict"]["verdict"] == "chaotic", s["verdict"]
     assert check(s), s["lyapunov_equations"]
     assert (out / "phase_portraits.png").stat().st_size > 5000
+
+
+def test_declared_events_are_recorded_consistently(model):
+    """Models that declare events: each recorded event lies in the recorded interval, in time
+    order, on the event surface (|g| at the located state ~ the root finder's tolerance)."""
+    v = model.parameters()
+    events = model.events(v) if model.kind == "ode" else ()
+    if not events:
+        pytest.skip(f"{model.name} declares no events")
+    e = events[0]
+    ds = recipdyn.simulate(model=model, revolutions=30, fs=50.0)
+    t_ev = ds[f"{e.name}_time"].values
+    assert t_ev.size > 0 and np.all(np.diff(t_ev) > 0)
+    assert ds.time.values[0] <= t_ev[0] and t_ev[-1] <= ds.time.values[-1]
+    s = model.system(v)
+    for k in range(t_ev.size):
+        y = np.array([ds[f"{e.name}_{n}"].values[k] for n in model.state_names])
+        assert abs(e.function(float(t_ev[k]), y, s.params)) < 1e-9 * max(1.0, np.abs(y).max())
+    assert ds[f"{e.name}_time"].attrs["units"] == model.time_unit
+
+
+class _Ball(recipdyn.model.protocol.Model):
+    """A test model with a reset event: a ball dropped on a fixed floor, restitution e."""
+
+    name = "test-ball"
+    description = "ball on a floor"
+    state_names = ("y", "v")
+    state_units = ("m", "m/s")
+    schema = recipdyn.model.protocol.Schema((
+        recipdyn.model.protocol.Param("e", "", 0.8, "restitution", 0.0, 1.0),
+    ))  # fmt: skip
+
+    def system(self, values):
+        from test_events import _fall
+
+        return ODESystem(rhs=_fall, params=np.array([9.81, values["e"]]),
+                         state_names=self.state_names, name=self.name)  # fmt: skip
+
+    def initial_state(self, values):
+        return np.array([2.0, 0.0])
+
+    def period(self, values):
+        return None
+
+    def events(self, values):
+        from test_events import _bounce, _ground
+
+        return (recipdyn.model.protocol.Event("impact", _ground, -1, "reset", _bounce),)
+
+
+def test_reset_events_through_simulate_and_lyapunov_refused(tmp_path):
+    """simulate records the state before and after every impact (the delivered restitution is
+    exact); Lyapunov exponents are refused up front, not computed wrongly without saltation."""
+    from recipdyn.model.registry import register
+    from recipdyn.sweep import SweepSpec, parse_axis
+
+    m = register(_Ball())
+    ds = recipdyn.simulate(model=m, revolutions=3.0, fs=100.0)
+    before, after = ds.impact_v.values, ds.impact_v_after.values
+    assert before.size >= 2
+    np.testing.assert_allclose(after / -before, 0.8, rtol=1e-12)
+    with pytest.raises(ParameterError, match="saltation"):
+        SweepSpec(axes=(parse_axis("e=0.5:0.9:3", m),), measures=("lyapunov",),
+                  settings=dict(points=5, revolutions=1.0, transient=0.0, lyap_revolutions=1.0,
+                                fs=100.0), model="test-ball")  # fmt: skip

@@ -209,6 +209,10 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     t0 = float(ds[dim].values[0])
     pair = m.state_names[:2] if m.dim >= 2 else m.state_names * 2
     lam, lam_err, section, k01 = None, 0.0, None, None
+    if not m.lyapunov_supported(values):
+        summary["lyapunov_equations"] = {"refused": "the model's events reset the state; "
+                                         "Benettin would need saltation matrices"}  # fmt: skip
+        return None, 0.0, None, None
     if m.kind == "map":
         section = np.c_[tuple(ds[s].values for s in pair)]
         res = lyapunov_spectrum_map(system, y0, max(1000, int(lyap_revolutions)), n_transient=0)
@@ -263,10 +267,13 @@ def _markdown(s: dict[str, Any]) -> str:
     for p in s["spectrum"]["peaks"]:
         lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} | {p['crank_order']} |")
     lines += ["", "## Lyapunov exponents", ""]
-    if "lyapunov_equations" in s:
-        le = s["lyapunov_equations"]
+    le = s.get("lyapunov_equations")
+    if le and "refused" in le:
+        lines.append(f"- Benettin (equations): refused — {le['refused']}")
+    elif le:
+        unit = le.get("units", "1/s")
         lines.append(
-            f"- Benettin (equations): {le['exponents_per_s']} 1/s, sum {le['sum_per_s']:.3g}"
+            f"- Benettin (equations): {le['exponents_per_s']} ({unit}), sum {le['sum_per_s']:.3g}"
         )
     for name, r in s["lyapunov_signal"].items():
         lines.append(f"- {name} (acceleration signal): {r.get('exponent_per_s', r.get('error'))}")

@@ -128,13 +128,17 @@ def write_error(path: Path, exc: BaseException) -> OSError:
 def _write_csv(ds, path: Path) -> None:
     import numpy as np
 
-    names = [k for k in ds.data_vars if ds[k].ndim == 1]
-    dim = ds[names[0]].dims[0] if names else next(iter(ds.dims))
+    dim = next((d for d in ("time", "iteration") if d in ds.dims), next(iter(ds.dims)))
+    names = [k for k in ds.data_vars if ds[k].dims == (dim,)]
+    other = [k for k in ds.data_vars if ds[k].dims != (dim,)]
     cols = [dim, *names]
     head = [f"{c} [{ds[c].attrs.get('units', '')}]" for c in cols]
     with open(path, "w", encoding="utf-8") as fh:
         for k, v in ds.attrs.items():
             fh.write(f"# {k} = {str(v).replace(chr(10), ' ')}\n")
+        if other:  # e.g. event records: another dimension, not a column of this table
+            fh.write(f"# not in this table (other dimensions; use .nc or .zarr): "
+                     f"{', '.join(other)}\n")  # fmt: skip
         fh.write(",".join(head) + "\n")
         np.savetxt(fh, np.column_stack([ds[c].values for c in cols]), delimiter=",", fmt="%.17g")
 

@@ -88,8 +88,8 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
     """Any model's record: up to three signals over time (or iteration) and a phase portrait
     of the first two (points for a map)."""
     plt = _mpl()
-    names = [k for k in ds.data_vars if ds[k].ndim == 1][:3]
-    dim = ds[names[0]].dims[0]
+    dim = "iteration" if "iteration" in ds.dims else "time"
+    names = [k for k in ds.data_vars if ds[k].dims == (dim,)][:3]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     t = ds[dim].values
     is_map = dim == "iteration"

@@ -322,11 +322,20 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     t_start = transient * T
     t_eval = t_start + np.arange(int(math.floor(n_float + 1e-9)) + 1) / fs
     failure = None
+    events = m.events(values)
+    if len(events) > 1:
+        raise ParameterError(f"model {m.name!r} declares {len(events)} events; the integrator "
+                             "locates one event function")  # fmt: skip
+    ev_kw = {}
+    if events:
+        e = events[0]
+        ev_kw = dict(event=e.function, event_direction=e.direction, event_action=e.action,
+                     reset=e.reset)  # fmt: skip
     t0 = time.perf_counter()
     try:
         sol = integrate(
             system, y0, (0.0, t_eval[-1]), method=method, rtol=rtol, atol=atol, h=h,
-            t_eval=t_eval, chunks=max(1, min(1000, int(transient + revolutions))),
+            t_eval=t_eval, chunks=max(1, min(1000, int(transient + revolutions))), **ev_kw,
         )  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
         failure, sol = exc, exc.partial
@@ -336,9 +345,27 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
                  solver_status=sol.message, solver_wall_time_s=time.perf_counter() - t0,
                  sampling_rate_hz=fs)  # fmt: skip
     ds = _dataset(m, values, sol.t, sol.y, "time", m.time_unit, attrs)
+    if events:
+        ds = _with_events(ds, m, events[0], sol, t_start)
     if failure is not None:
         failure.dataset = ds
         raise failure
+    return ds
+
+
+def _with_events(ds: xr.Dataset, m: Model, e, sol, t_start: float) -> xr.Dataset:
+    """The event records of the recorded interval, over an ``NAME_event`` dimension."""
+    keep = sol.t_events >= t_start
+    dim = f"{e.name}_event"
+    ds[f"{e.name}_time"] = (dim, sol.t_events[keep], {"units": m.time_unit,
+                            "long_name": f"time of {e.name}: {e.description}"})  # fmt: skip
+    for i, (s, u) in enumerate(zip(m.state_names, m.state_units, strict=True)):
+        ds[f"{e.name}_{s}"] = (dim, sol.y_events[keep, i], {"units": u,
+                               "long_name": f"{s} at {e.name}"})  # fmt: skip
+        if e.action == "reset":
+            ds[f"{e.name}_{s}_after"] = (dim, sol.y_events_after[keep, i], {"units": u,
+                                         "long_name": f"{s} after {e.name}"})  # fmt: skip
+    ds.attrs[f"events_{e.name}"] = f"{e.description} (direction {e.direction}, {e.action})"
     return ds
 
 

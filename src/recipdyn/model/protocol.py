@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import ParameterError, is_number
 from .base import DiscreteMap, ODESystem, Signal
 
-__all__ = ["Param", "Schema", "Model"]
+__all__ = ["Param", "Schema", "Model", "Event"]
 
 
 @dataclass(frozen=True)
@@ -191,6 +191,34 @@ class Schema:
                      description=p.description) for p in self.params]  # fmt: skip
 
 
+@dataclass(frozen=True)
+class Event:
+    """An event a model declares: crossings of ``function(t, y, p) = 0``.
+
+    Attributes
+    ----------
+    name : str
+        Prefix of the recorded variables (``NAME_time``, ``NAME_<state>``,
+        ``NAME_<state>_after``).
+    function : numba function
+        ``g(t, y, p) -> float`` compiled with :data:`~recipdyn.model.base.EVENT_SIGNATURE`.
+    direction : int
+        +1 rising, -1 falling, 0 both.
+    action : {"record", "terminal", "reset"}
+        Only recorded; ends the run; or ``reset(t, y, p, out)`` sets the state (impact laws).
+    reset : numba function, optional
+        With ``action="reset"``, compiled with :data:`~recipdyn.model.base.RHS_SIGNATURE`.
+    description : str
+    """
+
+    name: str
+    function: Callable[..., float]
+    direction: int = 0
+    action: str = "record"
+    reset: Callable[..., None] | None = None
+    description: str = ""
+
+
 class Model(ABC):
     """Base class of registered models (see the module docstring).
 
@@ -217,6 +245,16 @@ class Model(ABC):
 
     def vibration(self) -> tuple[str, str]:
         return self.vibration_signal or (self.state_names[0], self.state_units[0])
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        """Events to locate during a simulation (at most one today: the integrator locates
+        one event function). Default: none."""
+        return ()
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        """Benettin's method needs a smooth flow: a state reset would need its saltation
+        matrix in the tangent integration, which recipdyn does not have yet."""
+        return not any(e.action == "reset" for e in self.events(values))
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov

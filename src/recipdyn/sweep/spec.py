@@ -144,6 +144,15 @@ class SweepSpec:
             from ..integrate.solve import check_tolerances
 
             check_tolerances(self.settings.get("rtol", RTOL), self.settings.get("atol", ATOL))
+        if (
+            {"lyapunov", "verdict"} & set(self.measures)
+            and not isinstance(self.base, CompressorParams)
+            and not m.lyapunov_supported(self.base)
+        ):
+            raise ParameterError(
+                f"--measure lyapunov/verdict: not available for model {m.name!r}, whose events "
+                "reset the state (the tangent integration would need saltation matrices)"
+            )
         n = self.n_points
         if n > MAX_POINTS:
             raise ParameterError(

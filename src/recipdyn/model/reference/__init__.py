@@ -14,8 +14,8 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
-from ..protocol import Model, Param, Schema
+from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
+from ..protocol import Event, Model, Param, Schema
 from . import systems
 
 __all__ = ["Duffing", "Lorenz", "Henon", "DUFFING", "LORENZ", "HENON", "systems"]
@@ -33,6 +33,11 @@ def _duffing(t, y, p, out):
 def _duffing_jac(t, y, p, J):
     J[0, 0], J[0, 1] = 0.0, 1.0
     J[1, 0], J[1, 1] = -p[1] - 3.0 * p[2] * y[0] ** 2, -p[0]
+
+
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def _x_zero(t, y, p):
+    return y[0]
 
 
 class Duffing(Model):
@@ -71,6 +76,10 @@ class Duffing(Model):
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["w"])
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        """Well crossings: x through 0 upward (left well -> right well), recorded."""
+        return (Event("crossing", _x_zero, direction=1, description="x crosses 0 upward"),)
 
 
 class Lorenz(Model):
