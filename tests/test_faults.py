@@ -120,6 +120,11 @@ def load_store(path: Path) -> dict[str, np.ndarray]:
 
 def assert_same_store(a: dict, b: dict):
     assert a.keys() == b.keys()
+    assert np.array_equal(a["done"], b["done"]), (a["done"], b["done"])
+    assert [str(x) for x in a["error"].ravel()] == [str(x) for x in b["error"].ravel()], (
+        a["error"],
+        b["error"],
+    )
     for k in a:
         if a[k].dtype.kind == "f":
             assert np.array_equal(a[k], b[k], equal_nan=True), k

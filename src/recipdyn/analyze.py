@@ -155,8 +155,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
             res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
                                     rtol=rtol, atol=atol)  # fmt: skip
             lam = float(res.exponents[0])
-            tail = res.history[len(res.history) // 2 :, 0]
-            lam_err = float(np.std(tail)) if tail.size > 1 else 0.0
+            lam_err = _spread(res)
             summary["lyapunov_equations"] = {
                 "exponents_per_s": res.exponents.tolist(),
                 "exponents_per_revolution": res.per_period.tolist(),
@@ -175,6 +174,12 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
+
+
+def _spread(res) -> float:
+    """Uncertainty of lambda1: the spread of its running estimate over the second half."""
+    tail = res.history[len(res.history) // 2 :, 0]
+    return float(np.std(tail)) if tail.size > 1 else 0.0
 
 
 def _record_model(ds, path):
@@ -234,8 +239,7 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
                                 rtol=rtol, atol=atol)  # fmt: skip
         unit = f"per {m.time_unit}"
     lam = float(res.exponents[0])
-    tail = res.history[len(res.history) // 2 :, 0]
-    lam_err = float(np.std(tail)) if tail.size > 1 else 0.0
+    lam_err = _spread(res)
     summary["lyapunov_equations"] = {
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
         "spread_second_half": lam_err, "revolutions": lyap_revolutions,

@@ -29,8 +29,7 @@ from .defaults import SIMULATION
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
-__all__ = ["SimulationConfig", "RunConfig", "load_config", "read_config", "build_params",
-           "model_values"]  # fmt: skip
+__all__ = ["SimulationConfig", "RunConfig", "read_config", "build_params", "model_values"]
 
 _STRING_FIELDS = {"load_sign", "equations"}
 
@@ -104,15 +103,6 @@ def read_config(path: str | Path) -> RunConfig:
         first = exc.errors()[0]
         loc = ".".join(str(x) for x in first["loc"])
         raise ParameterError(f"config {path}: {loc}: {first['msg']}") from None
-
-
-def load_config(path: str | Path) -> tuple[CompressorParams, dict[str, Any]]:
-    """Read a TOML config of the compressor; returns ``(params, simulation settings in SI)``."""
-    cfg = read_config(path)
-    if cfg.model not in (None, "compressor"):
-        raise ParameterError(f"config {path}: model {cfg.model!r}; this command needs the "
-                             "compressor (or pass --model)")  # fmt: skip
-    return build_params(cfg.params), cfg.simulation.resolved()
 
 
 def model_values(model, values: dict[str, Any]) -> dict[str, Any]:

@@ -15,7 +15,7 @@ import contextlib
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from pathlib import Path
 
 from .errors import ParameterError
@@ -154,7 +154,7 @@ def save_figure(fig, path: str | Path, **kw) -> Path:
     return path
 
 
-def read_dataset(path: str | Path, *, required: Sequence[str] = (), what: str = "input",
+def read_dataset(path: str | Path, *, what: str = "input",
                  expected: str = "a recipdyn run (NetCDF from 'recipdyn simulate')"):  # fmt: skip
     """Open a NetCDF file as a loaded Dataset, refusing clearly when it is not what is needed."""
     import xarray as xr
@@ -172,12 +172,6 @@ def read_dataset(path: str | Path, *, required: Sequence[str] = (), what: str = 
     except Exception as exc:  # netCDF4/h5netcdf/xarray raise assorted errors on foreign files
         raise ParameterError(f"{what} {path}: cannot be read as NetCDF "
                              f"({type(exc).__name__}); expected {expected}") from None  # fmt: skip
-    missing = [v for v in required if v not in ds.variables]
-    if missing:
-        raise ParameterError(f"{what} {path}: variable(s) {', '.join(missing)} missing; "
-                             f"expected {expected}")  # fmt: skip
-    if required and ds.sizes.get(ds[required[0]].dims[0] if ds[required[0]].dims else "", 0) == 0:
-        raise ParameterError(f"{what} {path}: holds no samples")
     return ds
 
 

@@ -13,49 +13,32 @@ _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (d
     "of the available memory)."  # fmt: skip
 
 
-def _collect(rc, d, omega, sets, config):
-    from ..config import build_params, load_config
-    from ..units import parse_assignment
-
-    settings: dict = {}
-    if config is not None:
-        params, settings = load_config(config)
-    else:
-        from ..model.parameters import CompressorParams
-
-        params = CompressorParams()
-    values = {}
-    for name, val in (("rc", rc), ("d", d), ("omega", omega)):
-        if val is not None:
-            values[name] = val
-    for item in sets or []:
-        k, v = parse_assignment(item)
-        values[k] = v
-    return build_params(values, params), settings
-
-
 def _collect_model(model, rc, d, omega, sets, config):
-    """(model, parameters, simulation settings) from the options and an optional config."""
-    from ..config import model_values, read_config
+    """(model, parameters, simulation settings) from the options and an optional config.
+
+    For the compressor the parameters are a CompressorParams (``--rc/--d/--omega`` allowed),
+    for any other model a dict of its schema's values.
+    """
+    from ..config import build_params, model_values, read_config
+    from ..errors import ParameterError
     from ..model.registry import get_model
     from ..units import parse_assignment
 
     cfg = read_config(config) if config is not None else None
     m = get_model(model or (cfg.model if cfg is not None else None))
-    if m.name == "compressor":
-        params, settings = _collect(rc, d, omega, sets, config)
-        return m, params, settings
-    given = [f"--{n}" for n, v in (("rc", rc), ("d", d), ("omega", omega)) if v is not None]
-    if given:
-        from ..errors import ParameterError
-
-        raise ParameterError(f"{', '.join(given)}: compressor options; for model {m.name!r} use "
-                             "--set NAME=VALUE (see 'recipdyn models " + m.name + "')")  # fmt: skip
+    settings = cfg.simulation.resolved() if cfg is not None else {}
     values = dict(cfg.params) if cfg is not None else {}
+    options = {n: v for n, v in (("rc", rc), ("d", d), ("omega", omega)) if v is not None}
+    if options and m.name != "compressor":
+        raise ParameterError(f"{', '.join('--' + n for n in options)}: compressor options; for "
+                             f"model {m.name!r} use --set NAME=VALUE (see 'recipdyn models "
+                             f"{m.name}')")  # fmt: skip
+    values.update(options)  # the config, then the options, then --set (last wins)
     for item in sets or []:
         k, v = parse_assignment(item)
         values[k] = v
-    settings = cfg.simulation.resolved() if cfg is not None else {}
+    if m.name == "compressor":
+        return m, build_params(values), settings
     return m, model_values(m, values), settings
 
 

@@ -244,6 +244,7 @@ class Compressor(Model):
     section_signals = (("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
                        ("a", "m/s**2"))  # fmt: skip
     vibration_signal = ("a", "m/s**2")
+    section_pair = ("v", "a")
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics

@@ -238,10 +238,16 @@ class Model(ABC):
     #: The measured vibration signal (peak, RMS and spectrum in sweeps): (name, unit); empty =
     #: the first state component.
     vibration_signal: tuple[str, str] = ()
+    #: Two section signals whose points are counted for periodicity (default: the first two).
+    section_pair: tuple[str, str] = ()
 
     def sections(self) -> tuple[tuple[str, str], ...]:
         return self.section_signals or tuple(zip(self.state_names, self.state_units,
                                                  strict=True))  # fmt: skip
+
+    def pair(self) -> tuple[str, str]:
+        names = [k for k, _ in self.sections()]
+        return self.section_pair or tuple((names * 2)[:2])
 
     def vibration(self) -> tuple[str, str]:
         return self.vibration_signal or (self.state_names[0], self.state_units[0])

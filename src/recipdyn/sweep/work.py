@@ -74,6 +74,7 @@ class _Point:
             self.fc = 1.0 / period if period else None
             self.dynamic = m.has_dynamics(p)
         self.sections = [k for k, _ in m.sections()]
+        self.pair = m.pair()
         self.vib = m.vibration()[0]
 
 
@@ -96,8 +97,9 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         outs = pt.outputs(sol.t, sol.y)
         for k in pt.sections:
             res[f"poincare_{k}"] = outs[k].values
-        pair = pt.sections[-2:] if pt.model.name == "compressor" else pt.sections[:2]
-        res["poincare_distinct"] = count_distinct_points(np.c_[tuple(outs[k].values for k in pair)])
+        res["poincare_distinct"] = count_distinct_points(
+            np.c_[tuple(outs[k].values for k in pt.pair)]
+        )
         y_end, t_end = sol.y_final, sol.t_final
     else:
         y_end, t_end = y, 0.0
@@ -125,9 +127,8 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         else:
             res["lambda1"], res["lambda_sum"] = 0.0, 0.0
     if "verdict" in measures:
-        pair = pt.sections[-2:] if pt.model.name == "compressor" else pt.sections[:2]
         v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL),
-                     section=np.c_[tuple(res[f"poincare_{k}"] for k in pair)])  # fmt: skip
+                     section=np.c_[tuple(res[f"poincare_{k}"] for k in pt.pair)])  # fmt: skip
         res["verdict"] = v.verdict
     # final state, for continuation: integrate to a whole number of periods after t_end
     res["y_final"] = np.asarray(y_end, dtype=float)
@@ -150,7 +151,7 @@ def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
     for k in pt.sections:
         res[f"poincare_{k}"] = outs[k].values[:k_pts]
     res["poincare_distinct"] = count_distinct_points(
-        np.c_[tuple(outs[k].values[:k_pts] for k in pt.sections[:2])]
+        np.c_[tuple(outs[k].values[:k_pts] for k in pt.pair)]
     )
     a = outs[pt.vib].values
     if "peak" in measures or "spectrum" in measures:
@@ -168,7 +169,7 @@ def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
                                   n_transient=n0)  # fmt: skip
         res["lambda1"], res["lambda_sum"] = float(r.exponents[0]), float(r.sum)
     if "verdict" in measures:
-        sec = np.c_[tuple(res[f"poincare_{k}"] for k in pt.sections[:2])]
+        sec = np.c_[tuple(res[f"poincare_{k}"] for k in pt.pair)]
         v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL), section=sec)
         res["verdict"] = v.verdict
     res["y_final"] = np.asarray(orbit[-1], dtype=float)
