@@ -249,6 +249,11 @@ def test_declared_events_are_recorded_consistently(model):
         y = np.array([ds[f"{e.name}_{n}"].values[k] for n in model.state_names])
         assert abs(e.function(float(t_ev[k]), y, s.params)) < 1e-9 * max(1.0, np.abs(y).max())
     assert ds[f"{e.name}_time"].attrs["units"] == model.time_unit
+    # an event that acts is part of the dynamics: the compiled system carries it, so every
+    # integration (sections, sweeps, Lyapunov) applies it, not only simulate
+    for ev in events:
+        if ev.action != "record":
+            assert s.acting_event is not None and s.acting_event.function is ev.function
 
 
 class _Ball(recipdyn.model.protocol.Model):
@@ -280,9 +285,10 @@ class _Ball(recipdyn.model.protocol.Model):
         return (recipdyn.model.protocol.Event("impact", _ground, -1, "reset", _bounce),)
 
 
-def test_reset_events_through_simulate_and_lyapunov_refused(tmp_path):
+def test_reset_events_through_simulate_and_a_lyapunov_sweep(tmp_path):
     """simulate records the state before and after every impact (the delivered restitution is
-    exact); Lyapunov exponents are refused up front, not computed wrongly without saltation."""
+    exact); a sweep of a model with impacts computes exponents through the saltation matrices
+    (their exact sum is checked in test_events.py); here: the sweep applies the impacts."""
     from recipdyn.model.registry import register
     from recipdyn.sweep import SweepSpec, parse_axis
 
@@ -291,7 +297,16 @@ def test_reset_events_through_simulate_and_lyapunov_refused(tmp_path):
     before, after = ds.impact_v.values, ds.impact_v_after.values
     assert before.size >= 2
     np.testing.assert_allclose(after / -before, 0.8, rtol=1e-12)
-    with pytest.raises(ParameterError, match="saltation"):
-        SweepSpec(axes=(parse_axis("e=0.5:0.9:3", m),), measures=("lyapunov",),
-                  settings=dict(points=5, revolutions=1.0, transient=0.0, lyap_revolutions=1.0,
-                                fs=100.0), model="test-ball")  # fmt: skip
+    from recipdyn.sweep import open_sweep, run_sweep
+
+    io = recipdyn.model.registry.get_model("impact-oscillator")
+    spec = SweepSpec(axes=(parse_axis("r=0.5:0.9:2", io),), measures=("lyapunov", "poincare"),
+                     settings=dict(points=20, revolutions=5.0, transient=20.0,
+                                   lyap_revolutions=50.0, fs=20.0),
+                     model="impact-oscillator")  # fmt: skip
+    res = open_sweep(run_sweep(spec, tmp_path / "io", backend="serial", progress=False))
+    # every section point lies on the permitted side of the stop (x <= sigma = 0): without
+    # the resets the free oscillator (amplitude ~0.7/|1 - w^2| + the initial offset) crosses it
+    assert float(res.poincare_x.max()) <= 1e-9
+    # the exponent sum is below -2 zeta: the impacts contract phase volume by r**2 each
+    assert np.all(res.lambda_sum.values < -2 * 0.05 - 1e-3)

@@ -215,8 +215,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     pair = m.state_names[:2] if m.dim >= 2 else m.state_names * 2
     lam, lam_err, section, k01 = None, 0.0, None, None
     if not m.lyapunov_supported(values):
-        summary["lyapunov_equations"] = {"refused": "the model's events reset the state; "
-                                         "Benettin would need saltation matrices"}  # fmt: skip
+        summary["lyapunov_equations"] = {"refused": f"model {m.name!r} does not support "
+                                         "Benettin's method"}  # fmt: skip
         return None, 0.0, None, None
     if m.kind == "map":
         section = np.c_[tuple(ds[s].values for s in pair)]

@@ -13,7 +13,7 @@ import xarray as xr
 from . import __version__
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, is_number
-from .integrate import IntegrationError, integrate
+from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
@@ -280,8 +280,8 @@ def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
             raise ParameterError(f"{name} = {val!r} out of range; allowed: > {lo:g}")
     if not (is_number(transient) and math.isfinite(transient) and transient >= 0):
         raise ParameterError(f"transient = {transient!r} out of range; allowed: >= 0")
-    if method not in ("dop853", "rk4"):
-        raise ParameterError(f"method = {method!r}; allowed: dop853, rk4")
+    if method not in METHODS:
+        raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
     check_tolerances(rtol, atol)
 
 

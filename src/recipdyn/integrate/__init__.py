@@ -1,11 +1,11 @@
 """Compiled integrators for any :class:`~recipdyn.model.base.ODESystem`."""
 
-from .solve import METHODS, IntegrationError, Solution, integrate, propagate
+from .solve import METHODS, IntegrationError, Method, Solution, integrate, propagate
 from .tableaus import RK4, Tableau, dop853
 
 # DOP853 (the tableau) is built on first access (module __getattr__ below).
 __all__ = [
-    "integrate", "propagate", "Solution", "IntegrationError", "METHODS", "RK4", "Tableau",
+    "integrate", "propagate", "Solution", "IntegrationError", "METHODS", "Method", "RK4", "Tableau",
     "dop853",
 ]  # fmt: skip
 

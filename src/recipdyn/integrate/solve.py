@@ -8,7 +8,8 @@ Methods (registry :data:`METHODS`):
     are root-found on the dense output. Counts ``nfev``, ``nsteps`` and ``nreject``.
 ``"rk4"``
     Classical fixed-step RK4 (the paper's method) with step ``h`` (at most), landing exactly on
-    every output time.
+    every output time; run from its tableau by the generic fixed-step kernel, like any explicit
+    tableau added to :data:`METHODS`.
 
 Long runs can be split into chunks so a progress bar can advance; a chunk ends after the first
 step that reaches its boundary (the step is not shortened), so the results are bit-identical
@@ -26,12 +27,29 @@ import numpy as np
 from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
 from ..errors import Interrupted, ParameterError, deferred_signals, is_number
 from ..model.base import ODESystem
-from . import _kernels
-from .tableaus import dop853
+from . import kernels as _kernels
+from .tableaus import RK4, Tableau, dop853
 
-__all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS"]
+__all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS", "Method"]
 
-METHODS = ("dop853", "rk4")
+
+@dataclass(frozen=True)
+class Method:
+    """An integration method as data: its tableau and how its step is chosen."""
+
+    name: str
+    tableau: Callable[[], Tableau]
+    adaptive: bool
+    description: str
+
+
+#: The registry of methods: adaptive ones run :func:`kernels.dop853_kernel` (error control and
+#: dense output of DOP853), fixed-step ones run :func:`kernels.fixed_step_kernel` on any
+#: explicit tableau.
+METHODS: dict[str, Method] = {
+    "dop853": Method("dop853", dop853, True, "Dormand-Prince 8(5,3), adaptive, dense output"),
+    "rk4": Method("rk4", lambda: RK4, False, "classical Runge-Kutta, fixed step h"),
+}
 _MESSAGES = {
     0: "reached the end of the interval",
     1: "stopped at an event (terminal event or the requested number of events)",
@@ -108,8 +126,9 @@ def _check_inputs(system, y0, t_span, method, rtol, atol, h):
     if method not in METHODS:
         raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
     check_tolerances(rtol, atol)
-    if method == "rk4" and (h is None or not (is_number(h) and h > 0 and math.isfinite(h))):
-        raise ParameterError(f"h = {h!r}: method 'rk4' needs a step h > 0 s (finite)")
+    fixed = not METHODS[method].adaptive
+    if fixed and (h is None or not (is_number(h) and h > 0 and math.isfinite(h))):
+        raise ParameterError(f"h = {h!r}: method {method!r} needs a step h > 0 s (finite)")
     return y0, t0, t1
 
 
@@ -158,7 +177,8 @@ def integrate(
     max_step : float
         DOP853 maximum step.
     event : numba function ``g(t, y, p) -> float``, optional
-        Record crossings of ``g = 0`` (DOP853 only), root-found on the dense output;
+        Default: the system's own acting event (``system.events``), if it has one. Record
+        crossings of ``g = 0`` (DOP853 only), root-found on the dense output;
         ``event_direction`` +1 rising, -1 falling, 0 both; ``max_events`` caps the count
         (and stops the integration when reached; 0 = capacity only, default 100 000).
     event_action : {"record", "terminal", "reset"}
@@ -174,6 +194,16 @@ def integrate(
         Raise :class:`IntegrationError` (with the partial solution) on failure.
     """
     y0, t0, t1 = _check_inputs(system, y0, t_span, method, rtol, atol, h)
+    own = system.acting_event
+    if own is not None:  # the model's impact law (or stop) is part of its dynamics
+        if event is None:
+            event, event_direction, event_action = own.function, own.direction, own.action
+            reset = own.reset
+        elif event is not own.function:
+            raise ParameterError(
+                f"system {system.name!r} has its own {own.action} event {own.name!r}; the "
+                "integrator locates one event function, so another one cannot be added"
+            )
     rtol, atol, max_step, max_steps = float(rtol), float(atol), float(max_step), int(max_steps)
     if t_eval is None:
         t_eval = np.array([t0, t1])
@@ -188,7 +218,7 @@ def integrate(
         raise ParameterError("event_action 'reset' needs a reset function")
     if event_action != "record" and not use_event:
         raise ParameterError(f"event_action {event_action!r} needs an event function")
-    if use_event and method != "dop853":
+    if use_event and not METHODS[method].adaptive:
         raise ParameterError("events need method 'dop853' (located on its dense output)")
     action = actions[event_action]
     reset_fn = reset if reset is not None else _kernels.no_reset
@@ -209,7 +239,7 @@ def integrate(
     status = 0
     n_out = 0
     interrupted = 0
-    tab = dop853() if method == "dop853" else None
+    tab = METHODS[method].tableau()
     with deferred_signals() as pending:
         for t_stop in stops:
             if t >= t_stop and t_stop < t1:
@@ -219,7 +249,7 @@ def integrate(
                 break
             stats = np.zeros(5, dtype=np.int64)
             fstate = np.zeros(2)
-            if method == "dop853":
+            if METHODS[method].adaptive:
                 ev_cap = cap - len(ev_t) if use_event else 0
                 et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
                 ey2 = np.empty((ev_cap, system.dim))
@@ -233,9 +263,9 @@ def integrate(
                 ev_y.extend(ey[: stats[4]])
                 ev_y2.extend(ey2[: stats[4]])
             else:
-                status = _kernels.rk4_kernel(
+                status = _kernels.fixed_step_kernel(
                     system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
-                    max_steps - nsteps, Y[n_out:], stats, fstate,
+                    max_steps - nsteps, Y[n_out:], stats, fstate, tab.A, tab.B, tab.C,
                 )  # fmt: skip
             t, h_abs = float(fstate[0]), float(fstate[1])
             nf, ns, nr, k_out = (int(x) for x in stats[:4])

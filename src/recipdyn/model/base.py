@@ -41,8 +41,8 @@ import numpy as np
 from numba import types as _nbt
 
 __all__ = [
-    "ODESystem", "DiscreteMap", "Signal", "RHS_SIGNATURE", "JAC_SIGNATURE", "EVENT_SIGNATURE",
-    "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE",
+    "ODESystem", "DiscreteMap", "Signal", "Event", "RHS_SIGNATURE", "JAC_SIGNATURE",
+    "EVENT_SIGNATURE", "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE",
 ]  # fmt: skip
 
 #: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
@@ -81,6 +81,34 @@ class Signal:
 
 
 @dataclass(frozen=True)
+class Event:
+    """An event a model declares: crossings of ``function(t, y, p) = 0``.
+
+    Attributes
+    ----------
+    name : str
+        Prefix of the recorded variables (``NAME_time``, ``NAME_<state>``,
+        ``NAME_<state>_after``).
+    function : numba function
+        ``g(t, y, p) -> float`` compiled with :data:`~recipdyn.model.base.EVENT_SIGNATURE`.
+    direction : int
+        +1 rising, -1 falling, 0 both.
+    action : {"record", "terminal", "reset"}
+        Only recorded; ends the run; or ``reset(t, y, p, out)`` sets the state (impact laws).
+    reset : numba function, optional
+        With ``action="reset"``, compiled with :data:`~recipdyn.model.base.RHS_SIGNATURE`.
+    description : str
+    """
+
+    name: str
+    function: Callable[..., float]
+    direction: int = 0
+    action: str = "record"
+    reset: Callable[..., None] | None = None
+    description: str = ""
+
+
+@dataclass(frozen=True)
 class ODESystem:
     """A first-order ODE ``dy/dt = f(t, y; p)`` with compiled kernels.
 
@@ -106,6 +134,10 @@ class ODESystem:
         Short identifier.
     attrs : mapping
         Extra metadata (every input parameter) copied into result attributes.
+    events : tuple of Event
+        The model's events. One that acts (``reset`` or ``terminal``) is part of the dynamics:
+        :func:`recipdyn.integrate.integrate` and the Lyapunov integration apply it whenever
+        they are not given another event function.
     """
 
     rhs: Callable[..., Any]
@@ -117,6 +149,17 @@ class ODESystem:
     state_units: tuple[str, ...] | None = None
     name: str = "ode"
     attrs: Mapping[str, Any] = field(default_factory=dict)
+    events: tuple[Event, ...] = ()
+
+    @property
+    def acting_event(self) -> Event | None:
+        """The event that is part of the dynamics (reset or terminal), if any."""
+        return next((e for e in self.events if e.action != "record"), None)
+
+    def __post_init__(self) -> None:
+        # The kernels are compiled for float64 arrays: cast at the boundary (integer
+        # parameters would otherwise fail to dispatch inside compiled code).
+        object.__setattr__(self, "params", np.ascontiguousarray(self.params, dtype=np.float64))
 
     @property
     def dim(self) -> int:
@@ -155,6 +198,9 @@ class DiscreteMap:
     jac: Callable[..., Any] | None = None
     name: str = "map"
     attrs: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "params", np.ascontiguousarray(self.params, dtype=np.float64))
 
     @property
     def dim(self) -> int:

@@ -22,14 +22,14 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError, is_number
-from .base import DiscreteMap, ODESystem, Signal
+from .base import DiscreteMap, Event, ODESystem, Signal
 
 __all__ = ["Param", "Schema", "Model", "Event"]
 
@@ -191,34 +191,6 @@ class Schema:
                      description=p.description) for p in self.params]  # fmt: skip
 
 
-@dataclass(frozen=True)
-class Event:
-    """An event a model declares: crossings of ``function(t, y, p) = 0``.
-
-    Attributes
-    ----------
-    name : str
-        Prefix of the recorded variables (``NAME_time``, ``NAME_<state>``,
-        ``NAME_<state>_after``).
-    function : numba function
-        ``g(t, y, p) -> float`` compiled with :data:`~recipdyn.model.base.EVENT_SIGNATURE`.
-    direction : int
-        +1 rising, -1 falling, 0 both.
-    action : {"record", "terminal", "reset"}
-        Only recorded; ends the run; or ``reset(t, y, p, out)`` sets the state (impact laws).
-    reset : numba function, optional
-        With ``action="reset"``, compiled with :data:`~recipdyn.model.base.RHS_SIGNATURE`.
-    description : str
-    """
-
-    name: str
-    function: Callable[..., float]
-    direction: int = 0
-    action: str = "record"
-    reset: Callable[..., None] | None = None
-    description: str = ""
-
-
 class Model(ABC):
     """Base class of registered models (see the module docstring).
 
@@ -254,13 +226,15 @@ class Model(ABC):
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         """Events to locate during a simulation (at most one today: the integrator locates
-        one event function). Default: none."""
+        one event function). Default: none. An acting one (reset, terminal) must also be in
+        the :class:`~recipdyn.model.base.ODESystem`'s ``events``, so that every integration
+        applies it (the interface test checks this)."""
         return ()
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
-        """Benettin's method needs a smooth flow: a state reset would need its saltation
-        matrix in the tangent integration, which recipdyn does not have yet."""
-        return not any(e.action == "reset" for e in self.events(values))
+        """Whether Benettin's method applies (it needs the Jacobian; state resets are handled
+        by saltation matrices). Override to refuse where the model's flow does not allow it."""
+        return True
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov

@@ -33,6 +33,7 @@ _BUILTIN = {
     "lorenz": "recipdyn.model.reference:LORENZ",
     "henon": "recipdyn.model.reference:HENON",
     "double-pendulum": "recipdyn.model.reference.double_pendulum:DOUBLE_PENDULUM",
+    "impact-oscillator": "recipdyn.model.reference.impact_oscillator:IMPACT_OSCILLATOR",
 }
 _REGISTERED: dict[str, Model] = {}
 

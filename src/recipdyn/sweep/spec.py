@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..defaults import ATOL, RTOL
+from ..defaults import ATOL, RTOL, SWEEP
 from ..errors import ParameterError, is_number
 from ..model.parameters import CompressorParams, resolve_name
 from ..model.protocol import Model
@@ -110,6 +110,12 @@ class SweepSpec:
     model: str = "compressor"
 
     def __post_init__(self):
+        unknown = set(self.settings) - set(SWEEP) - {"lyap_tol"}
+        if unknown:
+            raise ParameterError(f"unknown sweep setting(s) {sorted(unknown)}; known: "
+                                 f"{', '.join(sorted(SWEEP))}, lyap_tol")  # fmt: skip
+        # every setting not given takes its default (defaults.SWEEP), so the spec is complete
+        object.__setattr__(self, "settings", {**SWEEP, **self.settings})
         m = self.get_model()
         if m.name != "compressor" and not isinstance(self.base, Mapping):
             object.__setattr__(self, "base", m.parameters())
@@ -150,8 +156,7 @@ class SweepSpec:
             and not m.lyapunov_supported(self.base)
         ):
             raise ParameterError(
-                f"--measure lyapunov/verdict: not available for model {m.name!r}, whose events "
-                "reset the state (the tangent integration would need saltation matrices)"
+                f"--measure lyapunov/verdict: model {m.name!r} does not support Benettin's method"
             )
         n = self.n_points
         if n > MAX_POINTS:

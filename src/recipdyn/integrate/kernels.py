@@ -1,4 +1,7 @@
-"""Compiled integrator loops (numba). The Python front end is :mod:`recipdyn.integrate.solve`.
+"""Compiled integrator loops (numba): the public compiled API of the integrator.
+
+The Python front end is :func:`recipdyn.integrate.integrate`; compiled callers (the Benettin
+loop of :mod:`recipdyn.analysis.lyapunov`) call :func:`dop853_kernel` directly.
 
 Both loops call the model's compiled ``rhs(t, y, p, out)`` directly. The DOP853 loop follows
 SciPy's ``solve_ivp(method="DOP853")`` step for step (initial step selection, error norm, step
@@ -98,6 +101,26 @@ def _dense_coefficients(rhs, t, y, f, y_new, f_new, h, A, C, D, n_stages, K, p, 
             for k in range(16):
                 acc += D[r, k] * K[k, j]
             Fd[3 + r, j] = h * acc
+
+
+@nb.njit(cache=True)
+def _error_norm(K, y, y_new, h, rtol, atol, E3, E5, n_stages):
+    """SciPy's DOP853 error norm: the 5th-order estimate, corrected by the 3rd-order one."""
+    n = y.shape[0]
+    e5n = 0.0
+    e3n = 0.0
+    for j in range(n):
+        sc = atol + max(abs(y[j]), abs(y_new[j])) * rtol
+        a5 = 0.0
+        a3 = 0.0
+        for k in range(n_stages + 1):
+            a5 += K[k, j] * E5[k]
+            a3 += K[k, j] * E3[k]
+        e5n += (a5 / sc) ** 2
+        e3n += (a3 / sc) ** 2
+    if e5n == 0.0 and e3n == 0.0:
+        return 0.0
+    return abs(h) * e5n / math.sqrt((e5n + 0.01 * e3n) * n)
 
 
 @nb.njit(cache=True)
@@ -211,8 +234,6 @@ def dop853_kernel(
     status = 0
     y_new = np.empty(n)
     f_new = np.empty(n)
-    err5 = np.empty(n)
-    err3 = np.empty(n)
     Fd = np.empty((7, n))
     ydense = np.empty(n)
     err_exp = -1.0 / 8.0
@@ -249,24 +270,7 @@ def dop853_kernel(
             nfev += n_stages
             for j in range(n):
                 K[n_stages, j] = f_new[j]
-            # error estimate
-            e5n = 0.0
-            e3n = 0.0
-            for j in range(n):
-                sc = atol + max(abs(y[j]), abs(y_new[j])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for k in range(n_stages + 1):
-                    a5 += K[k, j] * E5[k]
-                    a3 += K[k, j] * E3[k]
-                err5[j] = a5 / sc
-                err3[j] = a3 / sc
-                e5n += err5[j] * err5[j]
-                e3n += err3[j] * err3[j]
-            if e5n == 0.0 and e3n == 0.0:
-                err_norm = 0.0
-            else:
-                err_norm = abs(h) * e5n / math.sqrt((e5n + 0.01 * e3n) * n)
+            err_norm = _error_norm(K, y, y_new, h, rtol, atol, E3, E5, n_stages)
             if not math.isfinite(err_norm):
                 err_norm = 1e10  # treat as a failed step; shrink
             if err_norm < 1.0:
@@ -366,22 +370,22 @@ def dop853_kernel(
     return status
 
 
-@nb.njit(I8(RHS_TYPE, F8, V1, F8, F8, V1, F8, V1, I8, V2, T.int64[::1], V1), cache=True)
-def rk4_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate):
-    """Classical RK4 that lands exactly on every output time.
+@nb.njit(I8(RHS_TYPE, F8, V1, F8, F8, V1, F8, V1, I8, V2, T.int64[::1], V1, V2, V1, V1), cache=True)
+def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate,
+                      A, B, C):  # fmt: skip
+    """An explicit Runge-Kutta method given by its tableau ``(A, B, C)``, with fixed steps
+    that land exactly on every output time.
 
     Between consecutive stops (output times and ``t1``) it takes ``m = ceil(dt / h_max)`` equal
-    steps, so outputs are RK4 values, not interpolations. The call returns after the first
+    steps, so outputs are method values, not interpolations. The call returns after the first
     stop at or beyond ``t_stop`` (so splitting a run for a progress bar does not add stops).
     ``y0`` is updated in place; ``stats = [nfev, nsteps, 0, n_out, 0]``,
     ``fstate = [t_final, h]``.
     """
     n = y0.shape[0]
+    s = B.shape[0]
     y = y0.copy()
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
+    K = np.empty((s, n))
     yt = np.empty(n)
     n_eval = t_eval.shape[0]
     ie = 0
@@ -398,22 +402,21 @@ def rk4_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, f
         stop = t_eval[ie] if ie < n_eval and t_eval[ie] < t1 else t1
         m = max(1, int(math.ceil((stop - t) / h_max - 1e-9)))
         h = (stop - t) / m
-        ts = t
         for i in range(m):
-            tc = ts + i * h
-            rhs(tc, y, p, k1)
+            tc = t + i * h
+            for st in range(s):
+                for j in range(n):
+                    acc = 0.0
+                    for k in range(st):
+                        acc += A[st, k] * K[k, j]
+                    yt[j] = y[j] + h * acc
+                rhs(tc + C[st] * h, yt, p, K[st])
             for j in range(n):
-                yt[j] = y[j] + 0.5 * h * k1[j]
-            rhs(tc + 0.5 * h, yt, p, k2)
-            for j in range(n):
-                yt[j] = y[j] + 0.5 * h * k2[j]
-            rhs(tc + 0.5 * h, yt, p, k3)
-            for j in range(n):
-                yt[j] = y[j] + h * k3[j]
-            rhs(tc + h, yt, p, k4)
-            for j in range(n):
-                y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-            nfev += 4
+                acc = 0.0
+                for k in range(s):
+                    acc += B[k] * K[k, j]
+                y[j] += h * acc
+            nfev += s
             nsteps += 1
         t = stop
         finite = True
