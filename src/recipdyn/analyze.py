@@ -214,10 +214,9 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     t0 = float(ds[dim].values[0])
     pair = m.state_names[:2] if m.dim >= 2 else m.state_names * 2
     lam, lam_err, section, k01 = None, 0.0, None, None
-    if not m.lyapunov_supported(values):
-        summary["lyapunov_equations"] = {"refused": f"model {m.name!r} does not support "
-                                         "Benettin's method"}  # fmt: skip
-        return None, 0.0, None, None
+    supported = m.lyapunov_supported(values)
+    if not supported:
+        summary["lyapunov_equations"] = {"refused": m.lyapunov_refusal}
     if m.kind == "map":
         section = np.c_[tuple(ds[s].values for s in pair)]
         res = lyapunov_spectrum_map(system, y0, max(1000, int(lyap_revolutions)), n_transient=0)
@@ -235,6 +234,9 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
             if section_points >= 100:
                 k01 = zero_one_test(sec[m.state_names[0]].values)
             summary["poincare"] = {"points": section_points}
+        if not supported:
+            summary["zero_one_K"] = k01
+            return None, 0.0, section, k01
         res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
                                 rtol=rtol, atol=atol)  # fmt: skip
         unit = f"per {m.time_unit}"

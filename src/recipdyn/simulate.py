@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import time
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -62,7 +63,12 @@ def clean_attrs(attrs: dict[str, Any]) -> dict[str, Any]:
 
 
 def _coerce_params(params: CompressorParams | None, overrides: dict[str, Any]) -> CompressorParams:
+    if isinstance(params, Mapping):  # a plain mapping of the compressor's parameter values
+        params = CompressorParams(**{resolve_name(k): v for k, v in params.items()})
     base = CompressorParams() if params is None else params
+    if not isinstance(base, CompressorParams):
+        raise ParameterError(f"params must be CompressorParams or a mapping, got "
+                             f"{type(params).__name__}")  # fmt: skip
     if not overrides:
         return base
     import dataclasses

@@ -339,7 +339,9 @@ def lyapunov_spectrum(
     t_total : float
         Averaging time (after ``t_transient``).
     k : int, optional
-        Number of exponents (default: all, ``system.dim``).
+        Number of exponents (default: all, ``system.dim - system.aux_states``). The tangent
+        vectors start without components along auxiliary states; values an event records
+        (an impact's approach velocity) then follow the state through the saltation matrix.
     dt : float, optional
         Re-orthonormalisation interval; default ``period / 20`` for forced systems, else 0.1
         time units; halved automatically when the tangent vectors' growth spread exceeds
@@ -355,9 +357,10 @@ def lyapunov_spectrum(
     """
     y = np.asarray(y0, dtype=float).copy()
     n = system.dim
-    k = n if k is None else int(k)
-    if not (1 <= k <= n):
-        raise ValueError(f"k = {k}; allowed: 1..{n}")
+    n_dof = n - system.aux_states  # auxiliary states (recorded values, work integrals) last
+    k = n_dof if k is None else int(k)
+    if not (1 <= k <= n_dof):
+        raise ValueError(f"k = {k}; allowed: 1..{n_dof}")
     if not (t_total > 0 and math.isfinite(t_total)):
         raise ValueError(f"t_total = {t_total}; allowed: > 0")
     if dt is None:
@@ -381,7 +384,9 @@ def lyapunov_spectrum(
         t += t_transient
     tsys = tangent_system(system, k)
     t_start, y_start = t, y.copy()
-    z = np.concatenate([y, _initial_basis(n, k).ravel()])
+    basis = np.zeros((n, k))
+    basis[:n_dof] = _initial_basis(n_dof, k)  # no components along the auxiliary states
+    z = np.concatenate([y, basis.ravel()])
     n_hist = max(1, int(n_history))
     hist = np.zeros((n_hist, k))
     times = np.zeros(n_hist)

@@ -350,7 +350,14 @@ def dop853_kernel(
                     status = 1
                 rhs(t_new, y_new, p, f_new)
                 nfev += 1
+                g_scale = max(abs(g_old), abs(g_new))
                 g_new = event(t_new, y_new, p)
+                # A reset that leaves the state on the event surface (it changed other
+                # components, e.g. a recorded approach velocity) must not count the same
+                # crossing again: within rounding of the located root, g counts as 0, and a
+                # new crossing has to leave the surface first.
+                if abs(g_new) <= 2.0 * abs(event(t_new, ev_y[n_ev], p)) + 1e-12 * g_scale:
+                    g_new = 0.0
                 n_ev += 1
         g_old = g_new
         t = t_new

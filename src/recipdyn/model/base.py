@@ -150,6 +150,10 @@ class ODESystem:
     name: str = "ode"
     attrs: Mapping[str, Any] = field(default_factory=dict)
     events: tuple[Event, ...] = ()
+    #: The last ``aux_states`` components are auxiliary, not degrees of freedom (values an
+    #: event records, work integrals): their derivatives do not depend on them, and Lyapunov
+    #: exponents are computed for the other components only.
+    aux_states: int = 0
 
     @property
     def acting_event(self) -> Event | None:

@@ -140,8 +140,12 @@ def _body(lag: Lagrangian, exprs: list[sp.Expr]) -> tuple[list[str], list[str]]:
     return head, [printer.doprint(e) for e in reduced]
 
 
-def kernel_source(lag: Lagrangian, name: str, doc: str) -> str:
-    """Python source of ``{name}_rhs(t, y, p, out)`` and ``{name}_jac(t, y, p, J)``."""
+def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True) -> str:
+    """Python source of ``{name}_system(t, y, p, M, b)``, ``{name}_rhs(t, y, p, out)`` and
+    (with ``jacobian``) ``{name}_partials`` and ``{name}_jac(t, y, p, J)``.
+
+    A model whose generalized forces are computed numerically (contact laws) uses
+    ``{name}_system`` with the forces as parameters and ``jacobian=False``."""
     n = lag.n
     m_exprs = [lag.M[i, j] for i in range(n) for j in range(n)]
     b_exprs = [lag.b[i] for i in range(n)]
@@ -158,6 +162,20 @@ def kernel_source(lag: Lagrangian, name: str, doc: str) -> str:
             lines.append(f"    M[{i}, {j}] = {vals[i * n + j]}")
     for i in range(n):
         lines.append(f"    b[{i}] = {vals[n * n + i]}")
+    solve = "    acc[0] = b[0] / M[0, 0]" if n == 1 else "    acc[:] = np.linalg.solve(M, b)"
+    if n == 2:  # Cramer's rule: no LAPACK call in the hot loop
+        solve = ("    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]\n"
+                 "    acc[0] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det\n"
+                 "    acc[1] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det")  # fmt: skip
+    rhs_lines = ["", "", "@nb.njit(RHS_SIGNATURE, cache=True)", f"def {name}_rhs(t, y, p, out):",
+                 '    """(qd, qdd) with M qdd = b."""',
+                 f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})",
+                 f"    acc = np.empty({n})", f"    {name}_system(t, y, p, M, b)", solve,
+                 f"    for i in range({n}):", "        out[i] = y[" + str(n) + " + i]",
+                 f"        out[{n} + i] = acc[i]"]  # fmt: skip
+    if not jacobian:
+        lines = [x.replace("JAC_SIGNATURE, RHS_SIGNATURE", "RHS_SIGNATURE") for x in lines]
+        return "\n".join(lines + rhs_lines + [""])
     lines += ["", "", "@nb.njit(cache=True)", f"def {name}_partials(t, y, p, dM, db):",
               '    """dM[k] = dM/dy_k (2N x N x N), db[k] = db/dy_k (2N x N)."""']  # fmt: skip
     d_exprs = [lag.dM[k][i, j] for k in range(2 * n) for i in range(n) for j in range(n)]
@@ -172,14 +190,8 @@ def kernel_source(lag: Lagrangian, name: str, doc: str) -> str:
     for k in range(2 * n):
         for i in range(n):
             lines.append(f"    db[{k}, {i}] = {vals[off + k * n + i]}")
-    solve = "    acc[0] = b[0] / M[0, 0]" if n == 1 else "    acc[:] = np.linalg.solve(M, b)"
-    lines += ["", "", "@nb.njit(RHS_SIGNATURE, cache=True)", f"def {name}_rhs(t, y, p, out):",
-              '    """(qd, qdd) with M qdd = b."""',
-              f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})", f"    acc = np.empty({n})",
-              f"    {name}_system(t, y, p, M, b)", solve,
-              f"    for i in range({n}):", "        out[i] = y[" + str(n) + " + i]",
-              f"        out[{n} + i] = acc[i]",
-              "", "", "@nb.njit(JAC_SIGNATURE, cache=True)", f"def {name}_jac(t, y, p, J):",
+    lines += rhs_lines
+    lines += ["", "", "@nb.njit(JAC_SIGNATURE, cache=True)", f"def {name}_jac(t, y, p, J):",
               '    """Exact Jacobian: dqdd/dy_k = M^-1 (db/dy_k - dM/dy_k qdd)."""',
               f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})", f"    acc = np.empty({n})",
               f"    dM = np.empty(({2 * n}, {n}, {n}))", f"    db = np.empty(({2 * n}, {n}))",

@@ -231,10 +231,16 @@ class Model(ABC):
         applies it (the interface test checks this)."""
         return ()
 
+    #: Parameter values at which the model's declared events occur (for the interface test and
+    #: the docs, when they do not occur at the defaults).
+    event_example: Mapping[str, Any] = {}
+    #: Why Benettin's method is refused for this model (empty: it is supported).
+    lyapunov_refusal: str = ""
+
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Whether Benettin's method applies (it needs the Jacobian; state resets are handled
-        by saltation matrices). Override to refuse where the model's flow does not allow it."""
-        return True
+        by saltation matrices). A model refuses it by setting ``lyapunov_refusal``."""
+        return not self.lyapunov_refusal
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov

@@ -34,6 +34,7 @@ _BUILTIN = {
     "henon": "recipdyn.model.reference:HENON",
     "double-pendulum": "recipdyn.model.reference.double_pendulum:DOUBLE_PENDULUM",
     "impact-oscillator": "recipdyn.model.reference.impact_oscillator:IMPACT_OSCILLATOR",
+    "compressor-contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
 }
 _REGISTERED: dict[str, Model] = {}
 

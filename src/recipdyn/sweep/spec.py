@@ -156,7 +156,8 @@ class SweepSpec:
             and not m.lyapunov_supported(self.base)
         ):
             raise ParameterError(
-                f"--measure lyapunov/verdict: model {m.name!r} does not support Benettin's method"
+                f"--measure lyapunov/verdict: not available for model {m.name!r}: "
+                f"{m.lyapunov_refusal}"
             )
         n = self.n_points
         if n > MAX_POINTS:

@@ -100,7 +100,9 @@ def double_pendulum_rhs(t, y, p, out):
     b = np.empty(2)
     acc = np.empty(2)
     double_pendulum_system(t, y, p, M, b)
-    acc[:] = np.linalg.solve(M, b)
+    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    acc[0] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det
+    acc[1] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det
     for i in range(2):
         out[i] = y[2 + i]
         out[2 + i] = acc[i]
@@ -115,7 +117,9 @@ def double_pendulum_jac(t, y, p, J):
     dM = np.empty((4, 2, 2))
     db = np.empty((4, 2))
     double_pendulum_system(t, y, p, M, b)
-    acc[:] = np.linalg.solve(M, b)
+    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    acc[0] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det
+    acc[1] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det
     double_pendulum_partials(t, y, p, dM, db)
     for i in range(4):
         for k in range(4):
