@@ -379,6 +379,9 @@ def _dataset(m: Model, values, t, y, dim: str, t_units: str, attrs) -> xr.Datase
     outs = m.outputs(values, t, y)
     data_vars = {k: (dim, s.values, {"units": s.units, "long_name": s.long_name})
                  for k, s in outs.items()}  # fmt: skip
+    for i, (name, unit) in enumerate(zip(m.state_names, m.state_units, strict=True)):
+        if name not in data_vars:  # the whole state is always recorded (analyze rebuilds it)
+            data_vars[name] = (dim, np.asarray(y[:, i]), {"units": unit, "long_name": name})
     ds = xr.Dataset(data_vars, coords={dim: (dim, t, {"units": t_units, "long_name": dim})})
     ds.attrs = clean_attrs(attrs)
     return ds
