@@ -26,6 +26,7 @@ Benettin, Galgani, Giorgilli, Strelcyn (1980), Meccanica 15, 9-30.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -188,18 +189,11 @@ def _initial_basis(n: int, k: int) -> np.ndarray:
     return np.ascontiguousarray(q)
 
 
-#: Compiled tangent right-hand sides by (rhs, jac, rhs_jac, n, k): numba compiles a closure on
+#: Cached by (rhs, jac, rhs_jac, n, k): numba compiles a closure on
 #: its first call (~0.5 s), so a sweep that asks for exponents at every point compiles once per
 #: worker process instead of once per point.
-_TANGENT_CACHE: dict[tuple, object] = {}
-
-
+@functools.cache
 def _tangent_rhs(rhs, jac, both, n: int, k: int):
-    key = (rhs, jac, both, n, k)
-    cached = _TANGENT_CACHE.get(key)
-    if cached is not None:
-        return cached
-
     if both is not None:  # right-hand side and Jacobian share work: one call
 
         @nb.njit(RHS_JAC_SIGNATURE)
@@ -225,13 +219,10 @@ def _tangent_rhs(rhs, jac, both, n: int, k: int):
                     s += J[i, m] * z[n + m * k + j]
                 out[n + i * k + j] = s
 
-    _TANGENT_CACHE[key] = trhs
     return trhs
 
 
-_SALTATION_CACHE: dict[tuple, object] = {}
-
-
+@functools.cache  # compiled once per process, like _tangent_rhs
 def _tangent_reset(rhs, event, reset, n: int, k: int):
     r"""The reset of the augmented state ``[y, W]`` at an event: ``y+ = R(t, y)`` and
     ``W+ = S W`` with the saltation matrix (Müller 1995; Leine & Nijmeijer 2004)
@@ -242,10 +233,6 @@ def _tangent_reset(rhs, event, reset, n: int, k: int):
     ``R_t`` are central differences with steps ``1e-6 max(1, |y_i|)`` (truncation ~1e-12 and
     rounding ~1e-10 relative: far below what the exponents' finite-time scatter resolves).
     """
-    key = (rhs, event, reset, n, k)
-    cached = _SALTATION_CACHE.get(key)
-    if cached is not None:
-        return cached
 
     @nb.njit(RHS_SIGNATURE)
     def treset(t, z, p, out):
@@ -295,7 +282,6 @@ def _tangent_reset(rhs, event, reset, n: int, k: int):
                     acc += (Ry[i, m] + v[i] * grad[m]) * z[n + m * k + c]
                 out[n + i * k + c] = acc
 
-    _SALTATION_CACHE[key] = treset
     return treset
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
 from ..errors import Interrupted, ParameterError, deferred_signals, is_number
 from ..model.base import ODESystem
-from . import kernels as _kernels
+from . import kernels
 from .tableaus import RK4, Tableau, dop853
 
 __all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS", "Method"]
@@ -221,9 +221,9 @@ def integrate(
     if use_event and not METHODS[method].adaptive:
         raise ParameterError("events need method 'dop853' (located on its dense output)")
     action = actions[event_action]
-    reset_fn = reset if reset is not None else _kernels.no_reset
+    reset_fn = reset if reset is not None else kernels.no_reset
     cap = max_events if max_events > 0 else 100_000
-    ev = event if use_event else _kernels.no_event
+    ev = event if use_event else kernels.no_event
     chunks = max(1, int(chunks))
     # Progress stops: each kernel call returns after the first step that reaches the next one,
     # without clipping that step, so the step sequence (and every number) is the same for any
@@ -253,7 +253,7 @@ def integrate(
                 ev_cap = cap - len(ev_t) if use_event else 0
                 et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
                 ey2 = np.empty((ev_cap, system.dim))
-                status = _kernels.dop853_kernel(
+                status = kernels.dop853_kernel(
                     system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
                     max_step, t_eval[n_out:], max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
                     tab.E5, tab.D, use_event, event_direction, action, reset_fn, Y[n_out:], et,
@@ -263,7 +263,7 @@ def integrate(
                 ev_y.extend(ey[: stats[4]])
                 ev_y2.extend(ey2[: stats[4]])
             else:
-                status = _kernels.fixed_step_kernel(
+                status = kernels.fixed_step_kernel(
                     system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
                     max_steps - nsteps, Y[n_out:], stats, fstate, tab.A, tab.B, tab.C,
                 )  # fmt: skip

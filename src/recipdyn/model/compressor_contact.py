@@ -51,7 +51,7 @@ from .joints.contact import (
     normal_force,
     short_bearing_forces,
 )
-from .load import gas_force_kernel, mu_kernel, pack_table
+from .load import gas_force_kernel, pack_table
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -112,7 +112,7 @@ def _target() -> Path:
 @nb.njit(cache=True)
 def _joint(t, y, p, out5):
     """Joint quantities: out5 = [F_x, F_y, T_rod, F_n, F_t] (on the bearing) and returns
-    (power from the crank, power lost in the joint, theta2', delta)."""
+    (power from the crank, power lost in the joint, theta2', crosshead velocity x3')."""
     ex, ey, u, v = y[0], y[1], y[2], y[3]
     r, l, d, w = p[P_R], p[P_L], p[P_D], p[P_OMEGA]
     th1 = p[P_TH10] + w * t
@@ -120,6 +120,7 @@ def _joint(t, y, p, out5):
     s2 = -(d + r * s1 + ey) / l
     c2 = math.sqrt(1.0 - s2 * s2)
     th2d = -(r * w * c1 + v) / (l * c2)
+    v3 = -r * w * s1 + u - l * s2 * th2d  # x3 = Bx + l cos(theta2)
     vjx, vjy = -r * w * s1, r * w * c1  # journal-centre velocity
     c = p[P_C]
     rho = math.sqrt(ex * ex + ey * ey)
@@ -127,7 +128,7 @@ def _joint(t, y, p, out5):
     for i in range(5):
         out5[i] = 0.0
     if rho == 0.0:
-        return 0.0, 0.0, th2d, delta
+        return 0.0, 0.0, th2d, v3
     nx, ny = ex / rho, ey / rho
     tx, ty = -ny, nx
     drho = nx * u + ny * v  # = delta'
@@ -168,14 +169,12 @@ def _joint(t, y, p, out5):
     out5[0] = fx
     out5[1] = fy
     out5[2] = trod
-    return p_crank, p_loss, th2d, delta
+    return p_crank, p_loss, th2d, v3
 
 
 @nb.njit(cache=True)
 def _gas(t, p):
     th1 = p[P_TH10] + p[P_OMEGA] * t
-    if p[P_LOADKIND] == 0.0:
-        return p[P_LOADSIGN] * p[P_LOADAMP] * mu_kernel(th1)
     return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 
@@ -183,7 +182,7 @@ def _gas(t, p):
 def rhs(t, y, p, out):
     q = p[:14].copy()
     f5 = np.empty(5)
-    p_crank, p_loss, th2d, _ = _joint(t, y, p, f5)
+    p_crank, p_loss, _, v3 = _joint(t, y, p, f5)
     fg = _gas(t, p)
     q[P_FGAS] = fg
     q[P_FX] = f5[0]
@@ -198,12 +197,7 @@ def rhs(t, y, p, out):
     out[2] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det
     out[3] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det
     out[4] = 0.0
-    # gas power: F_gas x3', x3' = Bx' - l sin(theta2) theta2'
-    r, l, w = p[P_R], p[P_L], p[P_OMEGA]
-    th1 = p[P_TH10] + w * t
-    s2 = -(p[P_D] + r * math.sin(th1) + y[1]) / l
-    v3 = -r * w * math.sin(th1) + y[2] - l * s2 * th2d
-    out[5] = fg * v3 + p_crank
+    out[5] = fg * v3 + p_crank  # gas power + crank power through the journal
     out[6] = p_loss
 
 
@@ -336,18 +330,21 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
 
 @nb.njit(cache=True)
 def _joint_series(rhs, t, y, p):
+    """Per sample: F_x, F_y, T_rod, F_n, F_t, ex'', ey'', theta2', x3', gas force."""
     n = t.shape[0]
-    out = np.empty((n, 8))
+    out = np.empty((n, 10))
     f5 = np.empty(5)
     f = np.empty(y.shape[1])
     for i in range(n):
         yi = y[i].copy()
         rhs(t[i], yi, p, f)
-        _, _, th2d, delta = _joint(t[i], yi, p, f5)
+        _, _, th2d, v3 = _joint(t[i], yi, p, f5)
         out[i, 0:5] = f5
         out[i, 5] = f[2]
         out[i, 6] = f[3]
         out[i, 7] = th2d
+        out[i, 8] = v3
+        out[i, 9] = _gas(t[i], p)
     return out
 
 
@@ -421,7 +418,7 @@ class CompressorContact(Model):
         j = _joint_series(s.rhs, t, y, s.params)
         r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
         th1 = float(values["theta1_0"]) + w * t
-        ex, ey, u = y[:, 0], y[:, 1], y[:, 2]
+        ex, ey = y[:, 0], y[:, 1]
         s2 = -(d + r * np.sin(th1) + ey) / l
         c2 = np.sqrt(1.0 - s2**2)
         th2d = j[:, 7]
@@ -429,7 +426,7 @@ class CompressorContact(Model):
         s2dd = -(-r * w**2 * np.sin(th1) + j[:, 6]) / l
         th2dd = (s2dd + s2 * th2d**2) / c2
         x3 = r * np.cos(th1) + ex + l * c2
-        v3 = -r * w * np.sin(th1) + u - l * s2 * th2d
+        v3 = j[:, 8]
         a3 = -r * w**2 * np.cos(th1) + j[:, 5] - l * (c2 * th2d**2 + s2 * th2dd)
         rho = np.hypot(ex, ey)
         delta = rho - float(values["rc"])
@@ -451,8 +448,7 @@ class CompressorContact(Model):
             "joint_force_x": Signal(j[:, 0], "N", "joint force on the rod, x"),
             "joint_force_y": Signal(j[:, 1], "N", "joint force on the rod, y"),
             "joint_force": Signal(np.hypot(j[:, 0], j[:, 1]), "N", "joint force magnitude"),
-            "gas_force": Signal(np.array([_gas(ti, s.params) for ti in t]), "N",
-                                "gas force on the crosshead along +x"),
+            "gas_force": Signal(j[:, 9], "N", "gas force on the crosshead along +x"),
             "energy": Signal(en["mechanical"] + en["elastic"], "J",
                              "kinetic + gravity energy of rod and crosshead + contact elastic"),
         }  # fmt: skip

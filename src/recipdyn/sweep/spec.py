@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..defaults import ATOL, RTOL, SWEEP
+from ..defaults import SWEEP
 from ..errors import ParameterError, is_number
 from ..model.parameters import CompressorParams, resolve_name
 from ..model.protocol import Model
@@ -115,7 +115,8 @@ class SweepSpec:
             raise ParameterError(f"unknown sweep setting(s) {sorted(unknown)}; known: "
                                  f"{', '.join(sorted(SWEEP))}, lyap_tol")  # fmt: skip
         # every setting not given takes its default (defaults.SWEEP), so the spec is complete
-        object.__setattr__(self, "settings", {**SWEEP, **self.settings})
+        given = {k: v for k, v in self.settings.items() if v is not None}  # None = default
+        object.__setattr__(self, "settings", {**SWEEP, **given})
         m = self.get_model()
         if m.name != "compressor" and not isinstance(self.base, Mapping):
             object.__setattr__(self, "base", m.parameters())
@@ -130,31 +131,24 @@ class SweepSpec:
             raise ParameterError(f"--measure {bad or '(none)'}; allowed: {', '.join(MEASURES)}")
         if self.continuation and len(self.axes) != 1:
             raise ParameterError("--continuation needs a 1-D sweep")
-        for key, lo in (("revolutions", 0), ("points", 0), ("lyap_revolutions", 0), ("fs", 0)):
-            v = self.settings.get(key)
-            if v is not None and not (_finite(v) and v > lo):
-                raise ParameterError(f"{key} = {v!r}; allowed: > {lo} (finite)")
-        tr = self.settings.get("transient")
-        if tr is not None and not (_finite(tr) and tr >= 0):
+        s = self.settings
+        for key in ("revolutions", "points", "lyap_revolutions", "fs"):
+            if not (_finite(s[key]) and s[key] > 0):
+                raise ParameterError(f"{key} = {s[key]!r}; allowed: > 0 (finite)")
+        tr = s["transient"]
+        if not (_finite(tr) and tr >= 0):
             raise ParameterError(f"transient = {tr!r}; allowed: >= 0 (finite)")
-        if self.continuation and tr is not None and tr != int(tr):
+        if self.continuation and tr != int(tr):
             raise ParameterError(
                 f"transient = {tr!r}: --continuation needs a whole number of "
                 "revolutions (each point hands on its state at crank angle 0)"
             )
-        if self.settings.get("points") is not None and self.settings["points"] != int(
-            self.settings["points"]
-        ):
-            raise ParameterError(f"points = {self.settings['points']!r}; allowed: an integer >= 1")
-        if "rtol" in self.settings or "atol" in self.settings:
-            from ..integrate.solve import check_tolerances
+        if s["points"] != int(s["points"]):
+            raise ParameterError(f"points = {s['points']!r}; allowed: an integer >= 1")
+        from ..integrate.solve import check_tolerances
 
-            check_tolerances(self.settings.get("rtol", RTOL), self.settings.get("atol", ATOL))
-        if (
-            {"lyapunov", "verdict"} & set(self.measures)
-            and not isinstance(self.base, CompressorParams)
-            and not m.lyapunov_supported(self.base)
-        ):
+        check_tolerances(s["rtol"], s["atol"])
+        if {"lyapunov", "verdict"} & set(self.measures) and not m.lyapunov_supported(self.base):
             raise ParameterError(
                 f"--measure lyapunov/verdict: not available for model {m.name!r}: "
                 f"{m.lyapunov_refusal}"
