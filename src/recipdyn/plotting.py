@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-__all__ = ["response_figure", "provenance_footer", "model_figure", "axis_label"]
+__all__ = ["response_figure", "provenance_footer", "model_figure", "axis_label", "contact_figure"]
 
 
 def _mpl():
@@ -86,7 +86,10 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
 
 def model_figure(ds: xr.Dataset, *, title: str | None = None):
     """Any model's record: up to three signals over time (or iteration) and a phase portrait
-    of the first two (points for a map)."""
+    of the first two (points for a map). The contact-impact compressor gets
+    :func:`contact_figure`."""
+    if ds.attrs.get("model_name") == "compressor-contact":
+        return contact_figure(ds, title=title)
     plt = _mpl()
     dim = "iteration" if "iteration" in ds.dims else "time"
     names = [k for k in ds.data_vars if ds[k].dims == (dim,)][:3]
@@ -115,4 +118,126 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
     else:
         axes[1].set_axis_off()
     fig.suptitle(title or f"{ds.attrs.get('model', 'model')}: {ds.attrs.get('title', '')}")
+    return fig
+
+
+def _impacts(ds: xr.Dataset, key: str) -> np.ndarray:
+    """Indices into ``impact_event`` of the contact onsets at one joint (``key`` "" or
+    "_crosshead"): with clearance at both pins the event also fires at separations, and its
+    joint is the one on its surface."""
+    if "impact_time" not in ds:
+        return np.empty(0, dtype=int)
+    ex, ey = ds["impact_ex" + key].values, ds["impact_ey" + key].values
+    u, v = ds[f"impact_ex{key}_dot"].values, ds[f"impact_ey{key}_dot"].values
+    rho = np.hypot(ex, ey)
+    onset = (ex * u + ey * v) > 0
+    if ds.attrs.get("param_clearance_joints") == "both":
+        other = "_crosshead" if key == "" else ""
+        rc, rc_o = ds.attrs["param_rc" + key], ds.attrs["param_rc" + other]
+        rho_o = np.hypot(ds["impact_ex" + other].values, ds["impact_ey" + other].values)
+        onset &= np.abs(rho / rc - 1) <= np.abs(rho_o / rc_o - 1)
+    return np.flatnonzero(onset)
+
+
+def contact_figure(ds: xr.Dataset, *, title: str | None = None):
+    """The contact-impact joint's record, per clearance joint: crosshead acceleration and
+    joint force over crank angle with the impacts marked, the journal's orbit inside the
+    clearance circle, the joint force in polar form over the crank angle, and the impact map
+    (states at impacts) beside the stroboscopic section (once a revolution)."""
+    plt = _mpl()
+    joints = ds.attrs.get("param_clearance_joints", "crank")
+    keys = {"crank": [""], "crosshead": ["_crosshead"], "both": ["", "_crosshead"]}[joints]
+    deg = np.degrees(np.mod(ds["theta1"].values, 2 * np.pi))
+    t = ds["time"].values
+    fig = plt.figure(figsize=(13, 4.0 * (1 + len(keys))), constrained_layout=True)
+    grid = fig.add_gridspec(1 + len(keys), 3)
+    # row 0: the vibration signal with impacts, the stroboscopic section, impact map
+    ax = fig.add_subplot(grid[0, 0])
+    ax.plot(t, ds["a"].values, lw=0.5, color="C0")
+    colors = {"": "C3", "_crosshead": "C2"}
+    for key in keys:
+        i = _impacts(ds, key)
+        if i.size:
+            ti = ds["impact_time"].values[i]
+            ax.plot(ti, np.interp(ti, t, ds["a"].values), "v", ms=3, color=colors[key],
+                    label=f"impacts, {'crank' if key == '' else 'crosshead'} pin")  # fmt: skip
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(axis_label("crosshead acceleration", ds["a"]))
+    ax.grid(alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper right")
+    ax = fig.add_subplot(grid[0, 1])
+    T = 2 * np.pi / ds.attrs["param_omega"]
+    ts = np.arange(np.ceil(t[0] / T - 1e-9), np.floor(t[-1] / T + 1e-9) + 1) * T
+    if ts.size:
+        ax.plot(np.interp(ts, t, ds["v"].values), np.interp(ts, t, ds["a"].values), "o",
+                ms=3, color="C0")  # fmt: skip
+    ax.set_xlabel(axis_label("crosshead velocity", ds["v"]))
+    ax.set_ylabel(axis_label("crosshead acceleration", ds["a"]))
+    ax.set_title(f"stroboscopic section ({ts.size} revolutions)", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax = fig.add_subplot(grid[0, 2])
+    for key in keys:
+        i = _impacts(ds, key)
+        if i.size:
+            th = np.degrees(np.mod(ds.attrs["param_omega"] * ds["impact_time"].values[i]
+                                   + ds.attrs["param_theta1_0"], 2 * np.pi))  # fmt: skip
+            ax.plot(
+                th,
+                ds[f"impact_v_impact{key}_after"].values[i],
+                ".",
+                ms=4,
+                color=colors[key],
+                label="crank pin" if key == "" else "crosshead pin",
+            )
+    ax.set_xlim(0, 360)
+    ax.set_xlabel("crank angle at impact (deg)")
+    ax.set_ylabel("approach velocity (m/s)")
+    ax.set_title("impact map (state at each impact)", fontsize=9)
+    ax.grid(alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
+    for row, key in enumerate(keys, start=1):
+        where = "crank pin" if key == "" else "crosshead pin"
+        rc = ds.attrs["param_rc" + key]
+        ax = fig.add_subplot(grid[row, 0])
+        ax.plot(deg, ds["joint_force" + key].values, ".", ms=1, color="C0")
+        i = _impacts(ds, key)
+        if i.size:
+            ti = ds["impact_time"].values[i]
+            thi = np.degrees(np.mod(ds.attrs["param_omega"] * ti + ds.attrs["param_theta1_0"],
+                                    2 * np.pi))  # fmt: skip
+            ax.plot(thi, np.interp(ti, t, ds["joint_force" + key].values), "v", ms=3,
+                    color=colors[key], label="impacts")  # fmt: skip
+            ax.legend(fontsize=7, loc="upper right")
+        ax.set_xlim(0, 360)
+        ax.set_xlabel("crank angle (deg)")
+        ax.set_ylabel(f"{where} joint force (N)")
+        ax.grid(alpha=0.3)
+        ax = fig.add_subplot(grid[row, 1])
+        ring = np.linspace(0, 2 * np.pi, 361)
+        ax.plot(np.cos(ring), np.sin(ring), color="0.4", lw=1)
+        ex, ey = ds["ex" + key].values / rc, ds["ey" + key].values / rc
+        ax.plot(ex, ey, lw=0.5, color="C0")
+        ax.set_aspect("equal")
+        lim = max(1.1, float(np.nanmax(np.hypot(ex, ey))) * 1.05)
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_xlabel("e_x / c")
+        ax.set_ylabel("e_y / c")
+        ax.set_title(f"{where}: journal orbit in the clearance circle (c = {1e3 * rc:g} mm)",
+                     fontsize=9)  # fmt: skip
+        ax.grid(alpha=0.3)
+        ax = fig.add_subplot(grid[row, 2], projection="polar")
+        fx, fy = ds["joint_force_x" + key].values, ds["joint_force_y" + key].values
+        ax.plot(np.arctan2(fy, fx), np.hypot(fx, fy), ".", ms=1, color="C0")
+        ax.set_title(f"{where}: joint force on the rod, polar (N)", fontsize=9)
+    footer = (
+        f"compressor-contact, clearance at {joints}, law {ds.attrs.get('param_contact_law')}"
+        f" e={ds.attrs.get('param_restitution')}, friction {ds.attrs.get('param_friction')}"
+        f", omega={ds.attrs['param_omega']:g} rad/s | {ds.attrs.get('solver_method')} "
+        f"rtol={ds.attrs.get('solver_rtol')} | recipdyn {ds.attrs.get('recipdyn_version')}"
+    )
+    fig.text(0.01, 0.002, footer, fontsize=6.5, color="0.35")
+    fig.suptitle(title or "Contact-impact clearance joint")
     return fig

@@ -353,6 +353,8 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     ds = _dataset(m, values, sol.t, sol.y, "time", m.time_unit, attrs)
     if events:
         ds = _with_events(ds, m, events[0], sol, t_start)
+    if sol.t.size:
+        ds.attrs.update(clean_attrs(m.run_summary(values, ds)))
     if failure is not None:
         failure.dataset = ds
         raise failure

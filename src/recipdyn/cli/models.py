@@ -14,7 +14,7 @@ def models(
     """List the registered models, or print one model's parameters (default, unit, range,
     description, assumed or not)."""
     from rich.console import Console
-    from rich.table import Table
+    from rich.table import Column, Table
 
     from ..model.registry import DEFAULT_MODEL, get_model, model_names
 
@@ -29,7 +29,9 @@ def models(
         console.print("Parameters of one model: recipdyn models NAME")
         return
     m = get_model(name)
-    table = Table("name", "default", "unit", "allowed", "group", "assumed", "description",
+    width = max(len(p.name) for p in m.schema)  # names are never cut: users type them
+    table = Table(Column("name", no_wrap=True, min_width=width), "default", "unit", "allowed",
+                  "group", "assumed", "description",
                   title=f"{m.name}: {m.description}")  # fmt: skip
     for row in m.schema.table():
         table.add_row(row["name"], row["default"], row["unit"], row["range"], row["group"],

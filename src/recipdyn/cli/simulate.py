@@ -127,6 +127,9 @@ def simulate(
     write_dataset(ds, out)
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
+        summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}
+        for k, val in summary.items():
+            typer.echo(f"  {k} = {val:.4g}")
         if figure:
             from ..plotting import _mpl, model_figure
 

@@ -40,7 +40,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ._compressor_contact import contact_mechanism_system as _mechanism
+from ._compressor_contact import both_system, crank_system, crosshead_system
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal
 from .joints.contact import (
     FRICTION_LAWS,
@@ -58,51 +58,77 @@ from .protocol import Model, Param, Schema
 __all__ = ["CompressorContact", "COMPRESSOR_CONTACT", "lagrangian", "generate", "energy"]
 
 _INF = math.inf
-#: Mechanism parameters of the generated kernel, in order, then its force inputs.
+#: Where the clearance is: the crank pin, the crosshead pin, or both (``clearance_joints``).
+JOINTS = ("crank", "crosshead", "both")
+#: Mechanism parameters of the generated kernels, in order, then their force inputs.
 MECH = ("r", "l", "ls", "m2", "m3", "J2", "g", "d", "omega", "theta1_0")
-INPUTS = ("F_gas", "F_x", "F_y", "T_rod")
+INPUTS = ("F_gas", "F1_x", "F1_y", "F2_x", "F2_y", "T_rod")
+NHEAD = len(MECH) + len(INPUTS)
 
-# Packed parameter vector: the generated kernel's 14 slots first (inputs filled per call).
+# Packed parameter vector: the generated kernels' 16 slots first (inputs filled per call).
 (P_R, P_L, P_LS, P_M2, P_M3, P_J2, P_G, P_D, P_OMEGA, P_TH10,
- P_FGAS, P_FX, P_FY, P_TROD) = range(14)  # fmt: skip
-(P_C, P_K, P_CHI, P_RJ, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY, P_VMIN,
- P_LOADAMP, P_LOADSIGN, P_LOADKIND, P_TABLE) = range(14, 30)  # fmt: skip
+ P_FGAS, P_F1X, P_F1Y, P_F2X, P_F2Y, P_TROD) = range(NHEAD)  # fmt: skip
+(P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY,
+ P_VMIN, P_LOADAMP, P_LOADSIGN, P_LOADKIND, P_TABLE) = range(NHEAD, NHEAD + 19)  # fmt: skip
 
 
-@lru_cache(maxsize=1)
-def lagrangian():
-    """The derived :class:`~recipdyn.model.derive.Lagrangian` of the mechanism."""
+#: The state, the same for every joint configuration (a rigid joint's components stay 0).
+STATE_NAMES = ("ex", "ey", "ex_crosshead", "ey_crosshead", "ex_dot", "ey_dot",
+               "ex_crosshead_dot", "ey_crosshead_dot", "v_impact", "v_impact_crosshead", "W_in",
+               "W_loss")  # fmt: skip
+STATE_UNITS = ("m",) * 4 + ("m/s",) * 6 + ("J", "J")
+I_WIN, I_WLOSS = 10, 11
+
+
+@lru_cache(maxsize=3)
+def lagrangian(joints: str = "crank"):
+    """The derived :class:`~recipdyn.model.derive.Lagrangian` of the mechanism with clearance
+    at ``joints`` (module docstring)."""
     import sympy as sp
 
     from .derive import derive
 
     t = sp.Symbol("t", real=True)
-    ex, ey, u, v = sp.symbols("ex ey u v", real=True)
+    e = dict(zip(("e1x", "e1y", "e2x", "e2y"), sp.symbols("e1x e1y e2x e2y", real=True),
+                 strict=True))  # fmt: skip
+    names = {"crank": ("e1x", "e1y"), "crosshead": ("e2x", "e2y"),
+             "both": ("e1x", "e1y", "e2x", "e2y")}[joints]  # fmt: skip
+    q = tuple(e[k] for k in names)
+    qd = tuple(sp.Symbol(f"{k}_dot", real=True) for k in names)
+    e = {k: (v if k in names else sp.S.Zero) for k, v in e.items()}
     r, l, ls, m2, m3, J2, g, d, w, th10 = sp.symbols(" ".join(MECH), real=True)
-    Fg, Fx, Fy, Tr = sp.symbols(" ".join(INPUTS), real=True)
+    Fg, F1x, F1y, F2x, F2y, Tr = sp.symbols(" ".join(INPUTS), real=True)
     th1 = th10 + w * t
-    Bx, By = r * sp.cos(th1) + ex, r * sp.sin(th1) + ey
-    th2 = sp.asin(-(d + By) / l)
-    x3 = Bx + l * sp.cos(th2)
+    Bx, By = r * sp.cos(th1) + e["e1x"], r * sp.sin(th1) + e["e1y"]  # big end (bearing 1)
+    th2 = sp.asin((e["e2y"] - d - By) / l)  # small end at y = -d + e2y
+    x3 = Bx + l * sp.cos(th2) - e["e2x"]  # crosshead pin (journal 2) = small end - e2
     xg, yg = Bx + ls * sp.cos(th2), By + ls * sp.sin(th2)
 
-    def dt(e):  # total time derivative along (ex, ey) = (u, v)
-        return sp.diff(e, t) + sp.diff(e, ex) * u + sp.diff(e, ey) * v
+    def dt(x):  # total time derivative along q' = qd
+        return sp.diff(x, t) + sum(sp.diff(x, a) * b for a, b in zip(q, qd, strict=True))
 
     T = (m2 * (dt(xg) ** 2 + dt(yg) ** 2) + J2 * dt(th2) ** 2 + m3 * dt(x3) ** 2) / 2
     V = m2 * g * yg
-    Q = [Fx * sp.diff(Bx, q) + Fy * sp.diff(By, q) + Tr * sp.diff(th2, q) + Fg * sp.diff(x3, q)
-         for q in (ex, ey)]  # fmt: skip
-    return derive(T, V, (ex, ey), (u, v), t, (r, l, ls, m2, m3, J2, g, d, w, th10, Fg, Fx, Fy,
-                                              Tr), Q=Q)  # fmt: skip
+    # virtual work: F1 on the big end, F2 on the small end and -F2 on the crosshead pin
+    # (together F2 . d e2), the joints' torque on the rod, the gas force on the crosshead
+    Q = [F1x * sp.diff(Bx, k) + F1y * sp.diff(By, k) + F2x * sp.diff(e["e2x"], k)
+         + F2y * sp.diff(e["e2y"], k) + Tr * sp.diff(th2, k) + Fg * sp.diff(x3, k)
+         for k in q]  # fmt: skip
+    return derive(T, V, q, qd, t, (r, l, ls, m2, m3, J2, g, d, w, th10, Fg, F1x, F1y, F2x, F2y,
+                                   Tr), Q=Q)  # fmt: skip
 
 
 def generate() -> str:
     from .derive import kernel_source
 
-    return kernel_source(lagrangian(), "contact_mechanism",
-                         "Mechanism of the compressor with a contact-impact crank-pin joint "
-                         "(recipdyn.model.compressor_contact).", jacobian=False)  # fmt: skip
+    head = ['"""Generated by recipdyn.model.derive -- do not edit by hand.', "",
+            "Mechanism of the compressor with contact-impact clearance joints "
+            "(recipdyn.model.compressor_contact):", "M qdd = b for clearance at the crank pin, "
+            "the crosshead pin, or both.", '"""', "", "import math", "", "import numba as nb",
+            "", ""]  # fmt: skip
+    bodies = [kernel_source(lagrangian(j), j, "", system_only=True, header=False)
+              for j in JOINTS]  # fmt: skip
+    return "\n".join(head) + "\n\n".join(bodies)
 
 
 def _target() -> Path:
@@ -110,66 +136,74 @@ def _target() -> Path:
 
 
 @nb.njit(cache=True)
-def _joint(t, y, p, out5):
-    """Joint quantities: out5 = [F_x, F_y, T_rod, F_n, F_t] (on the bearing) and returns
-    (power from the crank, power lost in the joint, theta2', crosshead velocity x3')."""
-    ex, ey, u, v = y[0], y[1], y[2], y[3]
+def _kinematics(t, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
+    """(sin theta2, cos theta2, theta2', crosshead velocity x3') from the eccentricities."""
     r, l, d, w = p[P_R], p[P_L], p[P_D], p[P_OMEGA]
     th1 = p[P_TH10] + w * t
     s1, c1 = math.sin(th1), math.cos(th1)
-    s2 = -(d + r * s1 + ey) / l
+    s2 = (e2y - d - r * s1 - e1y) / l
     c2 = math.sqrt(1.0 - s2 * s2)
-    th2d = -(r * w * c1 + v) / (l * c2)
-    v3 = -r * w * s1 + u - l * s2 * th2d  # x3 = Bx + l cos(theta2)
-    vjx, vjy = -r * w * s1, r * w * c1  # journal-centre velocity
-    c = p[P_C]
+    th2d = (v2 - r * w * c1 - v1) / (l * c2)
+    v3 = -r * w * s1 + u1 - l * s2 * th2d - u2
+    return s2, c2, th2d, v3
+
+
+@nb.njit(cache=True)
+def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p, out):
+    """Forces of one clearance joint, e = (ex, ey) from the journal centre to the bearing
+    centre, journal and bearing turning at w_j and w_b: out = [F_x, F_y (on the bearing),
+    T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost]."""
+    for i in range(7):
+        out[i] = 0.0
     rho = math.sqrt(ex * ex + ey * ey)
-    delta = rho - c
-    for i in range(5):
-        out5[i] = 0.0
     if rho == 0.0:
-        return 0.0, 0.0, th2d, v3
+        return
+    delta = rho - c
     nx, ny = ex / rho, ey / rho
     tx, ty = -ny, nx
     drho = nx * u + ny * v  # = delta'
     et = tx * u + ty * v
-    Rj = p[P_RJ]
     Rb = Rj + c
-    fx = 0.0
-    fy = 0.0
-    trod = 0.0
-    p_crank = 0.0
-    p_loss = 0.0
     if delta > 0.0:
-        K = p[P_K]
-        fn = normal_force(delta, drho, max(y[4], p[P_VMIN]), K, p[P_CHI])
-        vt = et + w * Rj - th2d * Rb  # sliding velocity, bearing relative to journal
+        fn = normal_force(delta, drho, max(v_imp, p[P_VMIN]), K, p[P_CHI])
+        vt = et + w_j * Rj - w_b * Rb  # sliding velocity, bearing relative to journal
         ft = fn * friction_factor(vt, p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]))
-        fx += -fn * nx + ft * tx
-        fy += -fn * ny + ft * ty
-        trod += -Rb * ft
-        out5[3] = fn
-        out5[4] = ft
-        p_crank += -fn * (nx * vjx + ny * vjy) + ft * (tx * vjx + ty * vjy - w * Rj)
-        p_loss += (fn - K * delta * math.sqrt(delta)) * drho - ft * vt
+        out[0] += -fn * nx + ft * tx
+        out[1] += -fn * ny + ft * ty
+        out[2] += -Rb * ft
+        out[3] += Rj * ft
+        out[4] += fn
+        out[5] += ft
+        out[6] += (fn - K * delta * math.sqrt(delta)) * drho - ft * vt
     if p[P_OIL] > 0.0:
         # film forces on the journal, along its eccentricity -n and t_j = k x (-n) = -t
-        eps = rho / c
-        dgam = et / rho
-        fr, fth = short_bearing_forces(eps, drho / c, dgam, w + th2d, p[P_OIL], p[P_LB], Rj,
-                                       c, p[P_EPSDRY])  # fmt: skip
+        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, p[P_OIL], p[P_LB],
+                                       Rj, c, p[P_EPSDRY])  # fmt: skip
         bx = fr * nx + fth * tx  # on the bearing: minus the force on the journal
         by = fr * ny + fth * ty
-        fx += bx
-        fy += by
-        out5[3] += -fr
-        out5[4] += fth
-        p_crank += bx * vjx + by * vjy
-        p_loss += -(bx * u + by * v)
-    out5[0] = fx
-    out5[1] = fy
-    out5[2] = trod
-    return p_crank, p_loss, th2d, v3
+        out[0] += bx
+        out[1] += by
+        out[4] += -fr
+        out[5] += fth
+        out[6] += -(bx * u + by * v)
+
+
+@nb.njit(cache=True)
+def _joints(t, y, p, cfg, f):
+    """Both joints' forces into f (2 x 7, rows as :func:`_pair`; a rigid joint's row is 0) and
+    (power from the crank, power lost in the joints, theta2', x3')."""
+    _, _, th2d, v3 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
+    w = p[P_OMEGA]
+    p_crank = 0.0
+    f[:, :] = 0.0
+    if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
+        _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], y[8], p, f[0])
+        th1 = p[P_TH10] + w * t
+        vjx, vjy = -p[P_R] * w * math.sin(th1), p[P_R] * w * math.cos(th1)
+        p_crank = f[0, 0] * vjx + f[0, 1] * vjy - f[0, 3] * w
+    if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
+        _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], y[9], p, f[1])
+    return p_crank, f[0, 6] + f[1, 6], th2d, v3
 
 
 @nb.njit(cache=True)
@@ -178,59 +212,205 @@ def _gas(t, p):
     return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
-def rhs(t, y, p, out):
-    q = p[:14].copy()
-    f5 = np.empty(5)
-    p_crank, p_loss, _, v3 = _joint(t, y, p, f5)
+@nb.njit(cache=True)
+def _inputs(t, y, p, cfg, q, f):
+    """Fill the mechanism's force inputs into q; returns (gas + crank power, power lost)."""
+    p_crank, p_loss, _, v3 = _joints(t, y, p, cfg, f)
     fg = _gas(t, p)
     q[P_FGAS] = fg
-    q[P_FX] = f5[0]
-    q[P_FY] = f5[1]
-    q[P_TROD] = f5[2]
-    M = np.empty((2, 2))
-    b = np.empty(2)
-    _mechanism(t, y, q, M, b)
-    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
-    out[0] = y[2]
-    out[1] = y[3]
-    out[2] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det
-    out[3] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det
-    out[4] = 0.0
-    out[5] = fg * v3 + p_crank  # gas power + crank power through the journal
-    out[6] = p_loss
+    q[P_F1X] = f[0, 0]
+    q[P_F1Y] = f[0, 1]
+    q[P_F2X] = f[1, 0]
+    q[P_F2Y] = f[1, 1]
+    q[P_TROD] = f[0, 2] + f[1, 2]
+    return fg * v3 + p_crank, p_loss
+
+
+@nb.njit(cache=True)
+def _solve(M, b, x):
+    """x = M^-1 b by Gaussian elimination with partial pivoting (n <= 4; M, b overwritten)."""
+    n = b.shape[0]
+    for c in range(n):
+        piv = c
+        for r in range(c + 1, n):
+            if abs(M[r, c]) > abs(M[piv, c]):
+                piv = r
+        if piv != c:
+            for j in range(n):
+                M[c, j], M[piv, j] = M[piv, j], M[c, j]
+            b[c], b[piv] = b[piv], b[c]
+        for r in range(c + 1, n):
+            fac = M[r, c] / M[c, c]
+            for j in range(c, n):
+                M[r, j] -= fac * M[c, j]
+            b[r] -= fac * b[c]
+    for c in range(n - 1, -1, -1):
+        s = b[c]
+        for j in range(c + 1, n):
+            s -= M[c, j] * x[j]
+        x[c] = s / M[c, c]
+
+
+@nb.njit(cache=True)
+def _ideal_crank_power(t, y, p, yd, f2):
+    """Power of the crank through an ideal crank pin (the crosshead-pin-only configuration),
+    from Newton's law for the rod, independent of the Lagrangian: the pin's reaction is
+    F_A = m2 a_G - F2 + (0, m2 g) (F2 the crosshead joint's force on the rod, no torque from a
+    frictionless pin), its power F_A . v_A."""
+    r, l, ls, m2, g, w = p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_G], p[P_OMEGA]
+    th1 = p[P_TH10] + w * t
+    s1, c1 = math.sin(th1), math.cos(th1)
+    s2, c2, th2d, _ = _kinematics(t, p, 0.0, 0.0, 0.0, 0.0, y[2], y[3], y[6], y[7])
+    s2dd = (yd[7] + r * w * w * s1) / l
+    th2dd = (s2dd + s2 * th2d * th2d) / c2
+    agx = -r * w * w * c1 + ls * (-s2 * th2dd - c2 * th2d * th2d)
+    agy = -r * w * w * s1 + ls * (c2 * th2dd - s2 * th2d * th2d)
+    fax = m2 * agx - f2[0]
+    fay = m2 * agy - f2[1] + m2 * g
+    return r * w * (-fax * s1 + fay * c1)
+
+
+@nb.njit(cache=True)
+def _rhs(t, y, p, out, cfg):
+    q = p[:NHEAD].copy()
+    f = np.empty((2, 7))
+    p_in, p_loss = _inputs(t, y, p, cfg, q, f)
+    for i in range(4):
+        out[i] = y[4 + i]
+        out[4 + i] = 0.0
+    if cfg == 2:
+        M = np.empty((4, 4))
+        b = np.empty(4)
+        both_system(t, y, q, M, b)
+        _solve(M, b, out[4:8])
+    else:
+        k = 0 if cfg == 0 else 2  # the active joint's coordinates: y[k:k+2], rates y[4+k:6+k]
+        yl = np.array([y[k], y[k + 1], y[4 + k], y[5 + k]])
+        M = np.empty((2, 2))
+        b = np.empty(2)
+        if cfg == 0:
+            crank_system(t, yl, q, M, b)
+        else:
+            crosshead_system(t, yl, q, M, b)
+        det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]  # Cramer's rule
+        out[4 + k] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det
+        out[5 + k] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det
+    if cfg == 1:
+        p_in += _ideal_crank_power(t, y, p, out, f[1])
+    out[8] = 0.0
+    out[9] = 0.0
+    out[I_WIN] = p_in
+    out[I_WLOSS] = p_loss
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def rhs_crank(t, y, p, out):
+    _rhs(t, y, p, out, 0)
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def rhs_crosshead(t, y, p, out):
+    _rhs(t, y, p, out, 1)
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def rhs_both(t, y, p, out):
+    _rhs(t, y, p, out, 2)
+
+
+@nb.njit(cache=True)
+def _fd_jac(t, y, p, J, cfg):
+    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
+    (positions), c omega (rates)."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    c = p[P_C1] if cfg == 0 else (p[P_C2] if cfg == 1 else min(p[P_C1], p[P_C2]))
+    for k in range(n):
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else 1.0)
+        h = 1e-5 * max(abs(y[k]), scale)
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m], cfg)
+        yp[k] = y[k]
+        for i in range(n):
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
 
 
 @nb.njit(JAC_SIGNATURE, cache=True)
-def jac(t, y, p, J):
-    n = y.shape[0]
-    yp = y.copy()
-    f1 = np.empty(n)
-    f2 = np.empty(n)
-    c = p[P_C]
-    for k in range(n):
-        scale = c if k < 2 else (c * p[P_OMEGA] if k < 5 else 1.0)
-        h = 1e-6 * max(abs(y[k]), scale)
-        yp[k] = y[k] + h
-        rhs(t, yp, p, f1)
-        yp[k] = y[k] - h
-        rhs(t, yp, p, f2)
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (f1[i] - f2[i]) / (2.0 * h)
+def jac_crank(t, y, p, J):
+    _fd_jac(t, y, p, J, 0)
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def jac_crosshead(t, y, p, J):
+    _fd_jac(t, y, p, J, 1)
+
+
+@nb.njit(JAC_SIGNATURE, cache=True)
+def jac_both(t, y, p, J):
+    _fd_jac(t, y, p, J, 2)
 
 
 @nb.njit(EVENT_SIGNATURE, cache=True)
-def onset(t, y, p):
-    return math.sqrt(y[0] * y[0] + y[1] * y[1]) - p[P_C]
+def onset_crank(t, y, p):
+    return math.sqrt(y[0] * y[0] + y[1] * y[1]) - p[P_C1]
+
+
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def onset_crosshead(t, y, p):
+    return math.sqrt(y[2] * y[2] + y[3] * y[3]) - p[P_C2]
+
+
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def onset_both(t, y, p):
+    """Changes sign whenever either joint's penetration does (the integrator locates one
+    event function): (delta1 / c1) (delta2 / c2)."""
+    d1 = math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[P_C1] - 1.0
+    d2 = math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[P_C2] - 1.0
+    return d1 * d2
+
+
+@nb.njit(cache=True)
+def _record(y, ix, iy, iu, iv, k, p, out):
+    rho = math.sqrt(y[ix] * y[ix] + y[iy] * y[iy])
+    out[k] = max((y[ix] * y[iu] + y[iy] * y[iv]) / rho, p[P_VMIN])
 
 
 @nb.njit(RHS_SIGNATURE, cache=True)
-def record_approach(t, y, p, out):
+def record_crank(t, y, p, out):
     for i in range(y.shape[0]):
         out[i] = y[i]
-    rho = math.sqrt(y[0] * y[0] + y[1] * y[1])
-    out[4] = max((y[0] * y[2] + y[1] * y[3]) / rho, p[P_VMIN])
+    _record(y, 0, 1, 4, 5, 8, p, out)
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def record_crosshead(t, y, p, out):
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    _record(y, 2, 3, 6, 7, 9, p, out)
+
+
+@nb.njit(RHS_SIGNATURE, cache=True)
+def record_both(t, y, p, out):
+    """At a sign change of :func:`onset_both`: the joint on its surface (the smaller relative
+    |delta|), if approaching, records its approach velocity; a separation changes nothing."""
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[P_C1] - 1.0)
+    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[P_C2] - 1.0)
+    if d1 <= d2:
+        if y[0] * y[4] + y[1] * y[5] > 0.0:
+            _record(y, 0, 1, 4, 5, 8, p, out)
+    elif y[2] * y[6] + y[3] * y[7] > 0.0:
+        _record(y, 2, 3, 6, 7, 9, p, out)
+
+
+KERNELS = {  # joints -> (rhs, jac, event, reset, config code)
+    "crank": (rhs_crank, jac_crank, onset_crank, record_crank, 0),
+    "crosshead": (rhs_crosshead, jac_crosshead, onset_crosshead, record_crosshead, 1),
+    "both": (rhs_both, jac_both, onset_both, record_both, 2),
+}
 
 
 def _link(name: str, **changes) -> Param:
@@ -241,8 +421,13 @@ def _link(name: str, **changes) -> Param:
 
 SCHEMA = Schema((
     *(_link(k) for k in ("r", "l", "ls", "m2", "m3", "J2", "g")),
+    Param("clearance_joints", "", "crank", "where the clearance is: the crank pin, the crosshead "
+          "pin, or both (the other joints are ideal)", choices=JOINTS, group="joint"),
     _link("rc", description="radial clearance of the crank-pin joint, c = R_b - R_j",
           low=0.0, low_open=True),
+    Param("rc_crosshead", "m", 1e-4, "radial clearance of the crosshead-pin joint "
+          "(clearance_joints = crosshead or both)", 0.0, 0.05, low_open=True,
+          assumed="assumed: a worn crosshead bush", group="joint"),
     _link("d"),
     Param("joint", "", "dry", "'dry' contact-impact or 'lubricated' (oil film + dry contact "
           "beyond eps_dry)", choices=("dry", "lubricated"), group="joint"),
@@ -250,9 +435,15 @@ SCHEMA = Schema((
           choices=LAWS, group="joint"),
     Param("restitution", "", 0.9, "nominal coefficient of restitution of the law", 0.0, 1.0,
           low_open=True, group="joint"),
-    Param("K", "N/m**1.5", None, "contact stiffness (default: Hertz pin-in-hole from the radii "
-          "and materials)", 0.0, _INF, low_open=True, group="joint", optional=True),
+    Param("K", "N/m**1.5", None, "contact stiffness of the crank-pin joint (default: Hertz "
+          "pin-in-hole from the radii and materials)", 0.0, _INF, low_open=True, group="joint",
+          optional=True),
+    Param("K_crosshead", "N/m**1.5", None, "contact stiffness of the crosshead-pin joint "
+          "(default: Hertz pin-in-hole)", 0.0, _INF, low_open=True, group="joint",
+          optional=True),
     Param("journal_radius", "m", 0.05, "crank-pin (journal) radius R_j", 0.0, _INF,
+          low_open=True, assumed="assumed: not given in the paper", group="joint"),
+    Param("crosshead_pin_radius", "m", 0.03, "crosshead-pin (journal) radius", 0.0, _INF,
           low_open=True, assumed="assumed: not given in the paper", group="joint"),
     Param("bearing_length", "m", 0.06, "bearing length L (oil film)", 0.0, _INF,
           low_open=True, assumed="assumed: not given in the paper", group="joint"),
@@ -282,29 +473,35 @@ SCHEMA = Schema((
     _link("load_amplitude"), _link("load_sign"),
     Param("e0_angle", "rad", None, "initial direction of e (default: aligned with the rod "
           "load, as the massless link's default)", -1e6, 1e6, group="initial", optional=True),
-    Param("e0_ratio", "", 1.0, "initial |e| / rc", 0.0, 1.5, group="initial"),
+    Param("e0_angle_crosshead", "rad", None, "initial direction of the crosshead pin's e "
+          "(default: the crank pin's + pi)", -1e6, 1e6, group="initial", optional=True),
+    Param("e0_ratio", "", 1.0, "initial |e| / rc of each clearance joint", 0.0, 1.5,
+          group="initial"),
     Param("edot0_x", "m/s", 0.0, "initial ex'", -1e3, 1e3, group="initial"),
     Param("edot0_y", "m/s", 0.0, "initial ey'", -1e3, 1e3, group="initial"),
 ), aliases={"clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
             "c": "rc", "law": "contact_law"})  # fmt: skip
 
 
-def stiffness(values: Mapping[str, Any]) -> float:
-    """K (N/m^1.5): the value given, or Hertz's pin-in-hole formula."""
-    if values.get("K") is not None:
-        return float(values["K"])
-    rj = float(values["journal_radius"])
-    return hertz_stiffness(rj, rj + float(values["rc"]), values["E_journal"],
+def stiffness(values: Mapping[str, Any], joint: str = "crank") -> float:
+    """K (N/m^1.5) of a clearance joint: the value given, or Hertz's pin-in-hole formula."""
+    key, rc, rj = (("K", "rc", "journal_radius") if joint == "crank" else
+                   ("K_crosshead", "rc_crosshead", "crosshead_pin_radius"))  # fmt: skip
+    if values.get(key) is not None:
+        return float(values[key])
+    rj = float(values[rj])
+    return hertz_stiffness(rj, rj + float(values[rc]), values["E_journal"],
                            values["nu_journal"], values["E_bearing"],
                            values["nu_bearing"])  # fmt: skip
 
 
 def pack(values: Mapping[str, Any]) -> np.ndarray:
     v = values
-    head = [v[k] for k in MECH] + [0.0] * 4
-    head += [v["rc"], stiffness(v), hysteresis_factor(v["contact_law"], v["restitution"]),
-             v["journal_radius"], v["friction"], v["v0"], v["v1"],
-             float(FRICTION_LAWS.index(v["friction_law"])),
+    head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
+    head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
+             v["rc_crosshead"], stiffness(v, "crosshead"), v["crosshead_pin_radius"],
+             hysteresis_factor(v["contact_law"], v["restitution"]), v["friction"], v["v0"],
+             v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
              v["oil_viscosity"] if v["joint"] == "lubricated" else 0.0, v["bearing_length"],
              v["eps_dry"], v["v_impact_min"], v["load_amplitude"],
              -1.0 if v["load_sign"] == "physical" else 1.0, 0.0]  # fmt: skip
@@ -312,50 +509,57 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
 
 
 def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
-    """Kinetic + gravity energy of rod and crosshead and the contact's elastic energy (J)."""
+    """Kinetic + gravity energy of rod and crosshead and the contacts' elastic energy (J)."""
     r, l, ls, m2, m3, J2, g, d, w, th10 = (float(values[k]) for k in MECH)
     th1 = th10 + w * t
-    ex, ey, u, v = y[:, 0], y[:, 1], y[:, 2], y[:, 3]
-    s2 = -(d + r * np.sin(th1) + ey) / l
+    y = np.atleast_2d(y)
+    e1x, e1y, e2x, e2y, u1, v1, u2, v2 = (y[:, i] for i in range(8))
+    s2 = (e2y - d - r * np.sin(th1) - e1y) / l
     c2 = np.sqrt(1.0 - s2**2)
-    th2d = -(r * w * np.cos(th1) + v) / (l * c2)
-    vbx, vby = -r * w * np.sin(th1) + u, r * w * np.cos(th1) + v
+    vbx, vby = -r * w * np.sin(th1) + u1, r * w * np.cos(th1) + v1
+    th2d = (v2 - vby) / (l * c2)
     vgx, vgy = vbx - ls * s2 * th2d, vby + ls * c2 * th2d
-    v3 = vbx - l * s2 * th2d
+    v3 = vbx - l * s2 * th2d - u2
     kin = 0.5 * (m2 * (vgx**2 + vgy**2) + J2 * th2d**2 + m3 * v3**2)
-    pot = m2 * g * (r * np.sin(th1) + ey + ls * s2)
-    delta = np.maximum(np.hypot(ex, ey) - float(values["rc"]), 0.0)
-    return {"mechanical": kin + pot, "elastic": stiffness(values) * delta**2.5 / 2.5}
+    pot = m2 * g * (r * np.sin(th1) + e1y + ls * s2)
+    d1 = np.maximum(np.hypot(e1x, e1y) - float(values["rc"]), 0.0)
+    d2 = np.maximum(np.hypot(e2x, e2y) - float(values["rc_crosshead"]), 0.0)
+    elastic = stiffness(values, "crank") * d1**2.5 / 2.5
+    elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
+    return {"mechanical": kin + pot, "elastic": elastic}
 
 
 @nb.njit(cache=True)
-def _joint_series(rhs, t, y, p):
-    """Per sample: F_x, F_y, T_rod, F_n, F_t, ex'', ey'', theta2', x3', gas force."""
+def _joint_series(cfg, t, y, p):
+    """Per sample: both joints' rows of :func:`_pair` (14), the accelerations e1'', e2''
+    (4), theta2', x3', gas force."""
     n = t.shape[0]
-    out = np.empty((n, 10))
-    f5 = np.empty(5)
-    f = np.empty(y.shape[1])
+    out = np.zeros((n, 21))
+    f = np.empty((2, 7))
+    d = np.empty(y.shape[1])
     for i in range(n):
         yi = y[i].copy()
-        rhs(t[i], yi, p, f)
-        _, _, th2d, v3 = _joint(t[i], yi, p, f5)
-        out[i, 0:5] = f5
-        out[i, 5] = f[2]
-        out[i, 6] = f[3]
-        out[i, 7] = th2d
-        out[i, 8] = v3
-        out[i, 9] = _gas(t[i], p)
+        _rhs(t[i], yi, p, d, cfg)
+        _, _, th2d, v3 = _joints(t[i], yi, p, cfg, f)
+        out[i, 0:7] = f[0]
+        out[i, 7:14] = f[1]
+        out[i, 14:18] = d[4:8]
+        out[i, 18] = th2d
+        out[i, 19] = v3
+        out[i, 20] = _gas(t[i], p)
     return out
 
 
 class CompressorContact(Model):
-    """The compressor with a contact-impact (dry or lubricated) crank-pin clearance joint."""
+    """The compressor with contact-impact (dry or lubricated) clearance joints at the crank
+    pin, the crosshead pin, or both."""
 
     name = "compressor-contact"
-    description = ("compressor with a contact-impact crank-pin clearance joint (free flight, "
-                   "impacts, friction, oil film; Flores et al. 2008)")  # fmt: skip
-    state_names = ("ex", "ey", "ex_dot", "ey_dot", "v_impact", "W_in", "W_loss")
-    state_units = ("m", "m", "m/s", "m/s", "m/s", "J", "J")
+    description = ("compressor with contact-impact clearance joints at the crank pin, the "
+                   "crosshead pin or both (free flight, impacts, friction, oil film; Flores et "
+                   "al. 2008)")  # fmt: skip
+    state_names = STATE_NAMES
+    state_units = STATE_UNITS
     schema = SCHEMA
     section_signals = (("ex", "m"), ("ey", "m"), ("x", "m"), ("v", "m/s"), ("a", "m/s**2"))
     vibration_signal = ("a", "m/s**2")
@@ -376,36 +580,60 @@ class CompressorContact(Model):
         if values["rc"] >= values["r"]:
             raise ParameterError(f"rc = {values['rc']!r} m is out of range; allowed: "
                                  f"(0, r = {values['r']!r}) m")  # fmt: skip
-        dmax = values["l"] - values["r"] - 1.5 * values["rc"]
+        dmax = values["l"] - values["r"] - 1.5 * (values["rc"] + values["rc_crosshead"])
         if not abs(values["d"]) < dmax:
-            raise ParameterError(f"d = {values['d']!r} m is out of range; allowed: "
-                                 f"(-{dmax:g}, {dmax:g}) m (l - r - 1.5 rc)")  # fmt: skip
+            raise ParameterError(
+                f"d = {values['d']!r} m is out of range; allowed: "
+                f"(-{dmax:g}, {dmax:g}) m (l - r - 1.5 (rc + rc_crosshead))"
+            )
         if values["v1"] <= values["v0"]:
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
-        return (Event("impact", onset, direction=1, action="reset", reset=record_approach,
-                      description="contact onset (|e| = rc, approaching): the approach "
+        joints = values["clearance_joints"]
+        _, _, onset, record, _ = KERNELS[joints]
+        if joints == "both":
+            return (Event("impact", onset, direction=0, action="reset", reset=record,
+                          description="contact onset or separation at either joint (the "
+                          "sign of delta1 delta2 changes): at an onset the approach velocity "
+                          "is recorded for the damping law"),)  # fmt: skip
+        where = "|e| = rc" if joints == "crank" else "|e_crosshead| = rc_crosshead"
+        return (Event("impact", onset, direction=1, action="reset", reset=record,
+                      description=f"contact onset ({where}, approaching): the approach "
                       "velocity is recorded for the damping law"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
+        rhs, jac, *_ = KERNELS[values["clearance_joints"]]
         return ODESystem(rhs=rhs, jac=jac, params=pack(values), state_names=self.state_names,
                          state_units=self.state_units, period=self.period(values),
-                         name=self.name, events=self.events(values), aux_states=3)  # fmt: skip
+                         name=self.name, events=self.events(values), aux_states=4)  # fmt: skip
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Both eccentricities along the rod load as the massless link's equilibrium (rod in
+        compression: the crank pin's e points from the crosshead to the crank, the crosshead
+        pin's the other way), at rest relative to the journals; a rigid joint's are 0."""
         ang = values["e0_angle"]
-        if ang is None:  # as the massless link: e along the rod load (rod in compression)
+        if ang is None:
             from .compressor import equilibrium_theta_c
             from .parameters import CompressorParams
 
-            cp = CompressorParams(**{k: values[k] for k in (*MECH, "rc", "load_amplitude",
+            cp = CompressorParams(rs=0.0, **{k: values[k] for k in (*MECH, "rc", "load_amplitude",
                                                             "load_sign")})  # fmt: skip
             ang = equilibrium_theta_c(cp)
-        e = values["e0_ratio"] * values["rc"]
-        return np.array([e * math.cos(ang), e * math.sin(ang), values["edot0_x"],
-                         values["edot0_y"], values["v_impact_min"], 0.0, 0.0])  # fmt: skip
+        ang2 = values["e0_angle_crosshead"]
+        ang2 = ang + math.pi if ang2 is None else ang2
+        y = np.zeros(len(STATE_NAMES))
+        joints = values["clearance_joints"]
+        if joints != "crosshead":
+            e = values["e0_ratio"] * values["rc"]
+            y[[0, 1, 4, 5]] = (e * math.cos(ang), e * math.sin(ang), values["edot0_x"],
+                               values["edot0_y"])  # fmt: skip
+        if joints != "crank":
+            e = values["e0_ratio"] * values["rc_crosshead"]
+            y[[2, 3]] = e * math.cos(ang2), e * math.sin(ang2)
+        y[8] = y[9] = values["v_impact_min"]
+        return y
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["omega"])
@@ -415,44 +643,112 @@ class CompressorContact(Model):
         s = self.system(values)
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
-        j = _joint_series(s.rhs, t, y, s.params)
+        cfg = KERNELS[values["clearance_joints"]][4]
+        j = _joint_series(cfg, t, y, s.params)
         r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
         th1 = float(values["theta1_0"]) + w * t
-        ex, ey = y[:, 0], y[:, 1]
-        s2 = -(d + r * np.sin(th1) + ey) / l
+        e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))
+        s2 = (e2y - d - r * np.sin(th1) - e1y) / l
         c2 = np.sqrt(1.0 - s2**2)
-        th2d = j[:, 7]
-        # theta2'' from sin(theta2)'' = -(-r w^2 sin(theta1) + ey'') / l
-        s2dd = -(-r * w**2 * np.sin(th1) + j[:, 6]) / l
+        th2d = j[:, 18]
+        # theta2'' from sin(theta2)'' = (e2y'' - By'') / l, By'' = -r w^2 sin(theta1) + e1y''
+        s2dd = (j[:, 17] + r * w**2 * np.sin(th1) - j[:, 15]) / l
         th2dd = (s2dd + s2 * th2d**2) / c2
-        x3 = r * np.cos(th1) + ex + l * c2
-        v3 = j[:, 8]
-        a3 = -r * w**2 * np.cos(th1) + j[:, 5] - l * (c2 * th2d**2 + s2 * th2dd)
-        rho = np.hypot(ex, ey)
-        delta = rho - float(values["rc"])
+        x3 = r * np.cos(th1) + e1x + l * c2 - e2x
+        a3 = -r * w**2 * np.cos(th1) + j[:, 14] - l * (c2 * th2d**2 + s2 * th2dd) - j[:, 16]
         en = energy(values, t, y)
-        fn = j[:, 3]
         sig = {
             "x": Signal(x3, "m", "crosshead displacement x3"),
-            "v": Signal(v3, "m/s", "crosshead velocity"),
+            "v": Signal(j[:, 19], "m/s", "crosshead velocity"),
             "a": Signal(a3, "m/s**2", "crosshead acceleration"),
             "theta1": Signal(th1, "rad", "crank angle"),
             "theta2": Signal(np.arcsin(s2), "rad", "connecting-rod angle"),
-            "ex": Signal(ex, "m", "eccentricity x (bearing centre - journal centre)"),
-            "ey": Signal(ey, "m", "eccentricity y"),
-            "eccentricity_ratio": Signal(rho / float(values["rc"]), "", "|e| / rc"),
-            "delta": Signal(delta, "m", "penetration |e| - rc (> 0: in contact)"),
-            "contact": Signal((delta > 0).astype(float), "", "1 in contact, 0 in free flight"),
-            "normal_force": Signal(fn, "N", "joint normal force on the bearing (contact + film)"),
-            "tangential_force": Signal(j[:, 4], "N", "joint tangential force on the bearing"),
-            "joint_force_x": Signal(j[:, 0], "N", "joint force on the rod, x"),
-            "joint_force_y": Signal(j[:, 1], "N", "joint force on the rod, y"),
-            "joint_force": Signal(np.hypot(j[:, 0], j[:, 1]), "N", "joint force magnitude"),
-            "gas_force": Signal(j[:, 9], "N", "gas force on the crosshead along +x"),
+            "gas_force": Signal(j[:, 20], "N", "gas force on the crosshead along +x"),
             "energy": Signal(en["mechanical"] + en["elastic"], "J",
                              "kinetic + gravity energy of rod and crosshead + contact elastic"),
         }  # fmt: skip
+        joints = values["clearance_joints"]
+        for key, where, row, (ix, iy), rc in (
+            ("", "crank-pin", 0, (0, 1), "rc"),
+            ("_crosshead", "crosshead-pin", 1, (2, 3), "rc_crosshead"),
+        ):  # fmt: skip
+            if joints != "both" and joints != where.split("-")[0]:
+                continue
+            ex, ey = y[:, ix], y[:, iy]
+            rho = np.hypot(ex, ey)
+            c = float(values[rc])
+            delta = rho - c
+            f = j[:, 7 * row : 7 * row + 7]
+            sig.update({
+                "ex" + key: Signal(ex, "m", f"{where} eccentricity x (bearing centre - journal "
+                                   "centre)"),
+                "ey" + key: Signal(ey, "m", f"{where} eccentricity y"),
+                "eccentricity_ratio" + key: Signal(rho / c, "", f"{where} |e| / {rc}"),
+                "delta" + key: Signal(delta, "m", f"{where} penetration |e| - {rc} (> 0: in "
+                                      "contact)"),
+                "contact" + key: Signal((delta > 0).astype(float), "", f"{where} contact: 1 in "
+                                        "contact, 0 in free flight"),
+                "normal_force" + key: Signal(f[:, 4], "N", f"{where} normal force on the "
+                                             "bearing (contact + film)"),
+                "tangential_force" + key: Signal(f[:, 5], "N", f"{where} tangential force on "
+                                                 "the bearing"),
+                "joint_force_x" + key: Signal(f[:, 0], "N", f"{where} joint force on the rod, "
+                                              "x"),
+                "joint_force_y" + key: Signal(f[:, 1], "N", f"{where} joint force on the rod, "
+                                              "y"),
+                "joint_force" + key: Signal(np.hypot(f[:, 0], f[:, 1]), "N", f"{where} joint "
+                                            "force magnitude"),
+            })  # fmt: skip
         return sig
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
+        """Per clearance joint (suffix ``_crosshead`` for the crosshead pin): impacts (count,
+        per revolution, approach velocities), maximum penetration, contact fraction (free
+        flight is the rest), peak and RMS joint force; the energy lost in the joints and the
+        energy-balance residual over the recorded interval; the peak crosshead acceleration."""
+        out: dict[str, float] = {}
+        t = ds["time"].values
+        revs = (t[-1] - t[0]) / self.period(values) if t.size > 1 else float("nan")
+        joints = values["clearance_joints"]
+        active = [("", 0, 1, 4, 5, "rc")] if joints != "crosshead" else []
+        if joints != "crank":
+            active.append(("_crosshead", 2, 3, 6, 7, "rc_crosshead"))
+        has_ev = "impact_time" in ds
+        if has_ev:
+            ev = np.column_stack([ds[f"impact_{k}"].values for k in STATE_NAMES[:8]])
+            rel = np.column_stack([np.abs(np.hypot(ev[:, 0], ev[:, 1]) / values["rc"] - 1.0),
+                                   np.abs(np.hypot(ev[:, 2], ev[:, 3])
+                                          / values["rc_crosshead"] - 1.0)])  # fmt: skip
+            owner = np.argmin(rel, axis=1) if joints == "both" else np.full(
+                len(ev), 0 if joints == "crank" else 1)  # fmt: skip
+        for key, ix, iy, iu, iv, _rc in active:
+            if has_ev:
+                mine = owner == (0 if key == "" else 1)
+                vr = (ev[mine, ix] * ev[mine, iu] + ev[mine, iy] * ev[mine, iv]) / np.hypot(
+                    ev[mine, ix], ev[mine, iy])  # fmt: skip
+                vr = vr[vr > 0]  # onsets (with both joints the separations are events too)
+            else:
+                vr = np.empty(0)
+            force = ds["joint_force" + key].values
+            out.update({
+                f"impacts{key}": float(vr.size),
+                f"impacts_per_revolution{key}": vr.size / revs if revs > 0 else float("nan"),
+                f"impact_velocity_mean{key}_m_s": float(vr.mean()) if vr.size else 0.0,
+                f"impact_velocity_max{key}_m_s": float(vr.max()) if vr.size else 0.0,
+                f"max_penetration{key}_m": float(max(ds["delta" + key].values.max(), 0.0)),
+                f"contact_fraction{key}": float(ds["contact" + key].values.mean()),
+                f"peak_joint_force{key}_N": float(force.max()),
+                f"rms_joint_force{key}_N": float(np.sqrt(np.mean(force**2))),
+            })  # fmt: skip
+        E = ds["energy"].values
+        w_in, w_loss = ds["W_in"].values, ds["W_loss"].values
+        bal = E - E[0] - ((w_in - w_in[0]) - (w_loss - w_loss[0]))
+        out.update({
+            "energy_lost_in_joints_J": float(w_loss[-1] - w_loss[0]),
+            "energy_balance_residual": float(np.abs(bal).max() / max(np.abs(E).max(), 1e-300)),
+            "peak_abs_a_m_s2": float(np.abs(ds["a"].values).max()),
+        })  # fmt: skip
+        return out
 
 
 COMPRESSOR_CONTACT = CompressorContact()

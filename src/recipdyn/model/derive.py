@@ -140,12 +140,15 @@ def _body(lag: Lagrangian, exprs: list[sp.Expr]) -> tuple[list[str], list[str]]:
     return head, [printer.doprint(e) for e in reduced]
 
 
-def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True) -> str:
+def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True,
+                  system_only: bool = False, header: bool = True) -> str:  # fmt: skip
     """Python source of ``{name}_system(t, y, p, M, b)``, ``{name}_rhs(t, y, p, out)`` and
     (with ``jacobian``) ``{name}_partials`` and ``{name}_jac(t, y, p, J)``.
 
     A model whose generalized forces are computed numerically (contact laws) uses
-    ``{name}_system`` with the forces as parameters and ``jacobian=False``."""
+    ``{name}_system`` alone (``system_only``), with the forces as parameters, and solves
+    ``M qdd = b`` itself. ``header=False`` leaves out the module docstring and imports (to put
+    several systems in one module)."""
     n = lag.n
     m_exprs = [lag.M[i, j] for i in range(n) for j in range(n)]
     b_exprs = [lag.b[i] for i in range(n)]
@@ -173,6 +176,10 @@ def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True
                  f"    acc = np.empty({n})", f"    {name}_system(t, y, p, M, b)", solve,
                  f"    for i in range({n}):", "        out[i] = y[" + str(n) + " + i]",
                  f"        out[{n} + i] = acc[i]"]  # fmt: skip
+    if not header:
+        lines = lines[lines.index("@nb.njit(cache=True)") :]
+    if system_only:
+        return "\n".join(lines + [""])
     if not jacobian:
         lines = [x.replace("JAC_SIGNATURE, RHS_SIGNATURE", "RHS_SIGNATURE") for x in lines]
         return "\n".join(lines + rhs_lines + [""])

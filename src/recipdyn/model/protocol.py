@@ -285,5 +285,11 @@ class Model(ABC):
                 for i, (n, u) in enumerate(zip(self.state_names, self.state_units,
                                                strict=True))}  # fmt: skip
 
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
+        """Figures of merit of one simulated run (``ds``: the labelled result of
+        :func:`recipdyn.simulate`), written into its attributes and printed by the CLI.
+        Default: none."""
+        return {}
+
     def __repr__(self) -> str:
         return f"<model {self.name!r}: {self.description}>"
