@@ -92,6 +92,14 @@ def main(argv: list[str] | None = None) -> dict:
     b = res["benettin_compressor"]
     print(f"Benettin, compressor base case, {revs} revolutions (rtol 1e-8): {b['seconds']:.2f} s,"
           f" exponents {b['exponents']}, sum {b['sum']:.2e}")  # fmt: skip
+    res["summary"] = [
+        dict(metric=f"Benettin, compressor, {revs} revolutions", value=b["seconds"], unit="s",
+             target=8.0 if revs == 1000 else None, better="lower"),
+    ]  # fmt: skip
+    if "speedup_rosenstein_vs_nolds" in res:
+        res["summary"].append(dict(metric="Rosenstein vs nolds.lyap_r",
+                                   value=res["speedup_rosenstein_vs_nolds"], unit="x",
+                                   target=None, better="higher"))  # fmt: skip
     return res
 
 

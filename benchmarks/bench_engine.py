@@ -81,6 +81,12 @@ def main(argv: list[str] | None = None) -> dict:
         cli_cached_start_s=t_cli, scipy_numpy_rhs_s_extrapolated=t_np,
         speedup_vs_numpy_rhs=t_np / t_ours, nfev_scipy_numpy_rhs_partial=int(ref_np.nfev),
     )  # fmt: skip
+    res["summary"] = [
+        dict(metric="engine vs solve_ivp DOP853, same compiled rhs", value=res["speedup"],
+             unit="x", target=None, better="higher"),
+        dict(metric="engine vs solve_ivp DOP853, numpy rhs", value=res["speedup_vs_numpy_rhs"],
+             unit="x", target=None, better="higher"),
+    ]  # fmt: skip
     print(f"engine benchmark: base case, {revs:g} revolutions, rtol 1e-10")
     print(f"  recipdyn DOP853 (compiled): {t_ours:8.3f} s   nfev {ours.nfev}")
     print(f"  scipy solve_ivp DOP853:     {t_scipy:8.3f} s   nfev {ref.nfev}")

@@ -24,7 +24,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--points", type=int, default=200)
-    ap.add_argument("--grid", type=int, default=32, help="points of the throughput grid")
+    ap.add_argument("--grid", type=int, default=100, help="points of the throughput grid")
     ap.add_argument("--revs", type=int, default=300)
     args, _ = ap.parse_known_args(argv)
     n = 8 if args.quick else args.grid
@@ -60,6 +60,12 @@ def main(argv: list[str] | None = None) -> dict:
               f"processes: {100 * res['dask_overhead_vs_processes']:+.1f} % on a running "
               f"cluster, {100 * res['dask_overhead_incl_cluster_start']:+.1f} % including "
               "LocalCluster start-up")  # fmt: skip
+        res["summary"] = [
+            dict(metric=f"sweep: process pool vs serial, {n} points, 2 workers",
+                 value=res["speedup_processes"], unit="x", target=1.8, better="higher"),
+            dict(metric="sweep: Dask (running cluster) overhead vs pool",
+                 value=res["dask_overhead_vs_processes"], unit="", target=0.15, better="lower"),
+        ]  # fmt: skip
         pts = 10 if args.quick else args.points
         revs = 30 if args.quick else args.revs
         bif_settings = dict(SETTINGS, transient=revs // 3, points=revs - revs // 3)

@@ -90,3 +90,27 @@ def test_load_table_from_csv(tmp_path):
     from recipdyn.simulate import params_from_attrs
 
     assert params_from_attrs(ds.attrs).load_table[1] == (90.0, -40000.0)
+
+
+def test_help_and_import_load_no_heavy_library():
+    """Start-up (issue 15): 'import recipdyn' and the command-line help must not import numba,
+    SciPy, xarray, pint or dask (they cost ~2 s together); the public names still resolve, and
+    'recipdyn.simulate' stays the function even after its submodule was imported."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, recipdyn, recipdyn.cli\n"
+        "recipdyn.cli._register()\n"
+        "from recipdyn.cli import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "heavy = [m for m in ('numba', 'scipy', 'xarray', 'pint', 'dask', 'pandas') "
+        "if m in sys.modules]\n"
+        "print('HEAVY', heavy)\n"
+        "import recipdyn.simulate\n"
+        "print('FUNC', callable(recipdyn.simulate) and recipdyn.simulate.__name__)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "HEAVY []" in r.stdout, r.stdout[-500:]
+    assert "FUNC simulate" in r.stdout

@@ -127,3 +127,32 @@ def test_bad_solver_settings(kw, match):
     span = kw.pop("t_span", (0.0, 1.0))
     with pytest.raises(ValueError, match=match):
         integrate(OSC, [1.0, 0.0], span, **kw)
+
+
+def test_dop853_tableau_from_the_user_cache_equals_scipy(tmp_path, monkeypatch):
+    """The tableau is assembled from SciPy once and then read from the user's cache (so later
+    runs skip importing scipy.integrate): both ways give SciPy's coefficients bit for bit, and a
+    corrupt cache file is replaced, never used."""
+    from scipy.integrate import DOP853 as S
+
+    from recipdyn.integrate import tableaus
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "recipdyn" / "numba"))
+    for attempt in ("built from scipy", "read from the cache", "corrupt file rebuilt"):
+        if attempt == "corrupt file rebuilt":
+            for f in (tmp_path / "recipdyn").glob("dop853-*.npz"):
+                f.write_bytes(b"not an npz file")
+        tableaus.dop853.cache_clear()
+        tab = tableaus.dop853()
+        n = S.n_stages
+        assert np.array_equal(tab.A[:n, :n], S.A), attempt
+        assert np.array_equal(tab.A[n, :n], S.B), attempt
+        assert np.array_equal(tab.A[n + 1 :, :], S.A_EXTRA), attempt
+        assert np.array_equal(tab.C, np.concatenate([S.C, [1.0], S.C_EXTRA])), attempt
+        for k in ("B", "E3", "E5", "D"):
+            assert np.array_equal(getattr(tab, k), getattr(S, k)), (attempt, k)
+        assert (tab.order, tab.n_stages, tab.error_estimator_order) == (
+            S.order, S.n_stages, S.error_estimator_order)  # fmt: skip
+    assert len(list((tmp_path / "recipdyn").glob("dop853-*.npz"))) == 1
+    tableaus.dop853.cache_clear()

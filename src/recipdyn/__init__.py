@@ -5,28 +5,78 @@ Quick start::
     import recipdyn
     ds = recipdyn.simulate(rc=1e-3, d=1e-3, omega=20.0, revolutions=5)
     ds.a.plot()
+
+The names below are imported on first use (PEP 562), so ``import recipdyn`` and the command
+line start without loading numba, SciPy or xarray until a command needs them.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from __future__ import annotations
 
-try:
-    __version__ = version("recipdyn")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0+unknown"
+import importlib
+import os
+import sys
+import types
 
-from .integrate import IntegrationError, integrate, propagate  # noqa: E402
-from .model import (  # noqa: E402
-    ASSUMED,
-    CompressorParams,
-    DiscreteMap,
-    ODESystem,
-    ParameterError,
-    compressor_model,
-    paper_2d12,
-)
-from .simulate import simulate  # noqa: E402
 
-__all__ = [
-    "__version__", "simulate", "integrate", "propagate", "IntegrationError", "CompressorParams",
-    "paper_2d12", "compressor_model", "ODESystem", "DiscreteMap", "ParameterError", "ASSUMED",
-]  # fmt: skip
+def _cache_dir() -> str:
+    """Where numba keeps compiled code: the user's cache directory, not the package folder."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "recipdyn", "numba")
+
+
+# numba reads NUMBA_CACHE_DIR when it is first imported; an explicit setting wins.
+os.environ.setdefault("NUMBA_CACHE_DIR", _cache_dir())
+
+_LAZY = {
+    "simulate": "simulate",
+    "integrate": "integrate",
+    "propagate": "integrate",
+    "IntegrationError": "integrate",
+    "CompressorParams": "model",
+    "paper_2d12": "model",
+    "compressor_model": "model",
+    "ODESystem": "model",
+    "DiscreteMap": "model",
+    "ParameterError": "model",
+    "ASSUMED": "model",
+}
+
+__all__ = ["__version__", *_LAZY]
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("recipdyn")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0+unknown"
+
+
+def __getattr__(name: str):
+    if name == "__version__":  # importlib.metadata costs ~40 ms: only when asked for
+        globals()[name] = value = _version()
+        return value
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value  # later lookups skip this hook
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+class _Package(types.ModuleType):
+    """``recipdyn.simulate`` and ``recipdyn.integrate`` are the functions, as before lazy
+    loading: the import system would otherwise bind the submodules of the same names here when
+    they are first imported (the submodules stay importable by name)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in ("simulate", "integrate") and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

@@ -30,6 +30,15 @@ class ParameterError(ValueError):
     """Bad input; the message names the parameter (or file) and the allowed range."""
 
 
+class IntegrationError(RuntimeError):
+    """The integrator failed; ``partial`` holds what was computed before the failure."""
+
+    def __init__(self, message: str, partial: Any = None):
+        super().__init__(message)
+        self.partial = partial  # a recipdyn.integrate.Solution
+        self.dataset = None  # set by recipdyn.simulate: the partial record as a Dataset
+
+
 class Interrupted(BaseException):
     """Work was stopped by a signal.
 

@@ -45,6 +45,7 @@ from ..model.base import (
     RHS_TYPE,
     DiscreteMap,
     ODESystem,
+    typed,
 )
 
 __all__ = ["LyapunovResult", "lyapunov_spectrum", "lyapunov_spectrum_map", "tangent_system"]
@@ -61,7 +62,7 @@ _BENETTIN_SIG = nb.int64(
 _EVENT_BATCH = 256
 
 
-@nb.njit(_BENETTIN_SIG, cache=True)
+@nb.njit(cache=True)  # compiled for _BENETTIN_SIG on first use (base.typed)
 def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, hist, times,
                      info, event, use_event, event_dir, treset, A, B, C, E3, E5, D):  # fmt: skip
     """Benettin loop, compiled: DOP853 over each interval, then QR; records running means.
@@ -383,7 +384,7 @@ def lyapunov_spectrum(
         if use_event:
             ev, ev_dir = event.function, int(event.direction)
             treset = _tangent_reset(system.rhs, event.function, event.reset, n, k)
-        status = _benettin_dop853(
+        status = typed(_benettin_dop853, _BENETTIN_SIG)(
             tsys.rhs, z, system.params, n, k, t, t_total, dt, rtol, atol, max_log_spread,
             hist, times, info, ev, use_event, ev_dir, treset, _DOP.A, _DOP.B, _DOP.C, _DOP.E3,
             _DOP.E5, _DOP.D,
@@ -455,20 +456,12 @@ def _map_kernel(step, jac, x0, p, n_iter, n_transient, k, n_hist, q0):
     return sums / n_iter, hist[:h]
 
 
-_map_kernel_typed = nb.njit(
-    nb.types.Tuple((nb.float64[::1], nb.float64[:, :]))(
-        RHS_TYPE,
-        JAC_TYPE,
-        nb.float64[::1],
-        nb.float64[::1],
-        nb.int64,
-        nb.int64,
-        nb.int64,
-        nb.int64,
-        nb.float64[:, ::1],
-    ),
-    cache=True,
-)(_map_kernel)
+_MAP_KERNEL_SIG = nb.types.Tuple((nb.float64[::1], nb.float64[:, :]))(
+    RHS_TYPE, JAC_TYPE, nb.float64[::1], nb.float64[::1], nb.int64, nb.int64, nb.int64, nb.int64,
+    nb.float64[:, ::1],
+)  # fmt: skip
+#: Compiled for _MAP_KERNEL_SIG on first use (base.typed).
+_map_kernel_jit = nb.njit(cache=True)(_map_kernel)
 
 
 def lyapunov_spectrum_map(
@@ -480,7 +473,7 @@ def lyapunov_spectrum_map(
         raise ValueError(f"map {dmap.name!r} has no Jacobian")
     n = dmap.dim
     k = n if k is None else int(k)
-    ex, hist = _map_kernel_typed(
+    ex, hist = typed(_map_kernel_jit, _MAP_KERNEL_SIG)(
         dmap.step, dmap.jac, np.ascontiguousarray(x0, dtype=float), dmap.params, int(n_iter),
         int(n_transient), k, int(n_history), _initial_basis(n, k),
     )  # fmt: skip

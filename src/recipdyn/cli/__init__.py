@@ -14,12 +14,14 @@ No traceback reaches the user unless ``--debug`` (or ``RECIPDYN_DEBUG=1``) asks 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+import time
 
 import typer
 
-from ..errors import Interrupted, ParameterError, raise_on_signals
+from ..errors import IntegrationError, Interrupted, ParameterError, raise_on_signals
 
 app = typer.Typer(
     add_completion=False,
@@ -74,11 +76,27 @@ def _err(msg: str) -> None:
     typer.echo(msg, err=True)
 
 
+@contextlib.contextmanager
+def phase(message: str, *, say_after: float = 1.0):
+    """Say what a phase is doing: a spinner on a terminal while it runs, and one line when it
+    took longer than ``say_after`` seconds (so logs show it too)."""
+    t0 = time.perf_counter()
+    if sys.stderr.isatty():
+        from rich.console import Console
+
+        with Console(stderr=True).status(message + "..."):
+            yield
+    else:
+        yield
+    wall = time.perf_counter() - t0
+    if wall > say_after:
+        _err(f"{message}: {wall:.1f} s")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit status (see the module docstring)."""
     _register()
     raise_on_signals()
-    from ..integrate import IntegrationError
 
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app
+from . import app, phase
 
 _SET_HELP = "Set any parameter: NAME=VALUE with units, e.g. --set m3='40 kg' (repeatable)."
 _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (default: half " \
@@ -62,6 +62,20 @@ def keep_partial(exc, out: Path) -> Path | None:
     return write_dataset(ds, path)
 
 
+def _prepare(m, params, method: str) -> None:
+    """Load the compiled code a run needs (compile it on the first run), saying so."""
+    from ..integrate import prepare
+
+    if m.name == "compressor":
+        from ..model.compressor import compressor_model
+
+        system = compressor_model(params)
+    else:
+        system = m.system(params)
+    with phase("loading compiled kernels (compiling them on a machine's first run, ~10 s)"):
+        prepare(system, method)
+
+
 @app.command()
 def simulate(
     rc: str = typer.Option(None, "--rc", "--clearance", help="Radial clearance, e.g. '1 mm'."),
@@ -69,7 +83,7 @@ def simulate(
     omega: str = typer.Option(None, "--omega", help="Crank speed, e.g. '20 rad/s', '191 rpm'."),
     sets: list[str] = typer.Option(None, "--set", help=_SET_HELP),
     config: Path = typer.Option(
-        None, "--config", "-c", help="TOML config with [params] and [simulation] tables."
+        None, "--config", "-c", help="TOML config with \\[params] and \\[simulation] tables."
     ),
     revolutions: str = typer.Option(None, "--revolutions", "-n", help="Revolutions to record."),
     transient: str = typer.Option(None, "--transient", help="Revolutions to discard first."),
@@ -110,6 +124,7 @@ def simulate(
     for name, val in (("method", method), ("rtol", rtol), ("atol", atol)):
         if val is not None:
             kw[name] = val
+    _prepare(m, params, kw["method"])
     try:
         ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
                      model=m, **kw)  # fmt: skip

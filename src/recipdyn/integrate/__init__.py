@@ -1,12 +1,12 @@
 """Compiled integrators for any :class:`~recipdyn.model.base.ODESystem`."""
 
-from .solve import METHODS, IntegrationError, Method, Solution, integrate, propagate
+from .solve import METHODS, IntegrationError, Method, Solution, integrate, prepare, propagate
 from .tableaus import RK4, Tableau, dop853
 
 # DOP853 (the tableau) is built on first access (module __getattr__ below).
 __all__ = [
-    "integrate", "propagate", "Solution", "IntegrationError", "METHODS", "Method", "RK4", "Tableau",
-    "dop853",
+    "integrate", "prepare", "propagate", "Solution", "IntegrationError", "METHODS", "Method",
+    "RK4", "Tableau", "dop853",
 ]  # fmt: skip
 
 

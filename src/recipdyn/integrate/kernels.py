@@ -20,7 +20,7 @@ import numba as nb
 import numpy as np
 from numba import types as T
 
-from ..model.base import EVENT_SIGNATURE, EVENT_TYPE, RHS_SIGNATURE, RHS_TYPE
+from ..model.base import EVENT_SIGNATURE, EVENT_TYPE, RHS_SIGNATURE, RHS_TYPE, compiled
 
 F8, I8 = T.float64, T.int64
 V1, V2 = T.float64[::1], T.float64[:, ::1]
@@ -33,7 +33,7 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def no_event(t, y, p):  # pragma: no cover - trivial
     return 1.0
 
@@ -148,7 +148,7 @@ def _locate_event(event, t, y, h, xa, xb, ga, gb, Fd, p, ydense):
     return xm
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def no_reset(t, y, p, out):  # pragma: no cover - trivial
     for j in range(y.shape[0]):
         out[j] = y[j]
@@ -160,7 +160,7 @@ DOP853_SIG = I8(
 )  # fmt: skip
 
 
-@nb.njit(DOP853_SIG, cache=True)
+@nb.njit(cache=True)  # compiled for DOP853_SIG on first use: see typed()
 def dop853_kernel(
     rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
     A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2, stats,
@@ -377,7 +377,10 @@ def dop853_kernel(
     return status
 
 
-@nb.njit(I8(RHS_TYPE, F8, V1, F8, F8, V1, F8, V1, I8, V2, T.int64[::1], V1, V2, V1, V1), cache=True)
+FIXED_STEP_SIG = I8(RHS_TYPE, F8, V1, F8, F8, V1, F8, V1, I8, V2, T.int64[::1], V1, V2, V1, V1)
+
+
+@nb.njit(cache=True)  # compiled for FIXED_STEP_SIG on first use: see typed()
 def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate,
                       A, B, C):  # fmt: skip
     """An explicit Runge-Kutta method given by its tableau ``(A, B, C)``, with fixed steps

@@ -25,12 +25,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
-from ..errors import Interrupted, ParameterError, deferred_signals, is_number
-from ..model.base import ODESystem
+from ..errors import IntegrationError, Interrupted, ParameterError, deferred_signals, is_number
+from ..model.base import ODESystem, typed
 from . import kernels
 from .tableaus import RK4, Tableau, dop853
 
-__all__ = ["integrate", "propagate", "Solution", "IntegrationError", "METHODS", "Method"]
+__all__ = ["integrate", "propagate", "prepare", "Solution", "IntegrationError", "METHODS",
+           "Method"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -58,15 +59,6 @@ _MESSAGES = {
     -3: "the state became non-finite (NaN/inf)",
     -4: "interrupted",
 }
-
-
-class IntegrationError(RuntimeError):
-    """The integrator failed; ``partial`` holds what was computed before the failure."""
-
-    def __init__(self, message: str, partial: Solution | None = None):
-        super().__init__(message)
-        self.partial = partial
-        self.dataset = None  # set by recipdyn.simulate: the partial record as a Dataset
 
 
 @dataclass
@@ -253,7 +245,7 @@ def integrate(
                 ev_cap = cap - len(ev_t) if use_event else 0
                 et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
                 ey2 = np.empty((ev_cap, system.dim))
-                status = kernels.dop853_kernel(
+                status = typed(kernels.dop853_kernel, kernels.DOP853_SIG)(
                     system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
                     max_step, t_eval[n_out:], max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
                     tab.E5, tab.D, use_event, event_direction, action, reset_fn, Y[n_out:], et,
@@ -263,7 +255,7 @@ def integrate(
                 ev_y.extend(ey[: stats[4]])
                 ev_y2.extend(ey2[: stats[4]])
             else:
-                status = kernels.fixed_step_kernel(
+                status = typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)(
                     system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
                     max_steps - nsteps, Y[n_out:], stats, fstate, tab.A, tab.B, tab.C,
                 )  # fmt: skip
@@ -300,6 +292,26 @@ def integrate(
     if status < 0 and raise_on_failure:
         raise IntegrationError(f"integration failed at t = {t:.6g}: {sol.message}", sol)
     return sol
+
+
+def prepare(system: ODESystem, method: str = "dop853") -> None:
+    """Compile (first run on a machine) or load from the cache everything :func:`integrate`
+    needs for ``system``: the integrator loop, the model's right-hand side and its acting event.
+
+    Optional: :func:`integrate` does the same on its first call. The command line calls it
+    first, to say "compiling" while it takes long."""
+    if method not in METHODS:
+        raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
+    if METHODS[method].adaptive:
+        typed(kernels.dop853_kernel, kernels.DOP853_SIG)
+        METHODS[method].tableau()
+    else:
+        typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)
+    own = system.acting_event
+    for fn in (system.rhs, getattr(own, "function", None), getattr(own, "reset", None)):
+        sig_obj = getattr(fn, "recipdyn_signature", None)
+        if sig_obj is not None:  # a compiled() kernel: compile exactly its signature
+            fn.compile(sig_obj.args)
 
 
 def propagate(system: ODESystem, y0, t0: float, t1: float, **kwargs) -> np.ndarray:

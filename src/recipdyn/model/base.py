@@ -16,11 +16,12 @@ Kernel calling convention (all arrays ``float64``, C-contiguous):
 ``jac(t, y, p, out)``
     writes the Jacobian ``df/dy`` into ``out`` (shape ``(dim, dim)``, ``out[i, j] = df_i/dy_j``).
 
-Kernels must be compiled with the explicit signatures :data:`RHS_SIGNATURE` /
-:data:`JAC_SIGNATURE` (``@numba.njit(RHS_SIGNATURE, cache=True)``): the integrators receive them
-as first-class function values (:data:`RHS_TYPE`), which keeps the integrators' own compiled code
-cacheable across processes (a lazily typed dispatcher argument would force a recompile in every
-new process).
+Kernels are declared with :func:`compiled` and their signature (``@compiled(RHS_SIGNATURE)``):
+the integrators receive them as first-class function values (:data:`RHS_TYPE`), which keeps the
+integrators' own compiled code cacheable across processes (a dispatcher argument would
+specialise the integrator per model, which numba cannot cache). Compilation is lazy: a kernel is
+compiled (or loaded from numba's disk cache) when a run first uses it, never at import, so a run
+pays only for what it uses.
 
 For a map the same convention holds with the step index ``n`` (a float) in place of ``t`` and
 ``out`` receiving ``g``/``dg/dx``.
@@ -37,12 +38,14 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numba as _nb
 import numpy as np
 from numba import types as _nbt
 
 __all__ = [
     "ODESystem", "DiscreteMap", "Signal", "Event", "RHS_SIGNATURE", "JAC_SIGNATURE",
-    "EVENT_SIGNATURE", "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE",
+    "EVENT_SIGNATURE", "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE", "compiled",
+    "typed",
 ]  # fmt: skip
 
 #: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
@@ -59,6 +62,42 @@ EVENT_TYPE = _nbt.FunctionType(EVENT_SIGNATURE)
 RHS_JAC_SIGNATURE = _nbt.void(
     _nbt.float64, _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[::1], _nbt.float64[:, ::1]
 )
+
+
+def compiled(signature):
+    """Declare a compiled kernel: ``numba.njit(cache=True)``, compiled on first use.
+
+    ``signature`` documents the calling convention; numba compiles exactly it when the kernel is
+    first passed as a function value (:data:`RHS_TYPE`, ...) to an integrator, and the machine
+    code is kept in numba's disk cache (``NUMBA_CACHE_DIR``, by default the user's cache
+    directory, see :mod:`recipdyn`), so later processes load it instead of compiling.
+    """
+
+    def deco(func):
+        dispatcher = _nb.njit(cache=True)(func)
+        dispatcher.recipdyn_signature = signature
+        return dispatcher
+
+    return deco
+
+
+_TYPED: dict[int, Any] = {}
+
+
+def typed(dispatcher, signature):
+    """``dispatcher`` compiled for exactly ``signature`` and closed to other argument types.
+
+    For compiled loops called from Python with function values as arguments (the integrators):
+    the function values are then converted to :class:`numba.types.FunctionType` instead of
+    specialising the loop per model, so one cached loop serves every model. Compiled once per
+    process, on first use.
+    """
+    key = id(dispatcher)
+    if key not in _TYPED:
+        dispatcher.compile(signature)
+        dispatcher.disable_compile()
+        _TYPED[key] = dispatcher
+    return dispatcher
 
 
 @dataclass(frozen=True)

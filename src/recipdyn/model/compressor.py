@@ -24,7 +24,16 @@ import numba as nb
 import numpy as np
 
 from ._generated import clearance_acceleration, clearance_acceleration_jac
-from .base import JAC_SIGNATURE, RHS_JAC_SIGNATURE, RHS_SIGNATURE, RHS_TYPE, ODESystem, Signal
+from .base import (
+    JAC_SIGNATURE,
+    RHS_JAC_SIGNATURE,
+    RHS_SIGNATURE,
+    RHS_TYPE,
+    ODESystem,
+    Signal,
+    compiled,
+    typed,
+)
 from .kinematics import joint_forces, kinematics
 from .load import gas_force, gas_force_kernel, mu_kernel, pack_table
 from .paper_printed import paper_acceleration
@@ -57,7 +66,7 @@ def _force(t, p):
     return th1, gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def rhs_exact(t, y, p, out):
     out[0] = y[1]
     if p[P_RC] == 0.0:
@@ -70,7 +79,7 @@ def rhs_exact(t, y, p, out):
     )  # fmt: skip
 
 
-@nb.njit(RHS_JAC_SIGNATURE, cache=True)
+@compiled(RHS_JAC_SIGNATURE)
 def rhs_jac_exact(t, y, p, out, J):
     out[0] = y[1]
     J[0, 0] = 0.0
@@ -87,7 +96,7 @@ def rhs_jac_exact(t, y, p, out, J):
     )  # fmt: skip
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def jac_exact(t, y, p, out):
     f = np.empty(2)
     rhs_jac_exact(t, y, p, f, out)
@@ -101,13 +110,13 @@ def _paper_acc(t, q, qd, p):
     )
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def rhs_paper(t, y, p, out):
     out[0] = y[1]
     out[1] = 0.0 if p[P_RC] == 0.0 else _paper_acc(t, y[0], y[1], p)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def jac_paper(t, y, p, out):
     out[0, 0] = 0.0
     out[0, 1] = 1.0
@@ -121,9 +130,11 @@ def jac_paper(t, y, p, out):
     out[1, 1] = (_paper_acc(t, y[0], y[1] + hd, p) - _paper_acc(t, y[0], y[1] - hd, p)) / (2 * hd)
 
 
-@nb.njit(
-    nb.float64[::1](RHS_TYPE, nb.float64[::1], nb.float64[:, ::1], nb.float64[::1]), cache=True
-)
+_ACCELERATIONS_SIG = nb.float64[::1](RHS_TYPE, nb.float64[::1], nb.float64[:, ::1],
+                                     nb.float64[::1])  # fmt: skip
+
+
+@nb.njit(cache=True)  # compiled for _ACCELERATIONS_SIG on first use (base.typed)
 def _accelerations(rhs, t, y, p):
     out = np.empty(t.shape[0])
     buf = np.empty(2)
@@ -174,7 +185,7 @@ class CompressorModel(ODESystem):
 
     def accelerations(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Clearance-angle acceleration at each sample, from the equation of motion."""
-        return _accelerations(
+        return typed(_accelerations, _ACCELERATIONS_SIG)(
             self.rhs, np.ascontiguousarray(t, float), np.ascontiguousarray(y, float), self.params
         )
 

@@ -41,7 +41,7 @@ import numba as nb
 import numpy as np
 
 from ._compressor_contact import both_system, crank_system, crosshead_system
-from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal
+from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -303,17 +303,17 @@ def _rhs(t, y, p, out, cfg):
     out[I_WLOSS] = p_loss
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def rhs_crank(t, y, p, out):
     _rhs(t, y, p, out, 0)
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def rhs_crosshead(t, y, p, out):
     _rhs(t, y, p, out, 1)
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def rhs_both(t, y, p, out):
     _rhs(t, y, p, out, 2)
 
@@ -337,32 +337,32 @@ def _fd_jac(t, y, p, J, cfg):
             J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def jac_crank(t, y, p, J):
     _fd_jac(t, y, p, J, 0)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def jac_crosshead(t, y, p, J):
     _fd_jac(t, y, p, J, 1)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def jac_both(t, y, p, J):
     _fd_jac(t, y, p, J, 2)
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def onset_crank(t, y, p):
     return math.sqrt(y[0] * y[0] + y[1] * y[1]) - p[P_C1]
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def onset_crosshead(t, y, p):
     return math.sqrt(y[2] * y[2] + y[3] * y[3]) - p[P_C2]
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def onset_both(t, y, p):
     """Changes sign whenever either joint's penetration does (the integrator locates one
     event function): (delta1 / c1) (delta2 / c2)."""
@@ -377,21 +377,21 @@ def _record(y, ix, iy, iu, iv, k, p, out):
     out[k] = max((y[ix] * y[iu] + y[iy] * y[iv]) / rho, p[P_VMIN])
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def record_crank(t, y, p, out):
     for i in range(y.shape[0]):
         out[i] = y[i]
     _record(y, 0, 1, 4, 5, 8, p, out)
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def record_crosshead(t, y, p, out):
     for i in range(y.shape[0]):
         out[i] = y[i]
     _record(y, 2, 3, 6, 7, 9, p, out)
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def record_both(t, y, p, out):
     """At a sign change of :func:`onset_both`: the joint on its surface (the smaller relative
     |delta|), if approaching, records its approach velocity; a separation changes nothing."""

@@ -11,10 +11,9 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-import numba as nb
 import numpy as np
 
-from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
+from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem, compiled
 from ..protocol import Event, Model, Param, Schema
 from . import systems
 
@@ -23,19 +22,19 @@ __all__ = ["Duffing", "Lorenz", "Henon", "DUFFING", "LORENZ", "HENON", "systems"
 _INF = math.inf
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _duffing(t, y, p, out):
     out[0] = y[1]
     out[1] = -p[0] * y[1] - p[1] * y[0] - p[2] * y[0] ** 3 + p[3] * math.cos(p[4] * t)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _duffing_jac(t, y, p, J):
     J[0, 0], J[0, 1] = 0.0, 1.0
     J[1, 0], J[1, 1] = -p[1] - 3.0 * p[2] * y[0] ** 2, -p[0]
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def _x_zero(t, y, p):
     return y[0]
 

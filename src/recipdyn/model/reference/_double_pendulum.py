@@ -8,7 +8,7 @@ import math
 import numba as nb
 import numpy as np
 
-from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE
+from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE, compiled
 
 
 @nb.njit(cache=True)
@@ -93,7 +93,7 @@ def double_pendulum_partials(t, y, p, dM, db):
     db[3, 1] = x11
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def double_pendulum_rhs(t, y, p, out):
     """(qd, qdd) with M qdd = b."""
     M = np.empty((2, 2))
@@ -108,7 +108,7 @@ def double_pendulum_rhs(t, y, p, out):
         out[2 + i] = acc[i]
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def double_pendulum_jac(t, y, p, J):
     """Exact Jacobian: dqdd/dy_k = M^-1 (db/dy_k - dM/dy_k qdd)."""
     M = np.empty((2, 2))

@@ -19,33 +19,32 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-import numba as nb
 import numpy as np
 
-from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, ODESystem
+from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, ODESystem, compiled
 from ..protocol import Event, Model, Param, Schema
 
 __all__ = ["ImpactOscillator", "IMPACT_OSCILLATOR"]
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _rhs(t, y, p, out):
     out[0] = y[1]
     out[1] = -2.0 * p[0] * y[1] - y[0] + p[1] * math.cos(p[2] * t)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _jac(t, y, p, J):
     J[0, 0], J[0, 1] = 0.0, 1.0
     J[1, 0], J[1, 1] = -1.0, -2.0 * p[0]
 
 
-@nb.njit(EVENT_SIGNATURE, cache=True)
+@compiled(EVENT_SIGNATURE)
 def _at_stop(t, y, p):
     return y[0] - p[3]
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _impact(t, y, p, out):
     out[0] = p[3]  # exactly on the stop (the root is found to rounding)
     out[1] = -p[4] * y[1]

@@ -10,22 +10,21 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 
-from ..base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem
+from ..base import JAC_SIGNATURE, RHS_SIGNATURE, DiscreteMap, ODESystem, compiled
 
 __all__ = ["lorenz", "rossler", "ueda", "linear", "henon", "standard_map", "logistic_map"]
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _lorenz(t, y, p, out):
     out[0] = p[0] * (y[1] - y[0])
     out[1] = y[0] * (p[1] - y[2]) - y[1]
     out[2] = y[0] * y[1] - p[2] * y[2]
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _lorenz_jac(t, y, p, J):
     J[0, 0], J[0, 1], J[0, 2] = -p[0], p[0], 0.0
     J[1, 0], J[1, 1], J[1, 2] = p[1] - y[2], -1.0, -y[0]
@@ -37,14 +36,14 @@ def lorenz(sigma: float = 10.0, rho: float = 28.0, beta: float = 8.0 / 3.0) -> O
                      state_names=("x", "y", "z"), name="lorenz")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _rossler(t, y, p, out):
     out[0] = -y[1] - y[2]
     out[1] = y[0] + p[0] * y[1]
     out[2] = p[1] + y[2] * (y[0] - p[2])
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _rossler_jac(t, y, p, J):
     J[0, 0], J[0, 1], J[0, 2] = 0.0, -1.0, -1.0
     J[1, 0], J[1, 1], J[1, 2] = 1.0, p[0], 0.0
@@ -56,13 +55,13 @@ def rossler(a: float = 0.2, b: float = 0.2, c: float = 5.7) -> ODESystem:
                      state_names=("x", "y", "z"), name="rossler")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _ueda(t, y, p, out):
     out[0] = y[1]
     out[1] = -p[0] * y[1] - y[0] ** 3 + p[1] * math.cos(t)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _ueda_jac(t, y, p, J):
     J[0, 0], J[0, 1] = 0.0, 1.0
     J[1, 0], J[1, 1] = -3.0 * y[0] ** 2, -p[0]
@@ -74,7 +73,7 @@ def ueda(k: float = 0.05, B: float = 7.5) -> ODESystem:
                      period=2 * math.pi, name="ueda")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _linear(t, y, p, out):
     n = y.shape[0]
     for i in range(n):
@@ -84,7 +83,7 @@ def _linear(t, y, p, out):
         out[i] = s
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _linear_jac(t, y, p, J):
     n = y.shape[0]
     for i in range(n):
@@ -100,13 +99,13 @@ def linear(A) -> ODESystem:
                      name="linear")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _henon(n, x, p, out):
     out[0] = 1.0 - p[0] * x[0] ** 2 + x[1]
     out[1] = p[1] * x[0]
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _henon_jac(n, x, p, J):
     J[0, 0], J[0, 1] = -2.0 * p[0] * x[0], 1.0
     J[1, 0], J[1, 1] = p[1], 0.0
@@ -117,14 +116,14 @@ def henon(a: float = 1.4, b: float = 0.3) -> DiscreteMap:
                        state_names=("x", "y"), name="henon")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _standard(n, x, p, out):
     pn = x[1] + p[0] * math.sin(x[0])
     out[0] = (x[0] + pn) % (2.0 * math.pi)
     out[1] = pn
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _standard_jac(n, x, p, J):
     c = p[0] * math.cos(x[0])
     J[0, 0], J[0, 1] = 1.0 + c, 1.0
@@ -137,12 +136,12 @@ def standard_map(K: float = 6.0) -> DiscreteMap:
                        state_names=("theta", "p"), name="standard")  # fmt: skip
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)
 def _logistic(n, x, p, out):
     out[0] = p[0] * x[0] * (1.0 - x[0])
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _logistic_jac(n, x, p, J):
     J[0, 0] = p[0] * (1.0 - 2.0 * x[0])
 
