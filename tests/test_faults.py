@@ -153,8 +153,10 @@ USAGE = [
     (["simulate", "--atol", "-1"], "atol"),
     (["simulate", "--method", "rk4", "--h", "0 s"], "h"),
     (["simulate", "--method", "rk5"], "method"),
-    (["simulate", "-n", "1e7"], "memory"),
-    (["simulate", "--fs", "1 THz"], "memory"),
+    (["simulate", "-n", "1e7", "--no-stream"], "memory"),
+    (["simulate", "--fs", "1 THz", "--no-stream"], "memory"),
+    (["simulate", "-n", "1e7"], "disk"),  # streamed by default: memory is flat, disk is not
+    (["simulate", "--fs", "1 THz"], "disk"),
     (["simulate", "-o", "run.txt"], "extension"),
     (["sweep", "-p", "omega=10:20:1000000000"], "count"),
     (["sweep", "-p", "omega=10:20:100000", "-p", "rc=1mm:2mm:1000"], "split"),

@@ -22,7 +22,7 @@ from .errors import ParameterError
 
 __all__ = [
     "DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
-    "write_text", "save_figure",
+    "write_text", "save_figure", "StreamWriter", "open_record",
 ]  # fmt: skip
 
 #: File extension -> format of a simulated record.
@@ -184,3 +184,122 @@ def write_text(path: str | Path, text: str) -> Path:
     except Exception as exc:
         raise write_error(path, exc) from None
     return path
+
+
+class StreamWriter:
+    """Write a long record block by block, so memory stays flat in run length.
+
+    Blocks (Datasets over ``time``) are appended as they are computed: to a NetCDF-4 file with
+    an unlimited ``time`` dimension (netCDF4, one write per variable and block) for ``.nc``, to
+    a Zarr store (``to_zarr(append_dim="time")``) for ``.zarr``. Both are built beside the
+    output and moved into place by :meth:`finish`, so nothing is at ``path`` until the record
+    is complete; ``finish(partial=True)`` keeps an incomplete record as ``NAME.partial.EXT``.
+    ``float32`` stores the signals (not time) in single precision; ``compress`` adds zlib
+    compression to NetCDF (Zarr is always compressed).
+    """
+
+    #: Samples per NetCDF chunk.
+    CHUNK = 1 << 16
+
+    def __init__(self, path: str | Path, *, float32: bool = False, compress: bool = False):
+        path = check_output(path)
+        if path.suffix.lower() not in (".nc", ".zarr"):
+            raise ParameterError(f"streamed output {path}: use .nc or .zarr (CSV is written in "
+                                 "one piece: shorten the run or choose .nc)")  # fmt: skip
+        self.path, self.float32, self.compress = path, float32, compress
+        self.zarr = path.suffix.lower() == ".zarr"
+        self.tmpdir = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.stream-"))
+        self.tmp = self.tmpdir / ("data.zarr" if self.zarr else "data.nc")
+        self.nc = None
+        self.n = 0
+
+    def _dtype(self, v):
+        import numpy as np
+
+        return np.float32 if (self.float32 and v.dtype == np.float64) else v.dtype
+
+    def append(self, block) -> None:
+        m = block.sizes["time"]
+        try:
+            if self.zarr:
+                if self.float32:
+                    block = block.astype({k: self._dtype(v) for k, v in block.data_vars.items()})
+                if self.n == 0:
+                    block.to_zarr(str(self.tmp), mode="w", consolidated=False)
+                else:
+                    block.to_zarr(str(self.tmp), append_dim="time", consolidated=False)
+            else:
+                if self.nc is None:
+                    self._create(block)
+                for name in [*block.coords, *block.data_vars]:
+                    self.nc.variables[name][self.n : self.n + m] = block[name].values
+        except Exception as exc:
+            raise write_error(self.path, exc) from None
+        self.n += m
+
+    def _create(self, block) -> None:
+        import netCDF4
+
+        self.nc = netCDF4.Dataset(self.tmp, "w", format="NETCDF4")
+        self.nc.createDimension("time", None)
+        coords = [c for c in block.coords if c != "time"]
+        for name in ["time", *coords, *block.data_vars]:
+            v = block[name]
+            dtype = v.dtype if name in block.coords else self._dtype(v)
+            var = self.nc.createVariable(name, dtype, ("time",), zlib=self.compress,
+                                         complevel=4, chunksizes=(self.CHUNK,))  # fmt: skip
+            # HDF5 keeps up to its chunk cache per variable in memory (netCDF's default grows
+            # with the file): two chunks are enough for appending in order
+            var.set_var_chunk_cache(size=2 * self.CHUNK * 8, nelems=4, preemption=1.0)
+            var.setncatts({k: val for k, val in v.attrs.items()})
+            if name in block.data_vars and coords:
+                var.coordinates = " ".join(coords)
+
+    def finish(self, attrs: dict, *, partial: bool = False) -> Path | None:
+        """Move the record into place (``NAME.partial.EXT`` if ``partial``); ``None`` when
+        no sample was written."""
+        path = self.path
+        if partial:
+            path = path.with_name(path.stem + ".partial" + path.suffix)
+        try:
+            if self.n == 0:
+                return None
+            if self.zarr:
+                import zarr
+
+                zarr.open_group(str(self.tmp), mode="r+").attrs.update(attrs)
+            else:
+                self.nc.setncatts(dict(attrs))
+                self.nc.close()
+                self.nc = None
+            old = None
+            if path.exists() and path.is_dir():
+                old = path.with_name(f".{path.name}.old-{os.getpid()}")
+                os.replace(path, old)
+            os.replace(self.tmp, path)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        except Exception as exc:
+            raise write_error(path, exc) from None
+        finally:
+            self.discard()
+        return path
+
+    def discard(self) -> None:
+        if self.nc is not None:
+            try:
+                self.nc.close()
+            except Exception:  # pragma: no cover - already broken
+                pass
+            self.nc = None
+        shutil.rmtree(self.tmpdir, ignore_errors=True)
+
+
+def open_record(path: str | Path):
+    """A record written by :class:`StreamWriter`, opened lazily (dask, chunk by chunk)."""
+    import xarray as xr
+
+    path = Path(path)
+    if path.suffix.lower() == ".zarr":
+        return xr.open_zarr(str(path), consolidated=False)
+    return xr.open_dataset(path, chunks={})

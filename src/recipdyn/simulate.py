@@ -15,7 +15,7 @@ from . import __version__
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, is_number
 from .integrate import METHODS, IntegrationError, integrate
-from .integrate.solve import check_tolerances
+from .integrate.solve import UniformGrid, check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .model.protocol import Model
@@ -90,6 +90,10 @@ def simulate(
     progress: bool = False,
     max_memory: float | None = None,
     model: str | Model | None = None,
+    out: str | None = None,
+    columns: list[str] | None = None,
+    float32: bool = False,
+    compress: bool = False,
     **overrides: Any,
 ) -> xr.Dataset:
     """Simulate the compressor and return the crosshead response as a Dataset.
@@ -122,6 +126,14 @@ def simulate(
         models ``params`` is a mapping of their schema's parameters, ``revolutions`` and
         ``transient`` count forcing periods (time units for an autonomous system, iterations
         for a map) and the outputs are the model's.
+    out : str or Path, optional
+        Stream the record to this file (``.nc`` or ``.zarr``) block by block as it is
+        computed, so memory stays flat in run length (compressor model); the returned Dataset
+        is then opened lazily from the file. The samples are the same as in memory.
+    columns : list of str, optional
+        Keep only these output variables (default: all).
+    float32, compress : bool
+        With ``out``: store the signals in single precision; compress NetCDF (zlib).
     **overrides
         Parameter overrides by name or alias, e.g. ``rc=0.5e-3``, ``clearance=0.5e-3``.
 
@@ -151,6 +163,9 @@ def simulate(
     >>> float(ds.a.max())  # doctest: +SKIP
     """
     if model is not None and get_model(model).name != COMPRESSOR.name:
+        if out is not None or columns is not None:
+            raise ParameterError(f"out/columns: streaming is implemented for the compressor "
+                                 f"model only, not {get_model(model).name!r}")  # fmt: skip
         return _simulate_model(
             get_model(model), params, overrides, revolutions=revolutions, transient=transient,
             fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
@@ -164,16 +179,20 @@ def simulate(
     if h is not None and not (is_number(h) and math.isfinite(h) and 0 < h <= T):
         raise ParameterError(f"h = {h!r} s out of range; allowed: (0, {T:g}] (one revolution)")
     n_float = revolutions * T * fs
+    held = min(n_float, 2 * STREAM_BLOCK) if out is not None else n_float  # streamed: a block
     check_memory(
-        estimate_memory(n_float), f"simulate ({n_float:.3g} samples: {revolutions:g} revolutions "
+        estimate_memory(held), f"simulate ({n_float:.3g} samples: {revolutions:g} revolutions "
         f"at fs = {fs:g} Hz)", "reduce --revolutions or --fs", max_memory,
     )  # fmt: skip
+    if out is not None:
+        _check_disk(out, n_float, columns, float32)
     model = compressor_model(p)
     y0 = model.initial_state()
     t_start = transient * T
     t_end = t_start + revolutions * T
     n = int(math.floor(n_float + 1e-9)) + 1
-    t_eval = t_start + np.arange(n) / fs
+    # streamed: the output times are made block by block (never all 8 bytes x n at once)
+    t_eval = UniformGrid(t_start, fs, n) if out is not None else t_start + np.arange(n) / fs
     bar = None
     cb = None
     if progress:
@@ -189,35 +208,46 @@ def simulate(
     # Chunks let Ctrl-C stop a long run between chunks (the rest is kept) and drive the
     # progress bar; they never change the result (see recipdyn.integrate).
     chunks = max(1, min(1000, int(math.ceil(transient + revolutions))))
+    keep = _check_columns(columns)
+    writer = sink = None
+    min_force = [math.inf]
+    if out is not None:
+        from .io import StreamWriter
+
+        writer = StreamWriter(out, float32=float32, compress=compress)
+
+        def sink(t, y):
+            outs = model.outputs(t, y)
+            min_force[0] = min(min_force[0], float(np.min(outs["contact_force"].values)))
+            writer.append(_record(outs, t, T, keep))
+
     try:
         sol = integrate(
             model, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
-            chunks=chunks, progress=cb,
+            chunks=chunks, progress=cb, sink=sink, block=STREAM_BLOCK,
         )  # fmt: skip
     except IntegrationError as exc:  # keep what was computed: the partial record
         failure, sol = exc, exc.partial
     except Interrupted as exc:
         failure, sol = exc, exc.partial
+    except BaseException:  # anything else: no half-written store is left behind
+        if writer is not None:
+            writer.discard()
+        raise
     finally:
         if bar is not None:
             bar.close()
     wall = time.perf_counter() - t0
-    try:
-        outs = model.outputs(sol.t, sol.y)
-    except ParameterError as exc:  # the state left the feasible geometry before failing
-        raise IntegrationError(f"{failure or ''} {exc}".strip(), sol) from None
-    if sol.t.size == 0 and failure is None:
-        raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
-    data_vars = {
-        k: ("time", s.values, {"units": s.units, "long_name": s.long_name}) for k, s in outs.items()
-    }
-    ds = xr.Dataset(
-        data_vars,
-        coords={
-            "time": ("time", sol.t, {"units": "s", "long_name": "time"}),
-            "revolution": ("time", sol.t / T, {"units": "1", "long_name": "crank revolutions"}),
-        },
-    )
+    if writer is None:
+        try:
+            outs = model.outputs(sol.t, sol.y)
+        except ParameterError as exc:  # the state left the feasible geometry before failing
+            raise IntegrationError(f"{failure or ''} {exc}".strip(), sol) from None
+        if sol.t.size == 0 and failure is None:
+            raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
+        ds = _record(outs, sol.t, T, keep)
+        if sol.t.size:
+            min_force[0] = float(np.min(outs["contact_force"].values))
     attrs: dict[str, Any] = {
         "title": "recipdyn compressor simulation",
         "recipdyn_version": __version__,
@@ -247,16 +277,75 @@ def simulate(
         "transient_revolutions": transient,
         "sampling_rate_hz": fs,
         "crank_frequency_hz": p.crank_frequency,
-        "min_contact_force_N": (
-            float(np.min(outs["contact_force"].values)) if sol.t.size else float("nan")
-        ),
+        "min_contact_force_N": min_force[0] if math.isfinite(min_force[0]) else float("nan"),
+        "columns": "all" if keep is None else ",".join(keep),
+        "storage": "float32" if (float32 and writer is not None) else "float64",
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+    if writer is not None:
+        from .io import open_record
+
+        written = writer.finish(clean_attrs(attrs), partial=failure is not None)
+        if written is None and failure is None:
+            raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
+        ds = open_record(written) if written is not None else xr.Dataset(attrs=clean_attrs(attrs))
+        if failure is not None:
+            failure.kept_path = written
     ds.attrs = clean_attrs(attrs)
     if failure is not None:
         failure.dataset = ds  # the samples before the failure, with all attributes
         raise failure
     return ds
+
+
+#: Samples per block when a record is streamed to a file (memory ~ 25 signals x 8 B each).
+STREAM_BLOCK = 1 << 16
+
+
+def _check_disk(out, n_samples: float, columns, float32: bool) -> None:
+    """Refuse a streamed run whose record cannot fit on the output's disk."""
+    import shutil
+    from pathlib import Path
+
+    from .resources import format_bytes
+
+    n_vars = (len(columns) if columns is not None else 15) + 2  # + time, revolution
+    need = n_samples * n_vars * (4 if float32 else 8)
+    folder = Path(out).resolve().parent
+    while not folder.exists():
+        folder = folder.parent
+    free = shutil.disk_usage(folder).free
+    if need > free:
+        raise ParameterError(
+            f"simulate ({n_samples:.3g} samples) needs ~{format_bytes(need)} of disk for {out}; "
+            f"{format_bytes(free)} free: reduce --revolutions or --fs, or keep fewer --columns"
+        )
+
+
+def _check_columns(columns) -> tuple[str, ...] | None:
+    if columns is None:
+        return None
+    cols = tuple(c.strip() for c in ([columns] if isinstance(columns, str) else columns))
+    return cols or None
+
+
+def _record(outs, t, T: float, keep) -> xr.Dataset:
+    """The Dataset of one block (or the whole run) of compressor outputs."""
+    if keep is not None:
+        bad = [c for c in keep if c not in outs]
+        if bad:
+            raise ParameterError(f"columns {bad}: unknown; allowed: {', '.join(outs)}")
+    names = list(outs) if keep is None else list(keep)
+    data_vars = {k: ("time", outs[k].values, {"units": outs[k].units,
+                                              "long_name": outs[k].long_name})
+                 for k in names}  # fmt: skip
+    return xr.Dataset(
+        data_vars,
+        coords={
+            "time": ("time", t, {"units": "s", "long_name": "time"}),
+            "revolution": ("time", t / T, {"units": "1", "long_name": "crank revolutions"}),
+        },
+    )
 
 
 def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:

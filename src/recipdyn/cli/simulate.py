@@ -55,6 +55,8 @@ def keep_partial(exc, out: Path) -> Path | None:
     """Write the partial record an interrupted or failed simulation carries, next to ``out``."""
     from ..io import write_dataset
 
+    if getattr(exc, "kept_path", None) is not None:  # a streamed run kept it already
+        return exc.kept_path
     ds = getattr(exc, "dataset", None)
     if ds is None or ds.sizes.get("time", 0) == 0:
         return None
@@ -62,10 +64,18 @@ def keep_partial(exc, out: Path) -> Path | None:
     return write_dataset(ds, path)
 
 
+#: Runs with more samples than this are streamed to their file by default.
+STREAM_AUTO = 1e6
+#: A streamed run's figure and summary use at most this many of its last samples.
+FIGURE_SAMPLES = 500_000
+
+
 def _prepare(m, params, method: str) -> None:
     """Load the compiled code a run needs (compile it on the first run), saying so."""
     from ..integrate import prepare
 
+    if m.kind == "map":  # iterated, not integrated: nothing to prepare
+        return
     if m.name == "compressor":
         from ..model.compressor import compressor_model
 
@@ -98,6 +108,21 @@ def simulate(
     figure: bool = typer.Option(True, "--figure/--no-figure", help="Also write a PNG figure."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
     max_memory: str = typer.Option(None, "--max-memory", help=_MEM_HELP),
+    stream: bool = typer.Option(
+        None,
+        "--stream/--no-stream",
+        help="Write the record block by block as it is computed "
+        "(memory flat in run length; .nc/.zarr). Default: for runs over 10^6 samples.",
+    ),
+    columns: str = typer.Option(
+        None, "--columns", help="Comma list of outputs to keep, e.g. 'x,v,a' (default all)."
+    ),
+    float32: bool = typer.Option(
+        False, "--float32", help="Store signals in single precision (streamed runs)."
+    ),
+    compress: bool = typer.Option(
+        False, "--compress", help="zlib-compress NetCDF (streamed runs)."
+    ),
     model: str = typer.Option(
         None,
         "--model",
@@ -107,7 +132,7 @@ def simulate(
 ) -> None:
     """Simulate a model (default: the compressor); write the record (.nc, .csv or .zarr) and a
     figure."""
-    from ..errors import Interrupted
+    from ..errors import Interrupted, ParameterError
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset
     from ..simulate import DEFAULT_SETTINGS
@@ -125,9 +150,20 @@ def simulate(
         if val is not None:
             kw[name] = val
     _prepare(m, params, kw["method"])
+    period = 2 * 3.141592653589793 / params.omega if m.name == "compressor" else None
+    n_samples = kw["revolutions"] * period * kw["fs"] if period else 0.0
+    if stream is None:
+        stream = n_samples > STREAM_AUTO and out.suffix.lower() in (".nc", ".zarr")
+    extra = {}
+    if columns is not None:
+        extra["columns"] = [c for c in columns.split(",") if c.strip()]
+    if stream:
+        extra.update(out=out, float32=float32, compress=compress)
+    elif float32 or compress:
+        raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
     try:
         ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
-                     model=m, **kw)  # fmt: skip
+                     model=m, **extra, **kw)  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
         kept = keep_partial(exc, out)
         if kept is not None:
@@ -139,7 +175,8 @@ def simulate(
             else:
                 typer.echo(f"kept: {msg}", err=True)
         raise
-    write_dataset(ds, out)
+    if not stream:
+        write_dataset(ds, out)
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
         summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}
@@ -153,6 +190,13 @@ def simulate(
             _mpl().close(fig)
         return
     typer.echo(f"wrote {out}  ({ds.sizes['time']} samples, nfev={ds.attrs['solver_nfev']})")
+    if stream and ds.sizes["time"] > FIGURE_SAMPLES:  # the figure shows the last part
+        ds = ds.isel(time=slice(-FIGURE_SAMPLES, None))
+        typer.echo(f"figure and summary: the last {FIGURE_SAMPLES} samples")
+    ds = ds.load()
+    if not {"x", "v", "a", "theta_c", "gas_force", "contact_force"} <= set(ds.data_vars):
+        typer.echo("figure and summary need all outputs: not drawn (--columns)")
+        return
     if figure:
         from ..plotting import _mpl, response_figure
 

@@ -30,8 +30,8 @@ from ..model.base import ODESystem, typed
 from . import kernels
 from .tableaus import RK4, Tableau, dop853
 
-__all__ = ["integrate", "propagate", "prepare", "Solution", "IntegrationError", "METHODS",
-           "Method"]  # fmt: skip
+__all__ = ["integrate", "propagate", "prepare", "UniformGrid", "Solution", "IntegrationError",
+           "METHODS", "Method"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -151,6 +151,8 @@ def integrate(
     chunks: int = 1,
     progress: Callable[[float], None] | None = None,
     raise_on_failure: bool = True,
+    sink: Callable[[np.ndarray, np.ndarray], None] | None = None,
+    block: int = 1 << 16,
 ) -> Solution:
     """Integrate ``system`` from ``y0`` over ``t_span``.
 
@@ -184,6 +186,11 @@ def integrate(
         Split the run in this many pieces, calling ``progress(fraction)`` after each.
     raise_on_failure : bool
         Raise :class:`IntegrationError` (with the partial solution) on failure.
+    sink : callable ``sink(t, y)``, optional
+        Memory flat in run length: the outputs are handed to ``sink`` in blocks of about
+        ``block`` samples as the integration goes (in order, each sample once) and not kept;
+        the returned solution then has no samples (``t``, ``y`` empty). The steps, and so every
+        number, are the same as without a sink.
     """
     y0, t0, t1 = _check_inputs(system, y0, t_span, method, rtol, atol, h)
     own = system.acting_event
@@ -199,9 +206,15 @@ def integrate(
     rtol, atol, max_step, max_steps = float(rtol), float(atol), float(max_step), int(max_steps)
     if t_eval is None:
         t_eval = np.array([t0, t1])
-    t_eval = np.ascontiguousarray(t_eval, dtype=np.float64).reshape(-1)
-    if t_eval.size and (np.any(np.diff(t_eval) < 0) or t_eval[0] < t0 or t_eval[-1] > t1):
-        raise ParameterError("t_eval must be sorted and lie within t_span")
+    if isinstance(t_eval, UniformGrid):
+        if t_eval.n and (t_eval.at(0) < t0 or t_eval.at(t_eval.n - 1) > t1):
+            raise ParameterError("t_eval must lie within t_span")
+        if sink is None:
+            t_eval = t_eval[0 : t_eval.n]
+    else:
+        t_eval = np.ascontiguousarray(t_eval, dtype=np.float64).reshape(-1)
+        if t_eval.size and (np.any(np.diff(t_eval) < 0) or t_eval[0] < t0 or t_eval[-1] > t1):
+            raise ParameterError("t_eval must be sorted and lie within t_span")
     use_event = event is not None
     actions = {"record": 0, "terminal": 1, "reset": 2}
     if event_action not in actions:
@@ -222,7 +235,13 @@ def integrate(
     # number of chunks: progress observes the integration, it never changes it.
     stops = np.linspace(t0, t1, chunks + 1)[1:]
     stops[-1] = t1
-    Y = np.empty((t_eval.size, system.dim))
+    if sink is None:
+        Y = np.empty((t_eval.size, system.dim))
+    else:  # bounded memory: outputs go to the sink block by block (stops add no steps)
+        block = max(1, int(block))
+        bstops = t_eval[block - 1 :: block]
+        stops = np.unique(np.concatenate([stops, bstops[bstops < t1]]))
+    n_eval = t_eval.size
     ev_t, ev_y, ev_y2 = [], [], []
     y = y0.copy()  # updated in place by the kernels
     t = t0
@@ -239,28 +258,51 @@ def integrate(
             if pending.signum:  # everything before t is recorded: stop here and keep it
                 interrupted, status = pending.signum, -4
                 break
-            stats = np.zeros(5, dtype=np.int64)
-            fstate = np.zeros(2)
+            if sink is not None:  # the window: samples up to t_stop plus the last step's
+                k_end = _count_le(t_eval, t_stop)
+                margin = block
+                saved = (t, y.copy(), h_abs)
+            while True:
+                if sink is None:
+                    Yw, tw = Y[n_out:], t_eval[n_out:]
+                else:
+                    size = min(n_eval - n_out, k_end - n_out + margin)
+                    Yw, tw = np.empty((size, system.dim)), t_eval[n_out : n_out + size]
+                stats = np.zeros(5, dtype=np.int64)
+                fstate = np.zeros(2)
+                if METHODS[method].adaptive:
+                    ev_cap = cap - len(ev_t) if use_event else 0
+                    et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
+                    ey2 = np.empty((ev_cap, system.dim))
+                    status = typed(kernels.dop853_kernel, kernels.DOP853_SIG)(
+                        system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol,
+                        h_abs, max_step, tw, max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
+                        tab.E5, tab.D, use_event, event_direction, action, reset_fn, Yw, et, ey,
+                        ey2, stats, fstate,
+                    )  # fmt: skip
+                else:
+                    status = typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)(
+                        system.rhs, t, y, t1, float(t_stop), system.params, float(h), tw,
+                        max_steps - nsteps, Yw, stats, fstate, tab.A, tab.B, tab.C,
+                    )  # fmt: skip
+                k_out = int(stats[3])
+                full = sink is not None and k_out == tw.size and n_out + tw.size < n_eval
+                if full and float(fstate[0]) >= tw[-1]:
+                    # the last step may have passed samples beyond the window: redo the call
+                    # from the saved state with a wider window (deterministic: same steps)
+                    t, h_abs = saved[0], saved[2]
+                    y[:] = saved[1]
+                    margin *= 8
+                    continue
+                break
             if METHODS[method].adaptive:
-                ev_cap = cap - len(ev_t) if use_event else 0
-                et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
-                ey2 = np.empty((ev_cap, system.dim))
-                status = typed(kernels.dop853_kernel, kernels.DOP853_SIG)(
-                    system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol, h_abs,
-                    max_step, t_eval[n_out:], max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
-                    tab.E5, tab.D, use_event, event_direction, action, reset_fn, Y[n_out:], et,
-                    ey, ey2, stats, fstate,
-                )  # fmt: skip
                 ev_t.extend(et[: stats[4]])
                 ev_y.extend(ey[: stats[4]])
                 ev_y2.extend(ey2[: stats[4]])
-            else:
-                status = typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)(
-                    system.rhs, t, y, t1, float(t_stop), system.params, float(h), t_eval[n_out:],
-                    max_steps - nsteps, Y[n_out:], stats, fstate, tab.A, tab.B, tab.C,
-                )  # fmt: skip
             t, h_abs = float(fstate[0]), float(fstate[1])
-            nf, ns, nr, k_out = (int(x) for x in stats[:4])
+            nf, ns, nr = (int(x) for x in stats[:3])
+            if sink is not None and k_out:
+                sink(tw[:k_out].copy(), Yw[:k_out])
             n_out += k_out
             nfev += nf
             nsteps += ns
@@ -269,6 +311,8 @@ def integrate(
                 progress(min(1.0, (t - t0) / (t1 - t0)) if t1 > t0 else 1.0)
             if status != 0 or t >= t1:
                 break
+    if sink is not None:  # everything went to the sink
+        n_out, Y = 0, np.empty((0, system.dim))
     Y = Y[:n_out]
     sol = Solution(
         t=t_eval[: Y.shape[0]].copy(),
@@ -292,6 +336,44 @@ def integrate(
     if status < 0 and raise_on_failure:
         raise IntegrationError(f"integration failed at t = {t:.6g}: {sol.message}", sol)
     return sol
+
+
+@dataclass(frozen=True)
+class UniformGrid:
+    """Output times ``start + i / rate`` for ``i = 0 .. n-1``, made piece by piece (with a
+    ``sink``, a long run never holds all its output times). Slicing gives exactly the values
+    of ``start + np.arange(n) / rate``."""
+
+    start: float
+    rate: float
+    n: int
+
+    def __post_init__(self):
+        if not (self.rate > 0 and self.n >= 0):
+            raise ParameterError(f"UniformGrid: rate = {self.rate} must be > 0, n >= 0")
+
+    @property
+    def size(self) -> int:
+        return self.n
+
+    def at(self, i: int) -> float:
+        return float(self.start + np.float64(i) / self.rate)
+
+    def __getitem__(self, sl: slice) -> np.ndarray:
+        i, j, step = sl.indices(self.n)
+        return self.start + np.arange(i, j, step, dtype=np.float64) / self.rate
+
+
+def _count_le(t_eval, t: float) -> int:
+    """Number of output times <= t."""
+    if not isinstance(t_eval, UniformGrid):
+        return int(np.searchsorted(t_eval, t, side="right"))
+    k = min(max(int(math.floor((t - t_eval.start) * t_eval.rate)) + 1, 0), t_eval.n)
+    while k < t_eval.n and t_eval.at(k) <= t:
+        k += 1
+    while k > 0 and t_eval.at(k - 1) > t:
+        k -= 1
+    return k
 
 
 def prepare(system: ODESystem, method: str = "dop853") -> None:
