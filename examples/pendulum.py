@@ -24,20 +24,19 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 
-from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE, ODESystem
+from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE, ODESystem, compiled
 from recipdyn.model.protocol import Model, Param, Schema
 
 
-@nb.njit(RHS_SIGNATURE, cache=True)
+@compiled(RHS_SIGNATURE)  # numba, compiled on first use and cached on disk
 def _rhs(t, y, p, out):
     out[0] = y[1]
     out[1] = -p[0] * y[1] - p[1] * math.sin(y[0]) + p[2] * math.cos(p[3] * t)
 
 
-@nb.njit(JAC_SIGNATURE, cache=True)
+@compiled(JAC_SIGNATURE)
 def _jac(t, y, p, J):
     J[0, 0], J[0, 1] = 0.0, 1.0
     J[1, 0], J[1, 1] = -p[1] * math.cos(y[0]), -p[0]

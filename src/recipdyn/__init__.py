@@ -17,15 +17,11 @@ import os
 import sys
 import types
 
+from .resources import cache_dir as _cache_dir
 
-def _cache_dir() -> str:
-    """Where numba keeps compiled code: the user's cache directory, not the package folder."""
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return os.path.join(base, "recipdyn", "numba")
-
-
-# numba reads NUMBA_CACHE_DIR when it is first imported; an explicit setting wins.
-os.environ.setdefault("NUMBA_CACHE_DIR", _cache_dir())
+# numba keeps compiled code in the user's cache directory, not the package folder. It reads
+# NUMBA_CACHE_DIR when it is first imported; an explicit setting wins.
+os.environ.setdefault("NUMBA_CACHE_DIR", os.path.join(_cache_dir(), "numba"))
 
 _LAZY = {
     "simulate": "simulate",

@@ -213,17 +213,15 @@ class StreamWriter:
         self.nc = None
         self.n = 0
 
-    def _dtype(self, v):
+    def append(self, block) -> None:
         import numpy as np
 
-        return np.float32 if (self.float32 and v.dtype == np.float64) else v.dtype
-
-    def append(self, block) -> None:
         m = block.sizes["time"]
+        if self.float32:  # the signals only: time and the coordinates keep float64
+            block = block.assign({k: v.astype(np.float32) for k, v in block.data_vars.items()
+                                  if v.dtype == np.float64})  # fmt: skip
         try:
             if self.zarr:
-                if self.float32:
-                    block = block.astype({k: self._dtype(v) for k, v in block.data_vars.items()})
                 if self.n == 0:
                     block.to_zarr(str(self.tmp), mode="w", consolidated=False)
                 else:
@@ -245,8 +243,7 @@ class StreamWriter:
         coords = [c for c in block.coords if c != "time"]
         for name in ["time", *coords, *block.data_vars]:
             v = block[name]
-            dtype = v.dtype if name in block.coords else self._dtype(v)
-            var = self.nc.createVariable(name, dtype, ("time",), zlib=self.compress,
+            var = self.nc.createVariable(name, v.dtype, ("time",), zlib=self.compress,
                                          complevel=4, chunksizes=(self.CHUNK,))  # fmt: skip
             # HDF5 keeps up to its chunk cache per variable in memory (netCDF's default grows
             # with the file): two chunks are enough for appending in order
@@ -272,13 +269,8 @@ class StreamWriter:
                 self.nc.setncatts(dict(attrs))
                 self.nc.close()
                 self.nc = None
-            old = None
-            if path.exists() and path.is_dir():
-                old = path.with_name(f".{path.name}.old-{os.getpid()}")
-                os.replace(path, old)
-            os.replace(self.tmp, path)
-            if old is not None:
-                shutil.rmtree(old, ignore_errors=True)
+            with atomic_path(path, directory=self.zarr) as target:
+                os.replace(self.tmp, target)
         except Exception as exc:
             raise write_error(path, exc) from None
         finally:

@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+import os
+
 from .defaults import MEMORY_FRACTION
 from .errors import ParameterError
 
-__all__ = ["available_memory", "check_memory", "format_bytes", "memory_limit"]
+__all__ = ["available_memory", "cache_dir", "check_memory", "format_bytes", "memory_limit"]
+
+
+def cache_dir() -> str:
+    """recipdyn's folder in the user's cache directory (compiled code, the DOP853 tableau)."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "recipdyn")
 
 
 def available_memory() -> int:

@@ -184,11 +184,13 @@ def simulate(
         estimate_memory(held), f"simulate ({n_float:.3g} samples: {revolutions:g} revolutions "
         f"at fs = {fs:g} Hz)", "reduce --revolutions or --fs", max_memory,
     )  # fmt: skip
-    if out is not None:
-        _check_disk(out, n_float, columns, float32)
     model = compressor_model(p)
     y0 = model.initial_state()
     t_start = transient * T
+    # the output names, from one sample: columns are checked, and the disk, before any work
+    keep = _columns(columns, list(model.outputs(np.array([t_start]), y0[None, :])))
+    if out is not None:
+        _check_disk(out, n_float, len(keep) + 2, float32)  # + time, revolution
     t_end = t_start + revolutions * T
     n = int(math.floor(n_float + 1e-9)) + 1
     # streamed: the output times are made block by block (never all 8 bytes x n at once)
@@ -208,7 +210,6 @@ def simulate(
     # Chunks let Ctrl-C stop a long run between chunks (the rest is kept) and drive the
     # progress bar; they never change the result (see recipdyn.integrate).
     chunks = max(1, min(1000, int(math.ceil(transient + revolutions))))
-    keep = _check_columns(columns)
     writer = sink = None
     min_force = [math.inf]
     if out is not None:
@@ -278,7 +279,7 @@ def simulate(
         "sampling_rate_hz": fs,
         "crank_frequency_hz": p.crank_frequency,
         "min_contact_force_N": min_force[0] if math.isfinite(min_force[0]) else float("nan"),
-        "columns": "all" if keep is None else ",".join(keep),
+        "columns": "all" if columns is None else ",".join(keep),
         "storage": "float32" if (float32 and writer is not None) else "float64",
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
@@ -302,14 +303,13 @@ def simulate(
 STREAM_BLOCK = 1 << 16
 
 
-def _check_disk(out, n_samples: float, columns, float32: bool) -> None:
+def _check_disk(out, n_samples: float, n_vars: int, float32: bool) -> None:
     """Refuse a streamed run whose record cannot fit on the output's disk."""
     import shutil
     from pathlib import Path
 
     from .resources import format_bytes
 
-    n_vars = (len(columns) if columns is not None else 15) + 2  # + time, revolution
     need = n_samples * n_vars * (4 if float32 else 8)
     folder = Path(out).resolve().parent
     while not folder.exists():
@@ -322,23 +322,22 @@ def _check_disk(out, n_samples: float, columns, float32: bool) -> None:
         )
 
 
-def _check_columns(columns) -> tuple[str, ...] | None:
+def _columns(columns, names: list[str]) -> list[str]:
+    """The outputs to keep: ``columns`` (checked against ``names``), default all."""
     if columns is None:
-        return None
-    cols = tuple(c.strip() for c in ([columns] if isinstance(columns, str) else columns))
-    return cols or None
+        return names
+    cols = [c.strip() for c in ([columns] if isinstance(columns, str) else columns)]
+    bad = [c for c in cols if c not in names]
+    if bad or not cols:
+        raise ParameterError(f"columns {bad or cols}: unknown; allowed: {', '.join(names)}")
+    return cols
 
 
-def _record(outs, t, T: float, keep) -> xr.Dataset:
+def _record(outs, t, T: float, keep: list[str]) -> xr.Dataset:
     """The Dataset of one block (or the whole run) of compressor outputs."""
-    if keep is not None:
-        bad = [c for c in keep if c not in outs]
-        if bad:
-            raise ParameterError(f"columns {bad}: unknown; allowed: {', '.join(outs)}")
-    names = list(outs) if keep is None else list(keep)
     data_vars = {k: ("time", outs[k].values, {"units": outs[k].units,
                                               "long_name": outs[k].long_name})
-                 for k in names}  # fmt: skip
+                 for k in keep}  # fmt: skip
     return xr.Dataset(
         data_vars,
         coords={

@@ -150,8 +150,8 @@ def simulate(
         if val is not None:
             kw[name] = val
     _prepare(m, params, kw["method"])
-    period = 2 * 3.141592653589793 / params.omega if m.name == "compressor" else None
-    n_samples = kw["revolutions"] * period * kw["fs"] if period else 0.0
+    n_samples = kw["revolutions"] * params.crank_period * kw["fs"] if m.name == "compressor" \
+        else 0.0  # fmt: skip
     if stream is None:
         stream = n_samples > STREAM_AUTO and out.suffix.lower() in (".nc", ".zarr")
     extra = {}

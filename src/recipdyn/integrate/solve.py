@@ -251,6 +251,11 @@ def integrate(
     n_out = 0
     interrupted = 0
     tab = METHODS[method].tableau()
+    adaptive = METHODS[method].adaptive
+    if adaptive:  # compiled (or loaded) once per process, for the FunctionType signature
+        dop853_loop = typed(kernels.dop853_kernel, kernels.DOP853_SIG)
+    else:
+        fixed_loop = typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)
     with deferred_signals() as pending:
         for t_stop in stops:
             if t >= t_stop and t_stop < t1:
@@ -270,18 +275,18 @@ def integrate(
                     Yw, tw = np.empty((size, system.dim)), t_eval[n_out : n_out + size]
                 stats = np.zeros(5, dtype=np.int64)
                 fstate = np.zeros(2)
-                if METHODS[method].adaptive:
+                if adaptive:
                     ev_cap = cap - len(ev_t) if use_event else 0
                     et, ey = np.empty(ev_cap), np.empty((ev_cap, system.dim))
                     ey2 = np.empty((ev_cap, system.dim))
-                    status = typed(kernels.dop853_kernel, kernels.DOP853_SIG)(
+                    status = dop853_loop(
                         system.rhs, ev, t, y, t1, float(t_stop), system.params, rtol, atol,
                         h_abs, max_step, tw, max_steps - nsteps, tab.A, tab.B, tab.C, tab.E3,
                         tab.E5, tab.D, use_event, event_direction, action, reset_fn, Yw, et, ey,
                         ey2, stats, fstate,
                     )  # fmt: skip
                 else:
-                    status = typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)(
+                    status = fixed_loop(
                         system.rhs, t, y, t1, float(t_stop), system.params, float(h), tw,
                         max_steps - nsteps, Yw, stats, fstate, tab.A, tab.B, tab.C,
                     )  # fmt: skip
@@ -295,7 +300,7 @@ def integrate(
                     margin *= 8
                     continue
                 break
-            if METHODS[method].adaptive:
+            if adaptive:
                 ev_t.extend(et[: stats[4]])
                 ev_y.extend(ey[: stats[4]])
                 ev_y2.extend(ey2[: stats[4]])

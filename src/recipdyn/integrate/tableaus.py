@@ -44,9 +44,9 @@ def dop853() -> Tableau:
     cache directory (one file per SciPy version) and read from there by later processes."""
     import scipy
 
-    from .. import _cache_dir
+    from ..resources import cache_dir
 
-    path = os.path.join(os.path.dirname(_cache_dir()), f"dop853-scipy-{scipy.__version__}.npz")
+    path = os.path.join(cache_dir(), f"dop853-scipy-{scipy.__version__}.npz")
     try:
         with np.load(path) as z:
             arrays = {k: np.ascontiguousarray(z[k], dtype=np.float64) for k in _DOP853_ARRAYS}
