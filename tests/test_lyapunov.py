@@ -48,6 +48,23 @@ def test_short_run_does_not_collapse_to_zero():
     np.testing.assert_allclose(r.exponents, [0.7, -0.4], atol=1e-4)
 
 
+def test_reorthonormalisation_interval_adapts_to_the_spread_rate_only():
+    """The interval is halved while (lambda_1 - lambda_k) dt > max_log_spread: for
+    diag(3, -3) from dt = 2 that is 2 -> 1 -> 0.5 (6 * 0.5 = 3 <= 5), exactly. A fast harmonic
+    oscillator (omega = 1000, exponents 0) spreads its tangent vectors by ~ln(omega^2) = 13.8
+    within an interval through the units of x and x' alone; the rate is 0, so the interval
+    stays (the former single-interval criterion halved it to 1/16 for no accuracy)."""
+    r = lyapunov_spectrum(S.linear([[3.0, 0.0], [0.0, -3.0]]), [1.0, 1.0], 200.0, dt=2.0)
+    assert r.settings["dt_final"] == 0.5
+    np.testing.assert_allclose(r.exponents, [3.0, -3.0], atol=1e-9)
+    w = 1000.0
+    r = lyapunov_spectrum(S.linear([[0.0, 1.0], [-w * w, 0.0]]), [1.0, 0.0], 20.0, dt=0.1)
+    assert r.settings["dt_final"] == 0.1
+    # bounded growth: |log R| over 20 s stays below ln(omega^2), so |lambda| < 13.8 / 20
+    assert np.all(np.abs(r.exponents) < math.log(w * w) / 20.0)
+    assert r.sum == pytest.approx(0.0, abs=1e-6)  # trace 0: the area is preserved
+
+
 def test_henon_map():
     r = lyapunov_spectrum_map(S.henon(), [0.1, 0.1], 1_000_000)
     np.testing.assert_allclose(r.exponents, [0.4192, -1.6232], atol=0.005)

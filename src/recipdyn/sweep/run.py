@@ -10,15 +10,16 @@ Backends (one code path: :func:`recipdyn.sweep.work.run_point`):
     ``dask.distributed``: ``dask_local=N`` starts a ``LocalCluster`` of N single-threaded
     workers; ``scheduler="tcp://host:8786"`` uses an existing cluster (see docs/sweeps.md).
 
-The store (``OUT/sweep.zarr``) has one small chunk per point, so a point is written
-independently of the others. A point counts as done only after its data are written, read
-back and match their checksum (``checksum``, CRC-32 of every value of the point); ``done`` is
-written last. On ``resume=True`` every done point is verified again (a torn or corrupted chunk
-after ``kill -9`` or a disk fault is found and the point recomputed, never counted as done),
-and with ``continuation`` every point after the first missing one is recomputed from its
-predecessor's recorded final state, so a resumed sweep equals an uninterrupted one. A failing
-point gets its message in ``error`` and the sweep goes on. Only the coordinating process
-writes; every value depends only on its point, so results are bit-identical across backends.
+The store (``OUT/sweep.zarr``) has one small chunk per point (blocks of points along the last
+axis for grids above :data:`BLOCK_ABOVE` points), written in batches (:class:`StoreWriter`).
+A point counts as done only after its data are written, read back and match their checksum
+(``checksum``, CRC-32 of every value of the point); ``done`` is written last. On
+``resume=True`` every done point is verified again (a torn or corrupted chunk after ``kill -9``
+or a disk fault is found and its points recomputed, never counted as done), and with
+``continuation`` every point after the first missing one is recomputed from its predecessor's
+recorded final state, so a resumed sweep equals an uninterrupted one. A failing point gets its
+message in ``error`` and the sweep goes on. Only the coordinating process writes; every value
+depends only on its point, so results are bit-identical across backends.
 
 One sweep at a time per output folder (:class:`~recipdyn.locking.RunLock`). SIGINT/SIGTERM
 stop the sweep after the points already finished are written; the workers are ended and the
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import sys
 import time
 import zlib
 from collections.abc import Callable, Iterable
@@ -88,7 +90,7 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
         arr[:] = np.asarray(a.values)
         arr.attrs.update({"units": spec.get_model().schema[a.name].unit or "1",
                           "scale": a.scale})  # fmt: skip
-    one = (1,) * len(dims)
+    one = (1,) * (len(dims) - 1) + (min(point_block(spec.n_points), spec.shape[-1]),)
     for name, (dtype, extra, size, units) in _variables(spec).items():
         shape = spec.shape + ((size,) if extra else ())
         chunks = one + ((size,) if extra else ())
@@ -118,6 +120,20 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
 
 _FILL = {"f8": np.nan, "i8": -1, "str": ""}
 
+#: Grids larger than this store blocks of :data:`POINT_BLOCK` points (along the last axis) per
+#: chunk instead of one point per chunk: Zarr spends ~0.5 ms on every chunk it writes or reads
+#: and a file-system block of disk, so a 10^6-point map would otherwise take 15 million files
+#: and cap the coordinator at ~60 points/s (benchmarks/bench_scaling.py).
+BLOCK_ABOVE = 4096
+POINT_BLOCK = 64
+
+
+def point_block(n_points: int) -> int:
+    """Points per chunk along the last grid axis (1 keeps every point in its own chunk, so a
+    torn write can never touch a neighbour; with blocks, verification on resume finds the
+    neighbours a torn chunk damaged and recomputes them)."""
+    return POINT_BLOCK if n_points > BLOCK_ABOVE else 1
+
 
 def _canonical(name: str, dtype: str, shape: tuple[int, ...], value) -> bytes:
     if dtype == "str":
@@ -145,42 +161,172 @@ def _read_point(g, spec: SweepSpec, idx: tuple) -> dict[str, Any]:
 
 def _write(g, spec: SweepSpec, res: dict[str, Any]) -> None:
     """Write one point, read it back, check it, then mark it done."""
-    idx = tuple(res["index"])
-    for name, (dtype, _e, _s, _u) in _variables(spec).items():
-        g[name][idx] = res.get(name, _FILL[dtype])
-    g["error"][idx] = res["error"]
-    crc = _checksum(spec, res)
-    g["checksum"][idx] = crc
-    if _checksum(spec, _read_point(g, spec, idx)) != crc:  # pragma: no cover - disk fault
-        raise OSError(f"sweep point {idx} did not read back as written")
-    g["done"][idx] = True  # last: a point counts as done only once its data verify
+    w = StoreWriter(g, spec)
+    w.add(res)
+    w.flush()
+
+
+class StoreWriter:
+    """Writes finished points to the store in batches: each run of consecutive points of a
+    batch in one Zarr call per variable (Zarr writes the run's chunks concurrently), then the
+    batch is read back and each point's checksum compared, and only then are the points marked
+    done.
+
+    Every Zarr call costs ~0.7 ms of synchronisation whatever it carries, and a point has ~15
+    variables, so point by point the coordinator stored only ~30 points/s (measured:
+    ``benchmarks/bench_scaling.py``): a ceiling on any cluster. A batch is flushed when
+    ``max_batch`` points wait or ``max_wait`` seconds have passed since the last flush, and on
+    every interruption, so at most that much finished work sits in memory; ``on_stored`` is
+    called for each point once it is stored and verified.
+    """
+
+    def __init__(self, g, spec: SweepSpec, *, max_batch: int = 1, max_wait: float = 0.5,
+                 on_stored: Callable[[dict[str, Any]], None] | None = None) -> None:  # fmt: skip
+        self.spec = spec
+        self.vars = _variables(spec)
+        self.arrays = {name: g[name] for name in (*self.vars, "error", "checksum", "done")}
+        self.max_batch, self.max_wait = max(1, int(max_batch)), float(max_wait)
+        self.on_stored = on_stored
+        self.buffer: list[dict[str, Any]] = []
+        self.clobbered: list[tuple] = []
+        self.last = time.monotonic()
+
+    def add(self, res: dict[str, Any]) -> None:
+        self.buffer.append(res)
+        if len(self.buffer) >= self.max_batch or time.monotonic() - self.last >= self.max_wait:
+            self.flush()
+
+    def _runs(self, batch: list[dict[str, Any]]) -> list[tuple[tuple, int, int, list]]:
+        """The batch as runs of consecutive points along the last axis: ``(lead, start,
+        stop, results)``. Points finish roughly in grid order, so a batch makes few runs, and a
+        run is written with one Zarr call per variable (its chunks concurrently)."""
+        runs: list[tuple[tuple, int, int, list]] = []
+        for r in sorted(batch, key=lambda r: tuple(r["index"])):
+            idx = tuple(r["index"])
+            lead, k = idx[:-1], idx[-1]
+            if runs and runs[-1][0] == lead and runs[-1][2] == k:
+                lead0, start, _stop, rs = runs[-1]
+                runs[-1] = (lead0, start, k + 1, [*rs, r])
+            else:
+                runs.append((lead, k, k + 1, [r]))
+        return runs
+
+    def _put(self, name: str, lead: tuple, start: int, stop: int, vals: np.ndarray) -> None:
+        arr = self.arrays[name]
+        try:
+            arr[(*lead, slice(start, stop))] = vals
+        except Exception:  # a chunk the write must merge into is unreadable: rewrite it whole
+            cb = arr.chunks[len(lead)]
+            lo, hi = start // cb * cb, min(-(-stop // cb) * cb, arr.shape[len(lead)])
+            fill = {"error": "", "checksum": -1, "done": False}.get(name)
+            fill = _FILL[self.vars[name][0]] if fill is None else fill
+            full = np.full((hi - lo, *vals.shape[1:]), fill, dtype=vals.dtype)
+            full[start - lo : stop - lo] = vals
+            arr[(*lead, slice(lo, hi))] = full
+            for k in (*range(lo, start), *range(stop, hi)):  # neighbours lost with the chunk
+                self.clobbered.append((*lead, k))
+
+    def flush(self) -> None:
+        # emptied first: a callback that raises cannot make a second flush write it again
+        batch, self.buffer = self.buffer, []
+        self.last = time.monotonic()
+        if not batch:
+            return
+        runs = self._runs(batch)
+        for lead, start, stop, rs in runs:
+            for name, (dtype, extra, size, _u) in self.vars.items():
+                shape = (size,) if extra else ()
+                kind = str if dtype == "str" else dtype
+                vals = np.stack(
+                    [
+                        np.broadcast_to(np.asarray(r.get(name, _FILL[dtype]), dtype=kind), shape)
+                        for r in rs
+                    ]
+                )
+                self._put(name, lead, start, stop, vals)
+            self._put("error", lead, start, stop, np.array([r["error"] for r in rs], dtype=str))
+            crc = np.array([_checksum(self.spec, r) for r in rs], dtype=np.int64)
+            self._put("checksum", lead, start, stop, crc)
+        for lead, start, stop, rs in runs:  # read back and verify
+            region = (*lead, slice(start, stop))
+            back = {name: self.arrays[name][region] for name in (*self.vars, "error")}
+            for j, r in enumerate(rs):
+                if _checksum(self.spec, {k: v[j] for k, v in back.items()}) != _checksum(
+                    self.spec, r
+                ):  # pragma: no cover - disk fault
+                    raise OSError(f"sweep point {tuple(r['index'])} did not read back as written")
+        # last: a point counts as done only once its data verify
+        for lead, start, stop, _rs in runs:
+            self._put("done", lead, start, stop, np.ones(stop - start, dtype=bool))
+        for idx in self.clobbered:  # pragma: no cover - needs a chunk corrupted mid-run
+            self.arrays["done"][idx] = False
+        self.clobbered = []
+        if self.on_stored is not None:
+            for r in batch:
+                self.on_stored(r)
 
 
 def _verified_done(g, spec: SweepSpec) -> tuple[np.ndarray, int]:
-    """``done`` after re-checking every point marked done; returns (done, n_rejected)."""
+    """``done`` after re-checking every point marked done; returns (done, n_rejected).
+
+    Read slab by slab (rows of the first axis, ~4096 points at a time: one Zarr call per
+    variable, not per point); a slab with an unreadable chunk is re-checked point by point, so
+    one torn chunk does not hide the others."""
     done = np.zeros(spec.shape, dtype=bool)
-    rejected = 0
     try:
         marked = np.asarray(g["done"][...], dtype=bool)
     except Exception:  # a torn 'done' chunk: look at every point
         marked = None
-    for idx, _ in spec.grid():
-        if marked is not None and not marked[idx]:
+    names = (*_variables(spec), "error", "checksum")
+    arrays = {name: g[name] for name in names}
+    row = int(np.prod(spec.shape[1:], dtype=np.int64))
+    slab = max(1, 4096 // max(1, row))
+    bad: list[tuple] = []
+    for i0 in range(0, spec.shape[0], slab):
+        rows = slice(i0, min(i0 + slab, spec.shape[0]))
+        idxs = [i for i in np.ndindex(*spec.shape) if rows.start <= i[0] < rows.stop]
+        if marked is not None:
+            idxs = [i for i in idxs if marked[i]]
+        if not idxs:
             continue
-        try:  # point by point: one torn chunk must not hide the others
-            if not bool(g["done"][idx]):
-                continue
-            ok = _checksum(spec, _read_point(g, spec, idx)) == int(g["checksum"][idx])
-        except Exception:  # unreadable (truncated, corrupted) chunk
-            ok = False
-        done[idx] = ok
-        if not ok:
-            rejected += 1
+        try:
+            data = {name: a[rows] for name, a in arrays.items()}
+        except Exception:  # an unreadable chunk in this slab: point by point
+            data = None
+        for idx in idxs:
+            local = (idx[0] - i0, *idx[1:])
             try:
-                g["done"][idx] = False
-            except Exception:  # pragma: no cover - unwritable chunk: recomputing rewrites it
-                pass
+                if data is None:
+                    point = _read_point(g, spec, idx)
+                    crc = int(arrays["checksum"][idx])
+                else:
+                    point = {name: data[name][local] for name in names if name != "checksum"}
+                    crc = int(data["checksum"][local])
+                ok = _checksum(spec, point) == crc
+                if ok and marked is None:
+                    ok = bool(g["done"][idx])
+            except Exception:  # unreadable (truncated, corrupted) chunk
+                ok = False
+            done[idx] = ok
+            if not ok and (marked is None or marked[idx]):
+                bad.append(idx)
+    rejected = 0
+    for idx in bad:
+        try:
+            if marked is None and not _marked(g, idx):
+                continue  # never finished: not a rejection
+        except Exception:
+            pass
+        rejected += 1
+        try:
+            g["done"][idx] = False
+        except Exception:  # pragma: no cover - unwritable chunk: recomputing rewrites it
+            pass
     return done, rejected
+
+
+def _marked(g, idx: tuple) -> bool:
+    return bool(g["done"][idx])
 
 
 def open_sweep(path: str | Path) -> xr.Dataset:
@@ -245,7 +391,7 @@ def run_sweep(
                            progress, on_point)  # fmt: skip
 
 
-#: Disk used per point and variable: one chunk file (small, but one file-system block).
+#: Disk used by one chunk file at least (one file-system block).
 _BYTES_PER_CHUNK = 4096
 
 
@@ -268,7 +414,10 @@ def _check_resources(spec: SweepSpec, out: Path, backend, workers, dask_local,
         check_memory(n_par * estimate_memory(samples),
                      f"sweep ({n_par} point(s) at once, {samples:.3g} samples each)",
                      "reduce --revolutions, --fs or --workers", max_memory)  # fmt: skip
-    need = spec.n_points * (len(_variables(spec)) + 3) * _BYTES_PER_CHUNK
+    variables = _variables(spec)
+    n_chunks = -(-spec.n_points // min(point_block(spec.n_points), spec.shape[-1]))
+    data = spec.n_points * sum(8 * (size or 1) for _d, _e, size, _u in variables.values())
+    need = n_chunks * (len(variables) + 3) * _BYTES_PER_CHUNK + data
     free = shutil.disk_usage(out).free
     if need > free:
         from ..resources import format_bytes
@@ -334,9 +483,8 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
     failed = written = 0
     t0 = time.perf_counter()
 
-    def accept(res):
+    def stored(res):
         nonlocal failed, written
-        _write(g, spec, res)
         written += 1
         failed += bool(res["error"])
         if on_point is not None:
@@ -345,9 +493,13 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
             bar.update(1)
             bar.set_postfix(failed=failed)
 
+    sequential = spec.continuation or backend == "serial"
+    writer = StoreWriter(g, spec, max_batch=1 if sequential else WRITE_BATCH, on_stored=stored)
+    accept = writer.add
     try:
-        with deferred_signals() as pending:
-            if spec.continuation or backend == "serial":
+        with deferred_signals() as signals:
+            pending = _Ticking(signals, writer)
+            if sequential:
                 for task in _tasks(spec, todo):
                     pending.check()
                     if spec.continuation and y0 is not None:
@@ -356,12 +508,18 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
                     accept(res)
                     if spec.continuation:
                         y0 = None if res["error"] else res["y_final"]
-                pending.check()
             elif backend == "processes":
                 _run_processes(_tasks(spec, todo), workers, accept, pending)
             else:
-                _run_dask(_tasks(spec, todo), dask_local, scheduler, workers, accept, pending)
+                _run_dask(_tasks(spec, todo), len(todo), dask_local, scheduler, workers, accept,
+                          pending, progress)  # fmt: skip
+            writer.flush()
+            pending.check()
     except (KeyboardInterrupt, Interrupted) as exc:
+        try:  # the finished points waiting in the batch are kept too
+            writer.flush()
+        except KeyboardInterrupt:  # pragma: no cover - a second Ctrl-C while writing
+            pass
         intr = Interrupted.wrap(exc)
         intr.kept.append(f"{n_skip + written} of {n_total} sweep points ({written} new) in "
                          f"{store}; rerun the same command with --resume to finish")  # fmt: skip
@@ -376,35 +534,88 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
     return store
 
 
+#: Most finished points written in one batch by the parallel backends (see StoreWriter).
+WRITE_BATCH = 256
+
+
+class _Ticking:
+    """``pending.check()`` that also writes a waiting batch once it is old enough, so finished
+    points never wait in memory for the next result to arrive."""
+
+    def __init__(self, pending, writer: StoreWriter) -> None:
+        self.pending, self.writer = pending, writer
+
+    def check(self) -> None:
+        w = self.writer
+        if w.buffer and time.monotonic() - w.last >= w.max_wait:
+            w.flush()
+        self.pending.check()
+
+
 def _run_processes(tasks, workers, accept, pending) -> None:
     run_unordered(run_point, tasks, workers or os.cpu_count() or 1, accept, pending)
 
 
-def _run_dask(tasks, dask_local, scheduler, workers, accept, pending) -> None:
+#: Dask tasks in flight per worker: enough to keep every worker busy while results travel,
+#: few enough that a 10^6-point map never sits in the scheduler's memory at once.
+DASK_IN_FLIGHT = 2
+#: Most points one Dask task carries (see :func:`dask_batch_size`).
+DASK_MAX_BATCH = 32
+
+
+def dask_batch_size(n_points: int, n_workers: int) -> int:
+    """Points per Dask task: ~8 tasks a worker over the sweep (so the last wave is short), at
+    most :data:`DASK_MAX_BATCH`. The scheduler costs ~1 ms a task; a point costs 0.1-10 s, so
+    batching matters only for very many short points, where it divides that cost."""
+    return max(1, min(DASK_MAX_BATCH, n_points // (8 * max(1, n_workers))))
+
+
+def _run_dask(tasks, n_tasks, dask_local, scheduler, workers, accept, pending,
+              progress=False) -> None:  # fmt: skip
+    import itertools
+
     from dask.distributed import Client, LocalCluster, as_completed
+
+    from .work import run_points
 
     cluster = None
     if scheduler:
         client = Client(scheduler)
+        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     else:
-        n = dask_local or workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+        n_workers = dask_local or workers or os.cpu_count() or 1
+        t0 = time.perf_counter()
+        cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)  # fmt: skip
         client = Client(cluster)
-    futures = []
+        if progress:  # ~2 s a run: say so (a running cluster, --scheduler, does not pay it)
+            print(f"sweep: Dask LocalCluster of {n_workers} workers started in "
+                  f"{time.perf_counter() - t0:.1f} s", file=sys.stderr)  # fmt: skip
+    size = dask_batch_size(n_tasks, n_workers)
+    batches = iter(lambda: list(itertools.islice(tasks, size)), [])
+    running = as_completed()
+    n_running = 0
     try:
-        futures = [client.submit(run_point, t, pure=False) for t in tasks]
-        ac = as_completed(futures)
-        while not ac.is_empty():
-            batch = ac.next_batch(block=False)
-            for fut in batch:
-                accept(fut.result())
-            if not batch:
-                time.sleep(0.05)
+        while True:
+            while n_running < DASK_IN_FLIGHT * n_workers:
+                batch = next(batches, None)
+                if batch is None:
+                    break
+                running.add(client.submit(run_points, batch, pure=False))
+                n_running += 1
+            if n_running == 0:
+                break
+            done = running.next_batch(block=False)
+            for fut in done:
+                n_running -= 1
+                for res in fut.result():
+                    accept(res)
+            if not done:
+                time.sleep(0.02)
             pending.check()
     finally:
-        if futures:
-            client.cancel(futures)
+        if n_running:
+            client.cancel(list(running.futures))
         client.close()
         if cluster is not None:
             cluster.close()

@@ -48,6 +48,11 @@ def run_point(task: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def run_points(tasks: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """:func:`run_point` for each task (one Dask task carries several short points)."""
+    return [run_point(t) for t in tasks]
+
+
 class _Point:
     """One point's system, period, initial state and outputs, for any registered model.
 
