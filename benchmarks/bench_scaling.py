@@ -77,11 +77,11 @@ def _task_rate(client, n: int = 400) -> float:
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="12 points, 1-2 workers")
-    ap.add_argument("--workers", default=None, help="comma list (default 1,2,3,4)")
+    ap.add_argument("--workers", default=None, help="comma list (default 1,2,3)")
     args, _ = ap.parse_known_args(argv)
     from dask.distributed import Client, LocalCluster
 
-    counts = [1, 2] if args.quick else [1, 2, 3, 4]
+    counts = [1, 2] if args.quick else [1, 2, 3]
     if args.workers:
         counts = [int(w) for w in args.workers.split(",")]
     n_rc, n_omega = (3, 4) if args.quick else (6, 8)

@@ -26,12 +26,13 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from .defaults import SIMULATION
-from .model.parameters import CompressorParams, ParameterError, resolve_name
+from .model.parameters import SCHEMA, CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
 __all__ = ["SimulationConfig", "RunConfig", "read_config", "build_params", "model_values"]
 
-_STRING_FIELDS = {"load_sign", "equations"}
+#: The compressor's parameters whose values are names (every one with ``choices``).
+_STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
 
 
 class SimulationConfig(BaseModel):

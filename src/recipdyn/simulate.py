@@ -212,6 +212,7 @@ def simulate(
     chunks = max(1, min(1000, int(math.ceil(transient + revolutions))))
     writer = sink = None
     min_force = [math.inf]
+    tail: list[xr.Dataset] = []  # the last two blocks: the run summary's last revolution
     if out is not None:
         from .io import StreamWriter
 
@@ -220,7 +221,9 @@ def simulate(
         def sink(t, y):
             outs = model.outputs(t, y)
             min_force[0] = min(min_force[0], float(np.min(outs["contact_force"].values)))
-            writer.append(_record(outs, t, T, keep))
+            rec = _record(outs, t, T, keep)
+            writer.append(rec)
+            tail[:] = [*tail[-1:], rec]
 
     try:
         sol = integrate(
@@ -283,6 +286,9 @@ def simulate(
         "storage": "float32" if (float32 and writer is not None) else "float64",
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+    recent = ds if writer is None else xr.concat(tail, "time") if tail else None
+    if recent is not None and recent.sizes.get("time", 0):
+        attrs.update(clean_attrs(COMPRESSOR.run_summary(vars(p), recent)))
     if writer is not None:
         from .io import open_record
 

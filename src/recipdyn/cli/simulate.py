@@ -180,8 +180,7 @@ def simulate(
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
         summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}
-        for k, val in summary.items():
-            typer.echo(f"  {k} = {val:.4g}")
+        _echo_summary(summary)
         if figure:
             from ..plotting import _mpl, model_figure
 
@@ -209,6 +208,12 @@ def simulate(
         f"peak |a| = {abs(a).max():.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
         f"{ds.x.max().item():.5f}] m, min contact force = {ds.attrs['min_contact_force_N']:.4g} N"
     )
+    _echo_summary(m.run_summary(m.schema.from_attrs(ds.attrs), ds))
+
+
+def _echo_summary(summary: dict) -> None:
+    for k, val in summary.items():
+        typer.echo(f"  {k} = {val:.4g}" if isinstance(val, float) else f"  {k} = {val}")
 
 
 @app.command()

@@ -34,8 +34,9 @@ from .base import (
     compiled,
     typed,
 )
+from .cycle import cycle_states, cycle_summary
 from .kinematics import joint_forces, kinematics
-from .load import gas_force, gas_force_kernel, mu_kernel, pack_table
+from .load import gas_force, gas_force_kernel, mu_kernel, pack_load
 from .paper_printed import paper_acceleration
 from .parameters import SCHEMA, CompressorParams, ParameterError
 from .protocol import Model
@@ -52,10 +53,11 @@ P_RC, P_D, P_OMEGA, P_TH10, P_LOADKIND, P_LOADAMP, P_LOADSIGN, P_TABLE = range(1
 
 def pack_params(p: CompressorParams) -> np.ndarray:
     """Flat float64 vector for the compiled kernels (layout: the ``P_*`` constants)."""
+    kind, data = pack_load(vars(p))
     head = [p.r, p.rs, p.l, p.ls, p.m1, p.m2, p.m3, p.J1, p.J2, p.g, p.rc, p.d, p.omega]
-    head += [p.theta1_0, 0.0 if p.load_table is None else 1.0, p.load_amplitude]
+    head += [p.theta1_0, kind, p.load_amplitude]
     head += [-1.0 if p.load_sign == "physical" else 1.0]
-    return np.concatenate([np.asarray(head, dtype=np.float64), pack_table(p.load_table)])
+    return np.concatenate([np.asarray(head, dtype=np.float64), data])
 
 
 @nb.njit(cache=True)
@@ -123,7 +125,7 @@ def jac_exact(t, y, p, out):
 
 @compiled(RHS_SIGNATURE)
 def rhs_exact_table(t, y, p, out):
-    """Exact equation, a tabulated load."""
+    """Exact equation, a tabulated or compression-cycle load."""
     _rhs_exact(t, y, p, out, _force)
 
 
@@ -251,7 +253,21 @@ class CompressorModel(ODESystem):
                 jf.contact, "N", "joint contact force (>0: permanent contact holds)"
             ),
             "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+            **_cycle_outputs(p, k.theta1),
         }
+
+
+def _cycle_outputs(p: CompressorParams, theta1: np.ndarray) -> dict[str, Signal]:
+    """Cylinder pressures and volumes of the compression-cycle load (none for other loads)."""
+    if p.load != "cycle":
+        return {}
+    st = cycle_states(theta1, pack_load(vars(p))[1])
+    return {
+        "p_head": Signal(st["p_head"], "Pa", "head-end cylinder pressure (absolute)"),
+        "p_crank": Signal(st["p_crank"], "Pa", "crank-end cylinder pressure (absolute)"),
+        "V_head": Signal(st["V_head"], "m**3", "head-end cylinder volume"),
+        "V_crank": Signal(st["V_crank"], "m**3", "crank-end cylinder volume"),
+    }
 
 
 def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
@@ -261,7 +277,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
     if p.equations != "exact":
         rhs, jac, rhs_jac = rhs_paper, jac_paper, None
-    elif p.load_table is None:
+    elif p.load_table is None and p.load == "paper":
         rhs, jac, rhs_jac = rhs_exact, jac_exact, rhs_jac_exact
     else:
         rhs, jac, rhs_jac = rhs_exact_table, jac_exact_table, rhs_jac_exact_table
@@ -320,6 +336,11 @@ class Compressor(Model):
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         return self.system(values).outputs(t, y)
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """With ``load = "cycle"``: the API 618 pin-load reversal and the cycle's indicated
+        power and volumetric efficiencies (:func:`recipdyn.model.cycle.cycle_summary`)."""
+        return cycle_summary(values, ds)
 
 
 #: The registered instance (``recipdyn --model compressor``, the default).

@@ -42,6 +42,7 @@ import numpy as np
 
 from ._compressor_contact import both_system, crank_system, crosshead_system
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .cycle import cycle_summary
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -51,7 +52,7 @@ from .joints.contact import (
     normal_force,
     short_bearing_forces,
 )
-from .load import gas_force_kernel, pack_table
+from .load import CYCLE_PARAMS, gas_force_kernel, pack_load
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -470,7 +471,8 @@ SCHEMA = Schema((
     Param("v_impact_min", "m/s", 1e-3, "floor of the recorded approach velocity (grazing "
           "contacts)", 0.0, _INF, low_open=True, group="joint"),
     _link("omega"), _link("theta1_0"),
-    _link("load_amplitude"), _link("load_sign"),
+    _link("load_amplitude"), _link("load_sign"), _link("load"),
+    *(_link(k) for k in CYCLE_PARAMS),
     Param("e0_angle", "rad", None, "initial direction of e (default: aligned with the rod "
           "load, as the massless link's default)", -1e6, 1e6, group="initial", optional=True),
     Param("e0_angle_crosshead", "rad", None, "initial direction of the crosshead pin's e "
@@ -504,8 +506,9 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
              v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
              v["oil_viscosity"] if v["joint"] == "lubricated" else 0.0, v["bearing_length"],
              v["eps_dry"], v["v_impact_min"], v["load_amplitude"],
-             -1.0 if v["load_sign"] == "physical" else 1.0, 0.0]  # fmt: skip
-    return np.concatenate([np.asarray(head, dtype=np.float64), pack_table(None)])
+             -1.0 if v["load_sign"] == "physical" else 1.0]  # fmt: skip
+    kind, data = pack_load(v)
+    return np.concatenate([np.asarray([*head, kind], dtype=np.float64), data])
 
 
 def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
@@ -618,8 +621,8 @@ class CompressorContact(Model):
             from .compressor import equilibrium_theta_c
             from .parameters import CompressorParams
 
-            cp = CompressorParams(rs=0.0, **{k: values[k] for k in (*MECH, "rc", "load_amplitude",
-                                                            "load_sign")})  # fmt: skip
+            keys = (*MECH, "rc", "load_amplitude", "load_sign", "load", *CYCLE_PARAMS)
+            cp = CompressorParams(rs=0.0, **{k: values[k] for k in keys})
             ang = equilibrium_theta_c(cp)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
@@ -748,6 +751,7 @@ class CompressorContact(Model):
             "energy_balance_residual": float(np.abs(bal).max() / max(np.abs(E).max(), 1e-300)),
             "peak_abs_a_m_s2": float(np.abs(ds["a"].values).max()),
         })  # fmt: skip
+        out.update(cycle_summary(values, ds))
         return out
 
 

@@ -29,7 +29,17 @@ import math
 import numba as nb
 import numpy as np
 
-__all__ = ["mu_paper", "mu_kernel", "gas_force", "gas_force_kernel", "read_load_table"]
+from .cycle import cycle_force_kernel, pack_cycle
+
+__all__ = [
+    "mu_paper",
+    "mu_kernel",
+    "gas_force",
+    "gas_force_kernel",
+    "read_load_table",
+    "pack_load",
+    "CYCLE_PARAMS",
+]
 
 _PI = math.pi
 
@@ -56,10 +66,13 @@ def mu_paper(theta1) -> np.ndarray:
 def gas_force_kernel(theta1: float, kind: float, amp: float, sign: float, table) -> float:
     """Force on the crosshead along +x, N (compiled; see module docstring).
 
-    ``kind`` 0 = paper model, 1 = table; ``table`` is ``[n, angles_rad(n), forces_N(n)]``.
+    ``kind`` 0 = paper model, 1 = table (``table`` is ``[n, angles_rad(n), forces_N(n)]``),
+    2 = compression cycle (``table`` is :func:`recipdyn.model.cycle.pack_cycle`'s vector).
     """
     if kind == 0.0:
         return sign * amp * mu_kernel(theta1)
+    if kind == 2.0:
+        return cycle_force_kernel(theta1, table)
     n = int(table[0])
     ang = table[1 : 1 + n]
     val = table[1 + n : 1 + 2 * n]
@@ -83,11 +96,34 @@ def pack_table(table) -> np.ndarray:
     return np.concatenate([[len(arr)], np.deg2rad(arr[:, 0]), arr[:, 1]])
 
 
+#: Parameter names of the compression-cycle load, in :func:`pack_cycle`'s keyword order.
+CYCLE_PARAMS = (
+    "bore",
+    "rod_diameter",
+    "clearance_fraction",
+    "suction_pressure",
+    "discharge_pressure",
+    "n_compression",
+    "n_expansion",
+    "frame_pressure",
+    "acting",
+)
+
+
+def pack_load(v) -> tuple[float, np.ndarray]:
+    """``(kind, data)`` of the load for the compiled kernels from a mapping of parameter values
+    (``load``, ``load_table`` and the cycle's parameters; the mechanism's ``r``, ``l``, ``d``)."""
+    if v.get("load_table") is not None:
+        return 1.0, pack_table(v["load_table"])
+    if v.get("load", "paper") == "cycle":
+        return 2.0, pack_cycle(v["r"], v["l"], v["d"], **{k: v[k] for k in CYCLE_PARAMS})
+    return 0.0, pack_table(None)
+
+
 def gas_force(theta1, params) -> np.ndarray:
     """Force on the crosshead along +x (N) at crank angle(s) theta1 for ``params``."""
-    kind = 0.0 if params.load_table is None else 1.0
+    kind, tab = pack_load(vars(params))
     sign = -1.0 if params.load_sign == "physical" else 1.0
-    tab = pack_table(params.load_table)
     th = np.atleast_1d(np.asarray(theta1, dtype=np.float64))
     out = np.array([gas_force_kernel(x, kind, params.load_amplitude, sign, tab) for x in th])
     return out.reshape(np.shape(theta1))

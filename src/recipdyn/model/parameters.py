@@ -31,6 +31,7 @@ __all__ = [
     "CompressorParams",
     "ParameterError",
     "ASSUMED",
+    "ASSUMED_CYCLE",
     "PARAM_UNITS",
     "PARAM_ALIASES",
     "paper_2d12",
@@ -48,6 +49,23 @@ ASSUMED: dict[str, str] = {
     "J2": "assumed: slender uniform rod, m2*l**2/12",
     "theta_c0": "not given in the paper: default = link aligned with the rod load, at rest",
     "thetadot_c0": "not given in the paper: default 0",
+}
+
+#: Assumed values of the compression-cycle load (load = "cycle"): the paper gives no cylinder
+#: data. A first stage of a two-stage air compressor (8 bar final): suction 1 bar, discharge
+#: 3 bar, double-acting, 10 % clearance, polytropic exponent 1.3 (air, cooled cylinder).
+ASSUMED_CYCLE: dict[str, str] = {
+    k: "assumed: the paper gives no cylinder data (used only with load = 'cycle')"
+    for k in (
+        "bore",
+        "rod_diameter",
+        "clearance_fraction",
+        "suction_pressure",
+        "discharge_pressure",
+        "n_compression",
+        "n_expansion",
+        "acting",
+    )
 }
 
 _INF = math.inf
@@ -94,6 +112,29 @@ SCHEMA = Schema((
           "crank) or 'paper' (as in Eq. 46)", choices=("physical", "paper"), group="load"),
     Param("equations", "", "exact", "'exact' derivation or the paper's printed Eq. 43-47",
           choices=("exact", "paper-printed"), group="joint"),
+    Param("load", "", "paper", "cylinder load: 'paper' (Eq. 1-2, load_amplitude) or 'cycle' "
+          "(the compression cycle, ideal valves)", choices=("paper", "cycle"), group="load"),
+    Param("bore", "m", 0.5, "cylinder bore (load = cycle)", 0.0, 10.0, low_open=True,
+          assumed=ASSUMED_CYCLE["bore"], group="cycle"),
+    Param("rod_diameter", "m", 0.1, "piston-rod diameter (load = cycle; < bore)", 0.0, 10.0,
+          assumed=ASSUMED_CYCLE["rod_diameter"], group="cycle"),
+    Param("clearance_fraction", "", 0.1, "clearance volume / swept volume of each chamber "
+          "(load = cycle)", 0.0, 10.0, low_open=True, assumed=ASSUMED_CYCLE["clearance_fraction"],
+          group="cycle"),
+    Param("suction_pressure", "Pa", 1.0e5, "suction line pressure, absolute (load = cycle)",
+          0.0, 1e9, low_open=True, assumed=ASSUMED_CYCLE["suction_pressure"], group="cycle"),
+    Param("discharge_pressure", "Pa", 3.0e5, "discharge line pressure, absolute (load = cycle; "
+          ">= suction_pressure)", 0.0, 1e9, low_open=True,
+          assumed=ASSUMED_CYCLE["discharge_pressure"], group="cycle"),
+    Param("n_compression", "", 1.3, "polytropic exponent of compression (load = cycle)", 1.0,
+          2.0, assumed=ASSUMED_CYCLE["n_compression"], group="cycle"),
+    Param("n_expansion", "", 1.3, "polytropic exponent of re-expansion (load = cycle)", 1.0,
+          2.0, assumed=ASSUMED_CYCLE["n_expansion"], group="cycle"),
+    Param("acting", "", "double", "compressing chambers: 'head', 'crank' or 'double' (load = "
+          "cycle)", choices=("head", "crank", "double"), assumed=ASSUMED_CYCLE["acting"],
+          group="cycle"),
+    Param("frame_pressure", "Pa", 101325.0, "pressure in the frame / distance piece, on the rod "
+          "section and in an inactive chamber (load = cycle)", 0.0, 1e9, group="cycle"),
 ), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
@@ -178,6 +219,12 @@ class CompressorParams:
     equations : {"exact", "paper-printed"}
         ``"exact"``: our exact derivation. ``"paper-printed"``: Eq. (43)-(47) exactly as printed
         (with their errata), for comparison only.
+    load : {"paper", "cycle"}
+        ``"paper"``: the piecewise load of Eq. (1)-(2). ``"cycle"``: the gas force of the
+        compression cycle with ideal valves (:mod:`recipdyn.model.cycle`), from ``bore``,
+        ``rod_diameter``, ``clearance_fraction``, ``suction_pressure``, ``discharge_pressure``
+        (absolute, Pa), ``n_compression``, ``n_expansion``, ``acting`` and ``frame_pressure``;
+        ``load_amplitude`` and ``load_sign`` do not apply to it.
     """
 
     r: float = 0.12
@@ -200,6 +247,16 @@ class CompressorParams:
     load_amplitude: float = 200000.0
     load_sign: Literal["physical", "paper"] = "physical"
     equations: Literal["exact", "paper-printed"] = "exact"
+    load: Literal["paper", "cycle"] = "paper"
+    bore: float = 0.5
+    rod_diameter: float = 0.1
+    clearance_fraction: float = 0.1
+    suction_pressure: float = 1.0e5
+    discharge_pressure: float = 3.0e5
+    n_compression: float = 1.3
+    n_expansion: float = 1.3
+    acting: Literal["head", "crank", "double"] = "double"
+    frame_pressure: float = 101325.0
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
@@ -221,6 +278,15 @@ class CompressorParams:
             raise ParameterError("m2, m3, J2: at least one must be > 0 when rc > 0")
         if self.load_table is not None:
             _validate_table(self.load_table)
+            if self.load == "cycle":
+                raise ParameterError("load = 'cycle' and a load table exclude each other: "
+                                     "drop the table or set load = 'paper'")  # fmt: skip
+        _check("rod_diameter", self.rod_diameter, 0.0, self.bore, hi_open=True)
+        if self.discharge_pressure < self.suction_pressure:
+            raise ParameterError(
+                f"discharge_pressure = {self.discharge_pressure!r} Pa is out of range; allowed: "
+                f">= suction_pressure ({self.suction_pressure:g} Pa)"
+            )
 
     @property
     def crank_period(self) -> float:
@@ -237,7 +303,13 @@ class CompressorParams:
         out: dict[str, Any] = {}
         for k, v in asdict(self).items():
             if k == "load_table":
-                out["load_model"] = "table" if v is not None else "paper Eq. (1)-(2)"
+                out["load_model"] = (
+                    "table"
+                    if v is not None
+                    else "compression cycle, ideal valves"
+                    if self.load == "cycle"
+                    else "paper Eq. (1)-(2)"
+                )
                 if v is not None:
                     out["load_table_deg_N"] = [x for row in v for x in row]
                 continue
