@@ -241,3 +241,72 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
     fig.text(0.01, 0.002, footer, fontsize=6.5, color="0.35")
     fig.suptitle(title or "Contact-impact clearance joint")
     return fig
+
+
+def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
+    """The compression cycle of a run with ``load = "cycle"``, over its last revolution:
+    a) p-V diagram of each chamber (line pressures dashed), b) pressures over crank angle,
+    c) rod loads over crank angle: gas, inertia of the crosshead and piston (``-m3 a``) and
+    combined (the crosshead-pin load, compression > 0), with the API 618 reversal verdict.
+    """
+    from .model.cycle import rod_load_reversal
+
+    plt = _mpl()
+    n = ds.sizes["time"]
+    per = 2.0 * np.pi / float(ds.attrs["param_omega"])
+    t = ds["time"].values
+    k = min(n, int(np.ceil(per / (t[1] - t[0]))) + 1) if n > 1 else n
+    last = ds.isel(time=slice(n - k, None))
+    deg = np.degrees(np.mod(last["theta1"].values, 2.0 * np.pi))
+    order = np.argsort(deg)
+    ps = float(ds.attrs["param_suction_pressure"])
+    pdis = float(ds.attrs["param_discharge_pressure"])
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    ax = axes[0]
+    colors = {"head": "#0072B2", "crank": "#D55E00"}  # Okabe-Ito: colour-blind safe
+    acting = str(ds.attrs.get("param_acting", "double"))
+    ends = [e for e in ("head", "crank") if acting in (e, "double")]
+    for end in ends:
+        ax.plot(last[f"V_{end}"].values * 1e3, last[f"p_{end}"].values / 1e5, lw=1.2,
+                color=colors[end], label=f"{end} end")  # fmt: skip
+    for p_line, name in ((ps, "suction"), (pdis, "discharge")):
+        ax.axhline(p_line / 1e5, ls="--", lw=0.7, color="0.4")
+        ax.annotate(name, (0.99, p_line / 1e5), xycoords=("axes fraction", "data"), ha="right",
+                    va="bottom", fontsize=8, color="0.3")  # fmt: skip
+    ax.set_xlabel("cylinder volume (L)")
+    ax.set_ylabel("pressure, absolute (bar)")
+    ax.set_title("a) p-V diagram")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    ax = axes[1]
+    for end in ends:
+        ax.plot(deg[order], last[f"p_{end}"].values[order] / 1e5, lw=1.2, color=colors[end],
+                label=f"{end} end")  # fmt: skip
+    ax.set_xlabel("crank angle (deg, 0 = outer dead centre)")
+    ax.set_ylabel("pressure, absolute (bar)")
+    ax.set_title("b) cylinder pressure")
+    ax.set_xlim(0, 360)
+    ax.set_xticks(range(0, 361, 60))
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    ax = axes[2]
+    # on the crosshead along x: m3 a = F_gas + F_rod, so the rod's load on the pin is
+    # m3 a - F_gas = gas load (-F_gas) + inertia load (m3 a); compression > 0
+    gas = -last["gas_force"].values
+    inertia = float(ds.attrs["param_m3"]) * last["a"].values
+    pin = gas + inertia
+    for y, lab, c in ((gas, "gas (-F_gas)", "#009E73"), (inertia, "inertia (m3 a)", "#CC79A7"),
+                      (pin, "combined (crosshead pin)", "black")):  # fmt: skip
+        ax.plot(deg[order], y[order] / 1e3, lw=1.0, label=lab, color=c)
+    ax.axhline(0.0, lw=0.7, color="0.4")
+    rev = rod_load_reversal(last["theta1"].values, pin)
+    ax.set_title("c) rod load, compression > 0\n" + rev.describe(), fontsize=9)
+    ax.set_xlabel("crank angle (deg)")
+    ax.set_ylabel("load (kN)")
+    ax.set_xlim(0, 360)
+    ax.set_xticks(range(0, 361, 60))
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.suptitle(title or "Compression cycle (ideal valves) and rod loads, last revolution")
+    fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+    return fig

@@ -203,6 +203,13 @@ def simulate(
         png = save_figure(fig, out.with_suffix(".png"), dpi=130)
         _mpl().close(fig)
         typer.echo(f"wrote {png}")
+        if ds.attrs.get("param_load") == "cycle" and {"p_head", "V_head"} <= set(ds.data_vars):
+            from ..plotting import cycle_figure
+
+            fig = cycle_figure(ds)
+            png = save_figure(fig, out.with_name(out.stem + ".cycle.png"), dpi=110)
+            _mpl().close(fig)
+            typer.echo(f"wrote {png}")
     a = ds["a"].values
     typer.echo(
         f"peak |a| = {abs(a).max():.4g} m/s^2, x in [{ds.x.min().item():.5f}, "

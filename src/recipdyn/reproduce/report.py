@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import __version__
 from ..io import write_text
-from ..model.parameters import ASSUMED, PARAM_UNITS, CompressorParams
+from ..model.parameters import ASSUMED, ASSUMED_CYCLE, PARAM_UNITS, CompressorParams
 from .cases import PAPER_VALUES, PaperValue, case_by_id
 
 __all__ = ["comparison_rows", "write_tables", "write_html", "REASONS"]
@@ -212,8 +212,9 @@ def write_html(
         if k.endswith("_units") or k.endswith("_note") or k == "assumed_parameters":
             continue
         unit = PARAM_UNITS.get(k, "")
+        note = ASSUMED.get(k, "") or ASSUMED_CYCLE.get(k, "")
         parts.append(f"<tr><td>{e(k)}</td><td>{e(str(v))}</td><td>{e(unit)}</td>"
-                     f"<td>{e(ASSUMED.get(k, ''))}</td></tr>")  # fmt: skip
+                     f"<td>{e(note)}</td></tr>")  # fmt: skip
     parts.append("</table><h2>Settings</h2><table>")
     for k, v in settings.items():
         parts.append(f"<tr><td>{e(k)}</td><td>{e(str(v))}</td></tr>")
