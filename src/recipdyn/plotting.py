@@ -300,13 +300,17 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
         ax.plot(deg[order], y[order] / 1e3, lw=1.0, label=lab, color=c)
     ax.axhline(0.0, lw=0.7, color="0.4")
     rev = rod_load_reversal(last["theta1"].values, pin)
-    ax.set_title("c) rod load, compression > 0\n" + rev.describe(), fontsize=9)
+    ax.set_title("c) rod load at the crosshead pin, compression > 0")
+    verdict = rev.describe().replace(" (API", "\n(API").replace(", reverse", ",\nreverse")
+    ax.text(0.02, 0.02, verdict, transform=ax.transAxes, fontsize=8, va="bottom",
+            bbox=dict(boxstyle="round", fc="white", ec="0.6", alpha=0.9))  # fmt: skip
     ax.set_xlabel("crank angle (deg)")
     ax.set_ylabel("load (kN)")
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, 60))
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
     fig.suptitle(title or "Compression cycle (ideal valves) and rod loads, last revolution")
-    fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+    fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))  # room for the footer
+    fig.text(0.01, 0.005, provenance_footer(ds), fontsize=6.5, color="0.35")
     return fig

@@ -34,7 +34,7 @@ from .base import (
     compiled,
     typed,
 )
-from .cycle import cycle_states, cycle_summary
+from .cycle import cycle_force_kernel, cycle_states, cycle_summary
 from .kinematics import joint_forces, kinematics
 from .load import gas_force, gas_force_kernel, mu_kernel, pack_load
 from .paper_printed import paper_acceleration
@@ -123,9 +123,32 @@ def jac_exact(t, y, p, out):
     _rhs_jac_exact(t, y, p, f, out, _force_paper)
 
 
+@nb.njit(cache=True, inline="always")
+def _force_cycle(t, p):
+    th1 = p[P_TH10] + p[P_OMEGA] * t
+    return th1, cycle_force_kernel(th1, p[P_TABLE:])
+
+
+@compiled(RHS_SIGNATURE)
+def rhs_exact_cycle(t, y, p, out):
+    """Exact equation, the compression-cycle load."""
+    _rhs_exact(t, y, p, out, _force_cycle)
+
+
+@compiled(RHS_JAC_SIGNATURE)
+def rhs_jac_exact_cycle(t, y, p, out, J):
+    _rhs_jac_exact(t, y, p, out, J, _force_cycle)
+
+
+@compiled(JAC_SIGNATURE)
+def jac_exact_cycle(t, y, p, out):
+    f = np.empty(2)
+    _rhs_jac_exact(t, y, p, f, out, _force_cycle)
+
+
 @compiled(RHS_SIGNATURE)
 def rhs_exact_table(t, y, p, out):
-    """Exact equation, a tabulated or compression-cycle load."""
+    """Exact equation, a tabulated load."""
     _rhs_exact(t, y, p, out, _force)
 
 
@@ -279,6 +302,8 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         rhs, jac, rhs_jac = rhs_paper, jac_paper, None
     elif p.load_table is None and p.load == "paper":
         rhs, jac, rhs_jac = rhs_exact, jac_exact, rhs_jac_exact
+    elif p.load_table is None:
+        rhs, jac, rhs_jac = rhs_exact_cycle, jac_exact_cycle, rhs_jac_exact_cycle
     else:
         rhs, jac, rhs_jac = rhs_exact_table, jac_exact_table, rhs_jac_exact_table
     return CompressorModel(

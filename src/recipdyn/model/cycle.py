@@ -61,8 +61,8 @@ ACTING = {"head": 1.0, "crank": 2.0, "double": 3.0}
 
 # Layout of the packed cycle data (after the load-kind header in the model's parameter vector).
 (C_R, C_L, C_D, C_XMAX, C_XMIN, C_THODC, C_THIDC, C_AHE, C_ACE, C_AROD, C_CLEAR, C_PS, C_PD,
- C_NC, C_NE, C_PFRAME, C_ACTING) = range(17)  # fmt: skip
-N_CYCLE = 17
+ C_NC, C_NE, C_PFRAME, C_ACTING, C_PTOP, C_PBOT) = range(19)  # fmt: skip
+N_CYCLE = 19
 
 
 @dataclass(frozen=True)
@@ -106,26 +106,28 @@ def pack_cycle(r: float, l: float, d: float, *, bore: float, rod_diameter: float
                acting: str) -> np.ndarray:  # fmt: skip
     """The cycle's data vector for :func:`cycle_force_kernel` (layout: the ``C_*`` constants)."""
     g = cycle_geometry(r, l, d, bore, rod_diameter)
+    # the chambers' pressures at the dead centres are constants (module docstring): computed
+    # once here, so a call of the kernel costs one power per chamber
+    c = clearance_fraction
+    p_top = min(discharge_pressure, suction_pressure * ((1.0 + c) / c) ** n_compression)
+    p_bot = max(suction_pressure, p_top * (c / (1.0 + c)) ** n_expansion)
     return np.array([r, l, d, g.x_max, g.x_min, g.theta_odc, g.theta_idc, g.area_head,
                      g.area_crank, g.area_rod, clearance_fraction, suction_pressure,
                      discharge_pressure, n_compression, n_expansion, frame_pressure,
-                     ACTING[acting]], dtype=np.float64)  # fmt: skip
+                     ACTING[acting], p_top, p_bot], dtype=np.float64)  # fmt: skip
 
 
-@nb.njit(cache=True)
-def _chamber(V, V0, Vs, growing, ps, pd, nc, ne):
+@nb.njit(cache=True, inline="always")
+def _chamber(V, V0, Vs, growing, ps, pd, nc, ne, p_top, p_bot):
     """Pressure of an ideal-valve chamber. At the top (V0) it holds ``p_top``: p_d, or less
     when compression from p_s cannot reach p_d (no delivery); at the bottom ``p_bot``: p_s,
-    or more when re-expansion cannot reach p_s."""
-    vmax = V0 + Vs
-    p_top = min(pd, ps * (vmax / V0) ** nc)
+    or more when re-expansion cannot reach p_s (both the same for either chamber)."""
     if growing:
         return max(ps, p_top * (V0 / V) ** ne)
-    p_bot = max(ps, p_top * (V0 / vmax) ** ne)
-    return min(pd, p_bot * (vmax / V) ** nc)
+    return min(pd, p_bot * ((V0 + Vs) / V) ** nc)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def cycle_state(theta1, c):
     """``(p_head, p_crank, V_head, V_crank)`` at crank angle ``theta1`` (Pa, m^3)."""
     r, l, d = c[C_R], c[C_L], c[C_D]
@@ -144,8 +146,10 @@ def cycle_state(theta1, c):
     vs_ce = c[C_ACE] * stroke
     v0_ce = c[C_CLEAR] * vs_ce
     v_ce = v0_ce + c[C_ACE] * (x - xmin)
-    p_he = _chamber(v_he, v0_he, vs_he, head_grows, ps, pd, nc, ne) if acting & 1 else pf
-    p_ce = _chamber(v_ce, v0_ce, vs_ce, not head_grows, ps, pd, nc, ne) if acting & 2 else pf
+    pt, pb = c[C_PTOP], c[C_PBOT]
+    p_he = _chamber(v_he, v0_he, vs_he, head_grows, ps, pd, nc, ne, pt, pb) if acting & 1 else pf
+    p_ce = (_chamber(v_ce, v0_ce, vs_ce, not head_grows, ps, pd, nc, ne, pt, pb)
+            if acting & 2 else pf)  # fmt: skip
     return p_he, p_ce, v_he, v_ce
 
 
