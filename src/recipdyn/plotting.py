@@ -249,14 +249,10 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     c) rod loads over crank angle: gas, inertia of the crosshead and piston (``-m3 a``) and
     combined (the crosshead-pin load, compression > 0), with the API 618 reversal verdict.
     """
-    from .model.cycle import rod_load_reversal
+    from .model.cycle import last_revolution, rod_load_reversal
 
     plt = _mpl()
-    n = ds.sizes["time"]
-    per = 2.0 * np.pi / float(ds.attrs["param_omega"])
-    t = ds["time"].values
-    k = min(n, int(np.ceil(per / (t[1] - t[0]))) + 1) if n > 1 else n
-    last = ds.isel(time=slice(n - k, None))
+    last = last_revolution(ds, float(ds.attrs["param_omega"]), extra=1)
     deg = np.degrees(np.mod(last["theta1"].values, 2.0 * np.pi))
     order = np.argsort(deg)
     ps = float(ds.attrs["param_suction_pressure"])

@@ -258,6 +258,17 @@ def rod_load_reversal(theta1: np.ndarray, load: np.ndarray) -> RodReversal:
     return RodReversal(reversal, frac, tens, comp)
 
 
+def last_revolution(ds, omega: float, extra: int = 2):
+    """The samples of a uniformly sampled record's last crank revolution (plus ``extra``),
+    selected by position, so a streamed record is read only there."""
+    n = ds.sizes["time"]
+    if n < 2:
+        return ds
+    t01 = np.asarray(ds["time"].isel(time=slice(0, 2)).values, dtype=float)
+    k = int(math.ceil(2.0 * math.pi / omega / (t01[1] - t01[0]))) + extra if t01[1] > t01[0] else n
+    return ds.isel(time=slice(max(0, n - k), None))
+
+
 def cycle_summary(values, ds) -> dict[str, float | str]:
     """Figures of a run with ``load = "cycle"`` (empty otherwise): the API 618 crosshead-pin
     reversal over the last recorded revolution, of the combined load ``m3 a - F_gas`` and of
@@ -266,12 +277,7 @@ def cycle_summary(values, ds) -> dict[str, float | str]:
         return {}
     from .load import pack_load
 
-    n = ds.sizes["time"]
-    if n >= 2:  # only the last revolution is read (a streamed record stays on disk)
-        t01 = np.asarray(ds["time"].isel(time=slice(0, 2)).values, dtype=float)
-        per = 2.0 * math.pi / float(values["omega"])
-        k = int(math.ceil(per / (t01[1] - t01[0]))) + 2 if t01[1] > t01[0] else n
-        ds = ds.isel(time=slice(max(0, n - k), None))
+    ds = last_revolution(ds, float(values["omega"]))
     th = np.asarray(ds["theta1"].values, dtype=float)
     last = th >= th[-1] - 2.0 * math.pi
     out: dict[str, float | str] = {}

@@ -159,13 +159,6 @@ def _read_point(g, spec: SweepSpec, idx: tuple) -> dict[str, Any]:
     return out
 
 
-def _write(g, spec: SweepSpec, res: dict[str, Any]) -> None:
-    """Write one point, read it back, check it, then mark it done."""
-    w = StoreWriter(g, spec)
-    w.add(res)
-    w.flush()
-
-
 class StoreWriter:
     """Writes finished points to the store in batches: each run of consecutive points of a
     batch in one Zarr call per variable (Zarr writes the run's chunks concurrently), then the
@@ -313,7 +306,7 @@ def _verified_done(g, spec: SweepSpec) -> tuple[np.ndarray, int]:
     rejected = 0
     for idx in bad:
         try:
-            if marked is None and not _marked(g, idx):
+            if marked is None and not bool(g["done"][idx]):
                 continue  # never finished: not a rejection
         except Exception:
             pass
@@ -323,10 +316,6 @@ def _verified_done(g, spec: SweepSpec) -> tuple[np.ndarray, int]:
         except Exception:  # pragma: no cover - unwritable chunk: recomputing rewrites it
             pass
     return done, rejected
-
-
-def _marked(g, idx: tuple) -> bool:
-    return bool(g["done"][idx])
 
 
 def open_sweep(path: str | Path) -> xr.Dataset:
