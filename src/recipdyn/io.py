@@ -223,6 +223,7 @@ class StreamWriter:
         try:
             if self.zarr:
                 if self.n == 0:
+                    self.order = list(block.data_vars)
                     block.to_zarr(str(self.tmp), mode="w", consolidated=False)
                 else:
                     block.to_zarr(str(self.tmp), append_dim="time", consolidated=False)
@@ -264,6 +265,9 @@ class StreamWriter:
             if self.zarr:
                 import zarr
 
+                # a Zarr group lists its arrays in the file system's order (not the order they
+                # were written in): the column order is kept as an attribute for open_record
+                attrs = {**attrs, ORDER_ATTR: " ".join(self.order)}
                 zarr.open_group(str(self.tmp), mode="r+").attrs.update(attrs)
             else:
                 self.nc.setncatts(dict(attrs))
@@ -287,6 +291,9 @@ class StreamWriter:
         shutil.rmtree(self.tmpdir, ignore_errors=True)
 
 
+ORDER_ATTR = "data_variables"
+
+
 def open_record(path: str | Path):
     """A record written by :class:`StreamWriter`, opened lazily (dask, chunk by chunk).
 
@@ -298,5 +305,9 @@ def open_record(path: str | Path):
 
     path = Path(path)
     if path.suffix.lower() == ".zarr":
-        return xr.open_zarr(str(path), consolidated=False, create_default_indexes=False)
+        ds = xr.open_zarr(str(path), consolidated=False, create_default_indexes=False)
+        order = ds.attrs.pop(ORDER_ATTR, "").split()
+        if sorted(order) == sorted(ds.data_vars):
+            ds = ds[order]
+        return ds
     return xr.open_dataset(path, chunks={}, create_default_indexes=False)
