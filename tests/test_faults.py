@@ -225,7 +225,7 @@ def _write_inputs(d: Path) -> dict[str, Path]:
     [
         ("analyze", "text", "cannot be read"),
         ("analyze", "empty", "empty"),
-        ("analyze", "foreign", "missing"),
+        ("analyze", "foreign", "sampling rate"),  # not a recipdyn run: read as a signal
         ("analyze", "folder", "folder"),
         ("plot", "text", "sweep store"),
         ("plot", "foreign", "sweep store"),

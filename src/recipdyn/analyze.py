@@ -16,13 +16,12 @@ from .analysis import (
     amplitude_spectrum,
     classify,
     find_spectral_peaks,
-    lyap_rosenstein,
-    lyap_wolf,
     lyapunov_spectrum,
     stroboscopic_section,
     zero_one_test,
 )
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
+from .analysis.signal import assess_signal
 from .defaults import ATOL, LYAP_TOL, RTOL
 from .io import save_figure, write_text
 from .model.compressor import compressor_model
@@ -30,7 +29,7 @@ from .model.parameters import ParameterError
 from .plotting import _mpl, axis_label
 from .simulate import params_from_attrs
 
-__all__ = ["analyze_run", "MIN_SAMPLES"]
+__all__ = ["analyze_run", "analyze_signal", "is_record", "MIN_SAMPLES"]
 
 #: Fewest samples analyze accepts (a spectrum with a few lines and a phase portrait).
 MIN_SAMPLES = 64
@@ -112,18 +111,11 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     save_figure(fig, out / "phase_portraits.png", dpi=110)
     plt.close(fig)
 
-    n = min(a.size, max_signal_samples)
-    sig: dict[str, Any] = {}
-    for name, fn in (("wolf", lyap_wolf), ("rosenstein", lyap_rosenstein)):
-        try:
-            r = fn(a[:n], 1.0 / fs)
-            sig[name] = {"exponent_per_s": r.exponent, "params": _plain(r.params)}
-            fig = plot_divergence(r)
-            save_figure(fig, out / f"lyapunov_{name}.png", dpi=110)
-            plt.close(fig)
-        except ValueError as exc:
-            sig[name] = {"error": str(exc)}
-    summary["lyapunov_signal"] = sig
+    assessment = assess_signal(a, fs, max_samples=max_signal_samples)
+    summary["lyapunov_signal"] = {k: _plain(r.diagnostics())
+                                  for k, r in assessment.lyapunov.items()}  # fmt: skip
+    summary["signal_assessment"] = _plain(assessment.to_dict())
+    _divergence_figures(assessment, out, plt)
 
     lam = None
     lam_err = 0.0
@@ -168,12 +160,93 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
             plt.close(fig)
         summary["poincare"] = {"points": section_points}
         summary["zero_one_K"] = k01
+    # a simulated record is deterministic by construction: the surrogate test is reported
+    # (summary["signal_assessment"]) but does not enter; the signal exponents stand in only
+    # when the equations give none
     verdict = classify(lambda1=lam, lambda1_err=lam_err, k01=k01, section=section, spectrum=spec,
-                       lyap_tol=LYAP_TOL)  # fmt: skip
+                       lyap_tol=LYAP_TOL, signal_lyapunov=list(assessment.lyapunov.values()),
+                       time_scale=assessment.embedding.delay / fs)  # fmt: skip
     summary["verdict"] = verdict.to_dict()
     write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
+
+
+def _divergence_figures(assessment, out, plt) -> None:
+    for name, r in assessment.lyapunov.items():
+        if r.curve.size:
+            fig = plot_divergence(r)
+            save_figure(fig, out / f"lyapunov_{name}.png", dpi=110)
+            plt.close(fig)
+
+
+def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
+                   max_signal_samples: int = 40_000) -> dict[str, Any]:  # fmt: skip
+    """Analyse one channel of a measured (or any) signal file into folder ``out``: the signal,
+    its spectrum, the exponents from the signal with their statuses, the 0-1 test, the
+    surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``)."""
+    from .analysis.signal import assess_signal as assess
+    from .io import check_output
+    from .io_signal import read_signal
+
+    path, out = Path(path), Path(out)
+    sig = read_signal(path, column=column, fs=fs)
+    if sig.x.size < 200:
+        raise ParameterError(f"{path}: {sig.x.size} samples in {sig.name!r}; analyze needs at "
+                             "least 200 for a signal without equations")  # fmt: skip
+    if np.ptp(sig.x) == 0:
+        raise ParameterError(f"{path}: column {sig.name!r} is constant")
+    check_output(out, formats=None, what="analysis folder")
+    plt = _mpl()
+    x, rate = sig.x, sig.fs
+    t = np.arange(x.size) / rate
+    fig, ax = plt.subplots(figsize=(10, 3.5), constrained_layout=True)
+    shown = slice(0, min(x.size, 20_000))
+    ax.plot(t[shown], x[shown], lw=0.5)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(f"{sig.name} ({sig.units})" if sig.units else sig.name)
+    ax.set_title(
+        f"{sig.source}: {sig.name}, {rate:g} Hz"
+        + (f" (first {shown.stop} of {x.size} samples)" if shown.stop < x.size else "")
+    )
+    ax.grid(alpha=0.3)
+    save_figure(fig, out / "signal.png", dpi=110)
+    plt.close(fig)
+    spec = amplitude_spectrum(x, rate)
+    peaks = find_spectral_peaks(spec, n=8)
+    fig = plot_spectrum(spec, peaks, title=f"spectrum of {sig.name}")
+    save_figure(fig, out / "spectrum.png", dpi=110)
+    plt.close(fig)
+    a = assess(x, rate, max_samples=max_signal_samples)
+    _divergence_figures(a, out, plt)
+    summary: dict[str, Any] = {
+        "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(x.size),
+        "fs_hz": rate, "notes": sig.notes + a.notes, "model": "none (measured signal)",
+        "spectrum": {"resolution_hz": spec.resolution,
+                     "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude,
+                                    crank_order=p.order) for p in peaks]},
+        "lyapunov_signal": {k: r.diagnostics() for k, r in a.lyapunov.items()},
+        "signal_assessment": a.to_dict(), "verdict": a.verdict.to_dict(),
+        "evidence": [list(r) for r in a.evidence_table()],
+    }  # fmt: skip
+    summary = _plain(summary)
+    write_text(out / "summary.json", json.dumps(summary, indent=2))
+    write_text(out / "summary.md", _markdown(summary))
+    return summary
+
+
+def is_record(path: str | Path) -> bool:
+    """True for a NetCDF run written by recipdyn (it records its model and parameters)."""
+    import xarray as xr
+
+    path = Path(path)
+    if path.suffix.lower() != ".nc" or not path.is_file():
+        return False
+    try:
+        with xr.open_dataset(path) as ds:
+            return "model_spec" in ds.attrs or "param_rc" in ds.attrs or "model_name" in ds.attrs
+    except Exception:
+        return True  # let analyze_run report what is wrong with it
 
 
 def _spread(res) -> float:
@@ -272,6 +345,9 @@ def _markdown(s: dict[str, Any]) -> str:
              "| f (Hz) | amplitude (m/s^2) | crank order |", "|---|---|---|"]  # fmt: skip
     for p in s["spectrum"]["peaks"]:
         lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} | {p['crank_order']} |")
+    if s.get("evidence"):
+        lines += ["", "## Evidence", "", "| evidence | value | status |", "|---|---|---|"]
+        lines += [f"| {a} | {b} | {c} |" for a, b, c in s["evidence"]]
     lines += ["", "## Lyapunov exponents", ""]
     le = s.get("lyapunov_equations")
     if le and "refused" in le:
@@ -282,7 +358,8 @@ def _markdown(s: dict[str, Any]) -> str:
             f"- Benettin (equations): {le['exponents_per_s']} ({unit}), sum {le['sum_per_s']:.3g}"
         )
     for name, r in s["lyapunov_signal"].items():
-        lines.append(f"- {name} (acceleration signal): {r.get('exponent_per_s', r.get('error'))}")
+        val = r["exponent"] if r["status"] in ("ok", "flat") else f"refused ({r['reason']})"
+        lines.append(f"- {name} (signal {s.get('signal', 'a')}): {val}")
     if s.get("zero_one_K") is not None:
         lines.append(f"- 0-1 test K (stroboscopic theta_c'): {s['zero_one_K']:.3f}")
     return "\n".join(lines) + "\n"

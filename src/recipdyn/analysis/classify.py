@@ -11,6 +11,21 @@ Rules (each piece of evidence is optional; the verdict says which were used):
   section, incommensurate spectral lines).
 * **undetermined** when the evidence conflicts (e.g. positive exponent but K ~ 0): the
   evidence dict then shows why.
+
+For a measured signal (no equations) two more pieces enter:
+
+* ``determinism``: the surrogate test (:func:`~recipdyn.analysis.surrogates.surrogate_test`).
+  If it cannot reject linearly correlated noise, the verdict is never **chaotic**: it is
+  **periodic** when the spectrum or section says so, **periodic**/**quasi-periodic** by the
+  rules above when the exponents are flat and K < 0.5 (noise never gives a flat divergence
+  curve; line spectra are where the surrogate test is weakest), else **stochastic** (white
+  noise, coloured noise and a noisy periodic signal land here).
+* ``signal_lyapunov``: estimates from the signal (Wolf, Rosenstein, Kantz); only those with a
+  usable status count (refusals are listed, never read as 0). They stand in for ``lambda1``
+  when no equation-based exponent is given: positive when most usable estimates exceed
+  ``signal_tol / time_scale`` (``time_scale``: the embedding delay, about one decorrelation
+  time, in the exponents' time unit) and twice their fit error; flat when none does. A
+  deterministic signal whose estimators all refused is **chaotic** only with K > 0.8.
 """
 
 from __future__ import annotations
@@ -57,13 +72,60 @@ def _line_structure(spec: Spectrum, n: int = 12) -> dict[str, Any]:
     return {"lines": len(peaks), "fundamental_hz": f0, "harmonic_fraction": float(np.mean(harm))}
 
 
+def _signal_exponent(estimates, time_scale, tol, ev, reasons):
+    """(lambda1, err, all_refused) from signal estimates; records the evidence."""
+    usable = [e for e in estimates if e.ok]
+    for e in estimates:
+        ev[f"lambda1_{e.method}"] = e.exponent if e.ok else None
+        ev[f"lambda1_{e.method}_status"] = e.status
+        if not e.ok:
+            reasons.append(f"{e.method}: refused ({e.reason})")
+    if not usable:
+        return None, 0.0, True
+    lim = tol / time_scale
+    pos = [e for e in usable if e.exponent > max(lim, 2 * e.stderr)]
+    vals = np.array([e.exponent for e in usable])
+    ev["lambda1_signal_median"] = float(np.median(vals))
+    ev["lambda1_signal_tolerance"] = lim
+    if len(pos) * 2 > len(usable):  # a majority positive
+        lam = float(np.median([e.exponent for e in pos]))
+        reasons.append(f"{len(pos)} of {len(usable)} signal estimates positive "
+                       f"(median {lam:.4g} > {lim:.3g})")  # fmt: skip
+        return lam, 0.0, False
+    if pos:
+        reasons.append(f"signal estimates disagree: {len(pos)} of {len(usable)} positive")
+        ev["signal_estimates_conflict"] = True
+        return None, 0.0, False
+    return 0.0, 0.0, False
+
+
 def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: float | None = None,
              section=None, spectrum: Spectrum | None = None, lyap_tol: float = LYAP_TOL,
-             max_periodic_points: int = MAX_PERIODIC_POINTS) -> Verdict:  # fmt: skip
+             max_periodic_points: int = MAX_PERIODIC_POINTS, determinism=None,
+             signal_lyapunov=None, time_scale: float = 1.0,
+             signal_tol: float = LYAP_TOL) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
-    (array n x d), amplitude spectrum. ``lyap_tol`` is in the exponent's units."""
+    (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
+    :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
+    (``signal_lyapunov``: :class:`~recipdyn.analysis.lyapunov_signal.SignalLyapunov` list).
+    ``lyap_tol`` is in the exponent's units."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
+    deterministic = None
+    if determinism is not None:
+        deterministic = bool(getattr(determinism, "nonlinear", determinism))
+        ev["surrogate_nonlinear"] = deterministic
+        if hasattr(determinism, "summary"):
+            reasons.append("surrogate test: " + determinism.summary)
+    all_refused = False
+    conflict = False
+    if signal_lyapunov:
+        lam_s, _, all_refused = _signal_exponent(signal_lyapunov, time_scale, signal_tol, ev,
+                                                 reasons)  # fmt: skip
+        conflict = ev.get("signal_estimates_conflict", False)
+        if lambda1 is None and lam_s is not None:
+            lambda1, lambda1_err = lam_s, 0.0
+            lyap_tol = min(lyap_tol, 0.5 * ev["lambda1_signal_tolerance"])
     if lambda1 is not None:
         ev["lambda1"] = float(lambda1)
         ev["lambda1_err"] = float(lambda1_err)
@@ -78,6 +140,27 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     if spectrum is not None:
         ev.update({f"spectrum_{k}": v for k, v in _line_structure(spectrum).items()})
     pos = lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err)
+    flat = lambda1 == 0.0 and (k01 is None or k01 < 0.5)  # no divergence: noise never is
+    if deterministic is False and not flat:
+        regular = n_distinct is not None and n_distinct <= max_periodic_points
+        lines = ev.get("spectrum_harmonic_fraction") == 1 and not pos
+        if regular or (lines and lambda1 is not None):
+            reasons.append("regular: few section points" if regular
+                           else "flat divergence and harmonic spectral lines")  # fmt: skip
+            return Verdict("periodic", ev, reasons)
+        reasons.insert(0, "consistent with linearly correlated noise: not chaotic whatever the "
+                       "exponent estimates say")  # fmt: skip
+        return Verdict("stochastic", ev, reasons)
+    if conflict:
+        return Verdict("undetermined", ev, reasons)
+    if all_refused and lambda1 is None:
+        if deterministic and k01 is not None and k01 > 0.8:
+            reasons.append(f"deterministic and 0-1 test K = {k01:.2f} > 0.8 (no exponent could "
+                           "be estimated)")  # fmt: skip
+            return Verdict("chaotic", ev, reasons)
+        if n_distinct is None or n_distinct > max_periodic_points:
+            reasons.append("no exponent could be estimated from the signal")
+            return Verdict("undetermined", ev, reasons)
     if pos and (k01 is None or k01 > 0.5):
         reasons.append("largest Lyapunov exponent positive beyond its uncertainty")
         if k01 is not None:

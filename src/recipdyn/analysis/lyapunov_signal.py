@@ -39,9 +39,18 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.stats import linregress
 
-from .embedding import delay_embed, estimate_delay, estimate_dimension, mean_period
+from .embedding import choose_embedding, delay_embed
 
 __all__ = ["SignalLyapunov", "lyap_wolf", "lyap_rosenstein", "lyap_kantz"]
+
+#: Fewest points of a divergence curve a slope is fitted to (else: refused, no scaling region).
+MIN_FIT_POINTS = 5
+#: Least R^2 of the straight-line fit over the automatic scaling region.
+MIN_FIT_R2 = 0.95
+#: Fewest reference points with neighbours that Kantz's average must have.
+MIN_REFERENCES = 50
+#: Fewest Wolf evolutions (replacement intervals) an estimate is averaged over.
+MIN_EVOLUTIONS = 100
 
 
 @dataclass
@@ -51,6 +60,9 @@ class SignalLyapunov:
     ``exponent`` is per unit time when ``dt`` was given (else per sample). ``curve`` and
     ``steps`` are the divergence curve (Rosenstein/Kantz) or the running estimate (Wolf);
     ``fit`` the (start, stop) indices used; ``params`` every setting actually used.
+    ``status``: ``ok``; ``flat`` (no divergence: the exponent is 0 to the estimator's
+    resolution, a regular signal); ``refused`` (``exponent`` is NaN and ``reason`` says why:
+    no embedding dimension found, no linear scaling region, too few neighbours...).
     """
 
     method: str
@@ -60,6 +72,23 @@ class SignalLyapunov:
     fit: tuple[int, int] | None
     params: dict = field(default_factory=dict)
     stderr: float = float("nan")
+    status: str = "ok"
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """True when the estimate can be used (``status`` ``ok`` or ``flat``)."""
+        return self.status in ("ok", "flat")
+
+    def diagnostics(self) -> dict:
+        """Everything a reader needs to judge the estimate (JSON-ready)."""
+        out = {"method": self.method, "status": self.status, "reason": self.reason,
+               "exponent": None if not np.isfinite(self.exponent) else self.exponent,
+               "stderr": None if not np.isfinite(self.stderr) else self.stderr,
+               "fit": list(self.fit) if self.fit else None}  # fmt: skip
+        out.update({k: (v.item() if isinstance(v, np.generic) else v)
+                    for k, v in self.params.items()})  # fmt: skip
+        return out
 
 
 def _prepare(x, dim, delay, theiler, dt):
@@ -70,13 +99,27 @@ def _prepare(x, dim, delay, theiler, dt):
         raise ValueError("signal contains NaN or inf")
     if np.ptp(x) == 0:
         raise ValueError("signal is constant")
-    delay = estimate_delay(x) if delay is None else int(delay)
-    theiler = int(round(mean_period(x))) if theiler is None else int(theiler)
-    theiler = min(theiler, x.size // 10)
-    dim = estimate_dimension(x, delay, max_dim=8, theiler=0) if dim is None else int(dim)
-    dim = max(dim, 2)
-    X = delay_embed(x, dim, delay)
-    return X, dict(dim=dim, delay=delay, theiler=theiler, dt=dt if dt else 1.0)
+    emb = choose_embedding(x, delay=delay, dim=dim, theiler=theiler)
+    dim = max(emb.dim, 2)
+    X = delay_embed(x, dim, emb.delay)
+    prm = dict(dim=dim, delay=emb.delay, theiler=emb.theiler, dt=dt if dt else 1.0,
+               embedding=emb.status, embedding_reason=emb.reason)  # fmt: skip
+    return X, prm
+
+
+def _gate(method, prm):
+    """The result when no embedding was found: flat for an exactly repeating record (it is
+    periodic), refused otherwise."""
+    if prm["embedding"] == "degenerate":
+        return SignalLyapunov(method, 0.0, np.arange(0), np.arange(0.0), None, prm, 0.0,
+                              status="flat", reason="the record repeats exactly")  # fmt: skip
+    return _refused(method, "embedding: " + prm["embedding_reason"], prm)
+
+
+def _refused(method, reason, prm, steps=None, curve=None):
+    return SignalLyapunov(method, float("nan"), np.arange(0) if steps is None else steps,
+                          np.arange(0.0) if curve is None else curve, None, prm,
+                          status="refused", reason=reason)  # fmt: skip
 
 
 def _nearest_valid(tree, X, theiler, limit, k0=8, d_min=0.0):
@@ -101,32 +144,48 @@ def _nearest_valid(tree, X, theiler, limit, k0=8, d_min=0.0):
     return res_j, res_d
 
 
-def _fit_linear(steps, curve, fit_range, flat_tol, fractions=(0.1, 0.7)):
-    s0 = curve[0]
-    smax = np.nanmax(curve)
-    if fit_range is None:
-        if smax - s0 < flat_tol:
-            return None
-        lo = int(np.argmax(curve >= s0 + fractions[0] * (smax - s0)))
-        hi = int(np.argmax(curve >= s0 + fractions[1] * (smax - s0)))
-        if hi - lo < 3:
-            lo, hi = 0, max(hi, 3)
-        fit_range = (lo, hi)
-    lo, hi = fit_range
-    return lo, min(hi, len(curve) - 1)
+def _fit_linear(curve, fit_range, fractions):
+    """The scaling region: from where the curve has risen by ``fractions[0]`` of its total rise
+    to where it has risen by ``fractions[1]``; ``None`` with the reason if it is too short."""
+    if fit_range is not None:
+        lo, hi = fit_range
+        return (int(lo), min(int(hi), len(curve) - 1)), ""
+    s0, smax = curve[0], np.nanmax(curve)
+    lo = int(np.argmax(curve >= s0 + fractions[0] * (smax - s0)))
+    hi = int(np.argmax(curve >= s0 + fractions[1] * (smax - s0)))
+    if hi - lo < MIN_FIT_POINTS - 1:
+        return None, (
+            f"no scaling region: the divergence curve rises from "
+            f"{100 * fractions[0]:.0f} % to {100 * fractions[1]:.0f} % of its total "
+            f"rise within {hi - lo} step(s) (at least {MIN_FIT_POINTS - 1} needed): "
+            "no exponential divergence resolved (noise, or too coarse sampling)"
+        )
+    return (lo, hi), ""
 
 
 def _divergence_result(method, steps, curve, fit_range, flat_tol, params, fractions=(0.1, 0.7)):
     dt = params["dt"]
+    if params.get("embedding") not in ("ok", None):
+        return _refused(method, "embedding: " + params["embedding_reason"], params, steps, curve)
     if not np.any(np.isfinite(curve)):  # no usable pairs: the record repeats exactly
         return SignalLyapunov(method, 0.0, steps, curve, None,
-                              params | {"flat": True, "note": "no non-degenerate neighbours"},
-                              0.0)  # fmt: skip
-    fr = _fit_linear(steps, curve, fit_range, flat_tol, fractions)
+                              params | {"note": "no non-degenerate neighbours"}, 0.0,
+                              status="flat", reason="the record repeats exactly")  # fmt: skip
+    rise = np.nanmax(curve) - curve[0]
+    if fit_range is None and rise < flat_tol:
+        return SignalLyapunov(method, 0.0, steps, curve, None, params, 0.0, status="flat",
+                              reason=f"divergence curve rises by {rise:.2f} < {flat_tol} "
+                              "(log units): no divergence")  # fmt: skip
+    fr, why = _fit_linear(curve, fit_range, fractions)
     if fr is None:
-        return SignalLyapunov(method, 0.0, steps, curve, None, params | {"flat": True}, 0.0)
+        return _refused(method, why, params, steps, curve)
     lo, hi = fr
     reg = linregress(steps[lo : hi + 1] * dt, curve[lo : hi + 1])
+    r2 = float(reg.rvalue**2)
+    params = params | {"fit_r2": r2, "fit_points": hi - lo + 1}
+    if fit_range is None and r2 < MIN_FIT_R2:
+        return _refused(method, f"no linear scaling region: R^2 = {r2:.3f} < {MIN_FIT_R2} over "
+                        f"steps {lo}..{hi}", params, steps, curve)  # fmt: skip
     return SignalLyapunov(method, float(reg.slope), steps, curve, (lo, hi), params,
                           float(reg.stderr))  # fmt: skip
 
@@ -137,6 +196,8 @@ def lyap_rosenstein(x, dt: float | None = None, *, dim: int | None = None,
                     flat_tol: float = 0.5) -> SignalLyapunov:  # fmt: skip
     """Rosenstein et al. (1993). ``max_steps`` defaults to 4 mean periods (>= 20 samples)."""
     X, prm = _prepare(x, dim, delay, theiler, dt)
+    if prm["embedding"] != "ok":
+        return _gate("rosenstein", prm)
     n = X.shape[0]
     K = max_steps or int(max(20, 4 * prm["theiler"]))
     K = min(K, n // 4)
@@ -161,45 +222,72 @@ def lyap_kantz(x, dt: float | None = None, *, dim: int | None = None, delay: int
                theiler: int | None = None, eps: float | None = None,
                max_steps: int | None = None, max_points: int = 2000, fit_range=None,
                flat_tol: float = 0.5, seed: int = 0) -> SignalLyapunov:  # fmt: skip
-    """Kantz (1994). ``eps`` defaults to 0.5 % of the attractor's diameter; at most
-    ``max_points`` reference points (seeded random choice) are averaged. The automatic fit
-    skips the initial fast rise (neighbours not yet aligned with the unstable direction): it
-    uses the part of the curve between 35 % and 80 % of its total rise."""
+    """Kantz (1994). At most ``max_points`` reference points (seeded random choice) are
+    averaged. ``eps`` defaults to the smallest of 0.1, 0.2, 0.5, 1, 2, 4, 8 % of the attractor's
+    diameter at which half the references have at least 3 neighbours (outside the Theiler
+    window); if even 8 % does not, or fewer than ``MIN_REFERENCES`` references have any
+    neighbour, the estimate is refused (too few samples for the embedding dimension). The
+    automatic fit skips the initial fast rise (neighbours not yet aligned with the unstable
+    direction): it uses the part of the curve between 35 % and 80 % of its total rise."""
     X, prm = _prepare(x, dim, delay, theiler, dt)
+    if prm["embedding"] != "ok":
+        return _gate("kantz", prm)
     n = X.shape[0]
     K = max_steps or int(max(20, 4 * prm["theiler"]))
     K = min(K, n // 4)
     limit = n - K
     diam = np.linalg.norm(np.ptp(X, axis=0))
-    eps = 0.005 * diam if eps is None else float(eps)
+    d_min = 1e-8 * diam  # exact repeats carry no information (and would give log 0)
     tree = cKDTree(X[:limit])
     rng = np.random.default_rng(seed)
     refs = rng.choice(limit, size=min(max_points, limit), replace=False)
+
+    def neighbours(i, r):
+        nb = np.array(tree.query_ball_point(X[i], r), dtype=int)
+        nb = nb[np.abs(nb - i) > prm["theiler"]]
+        return nb[np.linalg.norm(X[nb] - X[i], axis=1) > d_min]
+
+    if eps is None:
+        probe = refs[:200]
+        for frac in (0.001, 0.002, 0.005, 0.01, 0.02, 0.04, 0.08):
+            counts = np.array([neighbours(i, frac * diam).size for i in probe])
+            if np.median(counts) >= 3:
+                break
+        eps = frac * diam
+        prm["eps_fraction_of_diameter"] = frac
+    eps = float(eps)
     sums = np.zeros(K + 1)
     count = 0
-    found_any = False
-    d_min = 1e-8 * diam  # exact repeats carry no information (and would give log 0)
+    n_neighbours = []
+    ks = np.arange(K + 1)
     for i in refs:
-        nb_idx = np.array(tree.query_ball_point(X[i], eps), dtype=int)
-        nb_idx = nb_idx[np.abs(nb_idx - i) > prm["theiler"]]
-        found_any |= nb_idx.size > 0
-        nb_idx = nb_idx[np.linalg.norm(X[nb_idx] - X[i], axis=1) > d_min]
+        nb_idx = neighbours(i, eps)
         if nb_idx.size == 0:
             continue
-        ks = np.arange(K + 1)
         dist = np.linalg.norm(X[i + ks][None, :, :] - X[nb_idx[:, None] + ks[None, :]], axis=2)
         m = dist.mean(axis=0)
         if np.any(m <= 0):
             continue
         sums += np.log(m)
         count += 1
-    if count == 0 and not found_any:
-        raise ValueError(f"no neighbours within eps = {eps:g}; increase eps")
-    if count == 0:
-        sums[:] = np.nan
-        count = 1
-    prm.update(eps=eps, max_steps=K, references=count)
-    return _divergence_result("kantz", np.arange(K + 1), sums / count, fit_range, flat_tol, prm,
+        n_neighbours.append(nb_idx.size)
+    prm.update(
+        eps=eps,
+        max_steps=K,
+        references=count,
+        references_tried=int(refs.size),
+        median_neighbours=float(np.median(n_neighbours)) if n_neighbours else 0.0,
+    )
+    curve = sums / count if count else np.full(K + 1, np.nan)
+    if count < MIN_REFERENCES:
+        return _refused("kantz", f"only {count} of {refs.size} reference points have a neighbour "
+                        f"within eps = {eps:.3g} ({count} < {MIN_REFERENCES}): too few samples "
+                        f"for dimension {prm['dim']}", prm, ks, curve)  # fmt: skip
+    if prm.get("median_neighbours", 0) < 3 and "eps_fraction_of_diameter" in prm:
+        return _refused("kantz", f"median {prm['median_neighbours']:.0f} neighbour(s) within "
+                        f"8 % of the attractor's diameter: too few samples for dimension "
+                        f"{prm['dim']}", prm, ks, curve)  # fmt: skip
+    return _divergence_result("kantz", ks, curve, fit_range, flat_tol, prm,
                               fractions=(0.35, 0.8))  # fmt: skip
 
 
@@ -219,6 +307,8 @@ def lyap_wolf(x, dt: float | None = None, *, dim: int | None = None, delay: int 
         candidate qualifies the closest one in angle is taken anyway and counted.
     """
     X, prm = _prepare(x, dim, delay, theiler, dt)
+    if prm["embedding"] != "ok":
+        return _gate("wolf", prm)
     n = X.shape[0]
     evolve = max(1, prm["delay"] if evolve is None else int(evolve))
     diam = np.linalg.norm(np.ptp(X, axis=0))
@@ -238,7 +328,8 @@ def lyap_wolf(x, dt: float | None = None, *, dim: int | None = None, delay: int 
     i = 0
     js, ds = candidates(i)
     if js.size == 0:
-        raise ValueError("no valid neighbour for the first point; adjust theiler/scale_min")
+        return _refused("wolf", "no neighbour of the first point outside the Theiler window and "
+                        "above scale_min", prm)  # fmt: skip
     j = int(js[0])
     total = 0.0
     steps_done = 0
@@ -282,4 +373,12 @@ def lyap_wolf(x, dt: float | None = None, *, dim: int | None = None, delay: int 
                replacements=replacements, replacements_over_max_angle=bad_angles,
                evolutions=steps_done)  # fmt: skip
     steps = (np.arange(len(running)) + 1) * evolve
-    return SignalLyapunov("wolf", float(lam), steps, np.array(running), None, prm)
+    running = np.array(running)
+    if steps_done < MIN_EVOLUTIONS or not np.isfinite(lam):
+        return _refused("wolf", f"{steps_done} evolution(s) before the neighbours ran out "
+                        f"(at least {MIN_EVOLUTIONS} needed)", prm, steps, running)  # fmt: skip
+    if replacements and bad_angles > 0.5 * replacements:
+        return _refused("wolf", f"{bad_angles} of {replacements} replacements exceed the angle "
+                        f"limit {max_angle} rad: the separation's direction is not kept (too few "
+                        "samples for the embedding)", prm, steps, running)  # fmt: skip
+    return SignalLyapunov("wolf", float(lam), steps, running, None, prm)

@@ -1,0 +1,188 @@
+"""Read a measured signal: one channel and its sampling rate from CSV, WAV, MAT, NetCDF,
+Parquet or NumPy files (``recipdyn analyze`` on data from elsewhere).
+
+Every failure is a :class:`~recipdyn.model.parameters.ParameterError` that names the file,
+the option and what is allowed (the columns the file has, the rates it implies).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .model.parameters import ParameterError
+from .units import to_si
+
+__all__ = ["MeasuredSignal", "read_signal", "SIGNAL_SUFFIXES"]
+
+SIGNAL_SUFFIXES = (".csv", ".txt", ".tsv", ".wav", ".mat", ".nc", ".parquet", ".npy")
+TIME_NAMES = ("time", "t", "time_s", "time (s)", "t (s)", "seconds")
+FS_NAMES = ("fs", "Fs", "FS", "sampling_rate", "sample_rate", "sr", "SampleRate")
+
+
+@dataclass
+class MeasuredSignal:
+    """One uniformly sampled channel: values, sampling rate (Hz), and where they came from."""
+
+    x: np.ndarray
+    fs: float
+    name: str
+    source: str
+    units: str = ""
+    notes: list[str] = field(default_factory=list)
+
+
+def _fs_option(fs) -> float | None:
+    if fs is None:
+        return None
+    out = to_si("fs", fs, "Hz")
+    if not out > 0:
+        raise ParameterError(f"fs: {fs!r}; allowed: a positive sampling rate (e.g. 10kHz)")
+    return out
+
+
+def _fs_from_time(t, path, name) -> float:
+    t = np.asarray(t, dtype=float)
+    dt = np.diff(t)
+    if t.size < 2 or not np.all(dt > 0):
+        raise ParameterError(f"{path}: time column {name!r} must increase")
+    if np.ptp(dt) > 1e-3 * np.median(dt):
+        raise ParameterError(f"{path}: time column {name!r} is not uniformly sampled (steps "
+                             f"{dt.min():.3g} to {dt.max():.3g} s); resample first")  # fmt: skip
+    return 1.0 / float(np.median(dt))
+
+
+def _pick(names, column, path, kind="column"):
+    """The chosen column name among ``names`` (by name or index)."""
+    names = list(names)
+    if column is None:
+        if len(names) == 1:
+            return names[0]
+        raise ParameterError(f"{path}: {len(names)} {kind}s ({', '.join(map(str, names))}); "
+                             f"choose one with --column")  # fmt: skip
+    if str(column) in map(str, names):
+        return names[[str(n) for n in names].index(str(column))]
+    try:
+        i = int(column)
+    except (TypeError, ValueError):
+        i = None
+    if i is not None and 0 <= i < len(names):
+        return names[i]
+    allowed = ", ".join(map(str, names))
+    raise ParameterError(f"column: {column!r} not in {path}; allowed: {allowed} or an index "
+                         f"0..{len(names) - 1}")  # fmt: skip
+
+
+def _table(frame, path, column, fs):
+    """A pandas table: a time column gives the rate, the chosen numeric column the values."""
+    cols = [c for c in frame.columns if np.issubdtype(frame[c].dtype, np.number)]
+    tcol = next((c for c in cols if str(c).strip().lower() in TIME_NAMES), None)
+    data = [c for c in cols if c != tcol]
+    if not data:
+        raise ParameterError(f"{path}: cannot be read as a signal: no numeric column besides "
+                             f"time (columns: {', '.join(map(str, frame.columns))})")  # fmt: skip
+    name = _pick(data, column, path)
+    notes = []
+    if fs is None:
+        if tcol is None:
+            raise ParameterError(f"{path}: no time column ({', '.join(TIME_NAMES[:3])}); give "
+                                 "the sampling rate with --fs (e.g. --fs 10kHz)")  # fmt: skip
+        fs = _fs_from_time(frame[tcol].to_numpy(), path, tcol)
+        notes.append(f"sampling rate {fs:.6g} Hz from column {tcol!r}")
+    return frame[name].to_numpy(dtype=float), fs, str(name), notes
+
+
+def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
+    """Read one channel of ``path``.
+
+    ``column``: column name or index (CSV, Parquet), variable name (MAT, NetCDF), channel
+    index (WAV). ``fs``: sampling rate (number in Hz or text with units); needed unless the
+    file gives it (a time column, the WAV header, an ``fs`` variable in a MAT file, the time
+    coordinate of a NetCDF variable); a given ``fs`` overrides the file's."""
+    path = Path(path)
+    if not path.exists():
+        raise ParameterError(f"input {path}: file not found")
+    if path.is_dir():
+        raise ParameterError(f"input {path}: is a folder; expected a signal file "
+                             f"({', '.join(SIGNAL_SUFFIXES)})")  # fmt: skip
+    if path.stat().st_size == 0:
+        raise ParameterError(f"input {path}: file is empty")
+    suffix = path.suffix.lower()
+    if suffix not in SIGNAL_SUFFIXES:
+        raise ParameterError(f"input {path}: unknown format {suffix!r}; allowed: "
+                             f"{', '.join(SIGNAL_SUFFIXES)}")  # fmt: skip
+    fs = _fs_option(fs)
+    notes: list[str] = []
+    units = ""
+    try:
+        if suffix in (".csv", ".txt", ".tsv"):
+            import pandas as pd
+
+            sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+            frame = pd.read_csv(path, sep=sep, engine="python", comment="#")
+            x, fs, name, notes = _table(frame, path, column, fs)
+        elif suffix == ".parquet":
+            import pandas as pd
+
+            x, fs, name, notes = _table(pd.read_parquet(path), path, column, fs)
+        elif suffix == ".wav":
+            from scipy.io import wavfile
+
+            rate, data = wavfile.read(path)
+            data = data.reshape(len(data), -1)
+            ch = _pick(list(range(data.shape[1])), 0 if column is None else column, path,
+                       "channel")  # fmt: skip
+            x, name = data[:, ch].astype(float), f"channel {ch}"
+            if np.issubdtype(data.dtype, np.integer):
+                notes.append(f"integer samples ({data.dtype}), not scaled to physical units")
+            if fs is None:
+                fs = float(rate)
+                notes.append(f"sampling rate {fs:g} Hz from the WAV header")
+        elif suffix == ".mat":
+            from scipy.io import loadmat
+
+            mat = loadmat(path, squeeze_me=True)
+            fs_var = next((k for k in FS_NAMES if k in mat and np.size(mat[k]) == 1), None)
+            arrays = [k for k, v in mat.items() if not k.startswith("__")
+                      and isinstance(v, np.ndarray) and v.ndim == 1 and v.size > 1
+                      and np.issubdtype(v.dtype, np.number)]  # fmt: skip
+            tvar = next((k for k in arrays if k.lower() in TIME_NAMES), None)
+            name = _pick([k for k in arrays if k != tvar], column, path, "variable")
+            x = np.asarray(mat[name], dtype=float)
+            if fs is None and fs_var is not None:
+                fs = float(mat[fs_var])
+                notes.append(f"sampling rate {fs:g} Hz from variable {fs_var!r}")
+            elif fs is None and tvar is not None:
+                fs = _fs_from_time(mat[tvar], path, tvar)
+                notes.append(f"sampling rate {fs:.6g} Hz from variable {tvar!r}")
+        elif suffix == ".nc":
+            from .io import read_dataset
+
+            ds = read_dataset(path, expected="a NetCDF file with a 1-D signal")
+            names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
+            name = _pick(names, column, path, "variable")
+            da = ds[name]
+            x, units = np.asarray(da.values, dtype=float), str(da.attrs.get("units", ""))
+            if fs is None and da.dims[0] in ds.coords:
+                fs = _fs_from_time(ds[da.dims[0]].values, path, da.dims[0])
+                notes.append(f"sampling rate {fs:.6g} Hz from coordinate {da.dims[0]!r}")
+        else:  # .npy: a plain array, one channel per column
+            data = np.load(path, allow_pickle=False)
+            data = data.reshape(len(data), -1)
+            ch = _pick(list(range(data.shape[1])), 0 if data.shape[1] == 1 else column, path)
+            x, name = data[:, ch].astype(float), f"column {ch}"
+    except ParameterError:
+        raise
+    except Exception as exc:  # parsers raise assorted errors on malformed files
+        raise ParameterError(f"input {path}: cannot be read as {suffix[1:].upper()} "
+                             f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+    if fs is None:
+        raise ParameterError(f"{path}: the file does not give a sampling rate; pass --fs "
+                             "(e.g. --fs 10kHz)")  # fmt: skip
+    bad = ~np.isfinite(x)
+    if bad.any():
+        raise ParameterError(f"{path}: column {name!r} has {int(bad.sum())} missing or "
+                             "non-finite value(s); fill or cut them first")  # fmt: skip
+    return MeasuredSignal(x, float(fs), str(name), path.name, units, notes)

@@ -1,0 +1,227 @@
+"""Chaos estimates from signals that say when they fail (issue 12): embedding, exponents with
+statuses, the FFT 0-1 test, IAAFT surrogates and the combined verdict, on systems with
+published exponents that the other tests do not use, on noise and on regular signals."""
+
+import numpy as np
+import pytest
+
+from recipdyn.analysis import lyapunov_spectrum, lyapunov_spectrum_map
+from recipdyn.analysis.embedding import choose_embedding
+from recipdyn.analysis.signal import assess_signal
+from recipdyn.analysis.surrogates import iaaft, match_ends, surrogate_test
+from recipdyn.analysis.zero_one import zero_one, zero_one_test
+from recipdyn.integrate import integrate
+from recipdyn.model.reference import systems as S
+
+N = 20_000
+
+# Published largest exponents (Sprott, Chaos and Time-Series Analysis, 2003, App. A; the
+# logistic map's is ln 2 exactly). Per iteration for maps, per time unit for flows.
+MAPS = {
+    "logistic": (S.logistic_map, [0.3], np.log(2.0)),
+    "ikeda": (S.ikeda_map, [0.1, 0.1], 0.5076),
+    "lozi": (S.lozi_map, [0.1, 0.1], 0.4702),
+}
+FLOWS = {  # system, start, sampling step, published lambda1
+    "rossler": (S.rossler, [1.0, 1.0, 1.0], 0.1, 0.0714),
+    "rossler-hyper": (S.rossler_hyper, [-10.0, -6.0, 0.0, 10.0], 0.1, 0.1120),
+    "ueda": (S.ueda, [2.5, 0.0], 2 * np.pi / 40, 0.1034),
+}
+
+_cache: dict = {}
+
+
+def signal(name):
+    """(x, dt, lambda1) of a named test signal, generated once per session."""
+    if name in _cache:
+        return _cache[name]
+    rng = np.random.default_rng(1)
+    if name in MAPS:
+        make, x0, lam = MAPS[name]
+        out = (S.iterate(make(), x0, N, 1000)[:, 0], 1.0, lam)
+    elif name in FLOWS:
+        make, y0, dt, lam = FLOWS[name]
+        t = 100.0 + np.arange(N) * dt
+        sol = integrate(make(), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-10)
+        out = (sol.y[:, 0], dt, lam)
+    elif name == "lorenz96":
+        y0 = np.r_[8.01, np.full(9, 8.0)]
+        t = 100.0 + np.arange(N) * 0.05
+        sol = integrate(S.lorenz96(10), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-10)
+        out = (sol.y[:, 0], 0.05, 1.178)
+    elif name == "white":
+        out = (rng.standard_normal(N), 1.0, 0.0)
+    elif name == "ar1":
+        e = rng.standard_normal(N)
+        x = np.empty(N)
+        x[0] = 0.0
+        for i in range(1, N):
+            x[i] = 0.95 * x[i - 1] + e[i]
+        out = (x, 1.0, 0.0)
+    else:
+        t = np.arange(N)
+        x = np.sin(2 * np.pi * 0.013 * t)
+        if name == "quasi":
+            x = x + 0.6 * np.sin(2 * np.pi * 0.013 * np.sqrt(2) * t)
+        elif name == "noisy-sine":
+            x = x + 0.2 * rng.standard_normal(N)
+        out = (x, 1.0, 0.0)
+    _cache[name] = out
+    return out
+
+
+def assessed(name, stride=1):
+    key = ("assessed", name, stride)
+    if key not in _cache:
+        x, dt, _ = signal(name)
+        _cache[key] = assess_signal(x[::stride], 1.0 / (dt * stride))
+    return _cache[key]
+
+
+def test_published_exponents_hold_for_the_equations():
+    """The reference values the estimators are judged against, recomputed from the equations
+    (QR over 2e5 iterations: standard error ~1e-3; Benettin over 5000 time units): within
+    2 % of the published numbers, so the table below tests the estimators, not the
+    references."""
+    for make, x0, lam in MAPS.values():
+        r = lyapunov_spectrum_map(make(), x0, 200_000)
+        assert r.exponents[0] == pytest.approx(lam, rel=0.02)
+    r = lyapunov_spectrum(S.rossler_hyper(), [-10, -6, 0, 10], 5000.0, t_transient=200.0)
+    assert r.exponents[0] == pytest.approx(0.1120, rel=0.03)
+    # the second positive exponent (hyperchaos; published 0.019) converges slowly: 0.0247
+    # after 5000 time units, 0.0206 after 20000 on this machine
+    assert 0.012 < r.exponents[1] < 0.032
+
+
+CHAOTIC = [*MAPS, *FLOWS]
+
+
+@pytest.mark.parametrize("name", CHAOTIC)
+def test_chaotic_signals_within_25_percent_or_refused(name):
+    """Every estimator either refuses with a reason or is usable; the median of the usable
+    ones is within 20 % of the published lambda1 and each within 30 %, and at least two
+    of the three are usable. Measured on this machine: worst single estimate -24 % (Kantz on
+    Rossler, eight trajectories; a straight divergence curve of slope 0.8 lambda1, a bias of
+    the method on this slowly rotating flow), worst median -15 %; a chaotic trajectory differs
+    between CPUs after ~500 time units, so the bounds leave room for that spread. Verdict:
+    chaotic, with determinism shown by the surrogates."""
+    a = assessed(name)
+    _, _, lam = signal(name)
+    usable = [r for r in a.lyapunov.values() if r.ok]
+    for r in a.lyapunov.values():
+        assert r.ok or (r.status == "refused" and r.reason and np.isnan(r.exponent))
+    assert len(usable) >= 2, {k: r.reason for k, r in a.lyapunov.items()}
+    vals = np.array([r.exponent for r in usable])
+    assert np.median(vals) == pytest.approx(lam, rel=0.20)
+    assert np.all(np.abs(vals / lam - 1) < 0.30), vals
+    assert a.surrogates.nonlinear
+    assert a.verdict.verdict == "chaotic", a.verdict.reasons
+
+
+def test_high_dimensional_flow_is_refused_not_misestimated():
+    """Lorenz-96 with 10 sites (lambda1 = 1.18, Kaplan-Yorke dimension ~6.5): 2e4 samples do
+    not embed it, so every estimator refuses and says so (the earlier code returned +466 %
+    from Rosenstein and a ValueError from Kantz); the verdict still says chaotic from the
+    0-1 test and the surrogates, with the reason."""
+    a = assessed("lorenz96")
+    assert a.embedding.status == "not_saturated"
+    for r in a.lyapunov.values():
+        assert r.status == "refused" and "embedding" in r.reason
+    assert a.verdict.verdict == "chaotic"
+    assert any("no exponent could be estimated" in s for s in a.verdict.reasons)
+
+
+@pytest.mark.parametrize("name", ["white", "ar1", "noisy-sine"])
+def test_noise_is_never_chaotic(name):
+    """White noise, AR(1) noise (phi = 0.95) and a sine with 20 % noise: the surrogates do not
+    reject linear noise, no estimator returns a positive exponent as usable, the verdict is
+    'stochastic' (the 0-1 test alone says K ~ 1 for noise, which is why it is not enough)."""
+    a = assessed(name)
+    assert not a.surrogates.nonlinear
+    assert not any(r.ok and r.exponent > 0.01 for r in a.lyapunov.values())
+    assert a.verdict.verdict == "stochastic", a.verdict.reasons
+
+
+@pytest.mark.parametrize("name, verdict", [("sine", "periodic"), ("quasi", "quasi-periodic")])
+def test_regular_signals(name, verdict):
+    """A sine and a two-tone incommensurate signal: exponents flat (|lambda1| at the level of
+    the estimators' resolution, below 1e-3 per sample), K ~ 0, the right verdict."""
+    a = assessed(name)
+    usable = [r for r in a.lyapunov.values() if r.ok]
+    assert usable and all(abs(r.exponent) < 1e-3 for r in usable)
+    assert abs(a.zero_one.K) < 0.1
+    assert a.verdict.verdict == verdict, a.verdict.reasons
+
+
+@pytest.mark.parametrize("name", ["rossler", "ueda", "sine", "quasi", "white"])
+def test_same_verdict_at_two_sampling_rates(name):
+    """Half the sampling rate, same verdict (the 0-1 test thins to one sample per
+    decorrelation time, the estimators work in time units)."""
+    assert assessed(name).verdict.verdict == assessed(name, 2).verdict.verdict
+
+
+def test_zero_one_fft_equals_the_direct_sums():
+    """The O(N log N) mean-square displacement equals the textbook O(N n_cut) sums: K of the
+    two agree to 1e-9 (only summation order differs)."""
+    rng = np.random.default_rng(3)
+    phi = np.cumsum(rng.standard_normal(3000)) * 0.01 + np.sin(0.3 * np.arange(3000))
+    K, ks = zero_one_test(phi, n_c=10, return_all=True)
+    cs = np.random.default_rng(0).uniform(np.pi / 5, 4 * np.pi / 5, 10)
+    j = np.arange(1, phi.size + 1)
+    ns = np.arange(1, phi.size // 10 + 1)
+    for c, k in zip(cs, ks, strict=True):
+        p, q = np.cumsum(phi * np.cos(j * c)), np.cumsum(phi * np.sin(j * c))
+        M = np.array([np.mean((p[n:] - p[:-n]) ** 2 + (q[n:] - q[:-n]) ** 2) for n in ns])
+        D = M - phi.mean() ** 2 * (1 - np.cos(ns * c)) / (1 - np.cos(c))
+        assert k == pytest.approx(np.corrcoef(ns, D)[0, 1], abs=1e-9)
+
+
+def test_zero_one_refuses_a_record_too_short_after_thinning():
+    x = np.sin(0.01 * np.arange(5000))  # decorrelation ~150 samples: ~30 values left
+    r = zero_one(x)
+    assert r.status == "refused" and np.isnan(r.K) and "at least" in r.reason
+
+
+def test_iaaft_keeps_values_and_spectrum():
+    """Each surrogate is a rearrangement of the data (identical sorted values) with Fourier
+    amplitudes within 2 % (relative L2) of the data's, and differs from the data."""
+    x, _, _ = signal("rossler")
+    x = x[:4096]
+    amp = np.abs(np.fft.rfft(x))
+    for s in iaaft(x, 5, seed=2):
+        assert np.array_equal(np.sort(s), np.sort(x))
+        assert np.linalg.norm(np.abs(np.fft.rfft(s)) - amp) / np.linalg.norm(amp) < 0.02
+        assert not np.allclose(s, x)
+
+
+def test_end_matching_finds_the_periodic_cut():
+    """A sine of period 100 samples, started off-phase: the chosen sub-record's ends agree to
+    within one sample's change in value and slope."""
+    x = np.sin(2 * np.pi * (np.arange(1037) + 13) / 100.0)
+    a, b = match_ends(x)
+    assert abs(x[a] - x[b - 1]) < 2 * np.pi / 100 and b - a > 0.8 * x.size
+    assert abs((x[a + 1] - x[a]) - (x[b - 1] - x[b - 2])) < 2e-3
+
+
+def test_surrogate_test_rejects_determinism_only():
+    """Henon's map is told apart from its surrogates by a wide margin (z > 10); its IAAFT
+    surrogates themselves are not (a surrogate tested as data: null hypothesis true)."""
+    x = S.iterate(S.henon(), [0.1, 0.1], 8000, 1000)[:, 0]
+    r = surrogate_test(x, dim=2, delay=1)
+    assert r.nonlinear and r.z > 10 and r.rank == 0
+    s = iaaft(x, 1, seed=7)[0]
+    assert not surrogate_test(s, dim=2, delay=1, seed=1).nonlinear
+
+
+def test_embedding_choice():
+    """Cao's E1: dimension 2 for the logistic map (delay 1: a map), 3 for Lorenz; white noise
+    does not saturate up to 10 and is flagged."""
+    x, _, _ = signal("logistic")
+    e = choose_embedding(x)
+    assert (e.delay, e.dim, e.status) == (1, 2, "ok")
+    sol = integrate(S.lorenz(), [1, 1, 1], (0, 150), t_eval=50 + np.arange(10000) * 0.01,
+                    rtol=1e-10, atol=1e-10)  # fmt: skip
+    e = choose_embedding(sol.y[:, 0])
+    assert e.dim == 3 and 8 <= e.delay <= 25 and e.status == "ok"
+    e = choose_embedding(signal("white")[0])
+    assert e.status == "not_saturated" and e.delay == 1
