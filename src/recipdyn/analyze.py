@@ -111,6 +111,13 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     save_figure(fig, out / "phase_portraits.png", dpi=110)
     plt.close(fig)
 
+    if compressor and fc:
+        from .analysis.vibration import crank_angle
+
+        revs = crank_angle(a.size, fs, speed_hz=fc, zero_rev=float(t[0]) * fc)
+        summary["vibration"] = vibration_section(
+            a, fs, out, plt, revs=revs, title=f"{path.name}: crosshead acceleration"
+        )
     assessment = assess_signal(a, fs, max_samples=max_signal_samples)
     summary["lyapunov_signal"] = {k: _plain(r.diagnostics())
                                   for k, r in assessment.lyapunov.items()}  # fmt: skip
@@ -146,13 +153,14 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         if p.rc > 0:
             res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
                                     rtol=rtol, atol=atol)  # fmt: skip
-            lam = float(res.exponents[0])
-            lam_err = _spread(res)
+            lam, lam_err = res.largest_limit()
             summary["lyapunov_equations"] = {
+                "lambda1_limit_per_s": lam,
+                "lambda1_limit_error": lam_err,
                 "exponents_per_s": res.exponents.tolist(),
                 "exponents_per_revolution": res.per_period.tolist(),
                 "sum_per_s": res.sum,
-                "spread_second_half": lam_err,
+                "spread_second_half": _spread(res),
                 "revolutions": lyap_revolutions,
             }
             fig = plot_lyapunov_history(res)
@@ -180,8 +188,44 @@ def _divergence_figures(assessment, out, plt) -> None:
             plt.close(fig)
 
 
+def parse_zones(text: str | None):
+    """'2.3,4.5,7.1 mm/s' -> the three boundaries in m/s (a bare number is m/s)."""
+    if not text:
+        return None
+    from .units import to_si
+
+    body, _, unit = text.strip().partition(" ")
+    parts = [p for p in body.split(",") if p.strip()]
+    if len(parts) != 3:
+        raise ParameterError(f"zones: {text!r}; allowed: three boundaries A/B, B/C, C/D, e.g. "
+                             "'2.3,4.5,7.1 mm/s' (from your copy of ISO 20816-8)")  # fmt: skip
+    vals = [to_si("zones", f"{p} {unit}".strip(), "m/s") for p in parts]
+    if not vals[0] < vals[1] < vals[2] or vals[0] <= 0:
+        raise ParameterError(f"zones: {text!r}; allowed: three increasing positive values")
+    return vals
+
+
+def vibration_section(x, fs, out, plt, *, revs=None, quantity="acceleration", zones=None,
+                      band=None, title="") -> dict[str, Any]:  # fmt: skip
+    """The vibration toolkit on one signal: ``vibration.png`` and the summary's section."""
+    from .analysis.plots import plot_vibration
+    from .analysis.vibration import vibration_report
+
+    try:
+        rep = vibration_report(x, fs, revs=revs, quantity=quantity, zones=zones, band=band)
+    except ValueError as exc:
+        raise ParameterError(f"vibration analysis: {exc}") from None
+    unit = {"acceleration": "(m/s$^2$)", "velocity": "(m/s)"}.get(quantity, "")
+    fig = plot_vibration(rep, title=title, unit=unit)
+    save_figure(fig, out / "vibration.png", dpi=100)
+    plt.close(fig)
+    return _plain(rep["summary"])
+
+
 def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
-                   max_signal_samples: int = 40_000) -> dict[str, Any]:  # fmt: skip
+                   max_signal_samples: int = 40_000, tacho=None, speed=None,
+                   quantity: str = "acceleration", zones=None,
+                   band=None) -> dict[str, Any]:  # fmt: skip
     """Analyse one channel of a measured (or any) signal file into folder ``out``: the signal,
     its spectrum, the exponents from the signal with their statuses, the 0-1 test, the
     surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``)."""
@@ -217,7 +261,27 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     fig = plot_spectrum(spec, peaks, title=f"spectrum of {sig.name}")
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
-    a = assess(x, rate, max_samples=max_signal_samples)
+    revs = None
+    if tacho is not None:
+        from .analysis.vibration import crank_angle, tacho_times
+
+        pulse = read_signal(path, column=tacho, fs=rate)
+        try:
+            revs = crank_angle(x.size, rate, pulses=tacho_times(pulse.x, rate))
+        except ValueError as exc:
+            raise ParameterError(f"tacho {tacho!r}: {exc}") from None
+    elif speed is not None:
+        from .analysis.vibration import crank_angle
+        from .units import to_si
+
+        f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
+        if not f_rev > 0:
+            raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
+        revs = crank_angle(x.size, rate, speed_hz=f_rev)
+    vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
+                            zones=parse_zones(zones), band=band,
+                            title=f"{sig.source}: {sig.name}")  # fmt: skip
+    a = assess(x, rate, max_samples=max_signal_samples, revs=revs)
     _divergence_figures(a, out, plt)
     summary: dict[str, Any] = {
         "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(x.size),
@@ -227,7 +291,7 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
                                     crank_order=p.order) for p in peaks]},
         "lyapunov_signal": {k: r.diagnostics() for k, r in a.lyapunov.items()},
         "signal_assessment": a.to_dict(), "verdict": a.verdict.to_dict(),
-        "evidence": [list(r) for r in a.evidence_table()],
+        "evidence": [list(r) for r in a.evidence_table()], "vibration": vib,
     }  # fmt: skip
     summary = _plain(summary)
     write_text(out / "summary.json", json.dumps(summary, indent=2))
@@ -313,11 +377,11 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
                                 rtol=rtol, atol=atol)  # fmt: skip
         unit = f"per {m.time_unit}"
-    lam = float(res.exponents[0])
-    lam_err = _spread(res)
+    lam, lam_err = res.largest_limit()
     summary["lyapunov_equations"] = {
+        "lambda1_limit": lam, "lambda1_limit_error": lam_err,
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
-        "spread_second_half": lam_err, "revolutions": lyap_revolutions,
+        "spread_second_half": _spread(res), "revolutions": lyap_revolutions,
     }  # fmt: skip
     fig = plot_lyapunov_history(res)
     save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
@@ -345,6 +409,17 @@ def _markdown(s: dict[str, Any]) -> str:
              "| f (Hz) | amplitude (m/s^2) | crank order |", "|---|---|---|"]  # fmt: skip
     for p in s["spectrum"]["peaks"]:
         lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} | {p['crank_order']} |")
+    vib = s.get("vibration")
+    if vib:
+        lines += ["", "## Vibration", ""]
+        lines += [f"- {k}: {v:.4g}" for k, v in vib["indicators"].items()]
+        if "velocity_rms_2_1000hz" in vib:
+            z = f" (zone {vib['zone']})" if "zone" in vib else ""
+            lines.append(f"- velocity RMS, 2-1000 Hz (ISO 20816-8 band): "
+                         f"{vib['velocity_rms_2_1000hz']:.4g} m/s{z}")  # fmt: skip
+        imp = vib["impacts"]
+        per = f", {imp['per_revolution']:.3g} per revolution" if imp["per_revolution"] else ""
+        lines.append(f"- impacts: {imp['count']}{per}")
     if s.get("evidence"):
         lines += ["", "## Evidence", "", "| evidence | value | status |", "|---|---|---|"]
         lines += [f"| {a} | {b} | {c} |" for a, b, c in s["evidence"]]

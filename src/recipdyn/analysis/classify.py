@@ -24,7 +24,8 @@ For a measured signal (no equations) two more pieces enter:
   usable status count (refusals are listed, never read as 0). They stand in for ``lambda1``
   when no equation-based exponent is given: positive when most usable estimates exceed
   ``signal_tol / time_scale`` (``time_scale``: the embedding delay, about one decorrelation
-  time, in the exponents' time unit) and twice their fit error; flat when none does. A
+  time, in the exponents' time unit) and twice their fit error; flat when most do not
+  (the dissenting estimator is named); undetermined on a tie. A
   deterministic signal whose estimators all refused is **chaotic** only with K > 0.8.
 """
 
@@ -92,23 +93,28 @@ def _signal_exponent(estimates, time_scale, tol, ev, reasons):
         reasons.append(f"{len(pos)} of {len(usable)} signal estimates positive "
                        f"(median {lam:.4g} > {lim:.3g})")  # fmt: skip
         return lam, 0.0, False
-    if pos:
+    if pos and len(pos) * 2 == len(usable):  # a tie
         reasons.append(f"signal estimates disagree: {len(pos)} of {len(usable)} positive")
         ev["signal_estimates_conflict"] = True
         return None, 0.0, False
+    if pos:
+        names = ", ".join(e.method for e in pos)
+        reasons.append(f"{len(usable) - len(pos)} of {len(usable)} signal estimates show no "
+                       f"divergence ({names} dissents)")  # fmt: skip
     return 0.0, 0.0, False
 
 
 def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: float | None = None,
              section=None, spectrum: Spectrum | None = None, lyap_tol: float = LYAP_TOL,
              max_periodic_points: int = MAX_PERIODIC_POINTS, determinism=None,
-             signal_lyapunov=None, time_scale: float = 1.0,
-             signal_tol: float = LYAP_TOL) -> Verdict:  # fmt: skip
+             signal_lyapunov=None, time_scale: float = 1.0, signal_tol: float = LYAP_TOL,
+             section_rtol: float = 1e-6) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
     :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
     (``signal_lyapunov``: :class:`~recipdyn.analysis.lyapunov_signal.SignalLyapunov` list).
-    ``lyap_tol`` is in the exponent's units."""
+    ``lyap_tol`` is in the exponent's units; ``section_rtol`` the relative distance under
+    which section points are one (1e-6 for an integration; larger for measured signals)."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
     deterministic = None
@@ -126,6 +132,19 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
         if lambda1 is None and lam_s is not None:
             lambda1, lambda1_err = lam_s, 0.0
             lyap_tol = min(lyap_tol, 0.5 * ev["lambda1_signal_tolerance"])
+        elif lambda1 is not None:
+            conflict = False  # the equations' exponent decides; the signal's is evidence
+            med = ev.get("lambda1_signal_median")
+            if med is not None and med > 0 and lambda1 > 0:
+                ratio = med / lambda1
+                ev["lambda1_signal_over_equations"] = ratio
+                if not 1 / 3 < ratio < 3:
+                    reasons.append(
+                        f"the signal estimates (median {med:.4g}) differ from the equations' "
+                        f"exponent ({lambda1:.4g}) by {ratio:.3g}x: they follow the divergence "
+                        "on the signal's fastest time scale (embedding delay "
+                        f"{time_scale:.3g}), not the attractor's; the equations' value is used"
+                    )
     if lambda1 is not None:
         ev["lambda1"] = float(lambda1)
         ev["lambda1_err"] = float(lambda1_err)
@@ -134,7 +153,7 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     n_distinct = None
     if section is not None:
         pts = np.atleast_2d(np.asarray(section, dtype=float))
-        n_distinct = count_distinct_points(pts)
+        n_distinct = count_distinct_points(pts, rtol=section_rtol)
         ev["section_points"] = int(pts.shape[0])
         ev["section_distinct"] = int(n_distinct)
     if spectrum is not None:

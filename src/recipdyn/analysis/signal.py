@@ -66,14 +66,28 @@ class SignalAssessment:
         return rows
 
 
+def _once_per_revolution(x, revs) -> np.ndarray:
+    """(x at angle 0, x 0.382 turn later) at every whole revolution covered (the second angle
+    an irrational fraction of a turn, unlikely to sit on an impact)."""
+    r = np.asarray(revs, dtype=float)
+    ok = np.isfinite(r)
+    r, y = r[ok], np.asarray(x, dtype=float)[ok]
+    whole = np.arange(np.ceil(r[0]), np.floor(r[-1] - 0.382) + 1)
+    return np.c_[np.interp(whole, r, y), np.interp(whole + 0.382, r, y)]
+
+
 def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
                   max_samples: int = 40_000, surrogates: bool = True, section=None,
-                  seed: int = 0) -> SignalAssessment:  # fmt: skip
+                  revs=None, seed: int = 0) -> SignalAssessment:  # fmt: skip
     """Assess a uniformly sampled signal ``x`` (sampling rate ``fs`` in Hz).
 
     At most ``max_samples`` samples (the first) enter the neighbour-based estimators; the 0-1
     test thins the whole record. ``section`` (points of a Poincaré section, if the caller has
-    one) joins the evidence."""
+    one) joins the evidence. With the crank angle ``revs`` (revolutions at each sample) of a
+    machine driven at that speed, the section is the signal once per revolution (at angle 0
+    and 0.382 turn later) and the 0-1 test runs on it: the stroboscopic map of a forced
+    system (a periodic signal thinned at an arbitrary stride looks quasi-periodic, and the
+    0-1 test is unreliable on it)."""
     x = np.asarray(x, dtype=float)
     if x.ndim != 1:
         raise ValueError("need a 1-D signal")
@@ -98,14 +112,23 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
             prm = {"dim": emb.dim, "delay": emb.delay, "theiler": emb.theiler, "dt": dt,
                    "embedding": emb.status, "embedding_reason": emb.reason}  # fmt: skip
             lyap[name] = _gate(name, prm)
-    z01 = zero_one(x, stride=emb.delay, seed=seed)
+    if revs is not None and section is None:
+        section = _once_per_revolution(x, revs)
+        notes.append(f"section: the signal once per revolution ({section.shape[0]} points)")
+    if section is not None and revs is not None:
+        z01 = zero_one(section[:, 0], stride=1, seed=seed)
+    else:
+        z01 = zero_one(x, stride=emb.delay, seed=seed)
     sur = None
     if surrogates:
         sur = surrogate_test(head, dim=emb.dim, delay=emb.delay, seed=seed)
     spec = amplitude_spectrum(x, fs)
+    # a section from a measured signal repeats only to the accuracy of the crank angle (tacho
+    # edges to a fraction of a sample): points within 1e-3 of the range are one
     verdict = classify(k01=z01.K if z01.status == "ok" else None, spectrum=spec,
                        section=section, determinism=sur, signal_lyapunov=list(lyap.values()),
-                       time_scale=emb.delay * dt)  # fmt: skip
+                       time_scale=emb.delay * dt,
+                       section_rtol=1e-3 if revs is not None else 1e-6)  # fmt: skip
     verdict.evidence["embedding_delay"] = emb.delay
     verdict.evidence["embedding_dim"] = emb.dim
     return SignalAssessment(verdict, emb, lyap, z01, sur, float(fs), int(x.size), notes)

@@ -53,6 +53,7 @@ def _root(
 
 def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
+    from . import features as _features  # noqa: F401
     from . import models as _models  # noqa: F401
     from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401

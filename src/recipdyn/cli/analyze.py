@@ -33,6 +33,21 @@ def analyze(
         help="Signal file: sampling rate, e.g. 10kHz (else "
         "from a time column, the WAV header or an fs variable).",
     ),
+    tacho: str = typer.Option(
+        None, "--tacho", help="Signal file: once-per-revolution pulse column/channel."
+    ),
+    speed: str = typer.Option(
+        None, "--speed", help="Signal file: constant crank speed instead of a tacho (191rpm)."
+    ),
+    quantity: str = typer.Option(
+        "acceleration", "--quantity", help="acceleration (m/s^2), velocity (m/s) or other."
+    ),
+    zones: str = typer.Option(
+        None,
+        "--zones",
+        help="Velocity zone boundaries A/B,B/C,C/D for your machine from ISO 20816-8, "
+        "e.g. '2.3,4.5,7.1 mm/s'.",
+    ),
 ) -> None:
     """Spectrum, phase portraits, Poincaré section, Lyapunov exponents, 0-1 test, verdict."""
     from ..analyze import analyze_run, analyze_signal, is_record
@@ -47,7 +62,13 @@ def analyze(
         s = analyze_run(run, out, section_points=section_points,
                         lyap_revolutions=lyap_revolutions)  # fmt: skip
     else:
-        s = analyze_signal(run, out, column=column, fs=fs)
+        if quantity not in ("acceleration", "velocity", "other"):
+            raise ParameterError(f"quantity: {quantity!r}; allowed: acceleration, velocity, "
+                                 "other")  # fmt: skip
+        if tacho is not None and speed is not None:
+            raise ParameterError("tacho and speed: give one of them")
+        s = analyze_signal(run, out, column=column, fs=fs, tacho=tacho, speed=speed,
+                           quantity=quantity, zones=zones)  # fmt: skip
         for note in s["notes"]:
             typer.echo(f"note: {note}")
         for name, value, status in s["evidence"]:

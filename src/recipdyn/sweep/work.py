@@ -17,6 +17,7 @@ from ..analysis import (
     count_distinct_points,
     find_spectral_peaks,
     lyapunov_spectrum,
+    zero_one_test,
 )
 from ..defaults import LYAP_TOL
 from ..integrate import IntegrationError, integrate
@@ -129,11 +130,15 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         if pt.dynamic:
             r = lyapunov_spectrum(m, y, s["lyap_revolutions"] * T, t_transient=t0, **solver)
             res["lambda1"], res["lambda_sum"] = float(r.exponents[0]), float(r.sum)
+            limit = r.largest_limit()  # the verdict's exponent: finite-time bias removed
         else:
             res["lambda1"], res["lambda_sum"] = 0.0, 0.0
+            limit = (0.0, 0.0)
     if "verdict" in measures:
-        v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL),
-                     section=np.c_[tuple(res[f"poincare_{k}"] for k in pt.pair)])  # fmt: skip
+        sec = np.c_[tuple(res[f"poincare_{k}"] for k in pt.pair)]
+        k01 = zero_one_test(sec[:, 0]) if sec.shape[0] >= 100 else None
+        v = classify(lambda1=limit[0], lambda1_err=limit[1], k01=k01, section=sec,
+                     lyap_tol=s.get("lyap_tol", LYAP_TOL))  # fmt: skip
         res["verdict"] = v.verdict
     # final state, for continuation: integrate to a whole number of periods after t_end
     res["y_final"] = np.asarray(y_end, dtype=float)
@@ -173,9 +178,12 @@ def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
         r = lyapunov_spectrum_map(pt.system, y, max(1, int(s["lyap_revolutions"])),
                                   n_transient=n0)  # fmt: skip
         res["lambda1"], res["lambda_sum"] = float(r.exponents[0]), float(r.sum)
+        limit = r.largest_limit()
     if "verdict" in measures:
         sec = np.c_[tuple(res[f"poincare_{k}"] for k in pt.pair)]
-        v = classify(lambda1=res["lambda1"], lyap_tol=s.get("lyap_tol", LYAP_TOL), section=sec)
+        k01 = zero_one_test(sec[:, 0]) if sec.shape[0] >= 100 else None
+        v = classify(lambda1=limit[0], lambda1_err=limit[1], k01=k01, section=sec,
+                     lyap_tol=s.get("lyap_tol", LYAP_TOL))  # fmt: skip
         res["verdict"] = v.verdict
     res["y_final"] = np.asarray(orbit[-1], dtype=float)
     res["t_final"] = float(n0 + n)

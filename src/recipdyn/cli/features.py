@@ -1,0 +1,56 @@
+"""``recipdyn features INPUT... -o TABLE``: a feature table for machine learning."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from . import app, phase
+
+
+@app.command()
+def features(
+    inputs: list[Path] = typer.Argument(
+        ...,
+        help="Runs (NetCDF from 'recipdyn simulate'), "
+        "signal files, or sweep stores (one row per point).",
+    ),
+    out: Path = typer.Option(..., "--out", "-o", help="Table to write: .csv or .parquet."),
+    column: str = typer.Option(None, "--column", "-c", help="Signal files: column/variable."),
+    fs: str = typer.Option(None, "--fs", help="Signal files: sampling rate, e.g. 10kHz."),
+    window: str = typer.Option(
+        None,
+        "--window",
+        "-w",
+        help="One row per window: e.g. '2 s' or '10 rev' (default: one row per input).",
+    ),
+    speed: str = typer.Option(
+        None,
+        "--speed",
+        help="Crank speed for order features, e.g. 191rpm (recipdyn runs know theirs).",
+    ),
+    tacho: str = typer.Option(None, "--tacho", help="Once-per-revolution pulse column."),
+    chaos: bool = typer.Option(
+        False,
+        "--chaos",
+        help="Add the 0-1 test and the Rosenstein exponent with their statuses (slower).",
+    ),
+) -> None:
+    """Time-domain statistics, spectral and order features, chaos indicators: one row per
+    run or window, labelled with the run's parameters."""
+    from ..features import file_features, sweep_features, write_table
+    from ..model.parameters import ParameterError
+
+    rows = []
+    for path in inputs:
+        if not path.exists():
+            raise ParameterError(f"input not found: {path}")
+        with phase(f"features of {path.name}"):
+            if path.is_dir():
+                rows += [{"store": path.name, **r} for r in sweep_features(path)]
+            else:
+                rows += file_features(path, column=column, fs=fs, window=window, speed=speed,
+                                      tacho=tacho, chaos=chaos)  # fmt: skip
+    write_table(rows, out)
+    typer.echo(f"wrote {len(rows)} row(s) to {out}")

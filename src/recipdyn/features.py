@@ -1,0 +1,184 @@
+"""Feature tables for machine learning (``recipdyn features``): one row per run or per window
+of time-domain statistics, spectral and order features and chaos indicators with their
+statuses; or one row per point of a sweep store.
+
+A row carries where it came from (file, column, window start) and, for a recipdyn run, every
+model parameter (``param_*``), so a fault-classification data set is labelled by construction.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .analysis.spectrum import amplitude_spectrum
+from .analysis.vibration import angle_resample, indicators, order_spectrum_angle, velocity_rms
+from .model.parameters import ParameterError
+
+__all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS"]
+
+#: Crank orders whose amplitudes are features (1..N_ORDERS).
+N_ORDERS = 10
+
+
+def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
+                    chaos: bool = False) -> dict[str, Any]:  # fmt: skip
+    """Features of one window: :func:`~recipdyn.analysis.vibration.indicators`, the
+    ISO 20816-8 band velocity RMS (for an acceleration), dominant frequency, spectral
+    centroid, spread and normalised entropy; with a crank angle (``revs``), the amplitudes of
+    orders 1..``N_ORDERS``; with ``chaos``, the 0-1 test K and the Rosenstein exponent, each
+    with its status."""
+    x = np.asarray(x, dtype=float)
+    row: dict[str, Any] = dict(indicators(x))
+    if quantity == "acceleration":
+        row["velocity_rms_2_1000hz"] = velocity_rms(x, fs) if fs > 2000 else math.nan
+    spec = amplitude_spectrum(x, fs)
+    p = spec.amplitude[1:] ** 2
+    f = spec.frequency[1:]
+    total = p.sum()
+    if total > 0:
+        q = p / total
+        row["dominant_hz"] = float(f[np.argmax(p)])
+        row["centroid_hz"] = float(np.sum(f * q))
+        row["spread_hz"] = float(np.sqrt(np.sum((f - row["centroid_hz"]) ** 2 * q)))
+        nz = q[q > 0]
+        row["spectral_entropy"] = float(-np.sum(nz * np.log(nz)) / np.log(q.size))
+    else:
+        row.update(dominant_hz=math.nan, centroid_hz=math.nan, spread_hz=math.nan,
+                   spectral_entropy=math.nan)  # fmt: skip
+    if revs is not None:
+        try:
+            r = np.asarray(revs, dtype=float)
+            _, xa = angle_resample(x, r - r[0], 64)  # orders do not care where it starts
+            osp = order_spectrum_angle(xa, 64)
+            for k in range(1, N_ORDERS + 1):
+                row[f"order_{k}"] = float(osp.amplitude[np.argmin(np.abs(osp.frequency - k))])
+        except ValueError:  # less than one revolution in the window
+            for k in range(1, N_ORDERS + 1):
+                row[f"order_{k}"] = math.nan
+    if chaos:
+        from .analysis.lyapunov_signal import lyap_rosenstein
+        from .analysis.zero_one import zero_one
+
+        z = zero_one(x)
+        row["k01"], row["k01_status"] = z.K, z.status
+        r = lyap_rosenstein(x, 1.0 / fs)
+        row["lambda1_rosenstein"], row["lambda1_status"] = r.exponent, r.status
+    return row
+
+
+def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
+    """(start, stop) sample ranges: the whole record, or consecutive windows of a duration
+    ('2 s', '500 ms') or of whole revolutions ('10 rev', needs the speed)."""
+    if not window:
+        return [(0, n)]
+    text = window.strip().lower()
+    if text.endswith("rev"):
+        if not rev_s:
+            raise ParameterError(f"window: {window!r} in revolutions needs the speed "
+                                 "(--speed, --tacho, or a recipdyn run)")  # fmt: skip
+        try:
+            seconds = float(text[:-3]) * rev_s
+        except ValueError:
+            raise ParameterError(f"window: {window!r}; allowed: e.g. '10 rev', '2 s'") from None
+    else:
+        from .units import to_si
+
+        seconds = to_si("window", window, "s")
+    m = int(round(seconds * fs))
+    if m < 64:
+        raise ParameterError(f"window: {window!r} is {m} samples; allowed: at least 64")
+    if m > n:
+        raise ParameterError(f"window: {window!r} is {m} samples, longer than the record ({n})")
+    return [(a, a + m) for a in range(0, n - m + 1, m)]
+
+
+def file_features(path: str | Path, *, column=None, fs=None, window: str | None = None,
+                  speed=None, tacho=None, chaos: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+    """Rows for one file: a recipdyn run (its vibration signal, speed and parameters) or a
+    measured signal (``column``/``fs`` as for analyze; ``speed`` or a ``tacho`` column for
+    the orders)."""
+    from .analysis.vibration import crank_angle, tacho_times
+    from .analyze import is_record
+    from .io_signal import read_signal
+    from .units import to_si
+
+    path = Path(path)
+    labels: dict[str, Any] = {}
+    if column is None and fs is None and is_record(path):
+        from .io import read_dataset
+
+        ds = read_dataset(path)
+        vib = "a" if "a" in ds else next(iter(ds.data_vars))
+        t = ds[ds[vib].dims[0]].values
+        x, rate = ds[vib].values.astype(float), 1.0 / float(np.median(np.diff(t)))
+        labels = {k: v for k, v in ds.attrs.items() if k.startswith("param_")
+                  and isinstance(v, (int, float, str, np.number))}  # fmt: skip
+        f_rev = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
+        name = vib
+    else:
+        sig = read_signal(path, column=column, fs=fs)
+        x, rate, name = sig.x, sig.fs, sig.name
+        f_rev = None
+    revs = None
+    if tacho is not None:
+        pulse = read_signal(path, column=tacho, fs=rate)
+        revs = crank_angle(x.size, rate, pulses=tacho_times(pulse.x, rate))
+        ok = np.isfinite(revs)
+        f_rev = (revs[ok][-1] - revs[ok][0]) / (ok.sum() / rate)
+    elif speed is not None:
+        f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
+        if not f_rev > 0:
+            raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
+    if revs is None and f_rev:
+        revs = crank_angle(x.size, rate, speed_hz=f_rev)
+    rows = []
+    for a, b in _windows(x.size, rate, window, 1.0 / f_rev if f_rev else None):
+        row = {"file": path.name, "signal": name, "window_start_s": a / rate,
+               "window_s": (b - a) / rate, "fs_hz": rate,
+               "speed_hz": f_rev if f_rev else math.nan}  # fmt: skip
+        row.update(signal_features(x[a:b], rate, revs=None if revs is None else revs[a:b],
+                                   chaos=chaos))  # fmt: skip
+        row.update(labels)
+        rows.append(row)
+    return rows
+
+
+def sweep_features(path: str | Path) -> list[dict[str, Any]]:
+    """One row per computed point of a sweep store: its parameter values and every scalar
+    measure (vector measures such as section points are left out)."""
+    from .sweep.run import open_sweep
+
+    ds = open_sweep(path)
+    grid = [d for d in ds["done"].dims]
+    scalar = [k for k, v in ds.data_vars.items() if tuple(v.dims) == tuple(grid) and k != "done"]
+    frame = ds[scalar + ["done"]].to_dataframe().reset_index()
+    frame = frame[frame["done"].astype(bool)].drop(columns=["done"])
+    return frame.to_dict("records")
+
+
+def write_table(rows: list[dict[str, Any]], path: str | Path) -> Path:
+    """CSV or Parquet (by suffix), written atomically; columns in first-seen order."""
+    import pandas as pd
+
+    from .io import atomic_path, write_error
+
+    path = Path(path)
+    if path.suffix.lower() not in (".csv", ".parquet"):
+        raise ParameterError(f"output {path}: use .csv or .parquet")
+    cols: list[str] = []
+    for r in rows:
+        cols += [k for k in r if k not in cols]
+    frame = pd.DataFrame(rows, columns=cols)
+    try:
+        with atomic_path(path) as tmp:
+            if path.suffix.lower() == ".csv":
+                frame.to_csv(tmp, index=False)
+            else:
+                frame.to_parquet(tmp, index=False)
+    except Exception as exc:
+        raise write_error(path, exc) from None
+    return path

@@ -1,0 +1,73 @@
+"""recipdyn features (issue 12, item 5): a labelled feature table from runs, signal files and
+sweep stores."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from recipdyn.cli import main
+from recipdyn.features import signal_features
+
+
+def test_features_of_a_known_signal():
+    """A 50 Hz sine of amplitude 2 plus 0.5 at 150 Hz (order 3 of a 50 Hz crank): RMS,
+    crest factor, dominant frequency and the order amplitudes are the closed-form values."""
+    fs = 5000.0
+    t = np.arange(50_000) / fs
+    x = 2.0 * np.sin(2 * np.pi * 50 * t) + 0.5 * np.sin(2 * np.pi * 150 * t)
+    r = signal_features(x, fs, revs=50.0 * t)
+    assert r["rms"] == pytest.approx(np.sqrt((4 + 0.25) / 2), rel=1e-9)
+    assert r["dominant_hz"] == pytest.approx(50.0)
+    assert r["order_1"] == pytest.approx(2.0, rel=1e-3)
+    assert r["order_3"] == pytest.approx(0.5, rel=1e-3)
+    assert r["order_2"] < 1e-3
+    assert r["velocity_rms_2_1000hz"] == pytest.approx(
+        np.sqrt((2 / (2 * np.pi * 50)) ** 2 + (0.5 / (2 * np.pi * 150)) ** 2) / np.sqrt(2),
+        rel=1e-6)  # fmt: skip
+
+
+def test_features_command_runs_windows_and_sweeps(tmp_path, capsys):
+    """Two simulated runs -> rows labelled with their parameters (rc differs), windows of one
+    revolution give one row per whole revolution; a CSV signal with --speed gets order
+    features and the chaos indicators with statuses; a sweep store gives one row per point."""
+    runs = []
+    for rc in ("0.5 mm", "1 mm"):
+        p = tmp_path / f"run{rc[:3].strip()}.nc"
+        assert main(["simulate", "--rc", rc, "-n", "3", "--fs", "5 kHz", "-o", str(p),
+                     "--no-figure", "--no-progress"]) == 0  # fmt: skip
+        runs.append(p)
+    out = tmp_path / "f.parquet"
+    assert main(["features", *map(str, runs), "-o", str(out), "--window", "1 rev"]) == 0
+    f = pd.read_parquet(out)
+    assert len(f) == 6 and sorted(f["param_rc"].unique()) == [5e-4, 1e-3]
+    assert np.all(np.isfinite(f["order_1"])) and np.all(f["window_s"] > 0.3)
+    sig = tmp_path / "s.csv"
+    fs = 2000.0
+    t = np.arange(8000) / fs
+    pd.DataFrame({"time": t, "acc": np.sin(2 * np.pi * 10 * t)}).to_csv(sig, index=False)
+    out2 = tmp_path / "g.csv"
+    assert main(["features", str(sig), "-c", "acc", "--speed", "600 rpm", "--chaos",
+                 "-o", str(out2)]) == 0  # fmt: skip
+    g = pd.read_csv(out2)
+    assert g["order_1"].iloc[0] == pytest.approx(1.0, rel=1e-3)
+    assert g["lambda1_status"].iloc[0] in ("flat", "ok") and "k01_status" in g
+    store = tmp_path / "sw"
+    assert main(["sweep", "-p", "rc=0.5mm:1mm:3", "-m", "peak", "--revolutions", "1",
+                 "--transient", "0", "-o", str(store), "--backend", "serial",
+                 "--no-progress"]) == 0  # fmt: skip
+    out3 = tmp_path / "h.csv"
+    assert main(["features", str(store / "sweep.zarr"), "-o", str(out3)]) == 0
+    h = pd.read_csv(out3)
+    assert len(h) == 3 and "peak_a" in h and "rc" in h
+    assert "wrote 3 row(s)" in capsys.readouterr().out
+
+
+def test_features_bad_window_exit_2(tmp_path, capsys):
+    sig = tmp_path / "s.csv"
+    pd.DataFrame({"time": np.arange(500) / 100.0, "acc": np.arange(500.0)}).to_csv(sig)
+    assert main(["features", str(sig), "-c", "acc", "-w", "10 rev", "-o",
+                 str(tmp_path / "x.csv")]) == 2  # fmt: skip
+    assert main(["features", str(sig), "-c", "acc", "-w", "1 ms", "-o",
+                 str(tmp_path / "x.csv")]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "needs the speed" in err and "at least 64" in err and "Traceback" not in err
