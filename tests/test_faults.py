@@ -243,7 +243,11 @@ def test_wrong_input_files(tmp_path, monkeypatch, capsys, command, kind, word):
     code = main([*args, "--no-figure", "-n", "0.05"] if command.startswith("simulate") else args)
     cap = capsys.readouterr()
     if kind == "empty" and command.startswith("simulate"):
-        assert code == 0  # an empty TOML file is a valid, empty config
+        # the empty file is e.nc: a recorded run is a config, and an empty one is not
+        assert code == 2 and "empty" in cap.err
+        toml = tmp_path / "e.toml"
+        toml.write_text("")
+        assert main(["simulate", "-c", str(toml), "--no-figure", "-n", "0.05"]) == 0
         return
     assert code == 2, cap.err
     no_traceback(cap.out, cap.err)

@@ -71,3 +71,50 @@ def test_features_bad_window_exit_2(tmp_path, capsys):
                  str(tmp_path / "x.csv")]) == 2  # fmt: skip
     err = capsys.readouterr().err
     assert "needs the speed" in err and "at least 64" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npy", ".wav", ".parquet", ".nc"])
+def test_windows_read_block_by_block_equal_the_whole_file(tmp_path, suffix):
+    """Windowed features read the file in blocks (here 1000 samples, windows of 730: every
+    window but the first straddles a block boundary): rows identical to windows cut from the
+    whole signal (float32 WAV: to its rounding)."""
+    import xarray as xr
+    from scipy.io import wavfile
+
+    from recipdyn.features import _streamed_rows
+    from recipdyn.io_signal import signal_blocks
+
+    fs = 1000.0
+    x = np.sin(2 * np.pi * 7 * np.arange(5000) / fs) + 0.1 * np.cos(np.arange(5000) ** 1.3)
+    p = tmp_path / f"s{suffix}"
+    if suffix == ".csv":
+        pd.DataFrame({"time": np.arange(x.size) / fs, "acc": x}).to_csv(p, index=False)
+    elif suffix == ".parquet":
+        pd.DataFrame({"time": np.arange(x.size) / fs, "acc": x}).to_parquet(p)
+    elif suffix == ".npy":
+        np.save(p, x)
+    elif suffix == ".wav":
+        x = x.astype(np.float32).astype(float)
+        wavfile.write(p, int(fs), x.astype(np.float32))
+    else:
+        xr.Dataset({"acc": ("time", x)}, coords={"time": np.arange(x.size) / fs}).to_netcdf(p)
+    kw = {"column": "acc"} if suffix in (".csv", ".parquet", ".nc") else {}
+    if suffix == ".npy":
+        kw["fs"] = "1 kHz"
+    rate, name, total, blocks = signal_blocks(p, block=1000, **kw)
+    assert rate == pytest.approx(fs) and np.array_equal(np.concatenate(list(blocks)), x)
+    import recipdyn.io_signal as io_signal
+
+    orig = io_signal.signal_blocks
+    io_signal.signal_blocks = lambda *a, **k: orig(*a, **{**k, "block": 1000})
+    try:
+        rows = _streamed_rows(p, kw.get("column"), kw.get("fs"), "0.73 s", "420 rpm", False,
+                              False)  # fmt: skip
+    finally:
+        io_signal.signal_blocks = orig
+    assert len(rows) == 5000 // 730
+    for i, r in enumerate(rows):
+        ref = signal_features(x[i * 730 : (i + 1) * 730], fs,
+                              revs=7.0 * np.arange(i * 730, (i + 1) * 730) / fs)  # fmt: skip
+        for k in ("rms", "kurtosis", "order_1", "dominant_hz"):
+            assert r[k] == pytest.approx(ref[k], rel=1e-12, abs=1e-12), (k, i)

@@ -114,3 +114,37 @@ def test_integrate_sink_gets_every_sample_once_in_order():
         assert sol.nsteps == ref.nsteps and sol.y.shape == (0, 2)
     grid = UniformGrid(0.0, 20001 / te[-1], 3)
     assert np.array_equal(grid[0:3], 0.0 + np.arange(3) / grid.rate)
+
+
+def test_negative_contact_force_is_flagged(tmp_path, capsys):
+    """A light gas load (1 kN amplitude) lets inertia pull the massless link (min contact
+    force about -1.8 kN): simulate warns (ModelValidityWarning, the record's 'validity'
+    attribute, one CLI line naming the contact-impact model); the default load does not. A
+    sweep over the load amplitude records min_contact_force per point and marks the points
+    that cross on its figure."""
+    import warnings
+
+    import recipdyn
+    from recipdyn.cli import main
+    from recipdyn.errors import ModelValidityWarning
+
+    with pytest.warns(ModelValidityWarning, match="compressor-contact"):
+        ds = recipdyn.simulate(revolutions=1.0, fs=5000.0, load_amplitude=1000.0)
+    assert ds.attrs["min_contact_force_N"] < 0 and "contact_force reaches" in ds.attrs["validity"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelValidityWarning)
+        assert recipdyn.simulate(revolutions=1.0, fs=5000.0).attrs["validity"] == "ok"
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "-n", "1", "--set", "load_amplitude=1 kN", "-o", str(out),
+                 "--no-figure", "--no-progress"]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("warning: contact_force reaches") == 1
+    store = tmp_path / "sw"
+    assert main(["sweep", "-p", "load_amplitude=1kN,100kN", "-m", "peak", "--revolutions", "1",
+                 "--transient", "0", "--backend", "serial", "-o", str(store),
+                 "--no-progress"]) == 0  # fmt: skip
+    from recipdyn.sweep.run import open_sweep
+
+    sw = open_sweep(store / "sweep.zarr")
+    low = sw["min_contact_force"].values
+    assert low[0] < 0 < low[1] and sw["min_contact_force"].attrs["units"] == "N"

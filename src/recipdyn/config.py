@@ -1,6 +1,7 @@
 """Typed configuration (TOML) for simulations: parameters and settings with units.
 
-Example ``case.toml``::
+Example (``examples/base_case.toml``; ``recipdyn simulate --dump-config FILE`` writes the full,
+commented config of any run, and ``recipdyn simulate -c RUN.nc`` reruns a recorded run)::
 
     [params]            # any CompressorParams field or alias, numbers in SI or quantities
     rc = "1 mm"
@@ -23,13 +24,22 @@ import tomllib
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from .defaults import SIMULATION
 from .model.parameters import SCHEMA, CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
-__all__ = ["SimulationConfig", "RunConfig", "read_config", "build_params", "model_values"]
+__all__ = [
+    "SimulationConfig",
+    "RunConfig",
+    "read_config",
+    "build_params",
+    "model_values",
+    "dump_config",
+    "config_from_record",
+]
 
 #: The compressor's parameters whose values are names (every one with ``choices``).
 _STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
@@ -74,7 +84,13 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
         elif name == "load_table":
             from .model.load import read_load_table
 
-            kw[name] = read_load_table(v)
+            if isinstance(v, (list, tuple)):  # inline [[deg, N], ...] (a dumped config)
+                rows = [tuple(map(float, r)) for r in v]
+                if len(rows) < 2 or any(len(r) != 2 for r in rows):
+                    raise ParameterError("load_table: need >= 2 rows of [angle_deg, force_N]")
+                kw[name] = tuple(sorted((a % 360.0, f) for a, f in rows))
+            else:
+                kw[name] = read_load_table(v)
         elif name == "theta_c0" and (v is None or str(v).lower() in ("default", "none")):
             kw[name] = None
         else:
@@ -83,8 +99,11 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
 
 
 def read_config(path: str | Path) -> RunConfig:
-    """Read and validate a TOML config file (clear errors, exit status 2 at the CLI)."""
+    """Read and validate a TOML config file (clear errors, exit status 2 at the CLI); a run
+    written by ``recipdyn simulate`` (``.nc``) gives the config that made it."""
     path = Path(path)
+    if path.suffix.lower() == ".nc":
+        return config_from_record(path)
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -113,3 +132,96 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
         p = model.schema[model.schema.resolve(k)]
         out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
     return model.parameters(out)
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(float(v)) if isinstance(v, float) else str(v)
+
+
+def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
+    """The full, commented TOML config of a run: every parameter of ``model`` (values in SI;
+    units, description, allowed range and assumptions as comments) and every simulation
+    setting. ``recipdyn simulate -c`` reads it back to the same run."""
+    lines = [f"# recipdyn run configuration: model {model.name!r} ({model.description})",
+             "# numbers are SI (the unit in each comment); quantities such as '1 mm' work too",
+             f'model = "{model.name}"', "", "[params]"]  # fmt: skip
+    group = None
+    for p in model.schema:
+        if p.group != group:
+            group = p.group
+            lines.append(f"# -- {group}")
+        v = values.get(p.name, p.default)
+        rng = (
+            f"one of {', '.join(p.choices)}"
+            if p.choices
+            else f"{'(' if p.low_open else '['}{p.low:g}, {p.high:g}{')' if p.high_open else ']'}"
+        )
+        note = f"; note: {p.assumed}" if p.assumed else ""
+        comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
+        if v is None:
+            lines.append(f"# {p.name} = (derived by the model){comment}")
+        elif p.name == "load_table":
+            lines.append(f"{p.name} = {_toml_value([list(r) for r in v])}{comment}")
+        else:
+            lines.append(f"{p.name} = {_toml_value(v)}{comment}")
+    lines += ["", "[simulation]"]
+    notes = {"revolutions": "revolutions recorded (periods for other models)",
+             "transient": "revolutions discarded first", "fs": "sampling rate, Hz",
+             "method": "dop853 or rk4", "rtol": "relative tolerance (dop853)",
+             "atol": "absolute tolerance (dop853)", "h": "RK4 step, s"}  # fmt: skip
+    for k, text in notes.items():
+        v = settings.get(k, SIMULATION.get(k))
+        if v is None:
+            lines.append(f"# {k} = (not set)  # {text}")
+        else:
+            lines.append(f"{k} = {_toml_value(v)}  # {text}")
+    return "\n".join(lines) + "\n"
+
+
+def config_from_record(path: str | Path) -> RunConfig:
+    """The config a recorded run was made with (its ``param_*`` and solver attributes)."""
+    from .io import read_dataset
+    from .model.registry import get_model
+
+    path = Path(path)
+    ds = read_dataset(path, what="config", expected="a run written by 'recipdyn simulate'")
+    attrs = ds.attrs
+    spec = attrs.get("model_spec") or attrs.get("model_name")
+    if spec is None or not any(k.startswith("param_") for k in attrs):
+        raise ParameterError(f"config {path}: not a recipdyn run (no model and parameters "
+                             "recorded)")  # fmt: skip
+    m = get_model(str(spec))
+    params: dict[str, Any] = {}
+    for p in m.schema:
+        key = f"param_{p.name}"
+        if p.name == "load_table" and "load_table_deg_N" in attrs:
+            flat = [float(x) for x in np.atleast_1d(attrs["load_table_deg_N"])]
+            params[p.name] = [flat[i : i + 2] for i in range(0, len(flat), 2)]
+        elif key in attrs:
+            v = attrs[key]
+            v = v.item() if isinstance(v, np.generic) else v
+            if v != "default":
+                params[p.name] = v
+    sim: dict[str, Any] = {}
+    for key, name in (
+        ("revolutions", "revolutions"),
+        ("transient_revolutions", "transient"),
+        ("sampling_rate_hz", "fs"),
+        ("solver_method", "method"),
+        ("solver_rtol", "rtol"),
+        ("solver_atol", "atol"),
+        ("solver_h", "h"),
+    ):
+        if key in attrs and attrs[key] != "adaptive":
+            v = attrs[key]
+            sim[name] = v.item() if isinstance(v, np.generic) else v
+    try:
+        return RunConfig(model=m.name, params=params, simulation=SimulationConfig(**sim))
+    except ValidationError as exc:
+        raise ParameterError(f"config {path}: recorded settings not valid ({exc})") from None

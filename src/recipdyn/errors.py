@@ -30,6 +30,12 @@ class ParameterError(ValueError):
     """Bad input; the message names the parameter (or file) and the allowed range."""
 
 
+class ModelValidityWarning(UserWarning):
+    """A result left the region where its model holds (e.g. the massless link asked to pull):
+    the numbers are what the equations give, but the equations no longer describe the
+    machine there."""
+
+
 class IntegrationError(RuntimeError):
     """The integrator failed; ``partial`` holds what was computed before the failure."""
 

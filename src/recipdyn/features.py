@@ -70,11 +70,9 @@ def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
     return row
 
 
-def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
-    """(start, stop) sample ranges: the whole record, or consecutive windows of a duration
-    ('2 s', '500 ms') or of whole revolutions ('10 rev', needs the speed)."""
-    if not window:
-        return [(0, n)]
+def _window_samples(window: str, fs: float, rev_s: float | None) -> int:
+    """Samples in a window given as a duration ('2 s', '500 ms') or whole revolutions
+    ('10 rev', needs the speed)."""
     text = window.strip().lower()
     if text.endswith("rev"):
         if not rev_s:
@@ -91,13 +89,22 @@ def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
     m = int(round(seconds * fs))
     if m < 64:
         raise ParameterError(f"window: {window!r} is {m} samples; allowed: at least 64")
+    return m
+
+
+def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
+    """(start, stop) sample ranges: the whole record, or consecutive whole windows."""
+    if not window:
+        return [(0, n)]
+    m = _window_samples(window, fs, rev_s)
     if m > n:
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record ({n})")
     return [(a, a + m) for a in range(0, n - m + 1, m)]
 
 
 def file_features(path: str | Path, *, column=None, fs=None, window: str | None = None,
-                  speed=None, tacho=None, chaos: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+                  speed=None, tacho=None, chaos: bool = False,
+                  progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
     """Rows for one file: a recipdyn run (its vibration signal, speed and parameters) or a
     measured signal (``column``/``fs`` as for analyze; ``speed`` or a ``tacho`` column for
     the orders)."""
@@ -120,6 +127,8 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         f_rev = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
         name = vib
     else:
+        if window and tacho is None:  # window by window: files longer than memory are fine
+            return _streamed_rows(path, column, fs, window, speed, chaos, progress)
         sig = read_signal(path, column=column, fs=fs)
         x, rate, name = sig.x, sig.fs, sig.name
         f_rev = None
@@ -144,6 +153,63 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
                                    chaos=chaos))  # fmt: skip
         row.update(labels)
         rows.append(row)
+    return rows
+
+
+def _speed_hz(speed) -> float | None:
+    from .units import to_si
+
+    if speed is None:
+        return None
+    f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
+    if not f_rev > 0:
+        raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
+    return f_rev
+
+
+def _streamed_rows(path, column, fs, window, speed, chaos, progress) -> list[dict[str, Any]]:
+    """Feature rows of consecutive windows of a signal file read block by block (memory: a
+    block of 10^6 samples and one window, whatever the file's length)."""
+    from .analysis.vibration import crank_angle
+    from .io_signal import signal_blocks
+
+    rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
+    f_rev = _speed_hz(speed)
+    m = _window_samples(window, rate, 1.0 / f_rev if f_rev else None)
+    if total is not None and m > total:
+        raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
+                             f"({total})")  # fmt: skip
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=total, unit="sample", desc=f"features {path.name}", leave=False)
+    rows, buf, start = [], np.empty(0), 0
+    try:
+        for block in blocks:
+            if bar is not None:
+                bar.update(block.size)
+            if not np.all(np.isfinite(block)):
+                raise ParameterError(f"{path}: column {name!r} has missing or non-finite "
+                                     "values; fill or cut them first")  # fmt: skip
+            buf = np.concatenate([buf, block])
+            while buf.size >= m:
+                w, buf = buf[:m], buf[m:]
+                revs = None
+                if f_rev:
+                    revs = crank_angle(m, rate, speed_hz=f_rev, zero_rev=start / rate * f_rev)
+                row = {"file": path.name, "signal": name, "window_start_s": start / rate,
+                       "window_s": m / rate, "fs_hz": rate,
+                       "speed_hz": f_rev if f_rev else math.nan}  # fmt: skip
+                row.update(signal_features(w, rate, revs=revs, chaos=chaos))
+                rows.append(row)
+                start += m
+    finally:
+        if bar is not None:
+            bar.close()
+    if not rows:
+        raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
+                             f"({start + buf.size})")  # fmt: skip
     return rows
 
 

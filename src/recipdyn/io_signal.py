@@ -15,7 +15,7 @@ import numpy as np
 from .model.parameters import ParameterError
 from .units import to_si
 
-__all__ = ["MeasuredSignal", "read_signal", "SIGNAL_SUFFIXES"]
+__all__ = ["MeasuredSignal", "read_signal", "SIGNAL_SUFFIXES", "signal_blocks"]
 
 SIGNAL_SUFFIXES = (".csv", ".txt", ".tsv", ".wav", ".mat", ".nc", ".parquet", ".npy")
 TIME_NAMES = ("time", "t", "time_s", "time (s)", "t (s)", "seconds")
@@ -186,3 +186,138 @@ def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
         raise ParameterError(f"{path}: column {name!r} has {int(bad.sum())} missing or "
                              "non-finite value(s); fill or cut them first")  # fmt: skip
     return MeasuredSignal(x, float(fs), str(name), path.name, units, notes)
+
+
+def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_000):
+    """``(fs, name, total_or_None, blocks)`` for a file too long to hold in memory: ``blocks``
+    yields consecutive arrays of at most ``block`` samples of the chosen channel.
+
+    CSV/TSV/TXT are read in chunks (pandas), Parquet by row groups (pyarrow), WAV and NPY
+    memory-mapped, NetCDF lazily; MAT files are read whole (scipy cannot stream them). A
+    time column must stay uniform across chunks (checked chunk by chunk)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    head = read_signal_head(path, column=column, fs=fs)
+    name, rate = head.name, head.fs
+    if suffix in (".csv", ".txt", ".tsv"):
+        import pandas as pd
+
+        sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+
+        def gen():
+            last_t = None
+            for frame in pd.read_csv(path, sep=sep, engine="python", comment="#",
+                                     chunksize=block):  # fmt: skip
+                tcol = next((c for c in frame.columns if str(c).strip().lower() in TIME_NAMES),
+                            None)  # fmt: skip
+                if tcol is not None and fs is None:
+                    t = frame[tcol].to_numpy(dtype=float)
+                    if last_t is not None:
+                        t = np.r_[last_t, t]
+                    if t.size > 1 and np.ptp(np.diff(t)) > 1e-3 / rate:
+                        raise ParameterError(f"{path}: time column {tcol!r} is not uniformly "
+                                             "sampled; resample first")  # fmt: skip
+                    last_t = t[-1]
+                yield frame[name].to_numpy(dtype=float)
+
+        return rate, name, None, gen()
+    if suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        pf = pq.ParquetFile(path)
+
+        def gen():
+            for batch in pf.iter_batches(batch_size=block, columns=[name]):
+                yield batch.column(0).to_numpy(zero_copy_only=False).astype(float)
+
+        return rate, name, pf.metadata.num_rows, gen()
+    if suffix in (".wav", ".npy"):
+        if suffix == ".wav":
+            from scipy.io import wavfile
+
+            _, data = wavfile.read(path, mmap=True)
+        else:
+            data = np.load(path, mmap_mode="r")
+        data = data.reshape(len(data), -1)
+        ch = int(name.split()[-1])
+
+        def gen():
+            for a in range(0, data.shape[0], block):
+                yield np.asarray(data[a : a + block, ch], dtype=float)
+
+        return rate, name, int(data.shape[0]), gen()
+    if suffix == ".nc":
+        import xarray as xr
+
+        ds = xr.open_dataset(path)
+        da = ds[name]
+
+        def gen():
+            try:
+                for a in range(0, da.shape[0], block):
+                    yield np.asarray(da[a : a + block].values, dtype=float)
+            finally:
+                ds.close()
+
+        return rate, name, int(da.shape[0]), gen()
+    x = read_signal(path, column=column, fs=fs).x  # .mat: whole
+    return rate, name, int(x.size), iter([x[a : a + block] for a in range(0, x.size, block)])
+
+
+def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000):
+    """The channel name and sampling rate of a file, from its first ``rows`` rows where the
+    format allows it (a whole read otherwise)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix in (".csv", ".txt", ".tsv") and path.is_file() and path.stat().st_size > 0:
+        import pandas as pd
+
+        sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+        try:
+            frame = pd.read_csv(path, sep=sep, engine="python", comment="#", nrows=rows)
+        except Exception as exc:
+            raise ParameterError(f"input {path}: cannot be read as {suffix[1:].upper()} "
+                                 f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+        x, rate, name, notes = _table(frame, path, column, _fs_option(fs))
+        return MeasuredSignal(x, rate, name, path.name, "", notes)
+    if suffix == ".parquet" and path.is_file():
+        import pyarrow.parquet as pq
+
+        first = next(pq.ParquetFile(path).iter_batches(batch_size=rows)).to_pandas()
+        x, rate, name, notes = _table(first, path, column, _fs_option(fs))
+        return MeasuredSignal(x, rate, name, path.name, "", notes)
+    if suffix in (".wav", ".npy") and path.is_file():
+        given = _fs_option(fs)
+        if suffix == ".wav":
+            from scipy.io import wavfile
+
+            rate, data = wavfile.read(path, mmap=True)
+            data = data.reshape(len(data), -1)
+            ch = _pick(list(range(data.shape[1])), 0 if column is None else column, path,
+                       "channel")  # fmt: skip
+            return MeasuredSignal(np.asarray(data[:rows, ch], dtype=float),
+                                  given or float(rate), f"channel {ch}", path.name)  # fmt: skip
+        data = np.load(path, mmap_mode="r")
+        data = data.reshape(len(data), -1)
+        ch = _pick(list(range(data.shape[1])), 0 if data.shape[1] == 1 else column, path)
+        if given is None:
+            raise ParameterError(f"{path}: the file does not give a sampling rate; pass --fs "
+                                 "(e.g. --fs 10kHz)")  # fmt: skip
+        return MeasuredSignal(np.asarray(data[:rows, ch], dtype=float), given, f"column {ch}",
+                              path.name)  # fmt: skip
+    if suffix == ".nc" and path.is_file():
+        import xarray as xr
+
+        with xr.open_dataset(path) as ds:
+            names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
+            name = _pick(names, column, path, "variable")
+            da = ds[name]
+            rate = _fs_option(fs)
+            if rate is None and da.dims[0] in ds.coords:
+                rate = _fs_from_time(ds[da.dims[0]].values[:rows], path, da.dims[0])
+            if rate is None:
+                raise ParameterError(f"{path}: the file does not give a sampling rate; pass "
+                                     "--fs (e.g. --fs 10kHz)")  # fmt: skip
+            return MeasuredSignal(np.asarray(da.values[:rows], dtype=float), rate, name,
+                                  path.name)  # fmt: skip
+    return read_signal(path, column=column, fs=fs)

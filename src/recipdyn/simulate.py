@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import time
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -12,8 +13,9 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
+from .config import dump_config
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
-from .errors import Interrupted, is_number
+from .errors import Interrupted, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import UniformGrid, check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
@@ -75,6 +77,17 @@ def _coerce_params(params: CompressorParams | None, overrides: dict[str, Any]) -
 
     names = {resolve_name(k): v for k, v in overrides.items()}
     return dataclasses.replace(base, **names)
+
+
+def validity_warning(model, minima: dict[str, float]) -> str:
+    """The warning text for the outputs whose minimum crossed the model's validity bound
+    (empty when none did)."""
+    out = []
+    for name, unit, bound, why, instead in model.validity_bounds:
+        low = minima.get(name)
+        if low is not None and math.isfinite(low) and low < bound:
+            out.append(f"{name} reaches {low:.4g} {unit} (< {bound:g}): {why}; use {instead}")
+    return "; ".join(out)
 
 
 def simulate(
@@ -286,6 +299,13 @@ def simulate(
         "storage": "float32" if (float32 and writer is not None) else "float64",
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+    attrs["config_toml"] = dump_config(COMPRESSOR, vars(p), dict(
+        revolutions=revolutions, transient=transient, fs=fs, method=method, rtol=rtol,
+        atol=atol, h=h))  # fmt: skip
+    warning = validity_warning(COMPRESSOR, {"contact_force": min_force[0]})
+    attrs["validity"] = warning or "ok"
+    if warning:
+        warnings.warn(warning, ModelValidityWarning, stacklevel=2)
     recent = ds if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
         attrs.update(clean_attrs(COMPRESSOR.run_summary(vars(p), recent)))
@@ -403,6 +423,9 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
         "period": period if period else "none (autonomous: revolutions count time units)",
         "state_initial": [float(x) for x in y0],
         **m.schema.to_attrs(values),
+        "config_toml": dump_config(m, values, dict(revolutions=revolutions, transient=transient,
+                                                   fs=fs, method=method, rtol=rtol, atol=atol,
+                                                   h=h)),
     }  # fmt: skip
     if m.kind == "map":
         n0, n = int(round(transient)), max(1, int(round(revolutions)))

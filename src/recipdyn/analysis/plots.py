@@ -99,7 +99,7 @@ def plot_vibration(rep, title: str = "", unit: str = ""):
     ax = axes[0, 0]
     if "orders" in rep:
         o = rep["orders"]
-        strong = o.frequency[o.amplitude > 1e-3 * o.amplitude.max()]
+        strong = o.frequency[o.amplitude > 0.03 * o.amplitude.max()]
         top = max(10.0, min(200.0, 1.1 * strong.max())) if strong.size else 40.0
         keep = (o.frequency <= top) & (o.frequency > 0)
         ax.semilogy(o.frequency[keep], o.amplitude[keep] + 1e-9 * o.amplitude.max(), lw=0.8)
@@ -148,9 +148,10 @@ def plot_vibration(rep, title: str = "", unit: str = ""):
     ax.set_title("cepstrum (harmonic families and echoes)")
     ax = axes[1, 1]
     hits = rep["impacts"]
-    if hits and np.isfinite(hits[0].angle_deg):
-        ax.scatter([h.angle_deg for h in hits], [h.revolution for h in hits],
-                   s=12, c=[h.peak for h in hits], cmap="viridis")  # fmt: skip
+    known = [h for h in hits if np.isfinite(h.angle_deg)]
+    if known:
+        ax.scatter([h.angle_deg for h in known], [h.revolution for h in known],
+                   s=12, c=[h.peak for h in known], cmap="viridis")  # fmt: skip
         ax.set_xlim(0, 360)
         ax.set_xticks(range(0, 361, 60))
         ax.set_xlabel("crank angle at onset (deg)")

@@ -30,7 +30,7 @@ from .spectrum import Spectrum, amplitude_spectrum
 __all__ = ["tacho_times", "crank_angle", "angle_resample", "order_spectrum_angle",
            "spectrogram", "campbell", "envelope_spectrum", "cepstrum", "band_rms",
            "velocity_rms", "zone", "indicators", "Impact", "detect_impacts",
-           "ISO20816_8_BAND_HZ", "vibration_report"]  # fmt: skip
+           "ISO20816_8_BAND_HZ", "vibration_report", "resonance_band"]  # fmt: skip
 
 #: Frequency band of the ISO 20816-8:2018 velocity evaluation, Hz.
 ISO20816_8_BAND_HZ = (2.0, 1000.0)
@@ -135,6 +135,20 @@ def campbell(x, fs: float, revs, *, nperseg: int | None = None, overlap: float =
     speed = np.gradient(revs, ts)
     frame_speed = np.interp(t, ts, speed)
     return f, frame_speed, A.T
+
+
+def resonance_band(x, fs: float, low: float | None = None) -> tuple[float, float]:
+    """A band for envelope analysis: +-30 % around the strongest spectral line above ``low``
+    (default 5 % of fs, above the running-speed harmonics), where impacts ring a structural
+    resonance (Randall 2021, ch. 5.5, chooses it by spectral kurtosis; the strongest line is
+    the simple stand-in). Clipped to (low, 0.45 fs)."""
+    spec = amplitude_spectrum(x, fs)
+    low = 0.05 * fs if low is None else float(low)
+    sel = (spec.frequency > low) & (spec.frequency < 0.45 * fs)
+    if not sel.any():
+        return (fs / 4, 0.45 * fs)
+    fc = float(spec.frequency[sel][np.argmax(spec.amplitude[sel])])
+    return (max(low, 0.7 * fc), min(0.45 * fs, 1.3 * fc))
 
 
 def envelope_spectrum(x, fs: float, band: tuple[float, float] | None = None,
@@ -306,7 +320,7 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
                 np.arange(revs.size), np.flatnonzero(ok), revs[ok])))  # fmt: skip
     if "campbell" not in rep:
         rep["spectrogram"] = spectrogram(x, fs)
-    lo_hi = band if band is not None else (fs / 4, 0.45 * fs)
+    lo_hi = band if band is not None else resonance_band(x, fs)
     rep["envelope"], _ = envelope_spectrum(x, fs, lo_hi)
     summ["envelope_band_hz"] = list(lo_hi)
     rep["cepstrum"] = cepstrum(x, fs)

@@ -105,8 +105,10 @@ def zero_one(x, *, stride: int | None = None, max_samples: int = 20_000, n_c: in
     stride = max(1, int(stride))
     y = x[::stride][:max_samples]
     if y.size < MIN_SAMPLES:
+        what = "values" if stride == 1 else f"values after thinning by {stride} (one per " \
+            "decorrelation time)"  # fmt: skip
         return ZeroOne(float("nan"), stride, int(y.size), "refused",
-                       f"{y.size} values after thinning by {stride} (one per decorrelation "
-                       f"time); at least {MIN_SAMPLES} needed: record longer")  # fmt: skip
+                       f"{y.size} {what}; at least {MIN_SAMPLES} needed: a longer "
+                       "record")  # fmt: skip
     return ZeroOne(zero_one_test(y, n_c=n_c, seed=seed), stride, int(y.size), "ok",
                    f"thinned by {stride} to {y.size} values")  # fmt: skip

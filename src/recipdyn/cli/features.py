@@ -36,6 +36,7 @@ def features(
         "--chaos",
         help="Add the 0-1 test and the Rosenstein exponent with their statuses (slower).",
     ),
+    progress: bool = typer.Option(True, "--progress/--no-progress"),
 ) -> None:
     """Time-domain statistics, spectral and order features, chaos indicators: one row per
     run or window, labelled with the run's parameters."""
@@ -51,6 +52,6 @@ def features(
                 rows += [{"store": path.name, **r} for r in sweep_features(path)]
             else:
                 rows += file_features(path, column=column, fs=fs, window=window, speed=speed,
-                                      tacho=tacho, chaos=chaos)  # fmt: skip
+                                      tacho=tacho, chaos=chaos, progress=progress)  # fmt: skip
     write_table(rows, out)
     typer.echo(f"wrote {len(rows)} row(s) to {out}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import typer
@@ -129,17 +130,24 @@ def simulate(
         help="A registered model (see 'recipdyn models') or module:object; "
         "default: the paper's compressor.",
     ),  # fmt: skip
+    dump_config: Path = typer.Option(
+        None,
+        "--dump-config",
+        help="Write the full, commented TOML config of this run to the file ('-': print it) "
+        "and stop; 'simulate -c FILE' runs it. A recorded run (.nc) is a config too.",
+    ),
 ) -> None:
     """Simulate a model (default: the compressor); write the record (.nc, .csv or .zarr) and a
     figure."""
-    from ..errors import Interrupted, ParameterError
+    from ..errors import Interrupted, ModelValidityWarning, ParameterError
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset
     from ..simulate import DEFAULT_SETTINGS
     from ..simulate import simulate as run_sim
     from ..units import to_si
 
-    out = check_output(out)  # before any work: a bad path is reported at once
+    if dump_config is None:
+        out = check_output(out)  # before any work: a bad path is reported at once
     m, params, settings = _collect_model(model, rc, d, omega, sets, config)
     kw = {**DEFAULT_SETTINGS, **settings}
     for name, val in (("revolutions", revolutions), ("transient", transient), ("fs", fs),
@@ -149,6 +157,20 @@ def simulate(
     for name, val in (("method", method), ("rtol", rtol), ("atol", atol)):
         if val is not None:
             kw[name] = val
+    if dump_config is not None:
+        import dataclasses
+
+        from ..config import dump_config as dump
+        from ..io import write_text
+
+        values = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else params
+        text = dump(m, values, kw)
+        if str(dump_config) == "-":
+            typer.echo(text, nl=False)
+        else:
+            write_text(dump_config, text)
+            typer.echo(f"wrote {dump_config} (run it with: recipdyn simulate -c {dump_config})")
+        return
     _prepare(m, params, kw["method"])
     n_samples = kw["revolutions"] * params.crank_period * kw["fs"] if m.name == "compressor" \
         else 0.0  # fmt: skip
@@ -162,8 +184,10 @@ def simulate(
     elif float32 or compress:
         raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
     try:
-        ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
-                     model=m, **extra, **kw)  # fmt: skip
+        with warnings.catch_warnings():  # said once below, as a line of its own
+            warnings.simplefilter("ignore", ModelValidityWarning)
+            ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
+                         model=m, **extra, **kw)  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
         kept = keep_partial(exc, out)
         if kept is not None:
@@ -177,6 +201,8 @@ def simulate(
         raise
     if not stream:
         write_dataset(ds, out)
+    if ds.attrs.get("validity", "ok") != "ok":
+        typer.echo(f"warning: {ds.attrs['validity']}", err=True)
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
         summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}

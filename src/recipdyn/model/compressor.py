@@ -338,6 +338,12 @@ class Compressor(Model):
                        ("a", "m/s**2"))  # fmt: skip
     vibration_signal = ("a", "m/s**2")
     section_pair = ("v", "a")
+    validity_bounds = ((
+        "contact_force", "N", 0.0,
+        "the massless link can only push: a negative joint contact force means the pin would "
+        "leave the bearing wall, where the permanent-contact model no longer holds",
+        "the contact-impact joint (--model compressor-contact)",
+    ),)  # fmt: skip
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics

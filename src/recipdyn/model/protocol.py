@@ -224,6 +224,11 @@ class Model(ABC):
     def vibration(self) -> tuple[str, str]:
         return self.vibration_signal or (self.state_names[0], self.state_units[0])
 
+    #: Outputs that must stay at or above a bound for the model to hold: (output name, unit,
+    #: lower bound, why, what to use instead). Simulate warns and sweeps record the minimum
+    #: (``min_<output>``) and mark the points that cross.
+    validity_bounds: tuple[tuple[str, str, float, str, str], ...] = ()
+
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         """Events to locate during a simulation (at most one today: the integrator locates
         one event function). Default: none. An acting one (reset, terminal) must also be in

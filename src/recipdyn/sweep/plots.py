@@ -21,6 +21,35 @@ def _axis(ds, name):
     return ds[name].values * k, f"{label} ({unit})"
 
 
+def _mark_invalid(ax, ds, x, y, done) -> None:
+    """Mark the points where the model left its validity region (``min_<output>`` below the
+    bound the model declares, e.g. a negative joint contact force): red crosses on a map, red
+    bands on a curve, with a legend entry."""
+    from ..model.registry import get_model
+
+    try:
+        bounds = get_model(ds.attrs.get("model", "compressor")).validity_bounds
+    except Exception:  # a store from a model that is not installed here
+        return
+    for name, unit, bound, *_ in bounds:
+        var = f"min_{name}"
+        if var not in ds:
+            continue
+        bad = done & (ds[var].values < bound)
+        if not bad.any():
+            continue
+        label = f"{name} < {bound:g} {unit}: outside the model"
+        if y is None:
+            step = np.min(np.diff(x)) / 2 if x.size > 1 else 0.5
+            for i, xi in enumerate(x[bad]):
+                ax.axvspan(xi - step, xi + step, color="tab:red", alpha=0.15,
+                           label=label if i == 0 else None)  # fmt: skip
+        else:
+            yy, xx = np.meshgrid(y, x, indexing="ij")
+            ax.plot(xx[bad], yy[bad], "x", color="tab:red", ms=6, label=label)
+        ax.legend(fontsize=7, loc="best")
+
+
 def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
     """Write every figure the store supports; returns their paths."""
     plt = _mpl()
@@ -64,6 +93,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
             if var in ds:
                 fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
                 ax.plot(x[done], ds[var].values[done], "o-", ms=3)
+                _mark_invalid(ax, ds, x, None, done)
                 ax.set_xlabel(xlabel)
                 ax.set_ylabel(ylab)
                 ax.axhline(0, color="k", lw=0.5)
@@ -95,6 +125,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.set_xscale("log")
             if ds[dims[0]].attrs.get("scale") == "log":
                 ax.set_yscale("log")
+            _mark_invalid(ax, ds, x, y, done)
             ax.set_title(f"Fault map: {clabel}")
             p = out / f"map_{var}.png"
             save_figure(fig, p, dpi=130)

@@ -114,7 +114,10 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         n = int(s["revolutions"] * T * fs) + 1
         te = t0 + np.arange(n) / fs
         sol = integrate(m, y, (0.0, te[-1]), t_eval=te, **solver)
-        a = pt.outputs(sol.t, sol.y)[pt.vib].values
+        outs = pt.outputs(sol.t, sol.y)
+        a = outs[pt.vib].values
+        for name, *_ in pt.model.validity_bounds:
+            res[f"min_{name}"] = float(np.min(outs[name].values))
         res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
         res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
         if "spectrum" in measures:
