@@ -69,8 +69,10 @@ def test_features_bad_window_exit_2(tmp_path, capsys):
                  str(tmp_path / "x.csv")]) == 2  # fmt: skip
     assert main(["features", str(sig), "-c", "acc", "-w", "1 ms", "-o",
                  str(tmp_path / "x.csv")]) == 2  # fmt: skip
+    assert main(["features", str(sig), "-c", "acc", "-o", str(tmp_path / "x.xlsx")]) == 2
     err = capsys.readouterr().err
     assert "needs the speed" in err and "at least 64" in err and "Traceback" not in err
+    assert "use .csv or .parquet" in err
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".npy", ".wav", ".parquet", ".nc"])

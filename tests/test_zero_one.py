@@ -29,3 +29,12 @@ def test_classify():
     assert classify(spectrum=spec).verdict == "periodic"
     assert classify(lambda1=0.5, k01=0.02).verdict == "undetermined"
     assert "verdict" in classify(lambda1=0.9, k01=0.99).to_dict()
+
+
+def test_spectrum_alone_does_not_make_noise_quasi_periodic():
+    """A broadband spectrum is no evidence of quasi-periodic motion (the old spectrum-only
+    rule called every broadband signal quasi-periodic): undetermined, with the reason; a
+    harmonic line spectrum alone still says periodic."""
+    x = np.random.default_rng(0).standard_normal(8000)
+    v = classify(spectrum=amplitude_spectrum(x, 100.0))
+    assert v.verdict == "undetermined" and "spectrum alone" in v.reasons[-1]

@@ -203,6 +203,10 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
         reasons.append("all strong spectral lines are harmonics of one fundamental")
         if k01 is None or k01 < 0.5:
             return Verdict("periodic", ev, reasons)
+    if lambda1 is None and k01 is None and n_distinct is None:
+        reasons.append("a spectrum alone cannot tell quasi-periodic motion from chaos or noise "
+                       "(its lines are not all harmonics of one fundamental)")  # fmt: skip
+        return Verdict("undetermined", ev, reasons)
     if k01 is None or k01 < 0.5:
         reasons.append("no positive exponent" if lambda1 is not None else "no exponent given")
         if k01 is not None:

@@ -43,6 +43,8 @@ def features(
     from ..features import file_features, sweep_features, write_table
     from ..model.parameters import ParameterError
 
+    if out.suffix.lower() not in (".csv", ".parquet"):  # before any work
+        raise ParameterError(f"output {out}: use .csv or .parquet")
     rows = []
     for path in inputs:
         if not path.exists():
