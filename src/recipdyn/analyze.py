@@ -231,7 +231,7 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``)."""
     from .analysis.signal import assess_signal as assess
     from .io import check_output
-    from .io_signal import read_signal
+    from .io_signal import crank_revs, read_signal
 
     path, out = Path(path), Path(out)
     sig = read_signal(path, column=column, fs=fs)
@@ -261,23 +261,7 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     fig = plot_spectrum(spec, peaks, title=f"spectrum of {sig.name}")
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
-    revs = None
-    if tacho is not None:
-        from .analysis.vibration import crank_angle, tacho_times
-
-        pulse = read_signal(path, column=tacho, fs=rate)
-        try:
-            revs = crank_angle(x.size, rate, pulses=tacho_times(pulse.x, rate))
-        except ValueError as exc:
-            raise ParameterError(f"tacho {tacho!r}: {exc}") from None
-    elif speed is not None:
-        from .analysis.vibration import crank_angle
-        from .units import to_si
-
-        f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
-        if not f_rev > 0:
-            raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
-        revs = crank_angle(x.size, rate, speed_hz=f_rev)
+    revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
     vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
                             zones=parse_zones(zones), band=band,
                             title=f"{sig.source}: {sig.name}")  # fmt: skip

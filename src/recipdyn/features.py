@@ -108,10 +108,9 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
     """Rows for one file: a recipdyn run (its vibration signal, speed and parameters) or a
     measured signal (``column``/``fs`` as for analyze; ``speed`` or a ``tacho`` column for
     the orders)."""
-    from .analysis.vibration import crank_angle, tacho_times
+    from .analysis.vibration import crank_angle
     from .analyze import is_record
-    from .io_signal import read_signal
-    from .units import to_si
+    from .io_signal import crank_revs, read_signal, speed_hz
 
     path = Path(path)
     labels: dict[str, Any] = {}
@@ -134,14 +133,11 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         f_rev = None
     revs = None
     if tacho is not None:
-        pulse = read_signal(path, column=tacho, fs=rate)
-        revs = crank_angle(x.size, rate, pulses=tacho_times(pulse.x, rate))
+        revs = crank_revs(path, x.size, rate, tacho=tacho)
         ok = np.isfinite(revs)
         f_rev = (revs[ok][-1] - revs[ok][0]) / (ok.sum() / rate)
     elif speed is not None:
-        f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
-        if not f_rev > 0:
-            raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
+        f_rev = speed_hz(speed)
     if revs is None and f_rev:
         revs = crank_angle(x.size, rate, speed_hz=f_rev)
     rows = []
@@ -156,25 +152,14 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
     return rows
 
 
-def _speed_hz(speed) -> float | None:
-    from .units import to_si
-
-    if speed is None:
-        return None
-    f_rev = to_si("speed", speed, "rad/s") / (2 * math.pi)
-    if not f_rev > 0:
-        raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
-    return f_rev
-
-
 def _streamed_rows(path, column, fs, window, speed, chaos, progress) -> list[dict[str, Any]]:
     """Feature rows of consecutive windows of a signal file read block by block (memory: a
     block of 10^6 samples and one window, whatever the file's length)."""
     from .analysis.vibration import crank_angle
-    from .io_signal import signal_blocks
+    from .io_signal import signal_blocks, speed_hz
 
     rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
-    f_rev = _speed_hz(speed)
+    f_rev = speed_hz(speed)
     m = _window_samples(window, rate, 1.0 / f_rev if f_rev else None)
     if total is not None and m > total:
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "

@@ -15,7 +15,14 @@ import numpy as np
 from .model.parameters import ParameterError
 from .units import to_si
 
-__all__ = ["MeasuredSignal", "read_signal", "SIGNAL_SUFFIXES", "signal_blocks"]
+__all__ = [
+    "MeasuredSignal",
+    "read_signal",
+    "SIGNAL_SUFFIXES",
+    "signal_blocks",
+    "speed_hz",
+    "crank_revs",
+]
 
 SIGNAL_SUFFIXES = (".csv", ".txt", ".tsv", ".wav", ".mat", ".nc", ".parquet", ".npy")
 TIME_NAMES = ("time", "t", "time_s", "time (s)", "t (s)", "seconds")
@@ -32,6 +39,10 @@ class MeasuredSignal:
     source: str
     units: str = ""
     notes: list[str] = field(default_factory=list)
+
+
+def _csv_sep(suffix: str) -> str:
+    return {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
 
 
 def _fs_option(fs) -> float | None:
@@ -120,7 +131,7 @@ def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
         if suffix in (".csv", ".txt", ".tsv"):
             import pandas as pd
 
-            sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+            sep = _csv_sep(suffix)
             frame = pd.read_csv(path, sep=sep, engine="python", comment="#")
             x, fs, name, notes = _table(frame, path, column, fs)
         elif suffix == ".parquet":
@@ -202,7 +213,7 @@ def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_
     if suffix in (".csv", ".txt", ".tsv"):
         import pandas as pd
 
-        sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+        sep = _csv_sep(suffix)
 
         def gen():
             last_t = None
@@ -272,7 +283,7 @@ def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000
     if suffix in (".csv", ".txt", ".tsv") and path.is_file() and path.stat().st_size > 0:
         import pandas as pd
 
-        sep = {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
+        sep = _csv_sep(suffix)
         try:
             frame = pd.read_csv(path, sep=sep, engine="python", comment="#", nrows=rows)
         except Exception as exc:
@@ -321,3 +332,29 @@ def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000
             return MeasuredSignal(np.asarray(da.values[:rows], dtype=float), rate, name,
                                   path.name)  # fmt: skip
     return read_signal(path, column=column, fs=fs)
+
+
+def speed_hz(speed) -> float | None:
+    """A crank speed option ('191 rpm', '20 rad/s', '3.2 Hz') in revolutions per second."""
+    if speed is None:
+        return None
+    f_rev = to_si("speed", speed, "rad/s") / (2 * np.pi)
+    if not f_rev > 0:
+        raise ParameterError(f"speed: {speed!r}; allowed: a positive speed, e.g. 191 rpm")
+    return f_rev
+
+
+def crank_revs(path: str | Path, n: int, fs: float, *, tacho=None, speed=None):
+    """The crank angle (revolutions) at each of ``n`` samples of ``path``: from its
+    once-per-revolution ``tacho`` column/channel, or a constant ``speed``; None with
+    neither."""
+    from .analysis.vibration import crank_angle, tacho_times
+
+    if tacho is not None:
+        pulse = read_signal(path, column=tacho, fs=fs)
+        try:
+            return crank_angle(n, fs, pulses=tacho_times(pulse.x, fs))
+        except ValueError as exc:
+            raise ParameterError(f"tacho {tacho!r}: {exc}") from None
+    f_rev = speed_hz(speed)
+    return None if f_rev is None else crank_angle(n, fs, speed_hz=f_rev)

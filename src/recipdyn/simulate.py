@@ -13,7 +13,6 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
-from .config import dump_config
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
@@ -77,6 +76,22 @@ def _coerce_params(params: CompressorParams | None, overrides: dict[str, Any]) -
 
     names = {resolve_name(k): v for k, v in overrides.items()}
     return dataclasses.replace(base, **names)
+
+
+def _track_minima(model, outs, minima: dict[str, float]) -> None:
+    """Lower ``minima`` to the smallest value of every output ``model`` bounds."""
+    for name, *_ in model.validity_bounds:
+        if name in outs and np.size(outs[name].values):
+            minima[name] = min(minima.get(name, math.inf), float(np.min(outs[name].values)))
+
+
+def _check_validity(model, minima: dict[str, float], attrs: dict) -> None:
+    """Record (``attrs["validity"]``) and warn (:class:`ModelValidityWarning`) when an output
+    crossed the model's validity bound."""
+    warning = validity_warning(model, minima)
+    attrs["validity"] = warning or "ok"
+    if warning:
+        warnings.warn(warning, ModelValidityWarning, stacklevel=3)
 
 
 def validity_warning(model, minima: dict[str, float]) -> str:
@@ -224,7 +239,7 @@ def simulate(
     # progress bar; they never change the result (see recipdyn.integrate).
     chunks = max(1, min(1000, int(math.ceil(transient + revolutions))))
     writer = sink = None
-    min_force = [math.inf]
+    minima: dict[str, float] = {}
     tail: list[xr.Dataset] = []  # the last two blocks: the run summary's last revolution
     if out is not None:
         from .io import StreamWriter
@@ -233,7 +248,7 @@ def simulate(
 
         def sink(t, y):
             outs = model.outputs(t, y)
-            min_force[0] = min(min_force[0], float(np.min(outs["contact_force"].values)))
+            _track_minima(COMPRESSOR, outs, minima)
             rec = _record(outs, t, T, keep)
             writer.append(rec)
             tail[:] = [*tail[-1:], rec]
@@ -263,8 +278,7 @@ def simulate(
         if sol.t.size == 0 and failure is None:
             raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
         ds = _record(outs, sol.t, T, keep)
-        if sol.t.size:
-            min_force[0] = float(np.min(outs["contact_force"].values))
+        _track_minima(COMPRESSOR, outs, minima)
     attrs: dict[str, Any] = {
         "title": "recipdyn compressor simulation",
         "recipdyn_version": __version__,
@@ -294,18 +308,17 @@ def simulate(
         "transient_revolutions": transient,
         "sampling_rate_hz": fs,
         "crank_frequency_hz": p.crank_frequency,
-        "min_contact_force_N": min_force[0] if math.isfinite(min_force[0]) else float("nan"),
+        "min_contact_force_N": minima.get("contact_force", float("nan")),
         "columns": "all" if columns is None else ",".join(keep),
         "storage": "float32" if (float32 and writer is not None) else "float64",
     }
     attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+    from .config import dump_config  # pydantic: imported when a run is recorded
+
     attrs["config_toml"] = dump_config(COMPRESSOR, vars(p), dict(
         revolutions=revolutions, transient=transient, fs=fs, method=method, rtol=rtol,
         atol=atol, h=h))  # fmt: skip
-    warning = validity_warning(COMPRESSOR, {"contact_force": min_force[0]})
-    attrs["validity"] = warning or "ok"
-    if warning:
-        warnings.warn(warning, ModelValidityWarning, stacklevel=2)
+    _check_validity(COMPRESSOR, minima, attrs)
     recent = ds if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
         attrs.update(clean_attrs(COMPRESSOR.run_summary(vars(p), recent)))
@@ -414,6 +427,8 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     T = float(period) if period else 1.0  # one "revolution" = one forcing period
     system = m.system(values)
     y0 = m.initial_state(values)
+    from .config import dump_config  # pydantic: imported when a run is recorded
+
     attrs: dict[str, Any] = {
         "title": f"recipdyn simulation: {m.name}", "recipdyn_version": __version__,
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
@@ -468,6 +483,10 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
                  solver_status=sol.message, solver_wall_time_s=time.perf_counter() - t0,
                  sampling_rate_hz=fs)  # fmt: skip
     ds = _dataset(m, values, sol.t, sol.y, "time", m.time_unit, attrs)
+    if m.validity_bounds:
+        minima: dict[str, float] = {}
+        _track_minima(m, ds, minima)
+        _check_validity(m, minima, ds.attrs)
     if events:
         ds = _with_events(ds, m, events[0], sol, t_start)
     if sol.t.size:

@@ -179,9 +179,9 @@ def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
     tau = estimate_delay(x) if delay is None else int(delay)
     th = int(round(mean_period(x))) if theiler is None else int(theiler)
     th = min(th, x.size // 10)
-    e1, e2 = cao(x[:max_points], tau, max_dim=max_dim)
     if dim is not None:
-        return Embedding(tau, int(dim), th, "ok", "dimension given", e1, e2)
+        return Embedding(tau, int(dim), th, "ok", "dimension given", np.empty(0), np.empty(0))
+    e1, e2 = cao(x[:max_points], tau, max_dim=max_dim)
     if np.all(np.isnan(e1)):
         return Embedding(tau, 2, th, "degenerate", "no two distinct embedded points", e1, e2)
     for d in range(1, max_dim - 1):

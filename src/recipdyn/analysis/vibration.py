@@ -236,13 +236,13 @@ class Impact:
 
 
 def detect_impacts(x, fs: float, *, revs=None, band: tuple[float, float] | None = None,
-                   threshold: float = 8.0,
-                   min_gap: float | None = None) -> list[Impact]:  # fmt: skip
+                   threshold: float = 8.0, min_gap: float | None = None,
+                   envelope=None) -> list[Impact]:  # fmt: skip
     """Impact bursts: where the band-passed envelope exceeds its median by ``threshold``
     robust standard deviations (1.4826 MAD), and 1 % of its largest value. Bursts closer
     than ``min_gap`` (s; default 2 % of a revolution with ``revs``, else 2 ms) are one
     impact."""
-    _, env = envelope_spectrum(x, fs, band)
+    env = envelope_spectrum(x, fs, band)[1] if envelope is None else np.asarray(envelope)
     # the band-pass filter and the Hilbert transform ring at the record's ends: bursts there
     # are artefacts (a few periods of the band's lower edge)
     lo = band[0] if band is not None else fs / 4
@@ -321,10 +321,10 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
     if "campbell" not in rep:
         rep["spectrogram"] = spectrogram(x, fs)
     lo_hi = band if band is not None else resonance_band(x, fs)
-    rep["envelope"], _ = envelope_spectrum(x, fs, lo_hi)
+    rep["envelope"], env = envelope_spectrum(x, fs, lo_hi)
     summ["envelope_band_hz"] = list(lo_hi)
     rep["cepstrum"] = cepstrum(x, fs)
-    hits = detect_impacts(x, fs, revs=revs, band=lo_hi, threshold=impact_threshold)
+    hits = detect_impacts(x, fs, revs=revs, band=lo_hi, threshold=impact_threshold, envelope=env)
     rep["impacts"] = hits
     n_rev = None
     if revs is not None and np.isfinite(revs).any():
