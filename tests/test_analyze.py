@@ -77,3 +77,26 @@ def test_finite_time_exponent_of_a_regular_orbit_is_extrapolated_away():
     r2 = lyapunov_spectrum(m2, m2.initial_state(), 100 * p2.crank_period)
     lam2, _ = r2.largest_limit()
     assert r2.exponents[0] > 1.0 and lam2 == pytest.approx(r2.exponents[0], rel=0.25)
+
+
+def test_analyze_says_what_it_is_doing(tmp_path):
+    """Every phase that can take long is announced through the ``phase`` hook (the CLI's
+    prints a spinner and a line with its duration): issue 14, item 3."""
+    import contextlib
+
+    from recipdyn.analyze import analyze_run
+
+    run = tmp_path / "base.nc"
+    assert main(["simulate", "-n", "2", "--fs", "2 kHz", "-o", str(run), "--no-figure",
+                 "--no-progress"]) == 0  # fmt: skip
+    seen = []
+
+    @contextlib.contextmanager
+    def record(message, **_):
+        seen.append(message)
+        yield
+
+    analyze_run(run, tmp_path / "an", section_points=20, lyap_revolutions=5, phase=record)
+    for what in ("spectrum", "vibration page", "exponents from the signal", "Poincaré section",
+                 "Benettin"):  # fmt: skip
+        assert any(what in m for m in seen), (what, seen)

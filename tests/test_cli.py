@@ -114,3 +114,48 @@ def test_help_and_import_load_no_heavy_library():
     assert r.returncode == 0, r.stderr
     assert "HEAVY []" in r.stdout, r.stdout[-500:]
     assert "FUNC simulate" in r.stdout
+
+
+def test_exports_and_json_summary(tmp_path, capsys):
+    """Issue 14, exports: the same run as NetCDF and MAT holds the same samples (MAT read back
+    with scipy, as MATLAB/Octave users would), with units and attributes; ``--json`` prints
+    one JSON object on stdout (everything else on stderr) whose numbers are the record's."""
+    import json
+
+    import numpy as np
+    import scipy.io as sio
+    import xarray as xr
+
+    args = ["simulate", "-n", "0.5", "--fs", "2 kHz", "--no-figure", "--no-progress"]
+    assert main([*args, "-o", str(tmp_path / "r.nc")]) == 0
+    capsys.readouterr()
+    assert main([*args, "-o", str(tmp_path / "r.mat"), "--json"]) == 0
+    io = capsys.readouterr()
+    summary = json.loads(io.out)  # stdout is exactly one JSON document
+    assert "wrote" in io.err and "wrote" not in io.out
+    with xr.open_dataset(tmp_path / "r.nc") as ds:
+        mat = sio.loadmat(tmp_path / "r.mat", squeeze_me=True)
+        np.testing.assert_array_equal(mat["a"], ds["a"].values)
+        np.testing.assert_array_equal(mat["time"], ds["time"].values)
+        assert str(mat["units"]["a"]) == ds["a"].attrs["units"]
+        assert float(mat["attrs"]["param_rc"]) == ds.attrs["param_rc"]
+        assert summary["peak_a"] == float(np.abs(ds["a"].values).max())
+        assert summary["parameters"]["rc"] == ds.attrs["param_rc"]
+    assert summary["samples"] == {"time": int(mat["time"].size)}
+    assert summary["validity"] == "ok"
+
+
+def test_analyze_json(tmp_path, capsys):
+    import json
+
+    run = tmp_path / "ideal.nc"
+    assert main(["simulate", "--rc", "0 mm", "-n", "2", "--fs", "2 kHz", "-o", str(run),
+                 "--no-figure", "--no-progress"]) == 0  # fmt: skip
+    capsys.readouterr()
+    assert main(["analyze", str(run), "-o", str(tmp_path / "an"), "--section-points", "20",
+                 "--json"]) == 0  # fmt: skip
+    s = json.loads(capsys.readouterr().out)
+    assert s["verdict"]["verdict"] == "periodic"
+    saved = json.loads((tmp_path / "an" / "summary.json").read_text(encoding="utf-8"))
+    assert s["verdict"] == saved["verdict"] and s["spectrum"] == saved["spectrum"]
+    assert s["output"] == str(tmp_path / "an")

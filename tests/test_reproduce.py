@@ -51,9 +51,32 @@ def test_table_covers_every_reported_number(report_dir):
 def test_html_report_embeds_all_figures(report_dir):
     html = (report_dir / "report.html").read_text()
     n_fig = len(list((report_dir / "figures").glob("*.png")))
-    assert html.count("data:image/png;base64,") == n_fig
+    assert html.count("src='data:image/webp;base64,") == n_fig
     for word in ("Findings", "assumed", "Every number the paper reports", "Benettin"):
         assert word in html
+
+
+def test_report_is_navigable_and_small(report_dir):
+    """Issue 14, item 2: a navigation bar, collapsible sections, every internal link lands on
+    an element, every linked file exists, every quantity of the table and every variant is in
+    the glossary, assumed parameters are marked, and the file stays under 3 MB."""
+    import re
+
+    from recipdyn.reproduce.report import GLOSSARY
+
+    path = report_dir / "report.html"
+    html = path.read_text()
+    assert path.stat().st_size < 3e6, f"{path.stat().st_size / 1e6:.2f} MB"
+    assert "<nav>" in html and html.count("<details") >= 8
+    ids = set(re.findall(r"id='([^']+)'", html))
+    anchors = re.findall(r"href='#([^']+)'", html)
+    assert anchors and not [a for a in anchors if a not in ids]
+    files = re.findall(r"href='(figures/[^']+)'", html)
+    assert len(files) == len(list((report_dir / "figures").glob("*.png")))
+    assert all((report_dir / f).is_file() for f in files)
+    used = {pv.quantity for pv in PAPER_VALUES} | {v.id for v in VARIANTS}
+    assert used <= set(GLOSSARY), sorted(used - set(GLOSSARY))
+    assert html.count("class=assumed") >= 5  # m1, m2, m3, J1, J2 at least
 
 
 def test_cache_is_reused(tmp_path):
@@ -68,7 +91,8 @@ def test_cache_is_reused(tmp_path):
 
 @pytest.mark.browser
 def test_report_renders_in_headless_chromium(report_dir, tmp_path):
-    """Open the report in Debian's Chromium: every embedded image decodes (naturalWidth > 0)."""
+    """Open the report in Debian's Chromium: every embedded image decodes (naturalWidth > 0)
+    and every in-page link has its target."""
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
     if exe is None:
         pytest.skip("chromium is not installed (CI installs it in .ci/run)")
@@ -80,3 +104,4 @@ def test_report_renders_in_headless_chromium(report_dir, tmp_path):
     n_fig = len(list((report_dir / "figures").glob("*.png")))
     assert 'data-images-ok="true"' in dom
     assert f'data-image-count="{n_fig}"' in dom
+    assert 'data-broken-anchors="0"' in dom

@@ -35,6 +35,19 @@ def test_tacho_edges_and_angle():
     assert np.isnan(ang[0])  # before the first pulse: unknown
 
 
+def test_narrow_keyphasor_pulses_are_found():
+    """A notch pulse over 2 % of a revolution (narrower than the 5 % percentile band) gives the
+    same edges as a wide pulse: the levels fall back to the minimum and maximum."""
+    t, revs, _ = _runup()
+    narrow = ((revs % 1.0) < 0.02).astype(float)
+    wide = ((revs % 1.0) < 0.2).astype(float)
+    e_narrow, e_wide = V.tacho_times(narrow, FS), V.tacho_times(wide, FS)
+    assert e_narrow.size == e_wide.size == int(revs[-1])
+    np.testing.assert_allclose(e_narrow, e_wide, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="flat"):
+        V.tacho_times(np.ones(1000), FS)
+
+
 def test_order_spectrum_is_sharp_during_a_runup():
     """Order 3 and order 7.5 components (amplitudes 1 and 0.4) during a 5 -> 15 Hz run-up: in
     the angle domain each is one line of its amplitude (within 2 %, Hann window on whole

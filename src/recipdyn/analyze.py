@@ -27,6 +27,7 @@ from .io import save_figure, write_text
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
 from .plotting import _mpl, axis_label
+from .progress import quiet
 from .simulate import params_from_attrs
 
 __all__ = ["analyze_run", "analyze_signal", "is_record", "MIN_SAMPLES"]
@@ -37,13 +38,15 @@ MIN_SAMPLES = 64
 
 def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                 lyap_revolutions: float = 100.0, max_signal_samples: int = 40_000,
-                rtol: float = RTOL, atol: float = ATOL) -> dict[str, Any]:  # fmt: skip
+                rtol: float = RTOL, atol: float = ATOL, phase=quiet) -> dict[str, Any]:  # fmt: skip
     """Analyse ``path`` (a NetCDF file from ``recipdyn simulate``) into folder ``out``.
 
     Equation-based results (stroboscopic section over ``section_points`` revolutions, Benettin
     over ``lyap_revolutions``) are computed when the file records recipdyn parameters; the
     signal-based ones (spectrum, Wolf, Rosenstein on the crosshead acceleration) always.
-    Returns the summary dict (also written as ``summary.json`` and ``summary.md``).
+    ``phase(message)`` is entered around each step that can take long (a context manager:
+    :func:`recipdyn.progress.phase` says what is running). Returns the summary dict (also
+    written as ``summary.json`` and ``summary.md``).
     """
     from .io import check_output, read_dataset
 
@@ -80,49 +83,53 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                                "model": m.name if m is not None else "unknown",
                                "signal": vib}  # fmt: skip
 
-    spec = amplitude_spectrum(a, fs)
-    peaks = find_spectral_peaks(spec, n=8, fundamental=fc)
-    summary["spectrum"] = {
-        "resolution_hz": spec.resolution,
-        "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude, crank_order=p.order)
-                  for p in peaks],
-    }  # fmt: skip
-    fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
-    what = "the crosshead acceleration" if compressor else vib
-    fig = plot_spectrum(spec, peaks, fmax=fmax, title=f"spectrum of {what}")
-    save_figure(fig, out / "spectrum.png", dpi=110)
-    plt.close(fig)
-    if compressor:
-        fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
-        plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
-        plot_phase(ds.v, ds.a, "v (m/s)", "a (m/s$^2$)", ax=axes[1],
-                   title="velocity-acceleration")  # fmt: skip
-        if "theta_c" in ds:
-            plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)",
-                       ax=axes[2], title="clearance angle")  # fmt: skip
-    else:
-        names = [s for s in m.state_names if s in ds]
-        pairs = list(zip(names, names[1:], strict=False))[:3] or [(names[0], names[0])]
-        fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
-                                 constrained_layout=True, squeeze=False)  # fmt: skip
-        for ax, (u, w) in zip(axes[0], pairs, strict=True):
-            plot_phase(ds[u], ds[w], axis_label(u, ds[u]), axis_label(w, ds[w]), ax=ax,
-                       points=dim == "iteration", title=f"{u}-{w}")  # fmt: skip
-    save_figure(fig, out / "phase_portraits.png", dpi=110)
-    plt.close(fig)
+    with phase("analyze: spectrum and phase portraits"):
+        spec = amplitude_spectrum(a, fs)
+        peaks = find_spectral_peaks(spec, n=8, fundamental=fc)
+        summary["spectrum"] = {
+            "resolution_hz": spec.resolution,
+            "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude, crank_order=p.order)
+                      for p in peaks],
+        }  # fmt: skip
+        fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
+        what = "the crosshead acceleration" if compressor else vib
+        fig = plot_spectrum(spec, peaks, fmax=fmax, title=f"spectrum of {what}")
+        save_figure(fig, out / "spectrum.png", dpi=110)
+        plt.close(fig)
+        if compressor:
+            fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
+            plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
+            plot_phase(ds.v, ds.a, "v (m/s)", "a (m/s$^2$)", ax=axes[1],
+                       title="velocity-acceleration")  # fmt: skip
+            if "theta_c" in ds:
+                plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)",
+                           ax=axes[2], title="clearance angle")  # fmt: skip
+        else:
+            names = [s for s in m.state_names if s in ds]
+            pairs = list(zip(names, names[1:], strict=False))[:3] or [(names[0], names[0])]
+            fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
+                                     constrained_layout=True, squeeze=False)  # fmt: skip
+            for ax, (u, w) in zip(axes[0], pairs, strict=True):
+                plot_phase(ds[u], ds[w], axis_label(u, ds[u]), axis_label(w, ds[w]), ax=ax,
+                           points=dim == "iteration", title=f"{u}-{w}")  # fmt: skip
+        save_figure(fig, out / "phase_portraits.png", dpi=110)
+        plt.close(fig)
 
     if compressor and fc:
         from .analysis.vibration import crank_angle
 
         revs = crank_angle(a.size, fs, speed_hz=fc, zero_rev=float(t[0]) * fc)
-        summary["vibration"] = vibration_section(
-            a, fs, out, plt, revs=revs, title=f"{path.name}: crosshead acceleration"
-        )
-    assessment = assess_signal(a, fs, max_samples=max_signal_samples)
-    summary["lyapunov_signal"] = {k: _plain(r.diagnostics())
-                                  for k, r in assessment.lyapunov.items()}  # fmt: skip
-    summary["signal_assessment"] = _plain(assessment.to_dict())
-    _divergence_figures(assessment, out, plt)
+        with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
+            summary["vibration"] = vibration_section(
+                a, fs, out, plt, revs=revs, title=f"{path.name}: crosshead acceleration"
+            )
+    with phase(f"analyze: exponents from the signal, 0-1 test, surrogates "
+               f"({min(a.size, max_signal_samples)} samples)"):  # fmt: skip
+        assessment = assess_signal(a, fs, max_samples=max_signal_samples)
+        summary["lyapunov_signal"] = {k: _plain(r.diagnostics())
+                                      for k, r in assessment.lyapunov.items()}  # fmt: skip
+        summary["signal_assessment"] = _plain(assessment.to_dict())
+        _divergence_figures(assessment, out, plt)
 
     lam = None
     lam_err = 0.0
@@ -130,7 +137,18 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     k01 = None
     if not compressor:
         lam, lam_err, section, k01 = _equations_any_model(
-            m, ds, dim, out, summary, section_points, lyap_revolutions, rtol, atol, plt, path
+            m,
+            ds,
+            dim,
+            out,
+            summary,
+            section_points,
+            lyap_revolutions,
+            rtol,
+            atol,
+            plt,
+            path,
+            phase,
         )
     elif "param_rc" in ds.attrs:
         try:
@@ -142,7 +160,8 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         model = compressor_model(p)
         y0 = np.array([float(ds.theta_c.values[0]), float(ds.thetadot_c.values[0])])
         t0 = float(t[0])
-        sec = stroboscopic_section(model, y0, section_points, t0=t0, rtol=rtol, atol=atol)
+        with phase(f"analyze: Poincaré section ({section_points} revolutions)"):
+            sec = stroboscopic_section(model, y0, section_points, t0=t0, rtol=rtol, atol=atol)
         section = np.c_[sec.v.values, sec.a.values]
         title = f"Poincaré section, once per revolution ({section_points} points)"
         fig = plot_phase(sec.v, sec.a, "v (m/s)", "a (m/s$^2$)", points=True, title=title)
@@ -151,8 +170,9 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         if section_points >= 100:
             k01 = zero_one_test(sec.thetadot_c.values)
         if p.rc > 0:
-            res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
-                                    rtol=rtol, atol=atol)  # fmt: skip
+            with phase(f"analyze: Benettin exponents ({lyap_revolutions:g} revolutions)"):
+                res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
+                                        rtol=rtol, atol=atol)  # fmt: skip
             lam, lam_err = res.largest_limit()
             summary["lyapunov_equations"] = {
                 "lambda1_limit_per_s": lam,
@@ -225,7 +245,7 @@ def vibration_section(x, fs, out, plt, *, revs=None, quantity="acceleration", zo
 def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
                    max_signal_samples: int = 40_000, tacho=None, speed=None,
                    quantity: str = "acceleration", zones=None,
-                   band=None) -> dict[str, Any]:  # fmt: skip
+                   band=None, phase=quiet) -> dict[str, Any]:  # fmt: skip
     """Analyse one channel of a measured (or any) signal file into folder ``out``: the signal,
     its spectrum, the exponents from the signal with their statuses, the 0-1 test, the
     surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``)."""
@@ -234,7 +254,8 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     from .io_signal import crank_revs, read_signal
 
     path, out = Path(path), Path(out)
-    sig = read_signal(path, column=column, fs=fs)
+    with phase(f"analyze: reading {path.name}"):
+        sig = read_signal(path, column=column, fs=fs)
     if sig.x.size < 200:
         raise ParameterError(f"{path}: {sig.x.size} samples in {sig.name!r}; analyze needs at "
                              "least 200 for a signal without equations")  # fmt: skip
@@ -262,11 +283,14 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
     revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
-    vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
-                            zones=parse_zones(zones), band=band,
-                            title=f"{sig.source}: {sig.name}")  # fmt: skip
-    a = assess(x, rate, max_samples=max_signal_samples, revs=revs)
-    _divergence_figures(a, out, plt)
+    with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
+        vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
+                                zones=parse_zones(zones), band=band,
+                                title=f"{sig.source}: {sig.name}")  # fmt: skip
+    with phase(f"analyze: exponents from the signal, 0-1 test, surrogates "
+               f"({min(x.size, max_signal_samples)} samples)"):  # fmt: skip
+        a = assess(x, rate, max_samples=max_signal_samples, revs=revs)
+        _divergence_figures(a, out, plt)
     summary: dict[str, Any] = {
         "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(x.size),
         "fs_hz": rate, "notes": sig.notes + a.notes, "model": "none (measured signal)",
@@ -318,7 +342,7 @@ def _record_model(ds, path):
 
 
 def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revolutions, rtol,
-                         atol, plt, path):  # fmt: skip
+                         atol, plt, path, phase=quiet):  # fmt: skip
     """Section, Benettin exponents and 0-1 test of any registered model's record."""
     from .analysis import lyapunov_spectrum_map
 
@@ -340,12 +364,16 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         summary["lyapunov_equations"] = {"refused": m.lyapunov_refusal}
     if m.kind == "map":
         section = np.c_[tuple(ds[s].values for s in pair)]
-        res = lyapunov_spectrum_map(system, y0, max(1000, int(lyap_revolutions)), n_transient=0)
+        with phase("analyze: Lyapunov exponents of the map"):
+            res = lyapunov_spectrum_map(system, y0, max(1000, int(lyap_revolutions)),
+                                        n_transient=0)  # fmt: skip
         unit = "per iteration"
     else:
         period = m.period(values)
         if period:
-            sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol, atol=atol)
+            with phase(f"analyze: Poincaré section ({section_points} periods)"):
+                sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol,
+                                           atol=atol)  # fmt: skip
             section = np.c_[tuple(sec[s].values for s in pair)]
             title = f"Poincaré section, once per period ({section_points})"
             fig = plot_phase(sec[pair[0]], sec[pair[1]], pair[0], pair[1], points=True,
@@ -358,8 +386,9 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         if not supported:
             summary["zero_one_K"] = k01
             return None, 0.0, section, k01
-        res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
-                                rtol=rtol, atol=atol)  # fmt: skip
+        with phase(f"analyze: Benettin exponents ({lyap_revolutions:g} periods)"):
+            res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
+                                    rtol=rtol, atol=atol)  # fmt: skip
         unit = f"per {m.time_unit}"
     lam, lam_err = res.largest_limit()
     summary["lyapunov_equations"] = {

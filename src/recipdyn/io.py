@@ -26,7 +26,7 @@ __all__ = [
 ]  # fmt: skip
 
 #: File extension -> format of a simulated record.
-DATASET_FORMATS = {".nc": "NetCDF", ".csv": "CSV", ".zarr": "Zarr"}
+DATASET_FORMATS = {".nc": "NetCDF", ".csv": "CSV", ".zarr": "Zarr", ".mat": "MAT"}
 
 
 def check_output(path: str | Path, formats: dict[str, str] | None = DATASET_FORMATS,
@@ -89,10 +89,12 @@ def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
 
 
 def write_dataset(ds, path: str | Path) -> Path:
-    """Write a Dataset in the format its extension names (.nc, .csv, .zarr), atomically.
+    """Write a Dataset in the format its extension names (.nc, .csv, .zarr, .mat), atomically.
 
     CSV: one column per variable over the first dimension, ``name [units]`` headers, and the
-    attributes as ``# key = value`` comment lines above the table.
+    attributes as ``# key = value`` comment lines above the table. MAT (MATLAB 5, read by
+    MATLAB, Octave and ``scipy.io.loadmat``): one variable per data variable and coordinate,
+    a struct ``units`` (variable -> unit) and a struct ``attrs`` with every attribute.
     """
     path = check_output(path)
     fmt = DATASET_FORMATS[path.suffix.lower()]
@@ -104,6 +106,8 @@ def write_dataset(ds, path: str | Path) -> Path:
         with atomic_path(path) as tmp:
             if fmt == "NetCDF":
                 ds.to_netcdf(tmp)
+            elif fmt == "MAT":
+                _write_mat(ds, tmp)
             else:
                 _write_csv(ds, tmp)
     except Exception as exc:  # HDF5/netCDF report a full disk as RuntimeError, zarr variously
@@ -141,6 +145,27 @@ def _write_csv(ds, path: Path) -> None:
                      f"{', '.join(other)}\n")  # fmt: skip
         fh.write(",".join(head) + "\n")
         np.savetxt(fh, np.column_stack([ds[c].values for c in cols]), delimiter=",", fmt="%.17g")
+
+
+def _mat_name(name: str) -> str:
+    """A valid MATLAB identifier (letters, digits, underscores; a letter first; <= 63)."""
+    import re
+
+    out = re.sub(r"\W", "_", str(name))
+    return (out if out[:1].isalpha() else "v_" + out)[:63]
+
+
+def _write_mat(ds, path: Path) -> None:
+    import numpy as np
+    from scipy.io import savemat
+
+    names = [*ds.coords, *ds.data_vars]
+    data = {_mat_name(k): np.asarray(ds[k].values) for k in names}
+    data["units"] = {_mat_name(k): str(ds[k].attrs.get("units", "")) for k in names}
+    data["attrs"] = {_mat_name(k): (v if isinstance(v, (int, float, np.number)) else str(v))
+                     for k, v in ds.attrs.items()}  # fmt: skip
+    with open(path, "wb") as fh:
+        savemat(fh, data, do_compression=True, oned_as="column")
 
 
 def save_figure(fig, path: str | Path, **kw) -> Path:

@@ -9,23 +9,129 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-__all__ = ["response_figure", "provenance_footer", "model_figure", "axis_label", "contact_figure"]
+__all__ = [
+    "response_figure",
+    "provenance_footer",
+    "model_figure",
+    "axis_label",
+    "contact_figure",
+    "plot_signal",
+    "plot_orbit",
+    "centred",
+    "unit_tex",
+    "is_dense",
+    "PALETTE",
+]
+
+from .mplstyle import PALETTE, _mpl  # noqa: F401  (the style lives on the floor)
 
 
-def _mpl():
-    import matplotlib
+def _columns(ax) -> int:
+    """Width of the axes in pixels at the figure's dpi (before layout: an estimate)."""
+    fig = ax.get_figure()
+    return max(100, int(ax.get_position().width * fig.get_figwidth() * fig.dpi))
 
-    if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg", "cairo"):
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    return plt
+def is_dense(y, columns: int, per_column: float = 1 / 3) -> bool:
+    """True when ``y`` has more than ``per_column * columns`` clear oscillations (prominence
+    above 1 % of its range): drawn as a line it fills the axes as a solid block."""
+    from scipy.signal import find_peaks
+
+    y = np.asarray(y, dtype=float)
+    span = float(np.ptp(y)) if y.size else 0.0
+    if y.size < 3 * columns or not span > 0:
+        return False
+    peaks, _ = find_peaks(y, prominence=0.01 * span)
+    return peaks.size > per_column * columns
+
+
+_PREFIX = ((1e-9, "n"), (1e-6, "\u00b5"), (1e-3, "m"), (1.0, ""))
+
+
+def unit_tex(unit: str) -> str:
+    """A unit string for an axis label: ``m/s**2`` / ``m/s^2`` -> ``m/s$^2$``."""
+    import re
+
+    return re.sub(r"(\*\*|\^)(-?\d+)", r"$^{\2}$", unit)
+
+
+def centred(values, name: str, unit: str) -> tuple[np.ndarray, str]:
+    """Values and axis label for a quantity whose spread is tiny beside its mean (a Poincaré
+    section of a nearly periodic orbit: v = -4.0101 mm/s +- 5 um/s), which plain tick labels
+    print as unreadable 8-digit numbers. Returns the deviation from the median in a prefixed
+    unit with the median in the label; unchanged when the spread is above 1 % of the mean."""
+    v = np.asarray(values, dtype=float)
+    fin = v[np.isfinite(v)]
+    label = f"{name} ({unit_tex(unit)})" if unit not in ("", "1") else name
+    if fin.size < 2:
+        return v, label
+    mid = float(np.median(fin))
+    span = float(np.ptp(fin))
+    if not (span > 0 and span < 0.01 * abs(mid)):
+        return v, label
+    scale, prefix = next(((k, p) for k, p in _PREFIX if span / k < 1000), (1.0, ""))
+    if unit in ("", "1"):
+        scale, prefix = 1.0, ""
+    shift = f"{name} {'+' if mid < 0 else chr(0x2212)} {abs(mid):.6g}"
+    return (v - mid) / scale, (f"{shift} ({prefix}{unit_tex(unit)})"
+                               if unit not in ("", "1") else shift)  # fmt: skip
+
+
+def plot_orbit(ax, x, y, *, color=None, lw: float = 0.5):
+    """A phase portrait. A dense orbit (more turns than twice the axes' pixel columns) is
+    drawn as its occupation density (a 2-D histogram of the samples, i.e. the time spent per
+    cell, on a log colour scale): a line would fill the axes as one block."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    cols = _columns(ax)
+    if not (is_dense(x, cols, 2.0) or is_dense(y, cols, 2.0)):  # a 2-D line takes more
+        return ax.plot(x, y, lw=lw, color=color)
+    from matplotlib.colors import LogNorm
+
+    ok = np.isfinite(x) & np.isfinite(y)
+    h, xe, ye = np.histogram2d(x[ok], y[ok], bins=(cols // 5, cols // 6))
+    h = np.where(h > 0, h / h.sum(), np.nan)
+    return ax.pcolormesh(xe, ye, h.T, cmap="Blues", norm=LogNorm(vmin=np.nanmax(h) * 1e-3),
+                         shading="flat", rasterized=True)  # fmt: skip
+
+
+def plot_signal(ax, t, y, *, color=None, label=None, lw: float = 0.7, zoom: bool = True):
+    """Draw ``y(t)``. A signal denser than the axes' pixel columns (e.g. a kHz link oscillation
+    over seconds) is drawn as its envelope, the minimum and maximum over each pixel column
+    (what a line would show as a block, at a fraction of the size), with an inset zoom on six
+    periods of the fast oscillation around the largest value, so its waveform stays visible.
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    cols = _columns(ax)
+    if not is_dense(y, cols):
+        return ax.plot(t, y, lw=lw, color=color, label=label)
+    edges = np.linspace(0, y.size, cols + 1).astype(int)
+    lo = np.minimum.reduceat(y, edges[:-1])
+    hi = np.maximum.reduceat(y, edges[:-1])
+    tc = t[edges[:-1]]
+    art = ax.fill_between(tc, lo, hi, color=color, lw=0, alpha=0.85,
+                          label=None if label is None else f"{label} (envelope)")  # fmt: skip
+    if zoom:
+        from scipy.signal import find_peaks
+
+        peaks, _ = find_peaks(y, prominence=0.01 * float(np.ptp(y)))
+        period = float(np.median(np.diff(t[peaks]))) if peaks.size > 1 else (t[-1] - t[0]) / 50
+        i = int(np.argmax(np.abs(y - np.median(y))))
+        sel = (t >= t[i] - 3 * period) & (t <= t[i] + 3 * period)
+        ins = ax.inset_axes([0.66, 0.64, 0.32, 0.33])
+        ins.plot(t[sel], y[sel], lw=0.8, color=color)
+        ins.set_title(f"zoom: t = {t[i]:.4g} s", fontsize=6.5, pad=2)
+        ins.tick_params(labelsize=6)
+        ins.patch.set_alpha(0.92)
+        ins.grid(alpha=0.3)
+    return art
 
 
 def axis_label(name: str, da) -> str:
     """``name (units)`` from a DataArray's ``units`` attribute (no unit for dimensionless)."""
     u = da.attrs.get("units", "")
-    return f"{name} ({u})" if u not in ("", "1") else name
+    return f"{name} ({unit_tex(u)})" if u not in ("", "1") else name
 
 
 def provenance_footer(ds: xr.Dataset) -> str:
@@ -46,7 +152,6 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
 
     Returns the matplotlib Figure.
     """
-    from scipy.signal import periodogram
 
     plt = _mpl()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), constrained_layout=True)
@@ -56,7 +161,7 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
         (axes[0, 1], "v", "b) velocity (m/s)"),
         (axes[1, 0], "a", "c) acceleration (m/s$^2$)"),
     ):
-        ax.plot(t, ds[name].values, lw=0.7)
+        plot_signal(ax, t, ds[name].values)
         ax.set_xlabel("time (s)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -68,15 +173,23 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
         fig.suptitle(title or "Crosshead response")
         fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
         return fig
+    from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
+
     fs = 1.0 / float(np.median(np.diff(t)))
-    # 'spectrum' scaling corrects for the window's coherent gain: sqrt(2 P) is the amplitude
-    freq, pxx = periodogram(ds["a"].values, fs, window="hann", scaling="spectrum")
-    ax.plot(freq, np.sqrt(2.0 * pxx), lw=0.7)
+    fc = float(ds.attrs["crank_frequency_hz"])
+    spec = amplitude_spectrum(ds["a"].values, fs, window="hann")
+    f_top = fmax if fmax is not None else display_band(spec, fc)
+    ax.semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.7)
+    top = float(spec.amplitude.max()) if spec.amplitude.size else 1.0
+    ax.set_ylim(max(top, 1e-300) * 1e-6, max(top, 1e-300) * 3)  # 120 dB below the largest line
+    f_link = nonharmonic_peak(spec.frequency, spec.amplitude, fc, min_rel_height=1e-4)
+    if np.isfinite(f_link) and f_link <= f_top:
+        amp = float(np.interp(f_link, spec.frequency, spec.amplitude))
+        ax.annotate(f"{f_link:.4g} Hz = {f_link / fc:.1f} crank orders\n(not a crank harmonic)",
+                    (f_link, amp), xytext=(-10, 12), textcoords="offset points", ha="right",
+                    fontsize=8, arrowprops=dict(arrowstyle="->", lw=0.6))  # fmt: skip
     ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("d) amplitude of a (m/s$^2$)")
-    f_top = (
-        fmax if fmax is not None else min(fs / 2, max(60.0 * ds.attrs["crank_frequency_hz"], 50))
-    )
+    ax.set_ylabel("d) amplitude of a (m/s$^2$), log scale")
     ax.set_xlim(0, f_top)
     ax.grid(alpha=0.3)
     fig.suptitle(title or "Crosshead response")

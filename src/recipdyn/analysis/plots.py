@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..plotting import _mpl
+from ..mplstyle import _mpl
 
 __all__ = [
     "plot_spectrum",

@@ -14,7 +14,15 @@ import numpy as np
 from scipy.fft import rfft, rfftfreq
 from scipy.signal import find_peaks, get_window
 
-__all__ = ["Spectrum", "Peak", "amplitude_spectrum", "find_spectral_peaks", "order_spectrum"]
+__all__ = [
+    "Spectrum",
+    "Peak",
+    "amplitude_spectrum",
+    "find_spectral_peaks",
+    "order_spectrum",
+    "nonharmonic_peak",
+    "display_band",
+]
 
 
 @dataclass(frozen=True)
@@ -118,3 +126,52 @@ def find_spectral_peaks(
 def order_spectrum(spec: Spectrum, fundamental: float) -> tuple[np.ndarray, np.ndarray]:
     """The spectrum over orders of ``fundamental`` (crank orders): ``(orders, amplitude)``."""
     return spec.frequency / fundamental, spec.amplitude
+
+
+def _harmonic_mask(freq: np.ndarray, fundamental: float, resolution: float, tol_bins: float):
+    """Bins within ``tol_bins`` bins of a harmonic, at most a quarter of the fundamental on
+    each side (a record of a few periods has bins so wide that the tolerance would otherwise
+    cover every frequency)."""
+    order = freq / fundamental
+    width = min(tol_bins * resolution, fundamental / 4)
+    return np.abs(order - np.round(order)) * fundamental < width
+
+
+def nonharmonic_peak(
+    freq, amp, fundamental: float, *, min_order: float = 8.0, tol_bins: float = 1.5,
+    min_rel_height: float = 1e-9,
+) -> float:  # fmt: skip
+    """Frequency of the largest spectral line above ``min_order`` orders of ``fundamental``
+    that is not one of its harmonics (in the compressor: the link's or the joint's own
+    oscillation); NaN when there is none above ``min_rel_height`` of the largest line."""
+    freq = np.asarray(freq, dtype=float)
+    amp = np.asarray(amp, dtype=float).copy()
+    if freq.size < 3 or not np.any(amp > 0):
+        return float("nan")
+    top = amp.max()
+    df = freq[1] - freq[0]
+    amp[(freq < min_order * fundamental) | _harmonic_mask(freq, fundamental, df, tol_bins)] = 0
+    if amp.max() <= min_rel_height * top:
+        return float("nan")
+    return float(freq[np.argmax(amp)])
+
+
+def display_band(
+    spec: Spectrum, fundamental: float | None = None, *, min_orders: float = 30.0,
+    min_rel_height: float = 1e-3, margin: float = 1.3, min_hz: float = 50.0,
+) -> float:  # fmt: skip
+    """Upper frequency limit that shows every line of ``spec`` above ``min_rel_height`` of the
+    largest one (``margin`` times the highest such line), at least ``min_orders`` orders of
+    ``fundamental`` (or ``min_hz``), at most the Nyquist frequency.
+
+    A fixed band (say 60 crank orders) hides what a clearance fault adds: the link's own
+    oscillation lies at hundreds of orders (kHz at 20 rad/s).
+    """
+    nyquist = spec.fs / 2.0
+    low = max(min_hz, min_orders * fundamental if fundamental else 0.0)
+    amp = spec.amplitude
+    if amp.size < 3 or not np.any(amp > 0):
+        return min(nyquist, low)
+    idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
+    highest = float(spec.frequency[idx].max()) if idx.size else 0.0
+    return float(min(nyquist, max(low, margin * highest)))

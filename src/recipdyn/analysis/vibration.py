@@ -40,11 +40,15 @@ def tacho_times(tacho, fs: float, *, threshold: float | None = None,
                 hysteresis: float = 0.1) -> np.ndarray:  # fmt: skip
     """Times (s) of the rising edges of a pulse channel, interpolated between samples.
 
-    ``threshold`` defaults to halfway between the 5th and 95th percentiles; an edge re-arms
-    only after the signal falls ``hysteresis`` (a fraction of that span) below it, so noise
-    on a slow edge does not count twice."""
+    ``threshold`` defaults to halfway between the 5th and 95th percentiles (robust to spikes),
+    or between the minimum and the maximum when the pulses are narrower than 5 % of the
+    revolution (a keyphasor notch: the percentiles then both lie on the baseline); an edge
+    re-arms only after the signal falls ``hysteresis`` (a fraction of that span) below it, so
+    noise on a slow edge does not count twice."""
     v = np.asarray(tacho, dtype=float)
     lo, hi = np.percentile(v, [5, 95])
+    if hi <= lo:
+        lo, hi = float(np.min(v)), float(np.max(v))
     if hi <= lo:
         raise ValueError("tacho channel is flat: no pulses")
     thr = 0.5 * (lo + hi) if threshold is None else float(threshold)

@@ -15,13 +15,18 @@ No traceback reaches the user unless ``--debug`` (or ``RECIPDYN_DEBUG=1``) asks 
 from __future__ import annotations
 
 import contextlib
+import contextvars
+import functools
+import inspect
+import json
+import math
 import os
 import sys
-import time
 
 import typer
 
 from ..errors import IntegrationError, Interrupted, ParameterError, raise_on_signals
+from ..progress import phase  # noqa: F401  (the commands' phase helper)
 
 app = typer.Typer(
     add_completion=False,
@@ -29,6 +34,67 @@ app = typer.Typer(
     help="Nonlinear dynamics of reciprocating compressors with joint clearance and subsidence.",
     pretty_exceptions_enable=False,
 )
+
+
+_REPORT: contextvars.ContextVar[dict | None] = contextvars.ContextVar("report", default=None)
+
+
+def with_json(func):
+    """Give a command a ``--json`` option: everything it says goes to standard error and one
+    JSON object (what the command passed to :func:`report`) is printed on standard output at
+    the end, for scripts (``recipdyn simulate ... --json | jq .peak_a``)."""
+    sig = inspect.signature(func)
+    extra = inspect.Parameter(
+        "json_out", inspect.Parameter.KEYWORD_ONLY, annotation=bool,
+        default=typer.Option(False, "--json", help="Print a JSON summary on stdout (what is "
+                             "said goes to stderr)."),
+    )  # fmt: skip
+
+    @functools.wraps(func)
+    def wrapper(*args, json_out: bool = False, **kw):
+        if not json_out:
+            return func(*args, **kw)
+        collected: dict = {}
+        token = _REPORT.set(collected)
+        real = sys.stdout
+        try:
+            with contextlib.redirect_stdout(sys.stderr):
+                rv = func(*args, **kw)
+        finally:
+            _REPORT.reset(token)
+        real.write(json.dumps(_plain(collected), allow_nan=False) + "\n")
+        real.flush()
+        return rv
+
+    wrapper.__signature__ = sig.replace(parameters=[*sig.parameters.values(), extra])
+    wrapper.__annotations__ = {**func.__annotations__, "json_out": bool}
+    return wrapper
+
+
+def report(**items) -> None:
+    """Add items to the ``--json`` summary of the running command (nothing without it)."""
+    collected = _REPORT.get()
+    if collected is not None:
+        collected.update(items)
+
+
+def _plain(obj):
+    """JSON-ready: numpy scalars and arrays to Python, paths to strings, NaN/inf to null."""
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None  # JSON has no NaN: null
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    return obj
 
 
 def _version(value: bool) -> None:
@@ -53,6 +119,8 @@ def _root(
 
 def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
+    from . import animate as _animate  # noqa: F401
+    from . import compare as _compare  # noqa: F401
     from . import features as _features  # noqa: F401
     from . import models as _models  # noqa: F401
     from . import reproduce as _reproduce  # noqa: F401
@@ -75,23 +143,6 @@ def _click_exception_types() -> list[tuple[type, type]]:
 
 def _err(msg: str) -> None:
     typer.echo(msg, err=True)
-
-
-@contextlib.contextmanager
-def phase(message: str, *, say_after: float = 1.0):
-    """Say what a phase is doing: a spinner on a terminal while it runs, and one line when it
-    took longer than ``say_after`` seconds (so logs show it too)."""
-    t0 = time.perf_counter()
-    if sys.stderr.isatty():
-        from rich.console import Console
-
-        with Console(stderr=True).status(message + "..."):
-            yield
-    else:
-        yield
-    wall = time.perf_counter() - t0
-    if wall > say_after:
-        _err(f"{message}: {wall:.1f} s")
 
 
 def main(argv: list[str] | None = None) -> int:

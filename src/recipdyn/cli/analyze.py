@@ -7,10 +7,11 @@ from pathlib import Path
 import typer
 
 from ..defaults import ANALYZE
-from . import app
+from . import app, phase, report, with_json
 
 
 @app.command()
+@with_json
 def analyze(
     run: Path = typer.Argument(
         ...,
@@ -60,7 +61,7 @@ def analyze(
     out = out or run.with_name(run.stem + "_analysis")
     if column is None and fs is None and is_record(run):
         s = analyze_run(run, out, section_points=section_points,
-                        lyap_revolutions=lyap_revolutions)  # fmt: skip
+                        lyap_revolutions=lyap_revolutions, phase=phase)  # fmt: skip
     else:
         if quantity not in ("acceleration", "velocity", "other"):
             raise ParameterError(f"quantity: {quantity!r}; allowed: acceleration, velocity, "
@@ -68,10 +69,11 @@ def analyze(
         if tacho is not None and speed is not None:
             raise ParameterError("tacho and speed: give one of them")
         s = analyze_signal(run, out, column=column, fs=fs, tacho=tacho, speed=speed,
-                           quantity=quantity, zones=zones)  # fmt: skip
+                           quantity=quantity, zones=zones, phase=phase)  # fmt: skip
         for note in s["notes"]:
             typer.echo(f"note: {note}")
         for name, value, status in s["evidence"]:
             typer.echo(f"  {name:<20} {value:<28} {status}")
     typer.echo(f"verdict: {s['verdict']['verdict']} ({'; '.join(s['verdict']['reasons'])})")
     typer.echo(f"wrote {out}/summary.md, summary.json and figures")
+    report(**s, output=str(out))

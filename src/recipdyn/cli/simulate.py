@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, phase
+from . import app, phase, report, with_json
 
 _SET_HELP = "Set any parameter: NAME=VALUE with units, e.g. --set m3='40 kg' (repeatable)."
 _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (default: half " \
@@ -88,6 +88,7 @@ def _prepare(m, params, method: str) -> None:
 
 
 @app.command()
+@with_json
 def simulate(
     rc: str = typer.Option(None, "--rc", "--clearance", help="Radial clearance, e.g. '1 mm'."),
     d: str = typer.Option(None, "--d", "--subsidence", help="Crosshead subsidence, e.g. '1 mm'."),
@@ -104,7 +105,10 @@ def simulate(
     atol: float = typer.Option(None, "--atol", help="Absolute tolerance (dop853)."),
     h: str = typer.Option(None, "--h", help="RK4 step, e.g. '1e-5 s'."),
     out: Path = typer.Option(
-        Path("out/simulation.nc"), "--out", "-o", help="Output: .nc (NetCDF), .csv or .zarr."
+        Path("out/simulation.nc"),
+        "--out",
+        "-o",
+        help="Output: .nc (NetCDF), .csv, .mat (MATLAB) or .zarr.",
     ),
     figure: bool = typer.Option(True, "--figure/--no-figure", help="Also write a PNG figure."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
@@ -201,12 +205,17 @@ def simulate(
         raise
     if not stream:
         write_dataset(ds, out)
+    params_used = {k.removeprefix("param_"): v for k, v in ds.attrs.items()
+                   if k.startswith("param_") and not k.endswith(("_note", "_units"))}  # fmt: skip
+    report(output=str(out), model=m.name, samples=dict(ds.sizes), parameters=params_used,
+           validity=ds.attrs.get("validity", "ok"))  # fmt: skip
     if ds.attrs.get("validity", "ok") != "ok":
         typer.echo(f"warning: {ds.attrs['validity']}", err=True)
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
         summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}
         _echo_summary(summary)
+        report(summary=summary)
         if figure:
             from ..plotting import _mpl, model_figure
 
@@ -241,7 +250,10 @@ def simulate(
         f"peak |a| = {abs(a).max():.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
         f"{ds.x.max().item():.5f}] m, min contact force = {ds.attrs['min_contact_force_N']:.4g} N"
     )
-    _echo_summary(m.run_summary(m.schema.from_attrs(ds.attrs), ds))
+    summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds)
+    _echo_summary(summary)
+    report(peak_a=float(abs(a).max()), x_min=ds.x.min().item(), x_max=ds.x.max().item(),
+           min_contact_force=float(ds.attrs["min_contact_force_N"]), summary=summary)  # fmt: skip
 
 
 def _echo_summary(summary: dict) -> None:

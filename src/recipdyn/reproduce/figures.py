@@ -9,10 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from ..io import save_figure
 from ..model.load import mu_paper
-from ..plotting import _mpl
+from ..plotting import PALETTE, _mpl, centred, is_dense, plot_orbit, plot_signal, unit_tex
 from .cases import case_by_id
 
 __all__ = ["FIGURES", "make_all_figures"]
@@ -50,7 +51,7 @@ def _response(ds, title, fmax):
     fig, axes = _grid(plt, title)
     t = ds.time.values
     for ax, (name, label), pl in zip(axes[:3], TIME_VARS, PANEL, strict=False):
-        ax.plot(t, ds[name].values, lw=0.6)
+        plot_signal(ax, t, ds[name].values, lw=0.6)
         ax.set_xlabel("time (s)")
         ax.set_ylabel(f"{pl}) {label}")
         ax.grid(alpha=0.3)
@@ -90,16 +91,42 @@ def figs14_16(runs, variant):
 
 
 def _overlay(runs, variant, num, var, label, cids, what):
+    """The paper's overlay of one signal over several cases, readable: when the signals are
+    smooth, the overlay and below it each case's difference from the first (reference) case,
+    which the overlay hides when the curves nearly coincide; when a case carries a fast
+    oscillation (the offset start's link ringing), one row per case on shared axes, each drawn
+    by :func:`~recipdyn.plotting.plot_signal` (envelope and zoom) instead of an overplot."""
     plt = _mpl()
-    fig, ax = plt.subplots(figsize=(9, 4.8), constrained_layout=True)
-    for cid in cids:
-        ds = runs[(cid, variant)]
-        ax.plot(ds.time, ds[var], lw=0.7, label=case_by_id(cid).label)
-    ax.set_xlabel("time (s)")
+    sets = [runs[(cid, variant)] for cid in cids]
+    names = [case_by_id(cid).label for cid in cids]
+    unit = label[label.rfind("(") :]
+    if any(is_dense(ds[var].values, 700) for ds in sets):
+        fig, axes = plt.subplots(len(cids), 1, figsize=(9, 1.7 * len(cids) + 1.0),
+                                 sharex=True, sharey=True, constrained_layout=True)  # fmt: skip
+        for ax, ds, name, color in zip(axes, sets, names, PALETTE, strict=False):
+            plot_signal(ax, ds.time.values, ds[var].values, color=color, lw=0.6)
+            ax.set_title(name, fontsize=8, loc="left", pad=2)
+            ax.grid(alpha=0.3)
+        axes[-1].set_xlabel("time (s)")
+        fig.supylabel(label)
+        fig.suptitle(f"Fig. {num}: crosshead {what} [{variant}], one row per case")
+        return fig
+    fig, (ax, axd) = plt.subplots(2, 1, figsize=(9, 6.4), sharex=True, height_ratios=(3, 2),
+                                  constrained_layout=True)  # fmt: skip
+    ref = sets[0]
+    for ds, name, color in zip(sets, names, PALETTE, strict=False):
+        ax.plot(ds.time, ds[var], lw=0.8, label=name, color=color)
+        n = min(ds.sizes["time"], ref.sizes["time"])
+        if ds is not ref:
+            axd.plot(ds.time[:n], ds[var].values[:n] - ref[var].values[:n], lw=0.8, color=color)
     ax.set_ylabel(label)
     ax.set_title(f"Fig. {num}: comparison of crosshead {what} [{variant}]")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
+    axd.set_xlabel("time (s)")
+    axd.set_ylabel(f"difference from the\nfirst case {unit}")
+    axd.axhline(0, color="k", lw=0.5)
+    axd.grid(alpha=0.3)
     return fig
 
 
@@ -135,9 +162,9 @@ def figs17_23(runs, variant):
             fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
             ds = runs[(cids[0], variant)]
             for ax, (a, b) in zip(axes, (("x", "v"), ("v", "a")), strict=True):
-                ax.plot(ds[a], ds[b], lw=0.5)
-                ax.set_xlabel(f"{a} ({ds[a].attrs['units']})")
-                ax.set_ylabel(f"{b} ({ds[b].attrs['units']})")
+                plot_orbit(ax, ds[a].values, ds[b].values)
+                ax.set_xlabel(f"{a} ({unit_tex(ds[a].attrs['units'])})")
+                ax.set_ylabel(f"{b} ({unit_tex(ds[b].attrs['units'])})")
                 ax.grid(alpha=0.3)
             fig.suptitle(f"Fig. 17: phase trajectories, no clearance, no subsidence [{variant}]")
             out[f"fig17_{variant}"] = fig
@@ -146,10 +173,10 @@ def figs17_23(runs, variant):
             fig, axes = _grid(plt, f"Fig. {num + j}: phase trajectories {kind} [{variant}]")
             for ax, cid, pl in zip(axes, cids, PANEL, strict=True):
                 ds = runs[(cid, variant)]
-                ax.plot(ds[a], ds[b], lw=0.4)
+                plot_orbit(ax, ds[a].values, ds[b].values, lw=0.4)
                 ax.set_title(f"{pl}) {case_by_id(cid).label}", fontsize=9)
-                ax.set_xlabel(f"{a} ({ds[a].attrs['units']})")
-                ax.set_ylabel(f"{b} ({ds[b].attrs['units']})")
+                ax.set_xlabel(f"{a} ({unit_tex(ds[a].attrs['units'])})")
+                ax.set_ylabel(f"{b} ({unit_tex(ds[b].attrs['units'])})")
                 ax.grid(alpha=0.3)
             out[f"fig{num + j:02d}_{variant}"] = fig
     return out
@@ -169,13 +196,15 @@ def figs25_28(runs, variant):
                      f"[{variant}]")  # fmt: skip
         for ax, cid, pl in zip(axes, cids, PANEL, strict=False):
             ds = runs[(cid, variant)]
-            ax.plot(ds.poincare_v, ds.poincare_a, ".", ms=3)
+            xv, xlab = centred(ds.poincare_v.values, "v", "m/s")
+            ya, ylab = centred(ds.poincare_a.values, "a", "m/s^2")
+            ax.plot(xv, ya, ".", ms=3)
             n_pts = ds.attrs["m_poincare_distinct"]
             what = f"{n_pts} distinct points" if n_pts >= 0 else "run failed"
             ax.set_title(f"{pl}) {case_by_id(cid).label}: {what}", fontsize=9)
-            ax.set_xlabel("v (m/s)")
-            ax.set_ylabel("a (m/s$^2$)")
-            ax.ticklabel_format(useOffset=False)
+            ax.set_xlabel(xlab)
+            ax.set_ylabel(ylab)
+            ax.xaxis.set_major_locator(MaxNLocator(5))
             ax.grid(alpha=0.3)
         out[f"fig{num:02d}_{variant}"] = fig
     return out
@@ -226,10 +255,21 @@ def save_figures(figs: dict, folder: Path, dpi: int = 100) -> dict[str, Path]:
     return paths
 
 
-def make_all_figures(runs, variants, folder: Path) -> dict[str, Path]:
-    """Every figure for every variant, plus Fig. 2 once, saved as PNG in ``folder``."""
+def make_all_figures(runs, variants, folder: Path, progress: bool = False) -> dict[str, Path]:
+    """Every figure for every variant, plus Fig. 2 once, saved as PNG in ``folder`` (with a
+    progress bar over the figure groups when ``progress``)."""
     out = save_figures(fig02_load(runs, None), folder)
-    for v in variants:
-        for f in FIGURES:
-            out.update(save_figures(f(runs, v), folder))
+    jobs = [(f, v) for v in variants for f in FIGURES]
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=len(jobs), desc="reproduce: figures", unit="group")
+    for f, v in jobs:
+        out.update(save_figures(f(runs, v), folder))
+        if bar is not None:
+            bar.set_postfix_str(f"{f.__name__} [{v}]")
+            bar.update(1)
+    if bar is not None:
+        bar.close()
     return out

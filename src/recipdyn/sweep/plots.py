@@ -8,9 +8,9 @@ import numpy as np
 import xarray as xr
 
 from ..io import save_figure
-from ..plotting import _mpl, axis_label
+from ..plotting import _mpl, axis_label, unit_tex
 
-__all__ = ["sweep_figures"]
+__all__ = ["sweep_figures", "cell_edges", "wrap_around_mean"]
 
 _LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
            "omega": ("crank speed omega", 1.0, "rad/s")}  # fmt: skip
@@ -19,6 +19,40 @@ _LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
 def _axis(ds, name):
     label, k, unit = _LABELS.get(name, (name, 1.0, ds[name].attrs.get("units", "")))
     return ds[name].values * k, f"{label} ({unit})"
+
+
+def cell_edges(centres, log: bool = False) -> np.ndarray:
+    """Edges of the cells around grid values: midpoints between neighbours, geometric on a
+    log axis (where arithmetic midpoints, as ``shading="nearest"`` takes, put each cell off
+    its value and make the cells of a regular log grid unequal); the outer edges mirror the
+    inner ones."""
+    c = np.asarray(centres, dtype=float)
+    if c.size == 1:
+        return c * np.array([0.9, 1.1]) if log else c + np.array([-0.5, 0.5])
+    u = np.log(c) if log else c
+    mid = (u[1:] + u[:-1]) / 2
+    edges = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+    return np.exp(edges) if log else edges
+
+
+def _label_grid(axis, values) -> None:
+    """Ticks at the grid values of a short log axis (a log axis spanning less than two decades
+    otherwise shows one or two labelled ticks)."""
+    if len(values) <= 12:
+        from matplotlib.ticker import FixedLocator, NullLocator
+
+        axis.set_major_locator(FixedLocator(values))
+        axis.set_major_formatter(lambda v, _pos: f"{v:.3g}")
+        axis.set_minor_locator(NullLocator())
+
+
+def wrap_around_mean(angle) -> tuple[np.ndarray, float]:
+    """Angles wrapped to one turn centred on their circular mean: a link that hangs near
+    +-pi then shows as one band instead of two halves at the top and bottom of (-pi, pi]."""
+    a = np.asarray(angle, dtype=float)
+    fin = a[np.isfinite(a)]
+    centre = float(np.angle(np.mean(np.exp(1j * fin)))) if fin.size else 0.0
+    return centre + np.angle(np.exp(1j * (a - centre))), centre
 
 
 def _mark_invalid(ax, ds, x, y, done) -> None:
@@ -70,8 +104,10 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
             for var, ylab in pairs:
                 fig, ax = plt.subplots(figsize=(9, 5), constrained_layout=True)
                 y = ds[var].values
-                if var == "poincare_theta_c":  # the link may turn over: wrap to (-pi, pi]
-                    y = np.angle(np.exp(1j * y))
+                wrapped = ""
+                if var == "poincare_theta_c":  # an angle: one turn centred on its mean
+                    y, centre = wrap_around_mean(y)
+                    wrapped = f"; angle wrapped to {centre:+.2f} \u00b1 \u03c0 rad"
                 xs = np.repeat(x[:, None], y.shape[1], axis=1)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ",k", alpha=0.6)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ".k", ms=1.0, alpha=0.5)
@@ -79,13 +115,14 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 compressor = ds.attrs.get("model", "compressor") == "compressor"
                 ax.set_ylabel(f"{ylab}, " + ("once per revolution" if compressor else
                                              "at the section points"))  # fmt: skip
-                ax.set_title(f"Bifurcation diagram ({y.shape[1]} section points per value)")
+                ax.set_title(f"Bifurcation diagram ({y.shape[1]} section points per value"
+                             f"{wrapped})")  # fmt: skip
                 ax.grid(alpha=0.3)
                 p = out / f"bifurcation_{var.split('_', 1)[1]}.png"
                 save_figure(fig, p, dpi=130)
                 plt.close(fig)
                 paths.append(p)
-        peaks = [(k, f"peak |{k.removeprefix('peak_')}| ({ds[k].attrs.get('units', '')})")
+        peaks = [(k, f"peak |{k.removeprefix('peak_')}| ({unit_tex(ds[k].attrs.get('units', ''))})")
                  for k in ds.data_vars if k.startswith("peak_") and ds[k].ndim == 1]  # fmt: skip
         lam = ("lambda1", f"largest Lyapunov exponent ({ds['lambda1'].attrs.get('units', '1/s')})"
                if "lambda1" in ds else "")  # fmt: skip
@@ -110,21 +147,26 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
             if (k.startswith("peak_") or k.startswith("rms_")) and ds[k].ndim == 2:
                 what, sig = k.split("_", 1)
                 maps.append((k, f"{'peak |' + sig + '|' if what == 'peak' else 'RMS ' + sig} "
-                                f"({ds[k].attrs.get('units', '')})"))  # fmt: skip
+                                f"({unit_tex(ds[k].attrs.get('units', ''))})"))  # fmt: skip
         maps.append(("poincare_distinct", "distinct section points"))
         for var, clabel in maps:
             if var not in ds:
                 continue
             z = np.where(done, ds[var].values.astype(float), np.nan)
             fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
-            m = ax.pcolormesh(x, y, z, shading="nearest", cmap="viridis")
+            log_x = ds[dims[1]].attrs.get("scale") == "log"
+            log_y = ds[dims[0]].attrs.get("scale") == "log"
+            m = ax.pcolormesh(cell_edges(x, log_x), cell_edges(y, log_y), z, shading="flat",
+                              cmap="viridis")  # fmt: skip
             fig.colorbar(m, ax=ax, label=clabel)
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
-            if ds[dims[1]].attrs.get("scale") == "log":
+            if log_x:
                 ax.set_xscale("log")
-            if ds[dims[0]].attrs.get("scale") == "log":
+                _label_grid(ax.xaxis, x)
+            if log_y:
                 ax.set_yscale("log")
+                _label_grid(ax.yaxis, y)
             _mark_invalid(ax, ds, x, y, done)
             ax.set_title(f"Fault map: {clabel}")
             p = out / f"map_{var}.png"
