@@ -21,7 +21,7 @@ LAYERS = [
     {"simulate", "io_signal"},
     {"plotting", "analyze", "compare", "animate"},
     {"sweep", "features"},  # features reads sweep stores
-    {"reproduce"},
+    {"reproduce", "app"},
     {"cli", "__main__"},
 ]  # fmt: skip
 RANK = {name: i for i, names in enumerate(LAYERS) for name in names}
