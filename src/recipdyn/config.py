@@ -77,7 +77,11 @@ class RunConfig(BaseModel):
 def build_params(values: dict[str, Any], base: CompressorParams | None = None) -> CompressorParams:
     """CompressorParams from ``{name_or_alias: number | quantity string}``, validated."""
     kw: dict[str, Any] = {}
+    pressure_table = None
     for k, v in values.items():
+        if k == "pressure_table":  # a measured indicator diagram: needs the final geometry
+            pressure_table = v
+            continue
         name = resolve_name(k)
         if name in _STRING_FIELDS:
             kw[name] = str(v)
@@ -95,7 +99,17 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
             kw[name] = None
         else:
             kw[name] = to_si(name, v)
-    return dataclasses.replace(base or CompressorParams(), **kw)
+    params = dataclasses.replace(base or CompressorParams(), **kw)
+    if pressure_table is not None:
+        from .model.load import read_pressure_table
+
+        if "load_table" in kw:
+            raise ParameterError("pressure_table and load_table: give one of them")
+        table = read_pressure_table(pressure_table, bore=params.bore,
+                                    rod_diameter=params.rod_diameter,
+                                    frame_pressure=params.frame_pressure)  # fmt: skip
+        params = dataclasses.replace(params, load_table=table)
+    return params
 
 
 def read_config(path: str | Path) -> RunConfig:

@@ -284,7 +284,12 @@ def _cycle_outputs(p: CompressorParams, theta1: np.ndarray) -> dict[str, Signal]
     """Cylinder pressures and volumes of the compression-cycle load (none for other loads)."""
     if p.load != "cycle":
         return {}
-    st = cycle_states(theta1, pack_load(vars(p))[1])
+    if p.gas != "ideal":
+        from .realgas import real_gas_states
+
+        st = real_gas_states(theta1, vars(p))
+    else:
+        st = cycle_states(theta1, pack_load(vars(p))[1])
     return {
         "p_head": Signal(st["p_head"], "Pa", "head-end cylinder pressure (absolute)"),
         "p_crank": Signal(st["p_crank"], "Pa", "crank-end cylinder pressure (absolute)"),
@@ -302,7 +307,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         rhs, jac, rhs_jac = rhs_paper, jac_paper, None
     elif p.load_table is None and p.load == "paper":
         rhs, jac, rhs_jac = rhs_exact, jac_exact, rhs_jac_exact
-    elif p.load_table is None:
+    elif p.load_table is None and p.gas == "ideal":
         rhs, jac, rhs_jac = rhs_exact_cycle, jac_exact_cycle, rhs_jac_exact_cycle
     else:
         rhs, jac, rhs_jac = rhs_exact_table, jac_exact_table, rhs_jac_exact_table

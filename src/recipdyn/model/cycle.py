@@ -291,9 +291,13 @@ def cycle_summary(values, ds) -> dict[str, float | str]:
                    pin_peak_tension_N=rev.peak_tension,
                    api618_pin_reversal="pass" if rev.passed else "FAIL",
                    gas_rod_load_reversal_deg=gas.reversal_deg)  # fmt: skip
-    _kind, c = pack_load(values)
     grid = np.linspace(0.0, 2.0 * math.pi, 20_000, endpoint=False)
-    st = cycle_states(grid, c)
+    if values.get("gas", "ideal") != "ideal":
+        from .realgas import real_gas_states
+
+        st = real_gas_states(grid, values)
+    else:
+        st = cycle_states(grid, pack_load(values)[1])
     acting = values.get("acting", "double")
     work = 0.0
     for end, on in (("head", acting in ("head", "double")), ("crank", acting != "head")):

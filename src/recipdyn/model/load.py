@@ -20,6 +20,13 @@ always positive, so the load never reverses.
 A table load (``CompressorParams.load_table``: rows of crank angle in degrees and force in N,
 already signed as the force on the crosshead along +x) is interpolated linearly and
 periodically; ``load_sign`` does not apply to it.
+
+A measured indicator diagram (cylinder pressure over crank angle, head end and optionally crank
+end) becomes such a table through :func:`read_pressure_table`: each pressure is interpolated
+periodically with a shape-preserving cubic (PCHIP: continuous slope, no overshoot at the valve
+events, passes through every sample), resampled every ``step_deg`` and turned into the force of
+the compression-cycle model, ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod``
+(:mod:`recipdyn.model.cycle`); an end without a column is at ``p_frame``.
 """
 
 from __future__ import annotations
@@ -37,6 +44,7 @@ __all__ = [
     "gas_force",
     "gas_force_kernel",
     "read_load_table",
+    "read_pressure_table",
     "pack_load",
     "CYCLE_PARAMS",
 ]
@@ -115,6 +123,10 @@ def pack_load(v) -> tuple[float, np.ndarray]:
     (``load``, ``load_table`` and the cycle's parameters; the mechanism's ``r``, ``l``, ``d``)."""
     if v.get("load_table") is not None:
         return 1.0, pack_table(v["load_table"])
+    if v.get("load", "paper") == "cycle" and v.get("gas", "ideal") != "ideal":
+        from .realgas import real_gas_force_table  # CoolProp: tabulated once, then a table
+
+        return 1.0, pack_table(real_gas_force_table(v))
     if v.get("load", "paper") == "cycle":
         return 2.0, pack_cycle(v["r"], v["l"], v["d"], **{k: v[k] for k in CYCLE_PARAMS})
     return 0.0, pack_table(None)
@@ -152,3 +164,103 @@ def read_load_table(path, *, area: float | None = None) -> tuple[tuple[float, fl
     val = data[:, 1] * (area if area is not None else 1.0)
     order = np.argsort(ang)
     return tuple((float(a), float(v)) for a, v in zip(ang[order], val[order], strict=True))
+
+
+def _unit_factor(header: str, default: str, what: str, path) -> float:
+    """The SI factor of the unit in ``name [unit]`` or ``name (unit)`` (pint), else of
+    ``default``."""
+    import re
+
+    import pint
+
+    from .parameters import ParameterError
+
+    m = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
+    unit = m.group(1) if m else default
+    try:
+        q = pint.UnitRegistry().Quantity(1.0, unit)
+        return float(q.to("Pa" if what == "pressure" else "degree").magnitude)
+    except Exception:
+        raise ParameterError(f"pressure table {path}: column {header.strip()!r}: unit {unit!r} "
+                             f"is not a {what} unit") from None  # fmt: skip
+
+
+def read_pressure_table(path, *, bore: float, rod_diameter: float,
+                        frame_pressure: float = 101325.0,
+                        step_deg: float = 0.25) -> tuple[tuple[float, float], ...]:  # fmt: skip
+    """A measured indicator diagram as a load table (rows of crank angle in deg and force in N).
+
+    Parameters
+    ----------
+    path : path
+        CSV: crank angle, head-end pressure and optionally crank-end pressure (absolute), one
+        revolution, ``#`` comments allowed. A header line may give units in brackets
+        (``angle [deg], p_head [bar], p_crank [bar]``); without one, degrees and Pa.
+    bore, rod_diameter : float
+        Cylinder bore and piston-rod diameter, m (the areas the pressures act on).
+    frame_pressure : float
+        Pressure on the rod section and in an end without a column, Pa.
+    step_deg : float
+        Resampling step of the force table, deg.
+
+    Notes
+    -----
+    PCHIP on the periodically continued samples (three copies) keeps the slope continuous and
+    never overshoots a sample, so a sharp valve event does not ring; between the
+    ``step_deg`` nodes the kernel interpolates linearly (error <= step^2/8 max|F''|).
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    from .parameters import ParameterError
+
+    try:
+        with open(path, encoding="utf-8") as fh:
+            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"pressure table {path}: cannot read ({exc})") from None
+    if not lines:
+        raise ParameterError(f"pressure table {path}: empty")
+    head = [c for c in lines[0].split(",")]
+    try:
+        [float(c) for c in head]
+        header, rows = None, lines
+    except ValueError:
+        header, rows = head, lines[1:]
+    try:
+        data = np.array([[float(c) for c in ln.split(",")] for ln in rows], dtype=float)
+    except ValueError:
+        raise ParameterError(f"pressure table {path}: non-numeric entries") from None
+    if data.ndim != 2 or data.shape[1] not in (2, 3) or data.shape[0] < 4:
+        raise ParameterError(f"pressure table {path}: need >= 4 rows of 'angle, p_head' or "
+                             "'angle, p_head, p_crank'")  # fmt: skip
+    if not np.all(np.isfinite(data)):
+        raise ParameterError(f"pressure table {path}: non-finite entries")
+    k_ang = _unit_factor(header[0], "deg", "angle", path) if header else 1.0
+    k_p = [_unit_factor(h, "Pa", "pressure", path) for h in header[1:]] if header else \
+        [1.0] * (data.shape[1] - 1)  # fmt: skip
+    ang = np.mod(data[:, 0] * k_ang, 360.0)
+    order = np.argsort(ang)
+    ang = ang[order]
+    keep = np.concatenate([[True], np.diff(ang) > 1e-9])  # 0 and 360 are one angle
+    ang = ang[keep]
+    press = [(data[order, j + 1] * k_p[j])[keep] for j in range(data.shape[1] - 1)]
+    if ang.size < 4:
+        raise ParameterError(f"pressure table {path}: need >= 4 distinct angles")
+    if any(np.any(p < 0) for p in press):
+        raise ParameterError(f"pressure table {path}: negative pressure; allowed: absolute "
+                             "pressures >= 0")  # fmt: skip
+    if not (0 < rod_diameter < bore):
+        raise ParameterError(f"rod_diameter = {rod_diameter}; allowed: 0 < rod_diameter < "
+                             f"bore = {bore}")  # fmt: skip
+    grid = np.arange(0.0, 360.0, step_deg)
+    a3 = np.concatenate([ang - 360.0, ang, ang + 360.0])
+
+    def smooth(p):
+        return PchipInterpolator(a3, np.tile(p, 3))(grid)
+
+    area = math.pi * bore**2 / 4
+    a_rod = math.pi * rod_diameter**2 / 4
+    p_he = smooth(press[0])
+    p_ce = smooth(press[1]) if len(press) > 1 else np.full_like(grid, frame_pressure)
+    force = -p_he * area + p_ce * (area - a_rod) + frame_pressure * a_rod
+    return tuple((float(a), float(f)) for a, f in zip(grid, force, strict=True))

@@ -65,10 +65,16 @@ ASSUMED_CYCLE: dict[str, str] = {
         "n_compression",
         "n_expansion",
         "acting",
+        "suction_temperature",
     )
 }
 
 _INF = math.inf
+
+#: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
+#: (real-gas isentropes, :mod:`recipdyn.model.realgas`).
+GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
+         "Ethane", "Propane", "CarbonDioxide", "R134a", "Ammonia")  # fmt: skip
 
 #: The compressor's parameter schema: units, static ranges, groups, assumptions. Ranges that
 #: depend on other parameters (rs <= r, ls <= l, rc < r, |d| < l - r - rc) are checked in
@@ -135,6 +141,12 @@ SCHEMA = Schema((
           group="cycle"),
     Param("frame_pressure", "Pa", 101325.0, "pressure in the frame / distance piece, on the rod "
           "section and in an inactive chamber (load = cycle)", 0.0, 1e9, group="cycle"),
+    Param("gas", "", "ideal", "gas of the cycle: 'ideal' (polytropes with n_compression, "
+          "n_expansion) or a CoolProp fluid (real-gas isentropes; load = cycle)",
+          choices=GASES, group="cycle"),
+    Param("suction_temperature", "K", 293.15, "suction temperature (load = cycle with a real "
+          "gas)", 0.0, 5000.0, low_open=True, assumed=ASSUMED_CYCLE["suction_temperature"],
+          group="cycle"),
 ), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
@@ -257,6 +269,8 @@ class CompressorParams:
     n_expansion: float = 1.3
     acting: Literal["head", "crank", "double"] = "double"
     frame_pressure: float = 101325.0
+    gas: str = "ideal"
+    suction_temperature: float = 293.15
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
