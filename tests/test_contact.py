@@ -324,3 +324,29 @@ def test_the_contact_figure_shows_impacts_orbits_and_forces_per_joint():
             assert np.all(np.isfinite(np.asarray(line.get_ydata(), dtype=float)))
     markers = [ln for ax in axes for ln in ax.get_lines() if ln.get_marker() == "v"]
     assert markers
+
+
+def test_sweep_records_the_contact_fraction(tmp_path):
+    """A contact-loss map: sweeps of the contact-impact joint with -m peak store the time
+    fraction in contact at each point (the mean of the run's 0/1 ``contact`` output). It equals
+    what simulate gives for the same point (the same integration; one sample of tolerance for
+    a flag that could flip on a rounding difference at a contact transition), the crosshead
+    pin's is NaN when that joint is not modelled, and the map is drawn."""
+    import recipdyn
+    from recipdyn.sweep.plots import sweep_figures
+    from recipdyn.sweep.run import open_sweep, run_sweep
+    from recipdyn.sweep.spec import SweepSpec, parse_axis
+
+    model = "compressor-contact"
+    spec = SweepSpec(axes=(parse_axis("rc=0.2mm:1mm:2", model), parse_axis("omega=20:60:2", model)),
+                     measures=("peak",), model=model,
+                     settings=dict(revolutions=0.5, transient=0, fs=5000.0))  # fmt: skip
+    ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False))
+    frac = ds["contact_fraction"].values
+    assert frac.shape == (2, 2) and np.all((frac > 0) & (frac <= 1))
+    assert np.isnan(ds["contact_fraction_crosshead"].values).all()
+    run = recipdyn.simulate(model=model, params=dict(rc=1e-3, omega=60.0), revolutions=0.5,
+                            transient=0, fs=5000.0)  # fmt: skip
+    n = run.sizes["time"]
+    assert abs(frac[1, 1] - float(run["contact"].mean())) <= 1.0 / n
+    assert any(p.name == "map_contact_fraction.png" for p in sweep_figures(ds, tmp_path / "f"))

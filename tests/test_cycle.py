@@ -384,3 +384,31 @@ def test_real_gas_from_the_cli(tmp_path, capsys):
     assert main(["simulate", "--set", "load=cycle", "--set", "gas=Unobtainium", "-o",
                  str(tmp_path / "x.nc"), "--no-progress"]) == 2  # fmt: skip
     assert "gas" in capsys.readouterr().err
+
+
+def test_sweep_over_pressure_ratio_is_the_cycle(tmp_path):
+    """Issue 13, item 5: a sweep over the discharge pressure (pressure ratios 2, 4, 6) with
+    the cycle load stores at each point what simulate gives for it (the minimum joint contact
+    force, same integration on the same machine, to 1e-9), and a point is marked outside the
+    massless link's validity exactly when simulate says so (the minimum is not monotonic in
+    the ratio: the reversal moves with the valve events)."""
+    import recipdyn
+    from recipdyn.model.parameters import CompressorParams
+    from recipdyn.sweep.run import open_sweep, run_sweep
+    from recipdyn.sweep.spec import SweepSpec, parse_axis
+
+    base = CompressorParams(load="cycle", rc=1e-3)
+    spec = SweepSpec(axes=(parse_axis("discharge_pressure=2bar:6bar:3"),), measures=("peak",),
+                     base=base, settings=dict(revolutions=1, transient=0, fs=5000.0))  # fmt: skip
+    ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False))
+    mins = ds["min_contact_force"].values
+    for pd, stored in zip(ds["discharge_pressure"].values, mins, strict=True):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run = recipdyn.simulate(CompressorParams(load="cycle", rc=1e-3, discharge_pressure=pd),
+                                    revolutions=1, transient=0, fs=5000.0)  # fmt: skip
+        assert stored == pytest.approx(run.attrs["min_contact_force_N"], rel=1e-9, abs=1e-6)
+        assert (stored < 0) == (run.attrs["validity"] != "ok")
+    assert mins.size == 3 and np.all(np.isfinite(mins))

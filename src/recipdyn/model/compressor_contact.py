@@ -557,6 +557,10 @@ class CompressorContact(Model):
     """The compressor with contact-impact (dry or lubricated) clearance joints at the crank
     pin, the crosshead pin, or both."""
 
+    mean_signals = (
+        ("contact", "contact_fraction", "1"),
+        ("contact_crosshead", "contact_fraction_crosshead", "1"),
+    )
     name = "compressor-contact"
     description = ("compressor with contact-impact clearance joints at the crank pin, the "
                    "crosshead pin or both (free flight, impacts, friction, oil film; Flores et "

@@ -228,6 +228,10 @@ class Model(ABC):
     #: lower bound, why, what to use instead). Simulate warns and sweeps record the minimum
     #: (``min_<output>``) and mark the points that cross.
     validity_bounds: tuple[tuple[str, str, float, str, str], ...] = ()
+    #: Outputs whose mean over a run sweeps store with the ``peak`` measure: (output name,
+    #: stored name, unit), e.g. the contact-impact joint's time fraction in contact; NaN for a
+    #: point whose run lacks the output.
+    mean_signals: tuple[tuple[str, str, str], ...] = ()
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         """Events to locate during a simulation (at most one today: the integrator locates

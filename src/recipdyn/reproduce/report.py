@@ -178,6 +178,11 @@ GLOSSARY: dict[str, str] = {
     "Poincare section": "the state once per crank revolution (stroboscopic); closed curves "
     "mean quasi-periodic motion, a finite set periodic, a scattered cloud chaotic",
     "assumed": "a value the paper does not give (its Table 1 is illegible); ours, labelled",
+    "contact fraction": "contact-impact joint: fraction of the time the journal touches the "
+    "bearing (penetration > 0)",
+    "impacts/rev": "contact-impact joint: contact onsets per crank revolution",
+    "link valid": "massless link: fraction of the time its contact force is positive (the "
+    "link can only push; outside, the model does not hold)",
 }
 
 #: What each paper figure shows (the report's captions).
@@ -197,6 +202,8 @@ CAPTIONS: dict[str, str] = {
     "spans micrometres per second is drawn as the deviation from its median (in the label).",
     "figX": "Investigation: peak |a| against the initial link offset, rc and the equations.",
     "figY": "The compression-cycle case: p-V, pressures and rod loads.",
+    "figZ": "Both joint models, light load: the massless link leaves its validity (red), the "
+    "contact-impact joint shows free flight and impacts.",
 }
 
 #: Width (px) of the copies embedded in the report; the full-size PNGs are linked.
@@ -252,6 +259,13 @@ dt{font-weight:bold;margin-top:.3em}dd{margin-left:1.5em}
 </style>"""
 
 
+def _gid(term: str) -> str:
+    """The glossary anchor of a term (letters, digits, '-' and '_' only)."""
+    import re
+
+    return "gl-" + re.sub(r"[^A-Za-z0-9_-]+", "-", term)
+
+
 def _figure_groups(figures: dict[str, Path]) -> list[tuple[str, str, list[str]]]:
     """Figures grouped as the paper groups them: ``(anchor, caption, stems)``."""
     groups: dict[str, list[str]] = {}
@@ -274,6 +288,7 @@ def write_html(
     settings: dict,
     runtime_s: float,
     findings: list[tuple[str, Any]],
+    joint_rows: list[dict[str, Any]] | None = None,
 ) -> Path:
     """A single self-contained HTML file: a navigation bar, collapsible sections (findings,
     notes, variants, parameters with the assumed ones marked, settings, the comparison table
@@ -285,7 +300,8 @@ def write_html(
     groups = _figure_groups(figures)
     sections = [("findings", "Findings"), ("notes", "Notes"), ("variants", "Variants"),
                 ("parameters", "Parameters and assumptions"), ("settings", "Settings"),
-                ("table", "Every number the paper reports"), ("figures", "Figures"),
+                ("table", "Every number the paper reports"),
+                ("joints", "Both joint models side by side"), ("figures", "Figures"),
                 ("glossary", "Glossary")]  # fmt: skip
     nav = ["<nav><b>recipdyn report</b>"]
     for sid, title in sections:
@@ -314,7 +330,7 @@ def write_html(
     for r, cells in zip(rows, body, strict=True):
         q = r["quantity"]
         cells = [e(c) for c in cells]
-        cells[2] = f"<a href='#gl-{q}'>{e(q)}</a> ({e(r['unit'])})"
+        cells[2] = f"<a href='#{_gid(q)}'>{e(q)}</a> ({e(r['unit'])})"
         trows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
     thead = "".join(f"<th>{e(h)}</th>" for h in head)
     figs = []
@@ -327,7 +343,7 @@ def write_html(
         )
         figs.append(f"<details id='{gid}' open><summary><h3>{e(cap)}</h3></summary>"
                     f"<div class='figs'>{items}</div></details>")  # fmt: skip
-    gloss = "".join(f"<dt id='gl-{e(k)}'>{e(k)}</dt><dd>{e(v)}</dd>" for k, v in GLOSSARY.items())
+    gloss = "".join(f"<dt id='{_gid(k)}'>{e(k)}</dt><dd>{e(v)}</dd>" for k, v in GLOSSARY.items())
     parts = [
         "<!doctype html><html lang='en'><head><meta charset='utf-8'>",
         "<meta name='viewport' content='width=device-width, initial-scale=1'>",
@@ -346,7 +362,7 @@ def write_html(
         section("notes", "Notes", "<ul>" + "".join(f"<li>{e(n)}</li>" for n in notes)
                 + "</ul>"),
         section("variants", "Variants", "<ul>" + "".join(
-            f"<li><b><a href='#gl-{e(v)}'>{e(v)}</a></b>: {e(variant_labels[v])}</li>"
+            f"<li><b><a href='#{_gid(v)}'>{e(v)}</a></b>: {e(variant_labels[v])}</li>"
             for v in variants) + "</ul>"),
         section("parameters", "Parameters and assumptions",
                 "<table><tr><th>parameter</th><th>value</th><th>unit</th><th>meaning</th></tr>"
@@ -358,6 +374,7 @@ def write_html(
                 "<p>ours [variant] and diff [variant] = (ours - paper) / paper for each "
                 "<a href='#variants'>variant</a>; the reason column says why they differ."
                 f"</p><table><tr>{thead}</tr>" + "".join(trows) + "</table>"),
+        section("joints", "Both joint models side by side", _joint_table(joint_rows or [])),
         section("figures", "Figures", "".join(figs)),
         section("glossary", "Glossary", f"<dl>{gloss}</dl>"),
         "</main></body></html>",
@@ -365,3 +382,28 @@ def write_html(
     path = out / "report.html"
     write_text(path, "\n".join(parts))
     return path
+
+
+def _joint_table(rows: list[dict[str, Any]]) -> str:
+    """The joint-model comparison as an HTML table (the CSV has every column)."""
+    if not rows:
+        return "<p>not run</p>"
+    e = html.escape
+    head = ["rc (mm)", "omega (rad/s)", "load (kN)", "impacts/rev", "peak |a| contact (m/s^2)",
+            "peak force contact (N)", "contact fraction", "peak |a| link (m/s^2)",
+            "peak force link (N)", "link valid", "peak |a| contact / link - 1"]  # fmt: skip
+    keys = ["rc_mm", "omega", "load_kN", "impacts_per_rev", "contact_peak_a",
+            "contact_peak_force_N", "contact_fraction", "link_peak_a", "link_peak_force_N",
+            "link_valid_fraction", "peak_a_contact_vs_link"]  # fmt: skip
+    link = {"impacts/rev": "impacts/rev", "contact fraction": "contact fraction",
+            "link valid": "link valid"}  # fmt: skip
+    cells = "".join(
+        f"<th><a href='#{_gid(link[h])}'>{e(h)}</a></th>" if h in link else f"<th>{e(h)}</th>"
+        for h in head
+    )
+    body = "".join("<tr>" + "".join(f"<td class=n>{e(_fmt(float(r[k])))}</td>" for k in keys)
+                   + "</tr>" for r in rows)  # fmt: skip
+    return ("<p>The paper's mechanism with the massless virtual link and with the "
+            "contact-impact clearance joint (docs/contact.md), the paper's geometry and the "
+            "assumed masses, recorded after a transient. All columns: joint_models.csv.</p>"
+            f"<table><tr>{cells}</tr>{body}</table>")  # fmt: skip
