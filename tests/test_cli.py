@@ -159,3 +159,19 @@ def test_analyze_json(tmp_path, capsys):
     saved = json.loads((tmp_path / "an" / "summary.json").read_text(encoding="utf-8"))
     assert s["verdict"] == saved["verdict"] and s["spectrum"] == saved["spectrum"]
     assert s["output"] == str(tmp_path / "an")
+
+
+def test_jsonable_gives_strict_json():
+    """One helper for every JSON output: numpy scalars (NaN included: np.float64(nan).item()
+    is a float NaN, which json.dumps would write as the invalid token NaN), arrays, paths."""
+    import json
+    from pathlib import Path
+
+    import numpy as np
+
+    from recipdyn.io import jsonable
+
+    obj = {"a": np.float64("nan"), "b": np.arange(3), 1: [np.int64(2), float("inf")],
+           "p": Path("x") / "y", "ok": 1.5}  # fmt: skip
+    text = json.dumps(jsonable(obj), allow_nan=False)
+    assert json.loads(text) == {"a": None, "b": [0, 1, 2], "1": [2, None], "p": "x/y", "ok": 1.5}

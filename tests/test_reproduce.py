@@ -125,3 +125,37 @@ def test_report_renders_in_headless_chromium(report_dir, tmp_path):
     assert 'data-images-ok="true"' in dom
     assert f'data-image-count="{n_fig}"' in dom
     assert 'data-broken-anchors="0"' in dom
+
+
+def test_every_reproduction_figure_is_labelled_and_finite(report_dir):
+    """Issue 14, item 1, for every figure of the report (rebuilt from the cached quick runs):
+    each panel has a y label (or the figure a shared one) and each column an x label, and no
+    drawn line contains NaN or infinity."""
+    import numpy as np
+
+    from recipdyn.plotting import _mpl
+    from recipdyn.reproduce.figures import FIGURES, fig02_load
+
+    s = Settings().quick()
+    runs = run_all([RunSpec(c, v, s) for c in CASES for v in VARIANTS], report_dir / "cache",
+                   jobs=1)  # fmt: skip
+    plt = _mpl()
+    checked = 0
+    groups = [lambda: fig02_load(runs, None)]
+    groups += [lambda m=make, v=v: m(runs, v.id) for v in VARIANTS for make in FIGURES]
+    for group in groups:
+        for stem, fig in group().items():  # one group open at a time
+            shared_y = fig._supylabel is not None and fig._supylabel.get_text()
+            for ax in fig.axes:
+                assert ax.get_ylabel().strip() or shared_y, (stem, ax.get_title())
+                for line in ax.get_lines():
+                    xy = np.asarray(line.get_xydata(), dtype=float)
+                    assert np.all(np.isfinite(xy)), (stem, line.get_label())
+            columns = {}
+            for ax in fig.axes:
+                key = round(ax.get_position().x0, 3)
+                columns[key] = columns.get(key, False) or bool(ax.get_xlabel().strip())
+            assert all(columns.values()), stem
+            checked += 1
+            plt.close(fig)
+    assert checked > 70

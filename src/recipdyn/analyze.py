@@ -6,7 +6,6 @@ JSON/Markdown summary. This is the application layer over the generic :mod:`reci
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +22,7 @@ from .analysis import (
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
 from .analysis.signal import assess_signal
 from .defaults import ATOL, LYAP_TOL, RTOL
+from .io import jsonable as _plain
 from .io import save_figure, write_text
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
@@ -401,18 +401,6 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     plt.close(fig)
     summary["zero_one_K"] = k01
     return lam, lam_err, section, k01
-
-
-def _plain(obj):
-    if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def _markdown(s: dict[str, Any]) -> str:

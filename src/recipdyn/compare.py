@@ -29,7 +29,7 @@ import numpy as np
 
 from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 from .errors import ParameterError
-from .io import check_output, read_dataset, save_figure, write_text
+from .io import check_output, jsonable, read_dataset, save_figure, write_text
 from .plotting import PALETTE, _mpl, axis_label, plot_signal
 
 __all__ = ["compare_runs", "MEASURES"]
@@ -148,21 +148,9 @@ def compare_runs(paths: list[str | Path], out: str | Path, *, signal: str | None
                "units": runs[0][signal].attrs.get("units", ""), "differing_inputs": differing,
                "measures": table}  # fmt: skip
     _figure(runs, labels, signal, out / "compare.png")
-    write_text(out / "compare.json", json.dumps(_jsonable(summary), indent=2))
+    write_text(out / "compare.json", json.dumps(jsonable(summary), indent=2))
     write_text(out / "compare.md", _markdown(summary))
     return summary
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None
-    return obj
 
 
 def _figure(runs, labels, signal, path: Path) -> None:

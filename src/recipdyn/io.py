@@ -168,6 +168,29 @@ def _write_mat(ds, path: Path) -> None:
         savemat(fh, data, do_compression=True, oned_as="column")
 
 
+def jsonable(obj):
+    """``obj`` ready for strict JSON: numpy scalars and arrays to Python, paths to strings,
+    dict keys to strings, NaN and infinities to ``None`` (JSON has no NaN)."""
+    import math
+    import os
+
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    return obj
+
+
 def save_figure(fig, path: str | Path, **kw) -> Path:
     """``fig.savefig`` to ``path`` atomically."""
     path = Path(path)

@@ -19,13 +19,13 @@ import contextvars
 import functools
 import inspect
 import json
-import math
 import os
 import sys
 
 import typer
 
 from ..errors import IntegrationError, Interrupted, ParameterError, raise_on_signals
+from ..io import jsonable
 from ..progress import phase  # noqa: F401  (the commands' phase helper)
 
 app = typer.Typer(
@@ -62,7 +62,7 @@ def with_json(func):
                 rv = func(*args, **kw)
         finally:
             _REPORT.reset(token)
-        real.write(json.dumps(_plain(collected), allow_nan=False) + "\n")
+        real.write(json.dumps(jsonable(collected), allow_nan=False) + "\n")
         real.flush()
         return rv
 
@@ -76,25 +76,6 @@ def report(**items) -> None:
     collected = _REPORT.get()
     if collected is not None:
         collected.update(items)
-
-
-def _plain(obj):
-    """JSON-ready: numpy scalars and arrays to Python, paths to strings, NaN/inf to null."""
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None  # JSON has no NaN: null
-    if isinstance(obj, os.PathLike):
-        return os.fspath(obj)
-    return obj
 
 
 def _version(value: bool) -> None:

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelValidityWarning
-from ..io import write_text
+from ..io import jsonable, write_text
 from ..model.kinematics import ideal_slider_crank
 from ..model.parameters import CompressorParams
 from ..progress import phase, quiet
@@ -164,7 +164,7 @@ def _reproduce(out: Path, t0: float, quick: bool, force: bool, jobs: int | None,
                    variant_labels={v.id: v.label for v in VARIANTS}, figures=figures,
                    notes=notes, settings=sdict, runtime_s=runtime, findings=findings,
                    joint_rows=joint_rows)  # fmt: skip
-    write_text(out / "investigation.json", json.dumps(inv_table, indent=1))
+    write_text(out / "investigation.json", json.dumps(jsonable(inv_table), indent=1))
     return out / "report.html"
 
 

@@ -21,7 +21,7 @@ import numpy as np
 from ..defaults import CALIBRATION_ATOL, CALIBRATION_RTOL
 from ..errors import ModelValidityWarning
 from ..integrate import IntegrationError
-from ..io import write_text
+from ..io import jsonable, write_text
 from ..model.parameters import CompressorParams
 from ..simulate import simulate
 from .cases import PAPER_VALUES, case_by_id
@@ -99,7 +99,7 @@ def calibrate(free=("m2", "m3", "J2"), *, fixed: dict[str, float] | None = None,
 
 def write_calibration(results: list[dict[str, Any]], out: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
-    write_text(out / "calibration.json", json.dumps(results, indent=1, default=float))
+    write_text(out / "calibration.json", json.dumps(jsonable(results), indent=1, default=float))
     lines = ["# Calibration of the unknown parameters to the paper's peak accelerations", ""]
     for r in results:
         lines += [f"## free: {', '.join(r['free'])}; fixed: {r['fixed'] or 'none'}", "",
