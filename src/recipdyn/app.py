@@ -118,6 +118,10 @@ def sweep_figure(store: str | Path, variable: str | None = None) -> tuple[Any, l
         ]  # fmt: skip
         if not options:
             raise ParameterError(f"store {store}: no map variable")
+        # a stable order whatever the store lists first: exponent, peaks, RMS, the rest
+        rank = ("lambda1", "peak_", "rms_", "min_")
+        options.sort(key=lambda k: (next((i for i, r in enumerate(rank) if k.startswith(r)),
+                                         len(rank)), k))  # fmt: skip
         variable = variable if variable in options else options[0]
         z = np.where(done, ds[variable].values, np.nan)
         fig = go.Figure(go.Heatmap(x=ds[dims[1]].values, y=ds[dims[0]].values, z=z,
