@@ -51,6 +51,7 @@ import numba as nb
 import numpy as np
 
 __all__ = [
+    "pressure_force",
     "CycleGeometry", "cycle_geometry", "pack_cycle", "cycle_state", "cycle_force_kernel",
     "ideal_volumetric_efficiency", "ideal_indicated_work", "indicated_work",
     "volumetric_efficiency", "RodReversal", "rod_load_reversal", "ACTING",
@@ -80,6 +81,16 @@ class CycleGeometry:
     @property
     def stroke(self) -> float:
         return self.x_max - self.x_min
+
+
+def pressure_force(p_head, p_crank, *, bore: float, rod_diameter: float,
+                   frame_pressure: float):  # fmt: skip
+    """Gas force on the crosshead along +x from the chamber pressures (Pa, absolute):
+    ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod`` (the kernel's formula, for tables)."""
+    area = math.pi * bore**2 / 4.0
+    a_rod = math.pi * rod_diameter**2 / 4.0
+    return -np.asarray(p_head) * area + np.asarray(p_crank) * (area - a_rod) \
+        + frame_pressure * a_rod  # fmt: skip
 
 
 def _x(theta, r, l, d):

@@ -36,7 +36,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .cycle import cycle_force_kernel, pack_cycle
+from .cycle import cycle_force_kernel, pack_cycle, pressure_force
 
 __all__ = [
     "mu_paper",
@@ -258,9 +258,8 @@ def read_pressure_table(path, *, bore: float, rod_diameter: float,
     def smooth(p):
         return PchipInterpolator(a3, np.tile(p, 3))(grid)
 
-    area = math.pi * bore**2 / 4
-    a_rod = math.pi * rod_diameter**2 / 4
     p_he = smooth(press[0])
     p_ce = smooth(press[1]) if len(press) > 1 else np.full_like(grid, frame_pressure)
-    force = -p_he * area + p_ce * (area - a_rod) + frame_pressure * a_rod
+    force = pressure_force(p_he, p_ce, bore=bore, rod_diameter=rod_diameter,
+                           frame_pressure=frame_pressure)  # fmt: skip
     return tuple((float(a), float(f)) for a, f in zip(grid, force, strict=True))

@@ -26,11 +26,10 @@ Chem. Res. 53(6), 2498-2508.
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 
-from .cycle import cycle_states, pack_cycle
+from .cycle import cycle_states, pack_cycle, pressure_force
 from .parameters import GASES  # noqa: F401  (re-exported)
 
 __all__ = [
@@ -129,9 +128,8 @@ def real_gas_force_table(values) -> tuple[tuple[float, float], ...]:
     """The gas force on the crosshead along +x as load-table rows ``(deg, N)``:
     ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod``."""
     deg, ph, pc = real_gas_pressures(values)
-    area = math.pi * values["bore"] ** 2 / 4
-    a_rod = math.pi * values["rod_diameter"] ** 2 / 4
-    force = -ph * area + pc * (area - a_rod) + values["frame_pressure"] * a_rod
+    force = pressure_force(ph, pc, bore=values["bore"], rod_diameter=values["rod_diameter"],
+                           frame_pressure=values["frame_pressure"])  # fmt: skip
     return tuple((float(a), float(f)) for a, f in zip(deg, force, strict=True))
 
 
