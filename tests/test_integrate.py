@@ -156,3 +156,31 @@ def test_dop853_tableau_from_the_user_cache_equals_scipy(tmp_path, monkeypatch):
             S.order, S.n_stages, S.error_estimator_order)  # fmt: skip
     assert len(list((tmp_path / "recipdyn").glob("dop853-*.npz"))) == 1
     tableaus.dop853.cache_clear()
+
+
+def test_numba_cache_folder_follows_the_sources(tmp_path):
+    """numba does not invalidate a cached caller when a compiled function it calls from another
+    file changes; the cache folder is therefore keyed by a fingerprint of every module: a
+    changed modification time of one module gives another folder, restoring it the same one,
+    and a fresh process puts NUMBA_CACHE_DIR under the user's cache with that fingerprint."""
+    import os
+    import subprocess
+    import sys
+
+    import recipdyn
+    from recipdyn.model import valves
+
+    fp = recipdyn._source_fingerprint()
+    st = os.stat(valves.__file__)
+    try:
+        os.utime(valves.__file__, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+        assert recipdyn._source_fingerprint() != fp
+    finally:
+        os.utime(valves.__file__, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert recipdyn._source_fingerprint() == fp
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    out = subprocess.run([sys.executable, "-c", "import os, recipdyn; "
+                          "print(os.environ['NUMBA_CACHE_DIR'])"], env=env, check=True,
+                         capture_output=True, text=True).stdout.strip()  # fmt: skip
+    assert out == os.path.join(str(tmp_path), "recipdyn", "numba", fp)

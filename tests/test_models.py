@@ -85,8 +85,9 @@ def test_kernels_deterministic_and_jacobian_exact(model, rng):
     assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == model.dim
     y0 = model.initial_state(values)
     fn = s.f if isinstance(s, ODESystem) else s.g
+    scale = model.state_scale(values)
     for _ in range(5):
-        y = y0 + 0.05 * rng.standard_normal(s.dim) * np.maximum(1.0, np.abs(y0))
+        y = y0 + 0.05 * rng.standard_normal(s.dim) * scale
         t = float(rng.uniform(0, 3))
         assert np.array_equal(fn(t, y), fn(t, y))
         J = np.empty((s.dim, s.dim))

@@ -45,7 +45,7 @@ from numba import types as _nbt
 __all__ = [
     "ODESystem", "DiscreteMap", "Signal", "Event", "RHS_SIGNATURE", "JAC_SIGNATURE",
     "EVENT_SIGNATURE", "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE", "compiled",
-    "typed",
+    "typed", "rhs_series",
 ]  # fmt: skip
 
 #: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
@@ -98,6 +98,33 @@ def typed(dispatcher, signature):
         dispatcher.disable_compile()
         _TYPED[key] = dispatcher
     return dispatcher
+
+
+_SERIES_SIG = _nbt.float64[:, ::1](RHS_TYPE, _nbt.float64[::1], _nbt.float64[:, ::1],
+                                   _nbt.float64[::1])  # fmt: skip
+
+
+@_nb.njit(cache=True)  # compiled for _SERIES_SIG on first use (typed)
+def _rhs_series(rhs, t, y, p):
+    n = y.shape[1]
+    out = np.empty((t.shape[0], n))
+    buf = np.empty(n)
+    yi = np.empty(n)
+    for i in range(t.shape[0]):
+        for j in range(n):
+            yi[j] = y[i, j]
+        rhs(t[i], yi, p, buf)
+        for j in range(n):
+            out[i, j] = buf[j]
+    return out
+
+
+def rhs_series(rhs, params: np.ndarray, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``f(t_i, y_i)`` at every sample of a trajectory (shape ``(len(t), dim)``), compiled:
+    e.g. the accelerations a model's outputs need."""
+    return typed(_rhs_series, _SERIES_SIG)(rhs, np.ascontiguousarray(t, dtype=np.float64),
+                                           np.ascontiguousarray(y, dtype=np.float64),
+                                           np.ascontiguousarray(params, dtype=np.float64))
 
 
 @dataclass(frozen=True)

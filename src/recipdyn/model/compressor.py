@@ -28,11 +28,10 @@ from .base import (
     JAC_SIGNATURE,
     RHS_JAC_SIGNATURE,
     RHS_SIGNATURE,
-    RHS_TYPE,
     ODESystem,
     Signal,
     compiled,
-    typed,
+    rhs_series,
 )
 from .cycle import cycle_force_kernel, cycle_states, cycle_summary
 from .kinematics import joint_forces, kinematics
@@ -191,23 +190,6 @@ def jac_paper(t, y, p, out):
     out[1, 1] = (_paper_acc(t, y[0], y[1] + hd, p) - _paper_acc(t, y[0], y[1] - hd, p)) / (2 * hd)
 
 
-_ACCELERATIONS_SIG = nb.float64[::1](RHS_TYPE, nb.float64[::1], nb.float64[:, ::1],
-                                     nb.float64[::1])  # fmt: skip
-
-
-@nb.njit(cache=True)  # compiled for _ACCELERATIONS_SIG on first use (base.typed)
-def _accelerations(rhs, t, y, p):
-    out = np.empty(t.shape[0])
-    buf = np.empty(2)
-    yi = np.empty(2)
-    for i in range(t.shape[0]):
-        yi[0] = y[i, 0]
-        yi[1] = y[i, 1]
-        rhs(t[i], yi, p, buf)
-        out[i] = buf[1]
-    return out
-
-
 def equilibrium_theta_c(p: CompressorParams, t: float = 0.0) -> float:
     r"""Clearance angle at which the link is aligned with the rod load at time ``t``.
 
@@ -246,9 +228,7 @@ class CompressorModel(ODESystem):
 
     def accelerations(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Clearance-angle acceleration at each sample, from the equation of motion."""
-        return typed(_accelerations, _ACCELERATIONS_SIG)(
-            self.rhs, np.ascontiguousarray(t, float), np.ascontiguousarray(y, float), self.params
-        )
+        return rhs_series(self.rhs, self.params, t, y)[:, 1]
 
     def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, Signal]:
         """Crosshead motion, rod angle, clearance state, gas force and joint forces."""

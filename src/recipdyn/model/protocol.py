@@ -251,6 +251,12 @@ class Model(ABC):
         by saltation matrices). A model refuses it by setting ``lyapunov_refusal``."""
         return not self.lyapunov_refusal
 
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Typical size of each state component (used to perturb states in the interface
+        tests). Default: ``max(1, |initial state|)``; a model whose states are far smaller
+        than 1 in SI units (a valve lift in m, a gas mass in kg) says so here."""
+        return np.maximum(1.0, np.abs(self.initial_state(values)))
+
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov
         exponents are then reported as 0 without integrating."""

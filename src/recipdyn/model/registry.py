@@ -35,6 +35,7 @@ _BUILTIN = {
     "double-pendulum": "recipdyn.model.reference.double_pendulum:DOUBLE_PENDULUM",
     "impact-oscillator": "recipdyn.model.reference.impact_oscillator:IMPACT_OSCILLATOR",
     "compressor-contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
+    "compressor-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
 }
 _REGISTERED: dict[str, Model] = {}
 

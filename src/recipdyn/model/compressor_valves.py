@@ -1,0 +1,393 @@
+r"""The compressor with dynamic valves: the massless-link mechanism and the cylinder gas as states.
+
+The paper's mechanism with the crank-pin clearance as the massless link (:mod:`.compressor`,
+the exact equation of motion) driven by the compression cycle with dynamic plate valves
+(:mod:`.valves`): the chamber pressures and masses and the valve plates are states integrated
+with the clearance angle, the chamber volumes follow the crosshead of the mechanism's own state,
+and the gas force on the crosshead follows the pressures. State::
+
+    (theta_c, theta_c', p_head, m_head, y_suction_head, u_suction_head, y_discharge_head,
+     u_discharge_head, <the same six for the crank end>, mass_in_head, mass_out_head,
+     mass_in_crank, mass_out_crank)
+
+The last four are auxiliary (mass counters; ``ODESystem.aux_states``). A chamber that does not
+compress (``acting = "head"`` or ``"crank"``) keeps its states at the frame pressure.
+
+The Jacobian: the mechanism rows are exact (the generated ``d theta_c''/d(theta_c,
+theta_c')`` of :mod:`._generated` and ``d theta_c''/d p`` = the equation's exact coefficient of
+the gas force, which enters linearly, times the piston areas); the gas rows are central
+differences of the gas right-hand side (the valve stops and the regularised nozzle are not
+everywhere smooth), with steps scaled by each state's size.
+
+Benettin's method is refused: a plate that comes to rest on a stop loses its velocity in a
+reset whose saltation matrix is singular, so the tangent dynamics of the valves has exponents
+of -infinity and the QR iteration is not defined (see :attr:`lyapunov_refusal`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+from . import cycle as cy
+from . import valves as va
+from ._generated import clearance_acceleration, clearance_acceleration_jac
+from .base import (
+    EVENT_SIGNATURE,
+    JAC_SIGNATURE,
+    RHS_SIGNATURE,
+    Event,
+    ODESystem,
+    Signal,
+    compiled,
+    rhs_series,
+)
+from .compressor import (
+    P_D,
+    P_G,
+    P_J2,
+    P_L,
+    P_LS,
+    P_M2,
+    P_M3,
+    P_OMEGA,
+    P_R,
+    P_RC,
+    P_TABLE,
+    P_TH10,
+    Compressor,
+    equilibrium_theta_c,
+    pack_params,
+)  # fmt: skip
+from .kinematics import joint_forces, kinematics
+from .parameters import SCHEMA as LINK_SCHEMA
+from .parameters import CompressorParams
+from .protocol import Param, Schema
+
+__all__ = ["CompressorValves", "COMPRESSOR_VALVES", "valve_summary"]
+
+_INF = math.inf
+#: Offsets in the packed vector: the cycle data, then the valve data.
+P_CYCLE = P_TABLE
+P_VALVE = P_TABLE + cy.N_CYCLE
+#: Offsets in the state: the gas states, then the mass counters.
+G0 = 2
+A0 = G0 + va.N_GAS
+STATE_NAMES = ("theta_c", "thetadot_c", *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
+STATE_UNITS = ("rad", "rad/s", *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
+N_STATE = len(STATE_NAMES)
+
+
+@nb.njit(cache=True, inline="always")
+def _crosshead(th1, thc, thcd, p):
+    """Crosshead position and velocity of the massless-link mechanism (:mod:`.kinematics`)."""
+    r, l, rc, w = p[P_R], p[P_L], p[P_RC], p[P_OMEGA]
+    s2 = -(p[P_D] + r * math.sin(th1) + rc * math.sin(thc)) / l
+    c2 = math.sqrt(1.0 - s2 * s2)
+    th2d = -(r * w * math.cos(th1) + rc * thcd * math.cos(thc)) / (l * c2)
+    x = r * math.cos(th1) + rc * math.cos(thc) + l * c2
+    v = -r * w * math.sin(th1) - rc * thcd * math.sin(thc) - l * s2 * th2d
+    return x, v
+
+
+@nb.njit(cache=True, inline="always")
+def _acc(th1, thc, thcd, F, p):
+    return clearance_acceleration(th1, thc, thcd, F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3],
+                                  p[P_J2], p[P_G], p[P_RC], p[P_D], p[P_OMEGA])  # fmt: skip
+
+
+@nb.njit(cache=True)
+def _gas(t, y, p, out):
+    th1 = p[P_TH10] + p[P_OMEGA] * t
+    x, xd = _crosshead(th1, y[0], y[1], p)
+    return th1, va.gas_rhs(x, xd, y, G0, A0, p[P_CYCLE:P_VALVE], p[P_VALVE:], out)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs_valves(t, y, p, out):
+    """Mechanism and gas: ``(theta_c', theta_c'', gas states', mass flows)``."""
+    th1, F = _gas(t, y, p, out)
+    out[0] = y[1]
+    out[1] = 0.0 if p[P_RC] == 0.0 else _acc(th1, y[0], y[1], F, p)
+
+
+@compiled(JAC_SIGNATURE)
+def jac_valves(t, y, p, J):
+    n = y.shape[0]
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+    f = np.empty(n)
+    th1, F = _gas(t, y, p, f)
+    J[0, 1] = 1.0
+    c = p[P_CYCLE:P_VALVE]
+    acting = int(c[cy.C_ACTING])
+    if p[P_RC] != 0.0:
+        _a, J[1, 0], J[1, 1] = clearance_acceleration_jac(
+            th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
+            p[P_RC], p[P_D], p[P_OMEGA])  # fmt: skip
+        # theta_c'' is linear in the gas force: its coefficient exactly, from two values
+        dF = 1.0 + abs(F)
+        dadF = (_acc(th1, y[0], y[1], F + dF, p) - _a) / dF
+        if acting & 1:
+            J[1, G0] = -dadF * c[cy.C_AHE]
+        if acting & 2:
+            J[1, G0 + 6] = dadF * c[cy.C_ACE]
+    # gas rows: central differences over the mechanism and gas states
+    v = p[P_VALVE:]
+    yh = y.copy()
+    f1 = np.empty(n)
+    f2 = np.empty(n)
+    for j in range(A0):
+        k = (j - G0) % 6 if j >= G0 else -1
+        if k == 0:
+            scale = c[cy.C_PS]
+        elif k == 1:
+            scale = abs(y[j]) + 1e-12
+        elif k == 2 or k == 4:
+            scale = v[va.V_LIFT]
+        else:
+            scale = 1.0
+        h = 1e-7 * (abs(y[j]) + scale)
+        yh[j] = y[j] + h
+        _gas(t, yh, p, f1)
+        yh[j] = y[j] - h
+        _gas(t, yh, p, f2)
+        yh[j] = y[j]
+        for i in range(G0, n):
+            J[i, j] = (f1[i] - f2[i]) / (2.0 * h)
+
+
+@compiled(EVENT_SIGNATURE)
+def valve_impact(t, y, p):
+    """Smallest normalised distance of a moving valve plate to its seat or guard."""
+    return va.valve_event(y, G0, p[P_VALVE:])
+
+
+@compiled(RHS_SIGNATURE)
+def valve_rebound(t, y, p, out):
+    va.valve_reset(y, G0, p[P_VALVE:], out)
+
+
+def _link(name: str, **changes) -> Param:
+    return replace(LINK_SCHEMA[name], **changes)
+
+
+_ASSUMED = "assumed: a lumped plate valve of typical proportions (the paper gives no valves)"
+_DROP = {"load", "load_amplitude", "load_sign", "equations", "gas"}
+SCHEMA = Schema((
+    *(p for p in LINK_SCHEMA if p.name not in _DROP),
+    Param("valve_area_fraction", "", 0.08, "flow area of each valve group at full lift / "
+          "piston area (head end)", 0.0, 1.0, low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("valve_lift", "m", 2.5e-3, "plate lift at the guard (full lift)", 0.0, 0.1,
+          low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("valve_mass", "kg", 0.05, "moving mass of each valve group's plates (lumped)", 0.0,
+          100.0, low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("valve_stiffness", "N/m", 8000.0, "spring stiffness of each valve group", 0.0, 1e9,
+          low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("valve_preload", "N", 5.0, "spring preload holding the plates on the seat", 0.0,
+          1e6, assumed=_ASSUMED, group="valves"),
+    Param("valve_damping", "", 0.1, "damping ratio of the plate on its spring (gas and "
+          "sticking)", 0.0, 10.0, assumed=_ASSUMED, group="valves"),
+    Param("valve_force_factor", "", 2.0, "effective force area of the plate / its flow area",
+          0.0, 100.0, low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("discharge_coefficient", "", 0.7, "discharge coefficient of the valve flow", 0.0,
+          1.0, low_open=True, assumed=_ASSUMED, group="valves"),
+    Param("valve_restitution", "", 0.3, "coefficient of restitution of the plate at the seat "
+          "and the guard", 0.0, 1.0, high_open=True, assumed=_ASSUMED, group="valves"),
+    Param("gas_constant", "J/(kg*K)", 287.05, "specific gas constant R (air: 287.05)", 0.0,
+          1e5, low_open=True, group="valves"),
+    Param("isentropic_exponent", "", 1.4, "isentropic exponent of the flow through the valves "
+          "(air: 1.4)", 1.0, 2.0, low_open=True, group="valves"),
+), aliases=dict(LINK_SCHEMA.aliases))  # fmt: skip
+
+
+def _cparams(values: Mapping[str, Any]) -> CompressorParams:
+    keys = set(CompressorParams.__dataclass_fields__) & set(LINK_SCHEMA.names)
+    return CompressorParams(load="cycle", **{k: values[k] for k in keys if k in values})
+
+
+def pack(values: Mapping[str, Any]) -> np.ndarray:
+    """Packed vector: the massless-link model's (with the cycle data), then the valves'."""
+    head = pack_params(_cparams(values))
+    return np.concatenate([head, va.pack_valves(values, head[P_CYCLE:P_VALVE])])
+
+
+def _last_revolution_mask(th: np.ndarray) -> np.ndarray:
+    return th >= th[-1] - 2.0 * math.pi
+
+
+def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+    """Figures of the last recorded revolution: indicated power, volumetric efficiency from
+    the mass taken in, the mass balance of each chamber, and per valve the number of impacts,
+    of separate openings (> 1: the plate flutters or reopens) and the crank angle of its final
+    closing after the dead centre at which the ideal valve closes (> 0: late closing)."""
+    ds = cy.last_revolution(ds, float(values["omega"]))
+    th = np.asarray(ds["theta1"].values, dtype=float)
+    if th.size < 8 or th[-1] - th[0] < 2.0 * math.pi * (1 - 1e-9):
+        return {}
+    last = _last_revolution_mask(th)
+    out: dict[str, Any] = {}
+    c = pack(values)[P_CYCLE:P_VALVE]
+    stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
+    rho_s = values["suction_pressure"] / (values["gas_constant"] * values["suction_temperature"])
+    work = 0.0
+    for j, end in enumerate(("head", "crank")):
+        if not int(c[cy.C_ACTING]) & (1 << j):
+            continue
+        p = np.asarray(ds[f"p_{end}"].values, dtype=float)[last]
+        V = np.asarray(ds[f"V_{end}"].values, dtype=float)[last]
+        work += cy.indicated_work(p, V)
+        m_in = np.asarray(ds[f"mass_in_{end}"].values, dtype=float)[last]
+        m_out = np.asarray(ds[f"mass_out_{end}"].values, dtype=float)[last]
+        din, dout = m_in[-1] - m_in[0], m_out[-1] - m_out[0]
+        area = c[cy.C_AHE] if j == 0 else c[cy.C_ACE]
+        out[f"volumetric_efficiency_{end}"] = float(din / (rho_s * area * stroke))
+        out[f"mass_balance_{end}"] = float((din - dout) / din) if din > 0 else math.nan
+        # the dead centre at which the ideal suction (discharge) valve closes
+        odc, idc = math.degrees(c[cy.C_THODC]), math.degrees(c[cy.C_THIDC])
+        close = {"suction": idc if j == 0 else odc, "discharge": odc if j == 0 else idc}
+        for kind in ("suction", "discharge"):
+            lift = np.asarray(ds[f"y_{kind}_{end}"].values, dtype=float)[last]
+            is_open = lift > 0.0
+            starts = np.flatnonzero(is_open & ~np.roll(is_open, 1))
+            out[f"openings_{kind}_{end}"] = int(starts.size)
+            if is_open.any() and not is_open.all():
+                ends = np.flatnonzero(~is_open & np.roll(is_open, 1))
+                # the last closing within 90 degrees of the dead centre
+                ang = np.degrees(th[last][ends]) % 360.0
+                lag = (ang - close[kind] + 180.0) % 360.0 - 180.0
+                near = lag[np.abs(lag) <= 90.0]
+                if near.size:
+                    out[f"closing_lag_{kind}_{end}_deg"] = float(near.max())
+    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
+    if "impact_time" in ds:
+        out["valve_impacts_per_rev"] = int(np.count_nonzero(
+            np.asarray(ds["impact_time"].values) >= float(ds["time"].values[-1])
+            - 2.0 * math.pi / float(values["omega"])))  # fmt: skip
+    fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
+    pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
+    rev = cy.rod_load_reversal(th[last], pin)
+    out.update(pin_reversal_deg=rev.reversal_deg, pin_reverse_fraction=rev.reverse_fraction,
+               api618_pin_reversal="pass" if rev.passed else "FAIL")  # fmt: skip
+    return out
+
+
+class CompressorValves(Compressor):
+    """The compressor with dynamic valves as a registered model (module docstring)."""
+
+    name = "compressor-valves"
+    description = (
+        "the compressor (massless-link clearance) driven by the compression cycle with "
+        "dynamic plate valves: cylinder pressures and valves as states"
+    )
+    state_names = STATE_NAMES
+    state_units = STATE_UNITS
+    schema = SCHEMA
+    lyapunov_refusal = (
+        "valve plates come to rest on their stops in resets with a singular saltation matrix "
+        "(Benettin's QR is undefined there); use the signal estimators or --model compressor "
+        "with load=cycle (ideal valves)"
+    )
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        return False
+
+    @staticmethod
+    def params(values: Mapping[str, Any]) -> CompressorParams:
+        return _cparams(values)
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        return (Event("impact", valve_impact, direction=-1, action="reset", reset=valve_rebound,
+                      description="a valve plate reaches its seat or guard: rebound with the "
+                      "restitution, or rest"),)  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> ODESystem:
+        p = self.params(values)
+        return ODESystem(rhs=rhs_valves, jac=jac_valves, params=pack(values),
+                         state_names=STATE_NAMES, state_units=STATE_UNITS,
+                         period=p.crank_period, name=self.name, attrs=p.to_attrs(),
+                         events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The massless link aligned with the ideal cycle's load, the gas states of the ideal
+        cycle at the initial crank angle, plates closed and at rest, counters 0."""
+        p = self.params(values)
+        thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
+        y = np.zeros(N_STATE)
+        y[0], y[1] = thc0 + p.theta_c_offset, p.thetadot_c0
+        y[G0:A0] = va.gas_initial(values, pack(values)[P_CYCLE:P_VALVE], p.theta1_0)
+        return y
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Pressures and masses at their initial size, lifts at the full lift, plate
+        velocities at 1 m/s, the mass counters at the initial gas mass."""
+        y0 = self.initial_state(values)
+        out = np.ones(N_STATE)
+        for j in range(2):
+            b = G0 + 6 * j
+            out[b], out[b + 1] = y0[b], y0[b + 1]
+            out[b + 2] = out[b + 4] = values["valve_lift"]
+            out[A0 + 2 * j] = out[A0 + 2 * j + 1] = y0[b + 1]
+        return out
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """The massless-link model's outputs with the gas force of the states, the chamber
+        volumes, temperatures and mass flows."""
+        p = self.params(values)
+        sys_ = self.system(values)
+        t = np.asarray(t, dtype=float)
+        dy = rhs_series(sys_.rhs, sys_.params, t, y)
+        thc, thcd = y[:, 0], y[:, 1]
+        k = kinematics(p, t, thc, thcd, dy[:, 1])
+        c = sys_.params[P_CYCLE:P_VALVE]
+        fg = cy.pressure_force(y[:, G0], y[:, G0 + 6], bore=p.bore, rod_diameter=p.rod_diameter,
+                               frame_pressure=p.frame_pressure)  # fmt: skip
+        jf = joint_forces(p, k, thc, fg)
+        stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
+        ahe, ace, clear = c[cy.C_AHE], c[cy.C_ACE], c[cy.C_CLEAR]
+        vol = {"head": clear * ahe * stroke + ahe * (c[cy.C_XMAX] - k.x3),
+               "crank": clear * ace * stroke + ace * (k.x3 - c[cy.C_XMIN])}  # fmt: skip
+        R = float(values["gas_constant"])
+        out = {
+            "x": Signal(k.x3, "m", "crosshead displacement x3"),
+            "v": Signal(k.v3, "m/s", "crosshead velocity"),
+            "a": Signal(k.a3, "m/s**2", "crosshead acceleration"),
+            "theta1": Signal(k.theta1, "rad", "crank angle"),
+            "theta2": Signal(k.theta2, "rad", "connecting-rod angle"),
+            "theta_c": Signal(thc, "rad", "clearance angle"),
+            "thetadot_c": Signal(thcd, "rad/s", "clearance angular velocity"),
+            "thetaddot_c": Signal(dy[:, 1], "rad/s**2", "clearance angular acceleration"),
+            "gas_force": Signal(fg, "N", "gas force on the crosshead along +x"),
+            "joint_force_x": Signal(jf.Fx, "N", "clearance-joint force on the rod, x"),
+            "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
+            "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
+            "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
+            "contact_force": Signal(jf.contact, "N",
+                                    "joint contact force (>0: permanent contact holds)"),
+            "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+        }
+        for j, end in enumerate(("head", "crank")):
+            b = G0 + 6 * j
+            out[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
+            out[f"V_{end}"] = Signal(vol[end], "m**3", f"{end}-end cylinder volume")
+            out[f"T_{end}"] = Signal(y[:, b] * vol[end] / (y[:, b + 1] * R), "K",
+                                     f"{end}-end gas temperature")  # fmt: skip
+            out[f"mdot_suction_{end}"] = Signal(
+                dy[:, A0 + 2 * j], "kg/s", f"{end}-end suction mass flow (in)")  # fmt: skip
+            out[f"mdot_discharge_{end}"] = Signal(
+                dy[:, A0 + 2 * j + 1], "kg/s", f"{end}-end discharge mass flow (out)")  # fmt: skip
+        return out
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        return valve_summary(values, ds)
+
+
+#: The registered instance (``recipdyn --model compressor-valves``).
+COMPRESSOR_VALVES = CompressorValves()

@@ -1,0 +1,300 @@
+r"""Dynamic valves: the cylinder pressure as a state, plate valves with mass, spring and stops.
+
+The compression cycle of :mod:`.cycle` with its ideal valves replaced by the lumped
+control-volume model of Soedel (*Design and Mechanics of Compressor Valves*, Purdue 1984, ch. 2
+and 5; the same formulation as Habing, *Flow and plate motion in compressor valves*, PhD thesis,
+University of Twente 2005, ch. 2). For each working chamber (head end, crank end):
+
+**Gas** (ideal gas, gas constant ``R``, uniform state in the chamber, adiabatic walls): the mass
+``m`` and pressure ``p`` are states; the temperature is ``T = p V / (m R)``. Mass and energy
+balances of the control volume give::
+
+    dm/dt = mdot_s + mdot_d
+    dp/dt = n / V (R T_s* mdot_s + R T_d* mdot_d - p dV/dt)
+
+``mdot`` > 0 into the chamber, ``T*`` the temperature of the gas that enters (the line's, or the
+chamber's own ``T`` for gas that leaves). With ``n = k`` this is the exact first law; like the
+ideal cycle, the exponent is ``n_compression`` while the chamber shrinks and ``n_expansion``
+while it grows, so that with closed valves ``p V^n`` is constant and the closed forms of
+:mod:`.cycle` are the limit of stiff, light valves (the tests check this). The suction line is
+at ``(p_s, T_s)``; the discharge line at ``p_d`` and (for back-flow) at the isentropic discharge
+temperature ``T_d = T_s (p_d/p_s)^((n_c-1)/n_c)``.
+
+**Flow** through a valve of lift ``y`` (max ``y_max``, the guard): an isentropic nozzle of
+effective area ``C_d A_v min(max(y, 0) / y_max, 1)`` (``A_v`` the flow area at full lift),
+exponent ``k`` (``isentropic_exponent``), choked below the critical pressure ratio::
+
+    mdot = C_d A p_u sqrt(2 k / ((k-1) R T_u) (pi^(2/k) - pi^((k+1)/k))),  pi = p_dn / p_u.
+
+Its slope in ``p_dn`` is infinite at ``pi -> 1``; below ``1 - pi = 1e-3`` the function is
+continued linearly to 0 (a laminar-like regularisation: at the default sizes it acts below a
+pressure difference of 0.1 % of the line pressure, where the flow is < 4 % of its value at the
+typical valve pressure drop), so that the equations stay Lipschitz.
+
+**Plates** (one lumped plate per valve group): ``m_v y'' = A_F dp - F_0 - k_v y - c_v y'``
+with ``dp`` the pressure difference that opens the valve (``p_s - p`` for suction, ``p - p_d``
+for discharge), ``A_F`` the effective force area (``valve_force_factor A_v``), ``F_0`` the
+spring preload, ``c_v = 2 zeta sqrt(k_v m_v)``. The seat (``y = 0``) and the guard
+(``y = y_max``) are rigid stops: an impact reverses the plate's velocity with the restitution
+``e`` (an event with a state reset), and a plate whose rebound is below ``V_REST`` = 1 cm/s, or
+that is pressed onto a stop, rests there (its derivatives are 0) until the net force pulls it
+away. This is the classical impact treatment of valve plates (Soedel 1984, ch. 5); it needs no
+stiff stop springs, so an explicit integrator steps through the cycle at the gas's own time
+scales.
+
+**Force on the mechanism**: ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod`` as in
+:mod:`.cycle`, with the pressures of the states. The chamber volumes follow the crosshead
+position of the mechanism's own state (not the ideal crank angle), so gas and mechanism are
+coupled both ways.
+
+Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: the line
+pressures are constant), no leakage past the piston rings or the valves, no heat transfer other
+than through the polytropic exponent, one lumped plate per valve group, ideal gas.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from . import cycle as cy
+
+__all__ = [
+    "VALVE_PARAMS", "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
+    "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
+    "flow_function", "V_REST", "EPS_LIN",
+]  # fmt: skip
+
+#: Rebound velocity (m/s) below which a plate comes to rest on its stop (no Zeno sequence of
+#: ever shorter bounces: a 1 cm/s bounce rises < 1 um against the default preload).
+V_REST = 1e-2
+#: ``1 - p_dn/p_u`` below which the nozzle flow is continued linearly to zero.
+EPS_LIN = 1e-3
+
+#: Parameter names of the valves, in :func:`pack_valves`'s order.
+VALVE_PARAMS = (
+    "valve_area_fraction", "valve_lift", "valve_mass", "valve_stiffness", "valve_preload",
+    "valve_damping", "valve_force_factor", "discharge_coefficient", "valve_restitution",
+    "gas_constant", "isentropic_exponent", "suction_temperature",
+)  # fmt: skip
+
+# Layout of the valve data (after the cycle data).
+(V_AREA, V_LIFT, V_MASS, V_K, V_F0, V_C, V_AF, V_CD, V_E, V_R, V_KAPPA, V_TS, V_TD,
+ V_NCH, V_CRIT, V_E1, V_E2, V_COEF) = range(18)  # fmt: skip
+N_VALVE = 18
+
+#: Gas states of one chamber: pressure, mass, suction-plate lift and velocity, discharge-plate
+#: lift and velocity.
+CHAMBER_STATES = ("p", "m", "y_suction", "u_suction", "y_discharge", "u_discharge")
+CHAMBER_UNITS = ("Pa", "kg", "m", "m/s", "m", "m/s")
+GAS_STATE_NAMES = tuple(f"{s}_{end}" for end in ("head", "crank") for s in CHAMBER_STATES)
+GAS_STATE_UNITS = CHAMBER_UNITS * 2
+N_GAS = len(GAS_STATE_NAMES)
+#: Auxiliary states: the mass that has passed each valve into the chamber (suction) or out of
+#: it (discharge) since t0, for the mass balance and the delivered mass.
+AUX_STATE_NAMES = ("mass_in_head", "mass_out_head", "mass_in_crank", "mass_out_crank")
+AUX_STATE_UNITS = ("kg",) * 4
+N_AUX = len(AUX_STATE_NAMES)
+
+
+def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
+    """Valve data for :func:`gas_rhs` (layout: the ``V_*`` constants)."""
+    area = float(values["valve_area_fraction"]) * cycle_data[cy.C_AHE]
+    k, m = float(values["valve_stiffness"]), float(values["valve_mass"])
+    nc = float(values["n_compression"])
+    ratio = float(values["discharge_pressure"]) / float(values["suction_pressure"])
+    t_s = float(values["suction_temperature"])
+    out = np.empty(N_VALVE)
+    out[V_AREA] = area
+    out[V_LIFT] = values["valve_lift"]
+    out[V_MASS] = m
+    out[V_K] = k
+    out[V_F0] = values["valve_preload"]
+    out[V_C] = 2.0 * float(values["valve_damping"]) * math.sqrt(k * m)
+    out[V_AF] = float(values["valve_force_factor"]) * area
+    out[V_CD] = values["discharge_coefficient"]
+    out[V_E] = values["valve_restitution"]
+    out[V_R] = values["gas_constant"]
+    out[V_KAPPA] = values["isentropic_exponent"]
+    out[V_TS] = t_s
+    out[V_TD] = t_s * ratio ** ((nc - 1.0) / nc)
+    out[V_NCH] = cycle_data[cy.C_ACTING]
+    out[V_CRIT:] = _nozzle_constants(float(values["isentropic_exponent"]))
+    return out
+
+
+def _nozzle_constants(kappa: float) -> tuple[float, float, float, float]:
+    """Critical pressure ratio, the exponents ``2/k`` and ``(k+1)/k``, and ``2k/(k-1)``."""
+    return ((2.0 / (kappa + 1.0)) ** (kappa / (kappa - 1.0)), 2.0 / kappa,
+            (kappa + 1.0) / kappa, 2.0 * kappa / (kappa - 1.0))  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always")
+def _psi(ratio, crit, e1, e2, coef):
+    lin = ratio > 1.0 - EPS_LIN
+    r = 1.0 - EPS_LIN if lin else max(ratio, crit)
+    psi = math.sqrt(coef * (r**e1 - r**e2))
+    if lin:
+        psi *= (1.0 - ratio) / EPS_LIN
+    return psi
+
+
+def flow_function(ratio: float, kappa: float) -> float:
+    """``sqrt(2 k/(k-1) (pi^(2/k) - pi^((k+1)/k)))`` for ``pi = p_dn/p_u`` in ``[0, 1]``,
+    choked below the critical ratio and linear in ``1 - pi`` below :data:`EPS_LIN` (the
+    kernel's function, callable from Python)."""
+    return float(_psi(float(ratio), *_nozzle_constants(float(kappa))))
+
+
+@nb.njit(cache=True, inline="always")
+def _mdot(p_line, t_line, p, t, area, v):
+    """Mass flow into the chamber from a line through an effective area (< 0: out of it)."""
+    if area <= 0.0 or p_line == p:
+        return 0.0
+    R = v[V_R]
+    if p_line > p:
+        psi = _psi(p / p_line, v[V_CRIT], v[V_E1], v[V_E2], v[V_COEF])
+        return area * p_line * psi / math.sqrt(R * t_line)
+    psi = _psi(p_line / p, v[V_CRIT], v[V_E1], v[V_E2], v[V_COEF])
+    return -area * p * psi / math.sqrt(R * t)
+
+
+@nb.njit(cache=True, inline="always")
+def _plate(y, dp, v, out, i):
+    """Plate equation of a valve at ``y[i], y[i+1]`` opened by ``dp``; rests on its stops."""
+    lift, u_ = y[i], y[i + 1]
+    force = v[V_AF] * dp - v[V_F0] - v[V_K] * lift - v[V_C] * u_
+    ymax = v[V_LIFT]
+    if (lift <= 0.0 and u_ <= 0.0 and force <= 0.0) or (lift >= ymax and u_ >= 0.0
+                                                         and force >= 0.0):  # fmt: skip
+        out[i] = 0.0
+        out[i + 1] = 0.0
+    else:
+        out[i] = u_
+        out[i + 1] = force / v[V_MASS]
+
+
+@nb.njit(cache=True, inline="always")
+def _area(lift, v):
+    return v[V_CD] * v[V_AREA] * min(max(lift, 0.0), v[V_LIFT]) / v[V_LIFT]
+
+
+@nb.njit(cache=True)
+def _chamber(V, dV, y, b, c, v, out):
+    """Derivatives of one chamber's six states at ``y[b:b+6]``; returns (mdot_s, mdot_d)."""
+    p, m = y[b], y[b + 1]
+    R = v[V_R]
+    T = p * V / (m * R)
+    ps, pd = c[cy.C_PS], c[cy.C_PD]
+    ms = _mdot(ps, v[V_TS], p, T, _area(y[b + 2], v), v)
+    md = _mdot(pd, v[V_TD], p, T, _area(y[b + 4], v), v)
+    n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
+    ts = v[V_TS] if ms > 0.0 else T
+    td = v[V_TD] if md > 0.0 else T
+    out[b] = n / V * (R * (ts * ms + td * md) - p * dV)
+    out[b + 1] = ms + md
+    _plate(y, ps - p, v, out, b + 2)
+    _plate(y, p - pd, v, out, b + 4)
+    return ms, md
+
+
+@nb.njit(cache=True)
+def gas_rhs(x, xdot, y, g, a, c, v, out):
+    """Derivatives of the gas states ``y[g:g+12]`` and the mass counters ``y[a:a+4]`` for the
+    crosshead at ``x`` moving at ``xdot``; returns the gas force on the crosshead along +x.
+    ``c``: the cycle data (:func:`recipdyn.model.cycle.pack_cycle`), ``v``: :func:`pack_valves`.
+    A chamber that does not compress (single-acting) keeps its states (derivatives 0) and the
+    frame pressure acts on its piston face."""
+    acting = int(v[V_NCH])
+    ahe, ace = c[cy.C_AHE], c[cy.C_ACE]
+    stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
+    force = c[cy.C_PFRAME] * c[cy.C_AROD]
+    for j in range(2):
+        b = g + 6 * j
+        if not acting & (1 << j):
+            for i in range(6):
+                out[b + i] = 0.0
+            out[a + 2 * j] = 0.0
+            out[a + 2 * j + 1] = 0.0
+            force += -c[cy.C_PFRAME] * ahe if j == 0 else c[cy.C_PFRAME] * ace
+            continue
+        if j == 0:
+            V = c[cy.C_CLEAR] * ahe * stroke + ahe * (c[cy.C_XMAX] - x)
+            dV = -ahe * xdot
+            force -= y[b] * ahe
+        else:
+            V = c[cy.C_CLEAR] * ace * stroke + ace * (x - c[cy.C_XMIN])
+            dV = ace * xdot
+            force += y[b] * ace
+        ms, md = _chamber(V, dV, y, b, c, v, out)
+        out[a + 2 * j] = ms
+        out[a + 2 * j + 1] = -md
+    return force
+
+
+@nb.njit(cache=True)
+def _distance(y, i, ymax):
+    """Normalised distance of plate ``i`` to the stop it moves toward; 1 for a plate at a
+    stop that rests there (slower than :data:`V_REST`) or leaves it."""
+    lift, u = y[i], y[i + 1]
+    if lift <= 0.0 and (u > -V_REST):
+        return 1.0
+    if lift >= ymax and (u < V_REST):
+        return 1.0
+    return min(lift, ymax - lift) / ymax
+
+
+@nb.njit(cache=True)
+def valve_event(y, g, v):
+    """The smallest normalised distance of a moving plate to its seat or guard (falls through
+    0 at an impact)."""
+    ymax = v[V_LIFT]
+    acting = int(v[V_NCH])
+    out = 1.0
+    for j in range(2):
+        if acting & (1 << j):
+            b = g + 6 * j
+            out = min(out, _distance(y, b + 2, ymax), _distance(y, b + 4, ymax))
+    return out
+
+
+@nb.njit(cache=True)
+def valve_reset(y, g, v, out):
+    """The impact of the plate closest to a stop and moving into it: rebound with the
+    restitution, or rest when the rebound is below :data:`V_REST`."""
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    ymax, e = v[V_LIFT], v[V_E]
+    best, dist = -1, math.inf
+    acting = int(v[V_NCH])
+    for j in range(2):
+        if not acting & (1 << j):
+            continue
+        for i in (g + 6 * j + 2, g + 6 * j + 4):
+            lift, u = y[i], y[i + 1]
+            if lift <= 0.5 * ymax and u < 0.0 and abs(lift) < dist:
+                best, dist = i, abs(lift)
+            elif lift > 0.5 * ymax and u > 0.0 and abs(ymax - lift) < dist:
+                best, dist = i, abs(ymax - lift)
+    if best < 0:
+        return
+    out[best] = 0.0 if y[best] <= 0.5 * ymax else ymax
+    u = -e * y[best + 1]
+    out[best + 1] = 0.0 if abs(u) < V_REST else u
+
+
+def gas_initial(values, c: np.ndarray, theta1: float) -> np.ndarray:
+    """The gas states at crank angle ``theta1``: the ideal cycle's pressures, the masses at
+    the temperature of a polytrope from the suction state, plates closed and at rest."""
+    p_he, p_ce, v_he, v_ce = cy.cycle_state(float(theta1), c)
+    R = float(values["gas_constant"])
+    ts, ps = float(values["suction_temperature"]), float(values["suction_pressure"])
+    nc = float(values["n_compression"])
+    y = np.zeros(N_GAS)
+    for j, (p, V) in enumerate(((p_he, v_he), (p_ce, v_ce))):
+        T = ts * (p / ps) ** ((nc - 1.0) / nc)
+        y[6 * j] = p
+        y[6 * j + 1] = p * V / (R * T)
+    return y
