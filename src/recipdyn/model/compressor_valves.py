@@ -257,6 +257,10 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
             is_open = lift > 0.0
             starts = np.flatnonzero(is_open & ~np.roll(is_open, 1))
             out[f"openings_{kind}_{end}"] = int(starts.size)
+            # share of the open time at full lift (< 1 and many impacts: the plate flutters)
+            n_open = np.count_nonzero(is_open)
+            at_guard = np.count_nonzero(lift >= float(values["valve_lift"]) * (1 - 1e-9))
+            out[f"full_lift_share_{kind}_{end}"] = at_guard / n_open if n_open else 0.0
             if is_open.any() and not is_open.all():
                 ends = np.flatnonzero(~is_open & np.roll(is_open, 1))
                 # the last closing within 90 degrees of the dead centre
