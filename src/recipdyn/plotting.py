@@ -135,16 +135,21 @@ def axis_label(name: str, da) -> str:
 
 
 def provenance_footer(ds: xr.Dataset) -> str:
-    """One line: the case's key parameters, solver and version (assumed values marked *)."""
+    """One line: the case's key parameters, solver and version (assumed values marked *);
+    parameters a model does not have are left out."""
     a = ds.attrs
-    return (
-        f"rc={1e3 * a['param_rc']:g} mm, d={1e3 * a['param_d']:g} mm, "
-        f"omega={a['param_omega']:g} rad/s, load sign={a['param_load_sign']}, "
-        f"equations={a['param_equations']}, theta_c0={a['theta_c_initial']:.4f} rad, "
-        f"m2*={a['param_m2']:g} kg, m3*={a['param_m3']:g} kg, J2*={a['param_J2']:g} kg m^2 "
-        f"(* assumed) | {a['solver_method']} rtol={a['solver_rtol']:g} | "
-        f"recipdyn {a['recipdyn_version']}"
-    )
+    parts = [f"rc={1e3 * a['param_rc']:g} mm, d={1e3 * a['param_d']:g} mm, "
+             f"omega={a['param_omega']:g} rad/s"]  # fmt: skip
+    if "param_load_sign" in a:
+        parts.append(f"load sign={a['param_load_sign']}")
+    if "param_equations" in a:
+        parts.append(f"equations={a['param_equations']}")
+    if "theta_c_initial" in a:
+        parts.append(f"theta_c0={a['theta_c_initial']:.4f} rad")
+    parts.append(f"m2*={a['param_m2']:g} kg, m3*={a['param_m3']:g} kg, "
+                 f"J2*={a['param_J2']:g} kg m^2 (* assumed)")  # fmt: skip
+    return (", ".join(parts) + f" | {a['solver_method']} rtol={a['solver_rtol']:g} | "
+            f"recipdyn {a['recipdyn_version']}")
 
 
 def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | None = None):
@@ -360,7 +365,8 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     """The compression cycle of a run with ``load = "cycle"``, over its last revolution:
     a) p-V diagram of each chamber (line pressures dashed), b) pressures over crank angle,
     c) rod loads over crank angle: gas, inertia of the crosshead and piston (``-m3 a``) and
-    combined (the crosshead-pin load, compression > 0), with the API 618 reversal verdict.
+    combined (the crosshead-pin load, compression > 0), with the API 618 reversal verdict;
+    with dynamic valves (model ``compressor-valves``) d) the valve lifts over crank angle.
     """
     from .model.cycle import last_revolution, rod_load_reversal
 
@@ -370,7 +376,9 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     order = np.argsort(deg)
     ps = float(ds.attrs["param_suction_pressure"])
     pdis = float(ds.attrs["param_discharge_pressure"])
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    valves = "y_suction_head" in ds
+    fig, axes = plt.subplots(1, 4 if valves else 3, figsize=(20 if valves else 15, 4.6),
+                             constrained_layout=True)  # fmt: skip
     ax = axes[0]
     colors = {"head": "#0072B2", "crank": "#D55E00"}  # Okabe-Ito: colour-blind safe
     acting = str(ds.attrs.get("param_acting", "double"))
@@ -419,7 +427,22 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     ax.set_xticks(range(0, 361, 60))
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
-    fig.suptitle(title or "Compression cycle (ideal valves) and rod loads, last revolution")
+    if valves:
+        ax = axes[3]
+        for end in ends:
+            for kind, ls in (("suction", "-"), ("discharge", "--")):
+                ax.plot(deg[order], last[f"y_{kind}_{end}"].values[order] * 1e3, lw=1.0, ls=ls,
+                        color=colors[end], label=f"{end} {kind}")  # fmt: skip
+        ax.axhline(float(ds.attrs["param_valve_lift"]) * 1e3, lw=0.7, color="0.4", ls=":")
+        ax.set_xlabel("crank angle (deg)")
+        ax.set_ylabel("valve lift (mm)")
+        ax.set_title("d) valve plate lift (guard dotted)")
+        ax.set_xlim(0, 360)
+        ax.set_xticks(range(0, 361, 60))
+        ax.legend(fontsize=8, loc="upper right")
+        ax.grid(alpha=0.3)
+    kind = "dynamic valves" if valves else "ideal valves"
+    fig.suptitle(title or f"Compression cycle ({kind}) and rod loads, last revolution")
     fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))  # room for the footer
     fig.text(0.01, 0.005, provenance_footer(ds), fontsize=6.5, color="0.35")
     return fig

@@ -222,6 +222,7 @@ def simulate(
             fig = model_figure(ds)
             typer.echo(f"wrote {save_figure(fig, out.with_suffix('.png'), dpi=130)}")
             _mpl().close(fig)
+            _cycle_png(ds, out)
         return
     typer.echo(f"wrote {out}  ({ds.sizes['time']} samples, nfev={ds.attrs['solver_nfev']})")
     if stream and ds.sizes["time"] > FIGURE_SAMPLES:  # the figure shows the last part
@@ -238,13 +239,7 @@ def simulate(
         png = save_figure(fig, out.with_suffix(".png"), dpi=130)
         _mpl().close(fig)
         typer.echo(f"wrote {png}")
-        if ds.attrs.get("param_load") == "cycle" and {"p_head", "V_head"} <= set(ds.data_vars):
-            from ..plotting import cycle_figure
-
-            fig = cycle_figure(ds)
-            png = save_figure(fig, out.with_name(out.stem + ".cycle.png"), dpi=110)
-            _mpl().close(fig)
-            typer.echo(f"wrote {png}")
+        _cycle_png(ds, out)
     a = ds["a"].values
     typer.echo(
         f"peak |a| = {abs(a).max():.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
@@ -254,6 +249,20 @@ def simulate(
     _echo_summary(summary)
     report(peak_a=float(abs(a).max()), x_min=ds.x.min().item(), x_max=ds.x.max().item(),
            min_contact_force=float(ds.attrs["min_contact_force_N"]), summary=summary)  # fmt: skip
+
+
+def _cycle_png(ds, out: Path) -> None:
+    """The compression-cycle figure (p-V, pressures, rod loads, valve lifts) of a run whose
+    load is the compression cycle (ideal or dynamic valves)."""
+    cycle = ds.attrs.get("param_load") == "cycle" or "y_suction_head" in ds.data_vars
+    if cycle and {"p_head", "V_head", "theta1", "a", "gas_force"} <= set(ds.data_vars):
+        from ..io import save_figure
+        from ..plotting import _mpl, cycle_figure
+
+        fig = cycle_figure(ds.load())
+        png = save_figure(fig, out.with_name(out.stem + ".cycle.png"), dpi=110)
+        _mpl().close(fig)
+        typer.echo(f"wrote {png}")
 
 
 def _echo_summary(summary: dict) -> None:
