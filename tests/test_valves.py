@@ -83,7 +83,7 @@ def test_valve_impact_law():
     than V_REST comes to rest (u = 0) exactly on the stop; the plates of a chamber that is not
     acting are never touched."""
     vals = MODEL.parameters({"valve_restitution": 0.4})
-    v = MODEL.system(vals).params[-va.N_VALVE:]
+    v = MODEL.system(vals).params[-va.N_VALVE :]
     lift = vals["valve_lift"]
     y = np.zeros(va.N_GAS)
     y[2], y[3] = -1e-12, -2.0  # head suction plate hits its seat at 2 m/s

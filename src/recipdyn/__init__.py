@@ -20,7 +20,6 @@ import types
 from .resources import cache_dir as _cache_dir
 
 
-
 def _source_fingerprint() -> str:
     """A hash of every module's path, size and modification time. numba invalidates a cached
     function when its own file changes, but not when a function it calls (and inlined) from

@@ -148,8 +148,10 @@ def provenance_footer(ds: xr.Dataset) -> str:
         parts.append(f"theta_c0={a['theta_c_initial']:.4f} rad")
     parts.append(f"m2*={a['param_m2']:g} kg, m3*={a['param_m3']:g} kg, "
                  f"J2*={a['param_J2']:g} kg m^2 (* assumed)")  # fmt: skip
-    return (", ".join(parts) + f" | {a['solver_method']} rtol={a['solver_rtol']:g} | "
-            f"recipdyn {a['recipdyn_version']}")
+    return (
+        ", ".join(parts) + f" | {a['solver_method']} rtol={a['solver_rtol']:g} | "
+        f"recipdyn {a['recipdyn_version']}"
+    )
 
 
 def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | None = None):

@@ -122,9 +122,12 @@ def _rhs_series(rhs, t, y, p):
 def rhs_series(rhs, params: np.ndarray, t: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``f(t_i, y_i)`` at every sample of a trajectory (shape ``(len(t), dim)``), compiled:
     e.g. the accelerations a model's outputs need."""
-    return typed(_rhs_series, _SERIES_SIG)(rhs, np.ascontiguousarray(t, dtype=np.float64),
-                                           np.ascontiguousarray(y, dtype=np.float64),
-                                           np.ascontiguousarray(params, dtype=np.float64))
+    return typed(_rhs_series, _SERIES_SIG)(
+        rhs,
+        np.ascontiguousarray(t, dtype=np.float64),
+        np.ascontiguousarray(y, dtype=np.float64),
+        np.ascontiguousarray(params, dtype=np.float64),
+    )
 
 
 @dataclass(frozen=True)

@@ -373,8 +373,9 @@ class CompressorValves(Compressor):
             "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
             "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
             "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
-            "contact_force": Signal(jf.contact, "N",
-                                    "joint contact force (>0: permanent contact holds)"),
+            "contact_force": Signal(
+                jf.contact, "N", "joint contact force (>0: permanent contact holds)"
+            ),
             "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
         }
         for j, end in enumerate(("head", "crank")):
