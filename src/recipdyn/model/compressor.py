@@ -256,20 +256,21 @@ class CompressorModel(ODESystem):
                 jf.contact, "N", "joint contact force (>0: permanent contact holds)"
             ),
             "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
-            **_cycle_outputs(p, k.theta1),
+            **cycle_outputs(vars(p), k.theta1),
         }
 
 
-def _cycle_outputs(p: CompressorParams, theta1: np.ndarray) -> dict[str, Signal]:
-    """Cylinder pressures and volumes of the compression-cycle load (none for other loads)."""
-    if p.load != "cycle":
+def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Signal]:
+    """Cylinder pressures and volumes of the compression-cycle load (none for other loads),
+    for any joint model whose parameters include the cycle's."""
+    if values.get("load") != "cycle" or values.get("load_table") is not None:
         return {}
-    if p.gas != "ideal":
+    if values.get("gas", "ideal") != "ideal":
         from .realgas import real_gas_states
 
-        st = real_gas_states(theta1, vars(p))
+        st = real_gas_states(theta1, values)
     else:
-        st = cycle_states(theta1, pack_load(vars(p))[1])
+        st = cycle_states(theta1, pack_load(values)[1])
     return {
         "p_head": Signal(st["p_head"], "Pa", "head-end cylinder pressure (absolute)"),
         "p_crank": Signal(st["p_crank"], "Pa", "crank-end cylinder pressure (absolute)"),

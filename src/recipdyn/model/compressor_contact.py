@@ -42,6 +42,7 @@ import numpy as np
 
 from ._compressor_contact import both_system, crank_system, crosshead_system
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .compressor import cycle_outputs
 from .cycle import cycle_summary
 from .joints.contact import (
     FRICTION_LAWS,
@@ -472,7 +473,7 @@ SCHEMA = Schema((
           "contacts)", 0.0, _INF, low_open=True, group="joint"),
     _link("omega"), _link("theta1_0"),
     _link("load_amplitude"), _link("load_sign"), _link("load"),
-    *(_link(k) for k in CYCLE_PARAMS),
+    *(_link(k) for k in (*CYCLE_PARAMS, "gas", "suction_temperature")),
     Param("e0_angle", "rad", None, "initial direction of e (default: aligned with the rod "
           "load, as the massless link's default)", -1e6, 1e6, group="initial", optional=True),
     Param("e0_angle_crosshead", "rad", None, "initial direction of the crosshead pin's e "
@@ -625,7 +626,16 @@ class CompressorContact(Model):
             from .compressor import equilibrium_theta_c
             from .parameters import CompressorParams
 
-            keys = (*MECH, "rc", "load_amplitude", "load_sign", "load", *CYCLE_PARAMS)
+            keys = (
+                *MECH,
+                "rc",
+                "load_amplitude",
+                "load_sign",
+                "load",
+                *CYCLE_PARAMS,
+                "gas",
+                "suction_temperature",
+            )
             cp = CompressorParams(rs=0.0, **{k: values[k] for k in keys})
             ang = equilibrium_theta_c(cp)
         ang2 = values["e0_angle_crosshead"]
@@ -673,6 +683,7 @@ class CompressorContact(Model):
             "gas_force": Signal(j[:, 20], "N", "gas force on the crosshead along +x"),
             "energy": Signal(en["mechanical"] + en["elastic"], "J",
                              "kinetic + gravity energy of rod and crosshead + contact elastic"),
+            **cycle_outputs(values, th1),
         }  # fmt: skip
         joints = values["clearance_joints"]
         for key, where, row, (ix, iy), rc in (
