@@ -79,13 +79,18 @@ def test_kernels_deterministic_and_jacobian_exact(model, rng):
     difference's own error: truncation ~h^2 |f'''| (h = 1e-6 scaled, < 1e-6 relative for
     these smooth kernels; we allow 1e-5) plus rounding ~eps |f| / h (large for the stiff
     compressor, whose theta_c'' reaches ~1e6 rad/s^2 off equilibrium; we allow 10 eps |f| / h).
-    """
+
+    Models with kinks (a valve plate on its seat, the contact surface) have no derivative
+    where a kink lies within the step: an entry is compared only where the central
+    differences with h and h/4 agree (they do wherever f is smooth, whatever the Jacobian),
+    and at most 2 % of the entries may be set aside so."""
     values = model.parameters()
     s = model.system(values)
     assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == model.dim
     y0 = model.initial_state(values)
     fn = s.f if isinstance(s, ODESystem) else s.g
     scale = model.state_scale(values)
+    kinks = total = 0
     for _ in range(5):
         y = y0 + 0.05 * rng.standard_normal(s.dim) * scale
         t = float(rng.uniform(0, 3))
@@ -93,14 +98,21 @@ def test_kernels_deterministic_and_jacobian_exact(model, rng):
         J = np.empty((s.dim, s.dim))
         s.jac(t, np.ascontiguousarray(y), s.params, J)
         for j in range(s.dim):
-            h = 1e-6 * max(1.0, abs(y[j]))
-            e = np.zeros(s.dim)
-            e[j] = h
-            fp, fm = fn(t, y + e), fn(t, y - e)
-            fd = (fp - fm) / (2 * h)
-            rounding = 10 * np.finfo(float).eps * np.maximum(np.abs(fp), np.abs(fm)) / h
+            fds = []
+            for h in (1e-6 * max(1.0, abs(y[j])), 2.5e-7 * max(1.0, abs(y[j]))):
+                e = np.zeros(s.dim)
+                e[j] = h
+                fp, fm = fn(t, y + e), fn(t, y - e)
+                rounding = 10 * np.finfo(float).eps * np.maximum(np.abs(fp), np.abs(fm)) / h
+                fds.append(((fp - fm) / (2 * h), rounding))
+            (fd, rounding), (fd4, rounding4) = fds
             tol = 1e-5 * np.maximum(1.0, np.abs(J[:, j])) + rounding
-            assert np.all(np.abs(fd - J[:, j]) <= tol), (model.name, j, fd, J[:, j])
+            smooth = np.abs(fd - fd4) <= 1e-5 * np.maximum(1.0, np.abs(fd)) + rounding4
+            kinks += int(np.count_nonzero(~smooth))
+            total += s.dim
+            ok = np.abs(fd - J[:, j]) <= tol
+            assert np.all(ok | ~smooth), (model.name, j, fd, J[:, j])
+    assert kinks <= 0.02 * total, (model.name, kinks, total)
 
 
 def test_simulate_records_outputs_with_units_and_inputs(model, tmp_path):

@@ -40,10 +40,11 @@ from typing import Any
 import numba as nb
 import numpy as np
 
+from . import valves as va
 from ._compressor_contact import both_system, crank_system, crosshead_system
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
 from .compressor import cycle_outputs
-from .cycle import cycle_summary
+from .cycle import N_CYCLE, cycle_summary
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -208,8 +209,18 @@ def _joints(t, y, p, cfg, f):
     return p_crank, f[0, 6] + f[1, 6], th2d, v3
 
 
+#: Load kind of the dynamic valves (:mod:`.compressor_contact_valves`): the gas force follows
+#: the chamber pressures of the state (gas states from :data:`G_GAS`, mass counters from
+#: :data:`G_AUX`; the cycle data, then the valve data, after ``P_TABLE``).
+LOAD_STATE = 3.0
+G_GAS = len(STATE_NAMES)
+G_AUX = G_GAS + va.N_GAS
+
+
 @nb.njit(cache=True)
-def _gas(t, p):
+def _gas(t, y, p):
+    if p[P_LOADKIND] == LOAD_STATE:
+        return va.state_force(y, G_GAS, p[P_TABLE:])
     th1 = p[P_TH10] + p[P_OMEGA] * t
     return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
@@ -218,7 +229,7 @@ def _gas(t, p):
 def _inputs(t, y, p, cfg, q, f):
     """Fill the mechanism's force inputs into q; returns (gas + crank power, power lost)."""
     p_crank, p_loss, _, v3 = _joints(t, y, p, cfg, f)
-    fg = _gas(t, p)
+    fg = _gas(t, y, p)
     q[P_FGAS] = fg
     q[P_F1X] = f[0, 0]
     q[P_F1Y] = f[0, 1]
@@ -303,6 +314,11 @@ def _rhs(t, y, p, out, cfg):
     out[9] = 0.0
     out[I_WIN] = p_in
     out[I_WLOSS] = p_loss
+    if p[P_LOADKIND] == LOAD_STATE:  # the cylinder gas and valve plates follow the crosshead
+        s2, c2, _, v3 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
+        x3 = p[P_R] * math.cos(p[P_TH10] + p[P_OMEGA] * t) + y[0] + p[P_L] * c2 - y[2]
+        c = p[P_TABLE:]
+        va.gas_rhs(x3, v3, y, G_GAS, G_AUX, c, c[N_CYCLE:], out)
 
 
 @compiled(RHS_SIGNATURE)
@@ -329,7 +345,9 @@ def _fd_jac(t, y, p, J, cfg):
     f = np.empty((4, n))
     c = p[P_C1] if cfg == 0 else (p[P_C2] if cfg == 1 else min(p[P_C1], p[P_C2]))
     for k in range(n):
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else 1.0)
+        # positions by the clearance, rates by c omega, work integrals 1 J; the gas states
+        # (dynamic valves) at least 1e-3 of their unit (a lift, a plate velocity)
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
         h = 1e-5 * max(abs(y[k]), scale)
         for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
             yp[k] = y[k] + step
@@ -550,7 +568,7 @@ def _joint_series(cfg, t, y, p):
         out[i, 14:18] = d[4:8]
         out[i, 18] = th2d
         out[i, 19] = v3
-        out[i, 20] = _gas(t[i], p)
+        out[i, 20] = _gas(t[i], yi, p)
     return out
 
 

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any
 
 import numba as nb
@@ -67,9 +66,9 @@ from .compressor import (
 from .kinematics import joint_forces, kinematics
 from .parameters import SCHEMA as LINK_SCHEMA
 from .parameters import CompressorParams
-from .protocol import Param, Schema
+from .protocol import Schema
 
-__all__ = ["CompressorValves", "COMPRESSOR_VALVES", "valve_summary"]
+__all__ = ["CompressorValves", "COMPRESSOR_VALVES"]
 
 _INF = math.inf
 #: Offsets in the packed vector: the cycle data, then the valve data.
@@ -174,36 +173,10 @@ def valve_rebound(t, y, p, out):
     va.valve_reset(y, G0, p[P_VALVE:], out)
 
 
-def _link(name: str, **changes) -> Param:
-    return replace(LINK_SCHEMA[name], **changes)
-
-
-_ASSUMED = "assumed: a lumped plate valve of typical proportions (the paper gives no valves)"
 _DROP = {"load", "load_amplitude", "load_sign", "equations", "gas"}
 SCHEMA = Schema((
     *(p for p in LINK_SCHEMA if p.name not in _DROP),
-    Param("valve_area_fraction", "", 0.08, "flow area of each valve group at full lift / "
-          "piston area (head end)", 0.0, 1.0, low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("valve_lift", "m", 2.5e-3, "plate lift at the guard (full lift)", 0.0, 0.1,
-          low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("valve_mass", "kg", 0.05, "moving mass of each valve group's plates (lumped)", 0.0,
-          100.0, low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("valve_stiffness", "N/m", 8000.0, "spring stiffness of each valve group", 0.0, 1e9,
-          low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("valve_preload", "N", 5.0, "spring preload holding the plates on the seat", 0.0,
-          1e6, assumed=_ASSUMED, group="valves"),
-    Param("valve_damping", "", 0.1, "damping ratio of the plate on its spring (gas and "
-          "sticking)", 0.0, 10.0, assumed=_ASSUMED, group="valves"),
-    Param("valve_force_factor", "", 2.0, "effective force area of the plate / its flow area",
-          0.0, 100.0, low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("discharge_coefficient", "", 0.7, "discharge coefficient of the valve flow", 0.0,
-          1.0, low_open=True, assumed=_ASSUMED, group="valves"),
-    Param("valve_restitution", "", 0.3, "coefficient of restitution of the plate at the seat "
-          "and the guard", 0.0, 1.0, high_open=True, assumed=_ASSUMED, group="valves"),
-    Param("gas_constant", "J/(kg*K)", 287.05, "specific gas constant R (air: 287.05)", 0.0,
-          1e5, low_open=True, group="valves"),
-    Param("isentropic_exponent", "", 1.4, "isentropic exponent of the flow through the valves "
-          "(air: 1.4)", 1.0, 2.0, low_open=True, group="valves"),
+    *va.SCHEMA_PARAMS,
 ), aliases=dict(LINK_SCHEMA.aliases))  # fmt: skip
 
 
@@ -216,70 +189,6 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
     """Packed vector: the massless-link model's (with the cycle data), then the valves'."""
     head = pack_params(_cparams(values))
     return np.concatenate([head, va.pack_valves(values, head[P_CYCLE:P_VALVE])])
-
-
-def _last_revolution_mask(th: np.ndarray) -> np.ndarray:
-    return th >= th[-1] - 2.0 * math.pi
-
-
-def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
-    """Figures of the last recorded revolution: indicated power, volumetric efficiency from
-    the mass taken in, the mass balance of each chamber, and per valve the number of impacts,
-    of separate openings (> 1: the plate flutters or reopens) and the crank angle of its final
-    closing after the dead centre at which the ideal valve closes (> 0: late closing)."""
-    ds = cy.last_revolution(ds, float(values["omega"]))
-    th = np.asarray(ds["theta1"].values, dtype=float)
-    if th.size < 8 or th[-1] - th[0] < 2.0 * math.pi * (1 - 1e-9):
-        return {}
-    last = _last_revolution_mask(th)
-    out: dict[str, Any] = {}
-    c = pack(values)[P_CYCLE:P_VALVE]
-    stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-    rho_s = values["suction_pressure"] / (values["gas_constant"] * values["suction_temperature"])
-    work = 0.0
-    for j, end in enumerate(("head", "crank")):
-        if not int(c[cy.C_ACTING]) & (1 << j):
-            continue
-        p = np.asarray(ds[f"p_{end}"].values, dtype=float)[last]
-        V = np.asarray(ds[f"V_{end}"].values, dtype=float)[last]
-        work += cy.indicated_work(p, V)
-        m_in = np.asarray(ds[f"mass_in_{end}"].values, dtype=float)[last]
-        m_out = np.asarray(ds[f"mass_out_{end}"].values, dtype=float)[last]
-        din, dout = m_in[-1] - m_in[0], m_out[-1] - m_out[0]
-        area = c[cy.C_AHE] if j == 0 else c[cy.C_ACE]
-        out[f"volumetric_efficiency_{end}"] = float(din / (rho_s * area * stroke))
-        out[f"mass_balance_{end}"] = float((din - dout) / din) if din > 0 else math.nan
-        # the dead centre at which the ideal suction (discharge) valve closes
-        odc, idc = math.degrees(c[cy.C_THODC]), math.degrees(c[cy.C_THIDC])
-        close = {"suction": idc if j == 0 else odc, "discharge": odc if j == 0 else idc}
-        for kind in ("suction", "discharge"):
-            lift = np.asarray(ds[f"y_{kind}_{end}"].values, dtype=float)[last]
-            is_open = lift > 0.0
-            starts = np.flatnonzero(is_open & ~np.roll(is_open, 1))
-            out[f"openings_{kind}_{end}"] = int(starts.size)
-            # share of the open time at full lift (< 1 and many impacts: the plate flutters)
-            n_open = np.count_nonzero(is_open)
-            at_guard = np.count_nonzero(lift >= float(values["valve_lift"]) * (1 - 1e-9))
-            out[f"full_lift_share_{kind}_{end}"] = at_guard / n_open if n_open else 0.0
-            if is_open.any() and not is_open.all():
-                ends = np.flatnonzero(~is_open & np.roll(is_open, 1))
-                # the last closing within 90 degrees of the dead centre
-                ang = np.degrees(th[last][ends]) % 360.0
-                lag = (ang - close[kind] + 180.0) % 360.0 - 180.0
-                near = lag[np.abs(lag) <= 90.0]
-                if near.size:
-                    out[f"closing_lag_{kind}_{end}_deg"] = float(near.max())
-    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
-    if "impact_time" in ds:
-        out["valve_impacts_per_rev"] = int(np.count_nonzero(
-            np.asarray(ds["impact_time"].values) >= float(ds["time"].values[-1])
-            - 2.0 * math.pi / float(values["omega"])))  # fmt: skip
-    fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
-    pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
-    rev = cy.rod_load_reversal(th[last], pin)
-    out.update(pin_reversal_deg=rev.reversal_deg, pin_reverse_fraction=rev.reverse_fraction,
-               api618_pin_reversal="pass" if rev.passed else "FAIL")  # fmt: skip
-    return out
 
 
 class CompressorValves(Compressor):
@@ -298,6 +207,11 @@ class CompressorValves(Compressor):
         "(Benettin's QR is undefined there); use the signal estimators or --model compressor "
         "with load=cycle (ideal valves)"
     )
+
+    validity_bounds = ((
+        *Compressor.validity_bounds[0][:4],
+        "the contact-impact joint with dynamic valves (--model compressor-contact-valves)",
+    ),)  # fmt: skip
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         return False
@@ -391,7 +305,7 @@ class CompressorValves(Compressor):
         return out
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
-        return valve_summary(values, ds)
+        return va.valve_summary(values, ds)
 
 
 #: The registered instance (``recipdyn --model compressor-valves``).

@@ -269,6 +269,13 @@ def rod_load_reversal(theta1: np.ndarray, load: np.ndarray) -> RodReversal:
     return RodReversal(reversal, frac, tens, comp)
 
 
+def covers_revolution(theta1: np.ndarray) -> bool:
+    """Whether uniformly sampled crank angles cover a whole revolution: ``n`` samples one step
+    apart span ``2 pi`` less one step when the revolution's end is not sampled again."""
+    th = np.asarray(theta1, dtype=float)
+    return th.size >= 2 and th[-1] - th[0] >= 2.0 * math.pi - 1.5 * (th[1] - th[0])
+
+
 def last_revolution(ds, omega: float, extra: int = 2):
     """The samples of a uniformly sampled record's last crank revolution (plus ``extra``),
     selected by position, so a streamed record is read only there."""
@@ -292,7 +299,7 @@ def cycle_summary(values, ds) -> dict[str, float | str]:
     th = np.asarray(ds["theta1"].values, dtype=float)
     last = th >= th[-1] - 2.0 * math.pi
     out: dict[str, float | str] = {}
-    if np.count_nonzero(last) >= 8 and th[-1] - th[0] >= 2.0 * math.pi * (1 - 1e-9):
+    if np.count_nonzero(last) >= 8 and covers_revolution(th):
         fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
         pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
         rev = rod_load_reversal(th[last], pin)

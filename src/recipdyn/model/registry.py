@@ -36,6 +36,7 @@ _BUILTIN = {
     "impact-oscillator": "recipdyn.model.reference.impact_oscillator:IMPACT_OSCILLATOR",
     "compressor-contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
     "compressor-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
+    "compressor-contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",  # noqa: E501
 }
 _REGISTERED: dict[str, Model] = {}
 

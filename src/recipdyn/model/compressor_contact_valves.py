@@ -1,0 +1,244 @@
+r"""The contact-impact clearance joint driven by the cylinder gas with dynamic valves.
+
+:mod:`.compressor_contact` (journal free in its bearing: flight, impacts, friction, oil film)
+with the gas load of :mod:`.valves`: the chamber pressures and masses and the valve plates are
+states integrated with the eccentricities, the chamber volumes follow the crosshead of the
+joint's own state, and the gas force follows the pressures (load kind
+:data:`~.compressor_contact.LOAD_STATE` of the contact kernels). This is the pairing the
+double-acting cycle needs: its rod load reverses twice a revolution, where the massless link of
+``compressor-valves`` leaves its validity and the journal really crosses its clearance.
+
+State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
+mass counters of :mod:`.valves`.
+
+Events: the integrator locates one event function, so the contact onset and the valve impacts
+share one: the product of the contact function (``delta/c``, or ``(delta1/c1)(delta2/c2)``
+with both joints worn) and the valves' smallest normalised distance to a stop, located in both
+directions. The reset acts on whichever factor is on its surface (the smaller in relative
+terms): a contact onset records the approach velocity (a separation changes nothing), a valve
+impact rebounds or rests. Two crossings inside one event sub-step (1/8 of a step) would cancel;
+at the steps of this model (a few microseconds in contact) that has not been seen.
+
+The Jacobian is the contact model's fourth-order central difference over the whole state;
+Benettin's method is refused as for both parent models.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+from . import compressor_contact as cc
+from . import cycle as cy
+from . import valves as va
+from .base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .load import CYCLE_PARAMS
+from .protocol import Schema
+
+__all__ = ["CompressorContactValves", "COMPRESSOR_CONTACT_VALVES"]
+
+G0, A0 = cc.G_GAS, cc.G_AUX
+STATE_NAMES = (*cc.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
+STATE_UNITS = (*cc.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
+N_STATE = len(STATE_NAMES)
+P_VALVE = cc.P_TABLE + cy.N_CYCLE
+
+
+@nb.njit(cache=True, inline="always")
+def _contact(y, p, cfg):
+    """The contact factor of the event: delta/c of the worn joint(s) (product for both)."""
+    d1 = math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0
+    d2 = math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0
+    if cfg == 0:
+        return d1
+    if cfg == 1:
+        return d2
+    return d1 * d2
+
+
+@nb.njit(cache=True)
+def _contact_distance(y, p, cfg):
+    """|delta|/c of the joint nearest its surface (the one an event belongs to)."""
+    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0)
+    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0)
+    return d1 if cfg == 0 else (d2 if cfg == 1 else min(d1, d2))
+
+
+@nb.njit(cache=True, inline="always")
+def _event(y, p, cfg):
+    return _contact(y, p, cfg) * va.valve_event(y, G0, p[P_VALVE:])
+
+
+@nb.njit(cache=True)
+def _reset(y, p, cfg, out):
+    valve = va.valve_event(y, G0, p[P_VALVE:])
+    if abs(valve) < _contact_distance(y, p, cfg):
+        va.valve_reset(y, G0, p[P_VALVE:], out)
+        return
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0)
+    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0)
+    first = cfg == 0 or (cfg == 2 and d1 <= d2)
+    ix, iy, iu, iv, k = (0, 1, 4, 5, 8) if first else (2, 3, 6, 7, 9)
+    if y[ix] * y[iu] + y[iy] * y[iv] > 0.0:  # approaching the wall: an onset
+        cc._record(y, ix, iy, iu, iv, k, p, out)
+
+
+@compiled(EVENT_SIGNATURE)
+def event_crank(t, y, p):
+    return _event(y, p, 0)
+
+
+@compiled(EVENT_SIGNATURE)
+def event_crosshead(t, y, p):
+    return _event(y, p, 1)
+
+
+@compiled(EVENT_SIGNATURE)
+def event_both(t, y, p):
+    return _event(y, p, 2)
+
+
+@compiled(RHS_SIGNATURE)
+def reset_crank(t, y, p, out):
+    _reset(y, p, 0, out)
+
+
+@compiled(RHS_SIGNATURE)
+def reset_crosshead(t, y, p, out):
+    _reset(y, p, 1, out)
+
+
+@compiled(RHS_SIGNATURE)
+def reset_both(t, y, p, out):
+    _reset(y, p, 2, out)
+
+
+EVENTS = {"crank": (event_crank, reset_crank), "crosshead": (event_crosshead, reset_crosshead),
+          "both": (event_both, reset_both)}  # fmt: skip
+
+_DROP = {"load", "load_amplitude", "load_sign", "gas"}
+SCHEMA = Schema((*(p for p in cc.SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
+                aliases=dict(cc.SCHEMA.aliases))  # fmt: skip
+_LOAD = {"load": "cycle", "load_amplitude": 0.0, "load_sign": "physical", "gas": "ideal"}
+
+
+def pack(values: Mapping[str, Any]) -> np.ndarray:
+    """The contact model's vector with the cycle data (load kind ``LOAD_STATE``), then the
+    valve data."""
+    head = cc.pack({**values, **_LOAD})
+    head[cc.P_LOADKIND] = cc.LOAD_STATE
+    return np.concatenate([head, va.pack_valves(values, head[cc.P_TABLE : P_VALVE])])
+
+
+class CompressorContactValves(cc.CompressorContact):
+    """The contact-impact joint with the cylinder gas and dynamic valves (module docstring)."""
+
+    name = "compressor-contact-valves"
+    description = ("compressor with contact-impact clearance joints driven by the compression "
+                   "cycle with dynamic plate valves (pressures and valves as states)")  # fmt: skip
+    state_names = STATE_NAMES
+    state_units = STATE_UNITS
+    schema = SCHEMA
+    event_example = {}  # the valves hit their stops at the defaults
+    lyapunov_refusal = cc.CompressorContact.lyapunov_refusal + (
+        "; the valve plates' rests are resets with singular saltation matrices"
+    )
+
+    def _values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return {**values, **_LOAD}
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        fn, reset = EVENTS[values["clearance_joints"]]
+        return (Event("impact", fn, direction=0, action="reset", reset=reset,
+                      description="a contact onset or separation, or a valve plate reaching "
+                      "its seat or guard (one event function: their product): an onset records "
+                      "the approach velocity, a plate rebounds or rests"),)  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> ODESystem:
+        rhs, jac, *_ = cc.KERNELS[values["clearance_joints"]]
+        return ODESystem(rhs=rhs, jac=jac, params=pack(values), state_names=STATE_NAMES,
+                         state_units=STATE_UNITS, period=self.period(values), name=self.name,
+                         events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        super().check(self._values(values))
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The contact model's initial state (journal along the ideal cycle's rod load), the
+        ideal cycle's gas states at the initial crank angle, plates closed, counters 0."""
+        y = np.zeros(N_STATE)
+        y[:G0] = super().initial_state(self._values(values))
+        c = cy.pack_cycle(values["r"], values["l"], values["d"],
+                          **{k: values[k] for k in CYCLE_PARAMS})  # fmt: skip
+        y[G0:A0] = va.gas_initial(values, c, float(values["theta1_0"]))
+        return y
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The contact model's scales for its states; the gas states at their own size."""
+        y0 = self.initial_state(values)
+        out = np.maximum(1.0, np.abs(y0))
+        for j in range(2):
+            b = G0 + 6 * j
+            out[b], out[b + 1] = y0[b], y0[b + 1]
+            out[b + 2] = out[b + 4] = values["valve_lift"]
+            out[A0 + 2 * j] = out[A0 + 2 * j + 1] = y0[b + 1]
+        return out
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """The contact model's outputs (its gas force is the pressures'), then the chambers'
+        pressures, volumes (from the recorded crosshead), temperatures and mass flows."""
+        from .base import rhs_series
+
+        sig = super().outputs(values, t, y)
+        s = self.system(values)
+        dy = rhs_series(s.rhs, s.params, t, y)
+        c = s.params[cc.P_TABLE : P_VALVE]
+        x3 = sig["x"].values
+        stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
+        ahe, ace, clear = c[cy.C_AHE], c[cy.C_ACE], c[cy.C_CLEAR]
+        vol = {"head": clear * ahe * stroke + ahe * (c[cy.C_XMAX] - x3),
+               "crank": clear * ace * stroke + ace * (x3 - c[cy.C_XMIN])}  # fmt: skip
+        R = float(values["gas_constant"])
+        for j, end in enumerate(("head", "crank")):
+            b = G0 + 6 * j
+            sig[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
+            sig[f"V_{end}"] = Signal(vol[end], "m**3", f"{end}-end cylinder volume")
+            sig[f"T_{end}"] = Signal(y[:, b] * vol[end] / (y[:, b + 1] * R), "K",
+                                     f"{end}-end gas temperature")  # fmt: skip
+            sig[f"mdot_suction_{end}"] = Signal(
+                dy[:, A0 + 2 * j], "kg/s", f"{end}-end suction mass flow (in)")  # fmt: skip
+            sig[f"mdot_discharge_{end}"] = Signal(
+                dy[:, A0 + 2 * j + 1], "kg/s", f"{end}-end discharge mass flow (out)")  # fmt: skip
+        return sig
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """The contact model's figures over the contact events and the valves' over the valve
+        events (each event is assigned to the factor of the event function on its surface)."""
+        if "impact_time" in ds:
+            p = self.system(values).params
+            ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
+                                                       for k in STATE_NAMES]))  # fmt: skip
+            cfg = cc.KERNELS[values["clearance_joints"]][4]
+            contact = np.array([_contact_distance(e, p, cfg) for e in ev])
+            valve = np.array([abs(va.valve_event(e, G0, p[P_VALVE:])) for e in ev])
+            is_valve = valve < contact
+            ds_contact = ds.isel(impact_event=np.flatnonzero(~is_valve))
+            ds_valve = ds.isel(impact_event=np.flatnonzero(is_valve))
+        else:
+            ds_contact = ds_valve = ds
+        out = super().run_summary(self._values(values), ds_contact)
+        for k in [k for k in out if k.startswith(("volumetric_efficiency", "indicated_power"))]:
+            del out[k]  # the ideal cycle's figures: the valves' own are below
+        out.update(va.valve_summary(values, ds_valve))
+        return out
+
+
+#: The registered instance (``recipdyn --model compressor-contact-valves``).
+COMPRESSOR_CONTACT_VALVES = CompressorContactValves()
