@@ -167,3 +167,21 @@ def test_contact_joint_with_closed_valves_keeps_the_polytrope():
     for end in ("head", "crank"):
         inv = ds[f"p_{end}"].values * ds[f"V_{end}"].values ** 1.3
         assert np.ptp(inv) / inv.mean() < 1e-7, (end, np.ptp(inv) / inv.mean())
+
+
+def test_valve_models_get_their_joint_models_figures(tmp_path):
+    """The record of a valve model is drawn with its joint model's figure (the massless link's
+    response figure; the contact joint's figure with impact map and orbit), whose impact
+    markers keep only the joint's own events (the event also carries the valve impacts)."""
+    from recipdyn.plotting import _impacts, model_figure
+
+    ds = _run(revolutions=0.5, transient=0.5, rc=1e-4)
+    fig = model_figure(ds)
+    assert fig._suptitle.get_text() == "Crosshead response"
+    ds = simulate(model=CONTACT, revolutions=1, transient=1, fs=20000)
+    fig = model_figure(ds)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert "impact map (state at each impact)" in titles
+    onsets = _impacts(ds, "")
+    assert 0 < onsets.size < ds.sizes["impact_event"]
+    assert onsets.size == round(ds.attrs["impacts"])

@@ -183,7 +183,7 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
     from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 
     fs = 1.0 / float(np.median(np.diff(t)))
-    fc = float(ds.attrs["crank_frequency_hz"])
+    fc = float(ds.attrs.get("crank_frequency_hz", ds.attrs["param_omega"] / (2 * np.pi)))
     spec = amplitude_spectrum(ds["a"].values, fs, window="hann")
     f_top = fmax if fmax is not None else display_band(spec, fc)
     ax.semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.7)
@@ -208,8 +208,11 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
     """Any model's record: up to three signals over time (or iteration) and a phase portrait
     of the first two (points for a map). The contact-impact compressor gets
     :func:`contact_figure`."""
-    if ds.attrs.get("model_name") == "compressor-contact":
-        return contact_figure(ds, title=title)
+    names = set(ds.data_vars)
+    if {"ex", "delta", "x", "v", "a"} <= names or {"ex_crosshead", "delta_crosshead"} <= names:
+        return contact_figure(ds, title=title)  # the contact-impact joint, any load
+    if {"theta_c", "contact_force", "gas_force", "x", "v", "a"} <= names:
+        return response_figure(ds, title=title)  # the massless link, any load
     plt = _mpl()
     dim = "iteration" if "iteration" in ds.dims else "time"
     names = [k for k in ds.data_vars if ds[k].dims == (dim,)][:3]
@@ -237,7 +240,7 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
         axes[1].grid(alpha=0.3)
     else:
         axes[1].set_axis_off()
-    fig.suptitle(title or f"{ds.attrs.get('model', 'model')}: {ds.attrs.get('title', '')}")
+    fig.suptitle(title or ds.attrs.get("title", ds.attrs.get("model", "model")))
     return fig
 
 
@@ -251,6 +254,9 @@ def _impacts(ds: xr.Dataset, key: str) -> np.ndarray:
     u, v = ds[f"impact_ex{key}_dot"].values, ds[f"impact_ey{key}_dot"].values
     rho = np.hypot(ex, ey)
     onset = (ex * u + ey * v) > 0
+    if "impact_y_suction_head" in ds:  # the event also carries the valve impacts: keep the
+        # events located on this joint's surface (to the root finder's precision)
+        onset &= np.abs(rho / ds.attrs["param_rc" + key] - 1) < 1e-6
     if ds.attrs.get("param_clearance_joints") == "both":
         other = "_crosshead" if key == "" else ""
         rc, rc_o = ds.attrs["param_rc" + key], ds.attrs["param_rc" + other]
