@@ -75,7 +75,9 @@ def run_figures(values: dict[str, Any], revolutions: float, fs: float,
     ph = go.Figure(go.Scattergl(x=v[::step], y=a[::step], mode="lines", line=dict(width=0.6)))
     ph.update_layout(title="phase portrait v-a", xaxis_title="v (m/s)", yaxis_title="a (m/s²)")
     T = p.crank_period
-    ts = np.arange(np.ceil(t[0] / T - 1e-9), np.floor(t[-1] / T + 1e-9) + 1) * T
+    from .analysis.poincare import strobe_times
+
+    ts = strobe_times(t[0], t[-1], T)
     sec = go.Figure(go.Scatter(x=np.interp(ts, t, v), y=np.interp(ts, t, a), mode="markers"))
     sec.update_layout(title=f"Poincaré section, once per revolution ({ts.size} points)",
                       xaxis_title="v (m/s)", yaxis_title="a (m/s²)")  # fmt: skip

@@ -87,7 +87,9 @@ def _section(ds, signal: str) -> tuple[np.ndarray, np.ndarray, str, str] | None:
     if not fc:
         return None
     t = ds["time"].values
-    ts = np.arange(np.ceil(t[0] * fc - 1e-9), np.floor(t[-1] * fc + 1e-9) + 1) / fc
+    from .analysis.poincare import strobe_times
+
+    ts = strobe_times(t[0], t[-1], 1.0 / fc)
     if ts.size < 2:
         return None
     first = "v" if "v" in ds and signal != "v" else next(

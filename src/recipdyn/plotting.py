@@ -294,7 +294,9 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
         ax.legend(fontsize=7, loc="upper right")
     ax = fig.add_subplot(grid[0, 1])
     T = 2 * np.pi / ds.attrs["param_omega"]
-    ts = np.arange(np.ceil(t[0] / T - 1e-9), np.floor(t[-1] / T + 1e-9) + 1) * T
+    from .analysis.poincare import strobe_times
+
+    ts = strobe_times(t[0], t[-1], T)
     if ts.size:
         ax.plot(np.interp(ts, t, ds["v"].values), np.interp(ts, t, ds["a"].values), "o",
                 ms=3, color="C0")  # fmt: skip

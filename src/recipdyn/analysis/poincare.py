@@ -27,7 +27,16 @@ import xarray as xr
 from ..integrate import integrate
 from ..model.base import EVENT_SIGNATURE, ODESystem
 
-__all__ = ["stroboscopic_section", "hyperplane_section", "count_distinct_points"]
+__all__ = ["stroboscopic_section", "hyperplane_section", "count_distinct_points",
+           "strobe_times"]  # fmt: skip
+
+
+def strobe_times(t_first: float, t_last: float, period: float) -> np.ndarray:
+    """The multiples of ``period`` in ``[t_first, t_last]`` (ends within 1e-9 periods count):
+    the once-per-period instants at which a recorded signal is sampled (interpolated) for a
+    stroboscopic section of a record."""
+    return np.arange(np.ceil(t_first / period - 1e-9), np.floor(t_last / period + 1e-9) + 1
+                     ) * period  # fmt: skip
 
 
 def _dataset(system: ODESystem, t, y, outputs: bool, attrs: dict[str, Any]) -> xr.Dataset:
