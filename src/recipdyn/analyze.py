@@ -22,8 +22,8 @@ from .analysis import (
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
 from .analysis.signal import assess_signal
 from .defaults import ATOL, LYAP_TOL, RTOL
+from .io import forcing_frequency, save_figure, write_text
 from .io import jsonable as _plain
-from .io import save_figure, write_text
 from .model.compressor import compressor_model
 from .model.parameters import ParameterError
 from .plotting import _mpl, axis_label
@@ -73,11 +73,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     check_output(out, formats=None, what="analysis folder")
     plt = _mpl()
     fs = 1.0 / float(np.median(np.diff(t)))
-    if compressor:
-        fc = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
-    else:
-        period = ds.attrs.get("period")
-        fc = 1.0 / float(period) if isinstance(period, (int, float, np.floating)) else None
+    fc = forcing_frequency(ds.attrs)
     a = ds[vib].values
     summary: dict[str, Any] = {"input": path.name, "samples": int(t.size), "fs_hz": fs,
                                "model": m.name if m is not None else "unknown",

@@ -29,7 +29,7 @@ import numpy as np
 
 from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 from .errors import ParameterError
-from .io import check_output, jsonable, read_dataset, save_figure, write_text
+from .io import check_output, forcing_frequency, jsonable, read_dataset, save_figure, write_text
 from .plotting import PALETTE, _mpl, axis_label, plot_signal
 
 __all__ = ["compare_runs", "MEASURES"]
@@ -54,20 +54,12 @@ def _same(a, b) -> bool:
     return str(a) == str(b)
 
 
-def _fundamental(ds) -> float | None:
-    fc = ds.attrs.get("crank_frequency_hz")
-    if fc:
-        return float(fc)
-    period = ds.attrs.get("period")
-    return 1.0 / float(period) if isinstance(period, (int, float, np.floating)) else None
-
-
 def _measures(ds, signal: str) -> dict[str, float]:
     t = ds["time"].values
     x = ds[signal].values.astype(float)
     fs = 1.0 / float(np.median(np.diff(t)))
     spec = amplitude_spectrum(x, fs)
-    fc = _fundamental(ds)
+    fc = forcing_frequency(ds.attrs)
     out = {
         "peak": float(np.max(np.abs(x))),
         "rms": float(np.sqrt(np.mean((x - x.mean()) ** 2))),
@@ -83,7 +75,7 @@ def _measures(ds, signal: str) -> dict[str, float]:
 def _section(ds, signal: str) -> tuple[np.ndarray, np.ndarray, str, str] | None:
     """Once-per-period samples of (velocity, signal) for the compressor, else of the first
     two state variables; ``None`` when the record is shorter than two periods."""
-    fc = _fundamental(ds)
+    fc = forcing_frequency(ds.attrs)
     if not fc:
         return None
     t = ds["time"].values
@@ -166,7 +158,7 @@ def _figure(runs, labels, signal, path: Path) -> None:
         spec = amplitude_spectrum(ds[signal].values, fs)
         axes[1].semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.8,
                          color=color, label=label)  # fmt: skip
-        top = max(top, display_band(spec, _fundamental(ds)))
+        top = max(top, display_band(spec, forcing_frequency(ds.attrs)))
         sec = _section(ds, signal)
         if sec is not None:
             axes[2].plot(sec[0], sec[1], "o", ms=3, color=color, label=label)

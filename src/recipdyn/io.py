@@ -22,8 +22,23 @@ from .errors import ParameterError
 
 __all__ = [
     "DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
-    "write_text", "save_figure", "StreamWriter", "open_record",
+    "write_text", "save_figure", "StreamWriter", "open_record", "forcing_frequency",
 ]  # fmt: skip
+
+
+def forcing_frequency(attrs) -> float | None:
+    """The forcing frequency (Hz) a simulation record states: the compressor's crank
+    frequency, or ``1 / period`` of a periodically forced model; ``None`` for an autonomous
+    system or a record without either."""
+    fc = attrs.get("crank_frequency_hz")
+    if fc:
+        return float(fc)
+    try:  # a number (also a numpy scalar read from a file) or a text for autonomous systems
+        period = float(attrs.get("period"))
+    except (TypeError, ValueError):
+        return None
+    return 1.0 / period if period > 0 else None
+
 
 #: File extension -> format of a simulated record.
 DATASET_FORMATS = {".nc": "NetCDF", ".csv": "CSV", ".zarr": "Zarr", ".mat": "MAT"}

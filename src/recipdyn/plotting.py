@@ -183,7 +183,9 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
     from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 
     fs = 1.0 / float(np.median(np.diff(t)))
-    fc = float(ds.attrs.get("crank_frequency_hz", ds.attrs["param_omega"] / (2 * np.pi)))
+    from .io import forcing_frequency
+
+    fc = forcing_frequency(ds.attrs) or float(ds.attrs["param_omega"]) / (2 * np.pi)
     spec = amplitude_spectrum(ds["a"].values, fs, window="hann")
     f_top = fmax if fmax is not None else display_band(spec, fc)
     ax.semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.7)
