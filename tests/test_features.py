@@ -120,3 +120,29 @@ def test_windows_read_block_by_block_equal_the_whole_file(tmp_path, suffix):
                               revs=7.0 * np.arange(i * 730, (i + 1) * 730) / fs)  # fmt: skip
         for k in ("rms", "kurtosis", "order_1", "dominant_hz"):
             assert r[k] == pytest.approx(ref[k], rel=1e-12, abs=1e-12), (k, i)
+
+
+def test_sweep_features_measure_equals_the_run_features(tmp_path):
+    """The sweep measure ``features`` stores, per point, the features of the point's vibration
+    signal: equal to :func:`signal_features` of the same run made by ``simulate`` (the same
+    integration, so to rounding: 1e-9 relative), orders from the exact crank angle; and
+    ``recipdyn features`` on the store writes them as columns after the parameters."""
+    import recipdyn
+    from recipdyn.features import signal_features
+
+    store = tmp_path / "sw"
+    assert main(["sweep", "-p", "rc=0.5mm,1mm", "-m", "features", "--revolutions", "2",
+                 "--transient", "1", "--fs", "5 kHz", "-o", str(store), "--backend",
+                 "serial", "--no-progress"]) == 0  # fmt: skip
+    out = tmp_path / "f.csv"
+    assert main(["features", str(store / "sweep.zarr"), "-o", str(out)]) == 0
+    f = pd.read_csv(out)
+    assert list(f.columns[:2]) == ["store", "rc"] and len(f) == 2
+    for rc in (5e-4, 1e-3):
+        ds = recipdyn.simulate(rc=rc, revolutions=2, transient=1, fs=5000)
+        a = ds["a"].values
+        ref = signal_features(a, 5000.0, revs=(ds["time"].values - ds["time"].values[0])
+                              * float(ds.attrs["crank_frequency_hz"]))  # fmt: skip
+        row = f[np.isclose(f["rc"], rc)].iloc[0]
+        for k in ("rms", "kurtosis", "crest_factor", "centroid_hz", "order_1", "order_2"):
+            assert row[f"feat_{k}"] == pytest.approx(ref[k], rel=1e-9), k

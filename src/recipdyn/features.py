@@ -18,7 +18,8 @@ from .analysis.spectrum import amplitude_spectrum
 from .analysis.vibration import angle_resample, indicators, order_spectrum_angle, velocity_rms
 from .model.parameters import ParameterError
 
-__all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS"]
+__all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS",
+           "feature_units"]  # fmt: skip
 
 #: Crank orders whose amplitudes are features (1..N_ORDERS).
 N_ORDERS = 10
@@ -68,6 +69,22 @@ def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
         r = lyap_rosenstein(x, 1.0 / fs)
         row["lambda1_rosenstein"], row["lambda1_status"] = r.exponent, r.status
     return row
+
+
+def feature_units(signal_unit: str, *, orders: bool = True,
+                  quantity: str = "acceleration") -> dict[str, str]:  # fmt: skip
+    """The numeric features of :func:`signal_features` (chaos indicators aside) and their
+    units, in its order, for a signal in ``signal_unit``: what a sweep's ``features`` measure
+    stores per point."""
+    length = signal_unit.split("/")[0] if "/" in signal_unit else signal_unit
+    units = {"rms": signal_unit, "peak": signal_unit, "peak_to_peak": signal_unit,
+             "crest_factor": "1", "kurtosis": "1", "skewness": "1"}  # fmt: skip
+    if quantity == "acceleration":
+        units["velocity_rms_2_1000hz"] = f"{length}/s" if length else "1"
+    units.update(dominant_hz="Hz", centroid_hz="Hz", spread_hz="Hz", spectral_entropy="1")
+    if orders:
+        units.update({f"order_{k}": signal_unit for k in range(1, N_ORDERS + 1)})
+    return units
 
 
 def _window_samples(window: str, fs: float, rev_s: float | None) -> int:
@@ -200,15 +217,18 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress) -> list[dic
 
 def sweep_features(path: str | Path) -> list[dict[str, Any]]:
     """One row per computed point of a sweep store: its parameter values and every scalar
-    measure (vector measures such as section points are left out)."""
+    measure (vector measures such as section points are left out); with the sweep measure
+    ``features``, the vibration signal's features of each point (``feat_*``). Columns: the
+    parameters, then the measures by name."""
     from .sweep.run import open_sweep
 
     ds = open_sweep(path)
     grid = [d for d in ds["done"].dims]
-    scalar = [k for k, v in ds.data_vars.items() if tuple(v.dims) == tuple(grid) and k != "done"]
+    scalar = sorted(k for k, v in ds.data_vars.items()
+                    if tuple(v.dims) == tuple(grid) and k != "done")  # fmt: skip
     frame = ds[scalar + ["done"]].to_dataframe().reset_index()
     frame = frame[frame["done"].astype(bool)].drop(columns=["done"])
-    return frame.to_dict("records")
+    return frame[grid + scalar].to_dict("records")
 
 
 def write_table(rows: list[dict[str, Any]], path: str | Path) -> Path:

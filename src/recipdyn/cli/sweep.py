@@ -22,7 +22,8 @@ def sweep(
         "poincare,peak",
         "--measure",
         "-m",
-        help="Comma list of: poincare, peak, spectrum, lyapunov, verdict.",
+        help="Comma list of: poincare, peak, spectrum, lyapunov, verdict, features (the "
+        "vibration signal's features for 'recipdyn features').",
     ),
     sets: list[str] = typer.Option(None, "--set", help="Base parameter NAME=VALUE (repeatable)."),
     config: Path = typer.Option(None, "--config", "-c", help="TOML config for the base case."),

@@ -64,6 +64,12 @@ def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | N
             v[f"poincare_{k}"] = ("f8", ("section",), n, u)
         v["poincare_distinct"] = ("i8", (), None, "1")
     sig, sig_unit = m.vibration()
+    if "features" in spec.measures:  # the vibration signal's features (recipdyn features)
+        from ..features import feature_units
+
+        for name, unit in feature_units(sig_unit, orders=m.kind == "ode" and bool(
+                m.period(m.parameters()))).items():  # fmt: skip
+            v[f"feat_{name}"] = ("f8", (), None, unit)
     if "peak" in spec.measures or "spectrum" in spec.measures:
         v[f"peak_{sig}"] = ("f8", (), None, sig_unit)
         v[f"rms_{sig}"] = ("f8", (), None, sig_unit)
@@ -395,7 +401,7 @@ def _check_resources(spec: SweepSpec, out: Path, backend, workers, dask_local,
     from ..simulate import estimate_memory
 
     s = spec.settings
-    if "peak" in spec.measures or "spectrum" in spec.measures:
+    if {"peak", "spectrum", "features"} & set(spec.measures):
         m = spec.get_model()
         periods = []
         for _, p in _corners(spec):

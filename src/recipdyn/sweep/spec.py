@@ -29,7 +29,7 @@ from ..units import to_si
 __all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
 
 #: Per-point work that can be requested.
-MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict")
+MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict", "features")
 #: Most points one sweep store holds (one chunk file per point and variable).
 MAX_POINTS = 10_000_000
 

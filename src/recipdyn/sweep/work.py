@@ -109,7 +109,7 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         y_end, t_end = sol.y_final, sol.t_final
     else:
         y_end, t_end = y, 0.0
-    if "peak" in measures or "spectrum" in measures:
+    if {"peak", "spectrum", "features"} & set(measures):
         fs = s["fs"]
         n = int(s["revolutions"] * T * fs) + 1
         te = t0 + np.arange(n) / fs
@@ -122,6 +122,10 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
             res[name] = float(np.mean(outs[out].values)) if out in outs else float("nan")
         res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
         res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
+        if "features" in measures:
+            # the crank angle in revolutions is exact: the forcing phase of each sample
+            revs = (sol.t - sol.t[0]) * pt.fc if pt.fc else None
+            res.update(_features(a, fs, revs, pt))
         if "spectrum" in measures:
             peaks = find_spectral_peaks(amplitude_spectrum(a, fs), n=N_PEAKS, fundamental=pt.fc)
             f = np.full(N_PEAKS, np.nan)
@@ -151,6 +155,16 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
     return res
 
 
+def _features(a, fs: float, revs, pt) -> dict[str, float]:
+    """The sweep's ``features`` measure: :func:`recipdyn.features.signal_features` of the
+    vibration signal, as ``feat_<name>`` (the numeric ones the store declares)."""
+    from ..features import feature_units, signal_features
+
+    row = signal_features(a, fs, revs=revs)
+    names = feature_units("", orders=revs is not None)
+    return {f"feat_{k}": float(row.get(k, float("nan"))) for k in names}
+
+
 def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
     """A map: section points are the iterates after the transient; exponents per iteration."""
     from ..analysis import lyapunov_spectrum_map
@@ -169,6 +183,8 @@ def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
         np.c_[tuple(outs[k].values[:k_pts] for k in pt.pair)]
     )
     a = outs[pt.vib].values
+    if "features" in measures:
+        res.update(_features(a, 1.0, None, pt))
     if "peak" in measures or "spectrum" in measures:
         res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
         res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
