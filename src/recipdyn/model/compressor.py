@@ -236,28 +236,34 @@ class CompressorModel(ODESystem):
         thc, thcd = y[:, 0], y[:, 1]
         thcdd = self.accelerations(t, y)
         k = kinematics(p, t, thc, thcd, thcdd)
-        fg = gas_force(k.theta1, p)
-        jf = joint_forces(p, k, thc, fg)
         return {
-            "x": Signal(k.x3, "m", "crosshead displacement x3"),
-            "v": Signal(k.v3, "m/s", "crosshead velocity"),
-            "a": Signal(k.a3, "m/s**2", "crosshead acceleration"),
-            "theta1": Signal(k.theta1, "rad", "crank angle"),
-            "theta2": Signal(k.theta2, "rad", "connecting-rod angle"),
-            "theta_c": Signal(thc, "rad", "clearance angle"),
-            "thetadot_c": Signal(thcd, "rad/s", "clearance angular velocity"),
-            "thetaddot_c": Signal(thcdd, "rad/s**2", "clearance angular acceleration"),
-            "gas_force": Signal(fg, "N", "gas force on the crosshead along +x"),
-            "joint_force_x": Signal(jf.Fx, "N", "clearance-joint force on the rod, x"),
-            "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
-            "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
-            "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
-            "contact_force": Signal(
-                jf.contact, "N", "joint contact force (>0: permanent contact holds)"
-            ),
-            "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+            **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(k.theta1, p)),
             **cycle_outputs(vars(p), k.theta1),
         }
+
+
+def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str, Signal]:
+    """The massless-link mechanism's signals from its kinematics ``k`` (:func:`kinematics`)
+    and the gas force ``fg`` on the crosshead, whatever load gives it."""
+    jf = joint_forces(p, k, thc, fg)
+    return {
+        "x": Signal(k.x3, "m", "crosshead displacement x3"),
+        "v": Signal(k.v3, "m/s", "crosshead velocity"),
+        "a": Signal(k.a3, "m/s**2", "crosshead acceleration"),
+        "theta1": Signal(k.theta1, "rad", "crank angle"),
+        "theta2": Signal(k.theta2, "rad", "connecting-rod angle"),
+        "theta_c": Signal(thc, "rad", "clearance angle"),
+        "thetadot_c": Signal(thcd, "rad/s", "clearance angular velocity"),
+        "thetaddot_c": Signal(thcdd, "rad/s**2", "clearance angular acceleration"),
+        "gas_force": Signal(fg, "N", "gas force on the crosshead along +x"),
+        "joint_force_x": Signal(jf.Fx, "N", "clearance-joint force on the rod, x"),
+        "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
+        "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
+        "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
+        "contact_force": Signal(jf.contact, "N",
+                                "joint contact force (>0: permanent contact holds)"),
+        "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+    }  # fmt: skip
 
 
 def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Signal]:

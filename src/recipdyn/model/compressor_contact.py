@@ -194,8 +194,8 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p, out):
 @nb.njit(cache=True)
 def _joints(t, y, p, cfg, f):
     """Both joints' forces into f (2 x 7, rows as :func:`_pair`; a rigid joint's row is 0) and
-    (power from the crank, power lost in the joints, theta2', x3')."""
-    _, _, th2d, v3 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
+    (power from the crank, power lost in the joints, theta2', x3', cos theta2)."""
+    _, c2, th2d, v3 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
     w = p[P_OMEGA]
     p_crank = 0.0
     f[:, :] = 0.0
@@ -206,7 +206,7 @@ def _joints(t, y, p, cfg, f):
         p_crank = f[0, 0] * vjx + f[0, 1] * vjy - f[0, 3] * w
     if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
         _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], y[9], p, f[1])
-    return p_crank, f[0, 6] + f[1, 6], th2d, v3
+    return p_crank, f[0, 6] + f[1, 6], th2d, v3, c2
 
 
 #: Load kind of the dynamic valves (:mod:`.compressor_contact_valves`): the gas force follows
@@ -227,8 +227,9 @@ def _gas(t, y, p):
 
 @nb.njit(cache=True)
 def _inputs(t, y, p, cfg, q, f):
-    """Fill the mechanism's force inputs into q; returns (gas + crank power, power lost)."""
-    p_crank, p_loss, _, v3 = _joints(t, y, p, cfg, f)
+    """Fill the mechanism's force inputs into q; returns (gas + crank power, power lost, x3',
+    cos theta2)."""
+    p_crank, p_loss, _, v3, c2 = _joints(t, y, p, cfg, f)
     fg = _gas(t, y, p)
     q[P_FGAS] = fg
     q[P_F1X] = f[0, 0]
@@ -236,7 +237,7 @@ def _inputs(t, y, p, cfg, q, f):
     q[P_F2X] = f[1, 0]
     q[P_F2Y] = f[1, 1]
     q[P_TROD] = f[0, 2] + f[1, 2]
-    return fg * v3 + p_crank, p_loss
+    return fg * v3 + p_crank, p_loss, v3, c2
 
 
 @nb.njit(cache=True)
@@ -287,7 +288,7 @@ def _ideal_crank_power(t, y, p, yd, f2):
 def _rhs(t, y, p, out, cfg):
     q = p[:NHEAD].copy()
     f = np.empty((2, 7))
-    p_in, p_loss = _inputs(t, y, p, cfg, q, f)
+    p_in, p_loss, v3, c2 = _inputs(t, y, p, cfg, q, f)
     for i in range(4):
         out[i] = y[4 + i]
         out[4 + i] = 0.0
@@ -315,7 +316,6 @@ def _rhs(t, y, p, out, cfg):
     out[I_WIN] = p_in
     out[I_WLOSS] = p_loss
     if p[P_LOADKIND] == LOAD_STATE:  # the cylinder gas and valve plates follow the crosshead
-        s2, c2, _, v3 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
         x3 = p[P_R] * math.cos(p[P_TH10] + p[P_OMEGA] * t) + y[0] + p[P_L] * c2 - y[2]
         c = p[P_TABLE:]
         va.gas_rhs(x3, v3, y, G_GAS, G_AUX, c, c[N_CYCLE:], out)
@@ -562,7 +562,7 @@ def _joint_series(cfg, t, y, p):
     for i in range(n):
         yi = y[i].copy()
         _rhs(t[i], yi, p, d, cfg)
-        _, _, th2d, v3 = _joints(t[i], yi, p, cfg, f)
+        _, _, th2d, v3, _ = _joints(t[i], yi, p, cfg, f)
         out[i, 0:7] = f[0]
         out[i, 7:14] = f[1]
         out[i, 14:18] = d[4:8]

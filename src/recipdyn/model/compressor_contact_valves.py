@@ -36,7 +36,6 @@ from . import compressor_contact as cc
 from . import cycle as cy
 from . import valves as va
 from .base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
-from .load import CYCLE_PARAMS
 from .protocol import Schema
 
 __all__ = ["CompressorContactValves", "COMPRESSOR_CONTACT_VALVES"]
@@ -174,21 +173,13 @@ class CompressorContactValves(cc.CompressorContact):
         ideal cycle's gas states at the initial crank angle, plates closed, counters 0."""
         y = np.zeros(N_STATE)
         y[:G0] = super().initial_state(self._values(values))
-        c = cy.pack_cycle(values["r"], values["l"], values["d"],
-                          **{k: values[k] for k in CYCLE_PARAMS})  # fmt: skip
-        y[G0:A0] = va.gas_initial(values, c, float(values["theta1_0"]))
+        y[G0:A0] = va.gas_initial(values, cy.cycle_data(values), float(values["theta1_0"]))
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """The contact model's scales for its states; the gas states at their own size."""
         y0 = self.initial_state(values)
-        out = np.maximum(1.0, np.abs(y0))
-        for j in range(2):
-            b = G0 + 6 * j
-            out[b], out[b + 1] = y0[b], y0[b + 1]
-            out[b + 2] = out[b + 4] = values["valve_lift"]
-            out[A0 + 2 * j] = out[A0 + 2 * j + 1] = y0[b + 1]
-        return out
+        return va.gas_scale(values, y0, G0, A0, np.maximum(1.0, np.abs(y0)))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
@@ -199,23 +190,8 @@ class CompressorContactValves(cc.CompressorContact):
         sig = super().outputs(values, t, y)
         s = self.system(values)
         dy = rhs_series(s.rhs, s.params, t, y)
-        c = s.params[cc.P_TABLE : P_VALVE]
-        x3 = sig["x"].values
-        stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-        ahe, ace, clear = c[cy.C_AHE], c[cy.C_ACE], c[cy.C_CLEAR]
-        vol = {"head": clear * ahe * stroke + ahe * (c[cy.C_XMAX] - x3),
-               "crank": clear * ace * stroke + ace * (x3 - c[cy.C_XMIN])}  # fmt: skip
-        R = float(values["gas_constant"])
-        for j, end in enumerate(("head", "crank")):
-            b = G0 + 6 * j
-            sig[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
-            sig[f"V_{end}"] = Signal(vol[end], "m**3", f"{end}-end cylinder volume")
-            sig[f"T_{end}"] = Signal(y[:, b] * vol[end] / (y[:, b + 1] * R), "K",
-                                     f"{end}-end gas temperature")  # fmt: skip
-            sig[f"mdot_suction_{end}"] = Signal(
-                dy[:, A0 + 2 * j], "kg/s", f"{end}-end suction mass flow (in)")  # fmt: skip
-            sig[f"mdot_discharge_{end}"] = Signal(
-                dy[:, A0 + 2 * j + 1], "kg/s", f"{end}-end discharge mass flow (out)")  # fmt: skip
+        sig.update(va.gas_outputs(values, sig["x"].values, y, dy, G0, A0,
+                                  s.params[cc.P_TABLE:P_VALVE]))  # fmt: skip
         return sig
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:

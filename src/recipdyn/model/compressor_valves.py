@@ -61,16 +61,16 @@ from .compressor import (
     P_TH10,
     Compressor,
     equilibrium_theta_c,
+    mechanism_outputs,
     pack_params,
 )  # fmt: skip
-from .kinematics import joint_forces, kinematics
+from .kinematics import kinematics
 from .parameters import SCHEMA as LINK_SCHEMA
 from .parameters import CompressorParams
 from .protocol import Schema
 
 __all__ = ["CompressorValves", "COMPRESSOR_VALVES"]
 
-_INF = math.inf
 #: Offsets in the packed vector: the cycle data, then the valve data.
 P_CYCLE = P_TABLE
 P_VALVE = P_TABLE + cy.N_CYCLE
@@ -243,66 +243,26 @@ class CompressorValves(Compressor):
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
-        """Pressures and masses at their initial size, lifts at the full lift, plate
-        velocities at 1 m/s, the mass counters at the initial gas mass."""
-        y0 = self.initial_state(values)
-        out = np.ones(N_STATE)
-        for j in range(2):
-            b = G0 + 6 * j
-            out[b], out[b + 1] = y0[b], y0[b + 1]
-            out[b + 2] = out[b + 4] = values["valve_lift"]
-            out[A0 + 2 * j] = out[A0 + 2 * j + 1] = y0[b + 1]
-        return out
+        """The mechanism's states at 1; the gas states at their own size
+        (:func:`~recipdyn.model.valves.gas_scale`)."""
+        return va.gas_scale(values, self.initial_state(values), G0, A0, np.ones(N_STATE))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
-        """The massless-link model's outputs with the gas force of the states, the chamber
-        volumes, temperatures and mass flows."""
+        """The massless-link model's outputs with the gas force of the pressure states, and
+        the chambers' pressures, volumes, temperatures and mass flows."""
         p = self.params(values)
         sys_ = self.system(values)
         t = np.asarray(t, dtype=float)
         dy = rhs_series(sys_.rhs, sys_.params, t, y)
         thc, thcd = y[:, 0], y[:, 1]
         k = kinematics(p, t, thc, thcd, dy[:, 1])
-        c = sys_.params[P_CYCLE:P_VALVE]
         fg = cy.pressure_force(y[:, G0], y[:, G0 + 6], bore=p.bore, rod_diameter=p.rod_diameter,
                                frame_pressure=p.frame_pressure)  # fmt: skip
-        jf = joint_forces(p, k, thc, fg)
-        stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-        ahe, ace, clear = c[cy.C_AHE], c[cy.C_ACE], c[cy.C_CLEAR]
-        vol = {"head": clear * ahe * stroke + ahe * (c[cy.C_XMAX] - k.x3),
-               "crank": clear * ace * stroke + ace * (k.x3 - c[cy.C_XMIN])}  # fmt: skip
-        R = float(values["gas_constant"])
-        out = {
-            "x": Signal(k.x3, "m", "crosshead displacement x3"),
-            "v": Signal(k.v3, "m/s", "crosshead velocity"),
-            "a": Signal(k.a3, "m/s**2", "crosshead acceleration"),
-            "theta1": Signal(k.theta1, "rad", "crank angle"),
-            "theta2": Signal(k.theta2, "rad", "connecting-rod angle"),
-            "theta_c": Signal(thc, "rad", "clearance angle"),
-            "thetadot_c": Signal(thcd, "rad/s", "clearance angular velocity"),
-            "thetaddot_c": Signal(dy[:, 1], "rad/s**2", "clearance angular acceleration"),
-            "gas_force": Signal(fg, "N", "gas force on the crosshead along +x"),
-            "joint_force_x": Signal(jf.Fx, "N", "clearance-joint force on the rod, x"),
-            "joint_force_y": Signal(jf.Fy, "N", "clearance-joint force on the rod, y"),
-            "joint_force": Signal(jf.magnitude, "N", "clearance-joint force magnitude"),
-            "joint_force_angle": Signal(jf.direction, "rad", "clearance-joint force direction"),
-            "contact_force": Signal(
-                jf.contact, "N", "joint contact force (>0: permanent contact holds)"
-            ),
-            "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
+        return {
+            **mechanism_outputs(p, k, thc, thcd, dy[:, 1], fg),
+            **va.gas_outputs(values, k.x3, y, dy, G0, A0, sys_.params[P_CYCLE:P_VALVE]),
         }
-        for j, end in enumerate(("head", "crank")):
-            b = G0 + 6 * j
-            out[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
-            out[f"V_{end}"] = Signal(vol[end], "m**3", f"{end}-end cylinder volume")
-            out[f"T_{end}"] = Signal(y[:, b] * vol[end] / (y[:, b + 1] * R), "K",
-                                     f"{end}-end gas temperature")  # fmt: skip
-            out[f"mdot_suction_{end}"] = Signal(
-                dy[:, A0 + 2 * j], "kg/s", f"{end}-end suction mass flow (in)")  # fmt: skip
-            out[f"mdot_discharge_{end}"] = Signal(
-                dy[:, A0 + 2 * j + 1], "kg/s", f"{end}-end discharge mass flow (out)")  # fmt: skip
-        return out
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         return va.valve_summary(values, ds)

@@ -51,11 +51,16 @@ import numba as nb
 import numpy as np
 
 __all__ = [
-    "pressure_force",
+    "pressure_force", "CYCLE_PARAMS", "cycle_data", "pin_reversal_summary",
     "CycleGeometry", "cycle_geometry", "pack_cycle", "cycle_state", "cycle_force_kernel",
     "ideal_volumetric_efficiency", "ideal_indicated_work", "indicated_work",
     "volumetric_efficiency", "RodReversal", "rod_load_reversal", "ACTING",
 ]  # fmt: skip
+
+#: Parameter names of the compression cycle, in :func:`pack_cycle`'s keyword order.
+CYCLE_PARAMS = ("bore", "rod_diameter", "clearance_fraction", "suction_pressure",
+                "discharge_pressure", "n_compression", "n_expansion", "frame_pressure",
+                "acting")  # fmt: skip
 
 #: Which chambers compress gas: 1 head end, 2 crank end, 3 both.
 ACTING = {"head": 1.0, "crank": 2.0, "double": 3.0}
@@ -126,6 +131,13 @@ def pack_cycle(r: float, l: float, d: float, *, bore: float, rod_diameter: float
                      g.area_crank, g.area_rod, clearance_fraction, suction_pressure,
                      discharge_pressure, n_compression, n_expansion, frame_pressure,
                      ACTING[acting], p_top, p_bot], dtype=np.float64)  # fmt: skip
+
+
+def cycle_data(values) -> np.ndarray:
+    """:func:`pack_cycle` of a mapping of parameter values (the mechanism's ``r``, ``l``,
+    ``d`` and :data:`CYCLE_PARAMS`)."""
+    return pack_cycle(values["r"], values["l"], values["d"],
+                      **{k: values[k] for k in CYCLE_PARAMS})  # fmt: skip
 
 
 @nb.njit(cache=True, inline="always")
@@ -287,6 +299,27 @@ def last_revolution(ds, omega: float, extra: int = 2):
     return ds.isel(time=slice(max(0, n - k), None))
 
 
+def pin_reversal_summary(values, ds) -> dict[str, float | str]:
+    """The API 618 crosshead-pin reversal over the last recorded revolution of a record with
+    ``theta1``, ``a`` and ``gas_force``: of the combined load ``m3 a - F_gas`` (degrees,
+    reverse fraction, peaks, verdict) and of the gas load alone; empty for a record shorter
+    than a revolution."""
+    ds = last_revolution(ds, float(values["omega"]))
+    th = np.asarray(ds["theta1"].values, dtype=float)
+    last = th >= th[-1] - 2.0 * math.pi
+    if np.count_nonzero(last) < 8 or not covers_revolution(th):
+        return {}
+    fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
+    pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
+    rev = rod_load_reversal(th[last], pin)
+    gas = rod_load_reversal(th[last], -fg)
+    return dict(pin_reversal_deg=rev.reversal_deg, pin_reverse_fraction=rev.reverse_fraction,
+                pin_peak_compression_N=rev.peak_compression,
+                pin_peak_tension_N=rev.peak_tension,
+                api618_pin_reversal="pass" if rev.passed else "FAIL",
+                gas_rod_load_reversal_deg=gas.reversal_deg)  # fmt: skip
+
+
 def cycle_summary(values, ds) -> dict[str, float | str]:
     """Figures of a run with ``load = "cycle"`` (empty otherwise): the API 618 crosshead-pin
     reversal over the last recorded revolution, of the combined load ``m3 a - F_gas`` and of
@@ -295,20 +328,7 @@ def cycle_summary(values, ds) -> dict[str, float | str]:
         return {}
     from .load import pack_load
 
-    ds = last_revolution(ds, float(values["omega"]))
-    th = np.asarray(ds["theta1"].values, dtype=float)
-    last = th >= th[-1] - 2.0 * math.pi
-    out: dict[str, float | str] = {}
-    if np.count_nonzero(last) >= 8 and covers_revolution(th):
-        fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
-        pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
-        rev = rod_load_reversal(th[last], pin)
-        gas = rod_load_reversal(th[last], -fg)
-        out.update(pin_reversal_deg=rev.reversal_deg, pin_reverse_fraction=rev.reverse_fraction,
-                   pin_peak_compression_N=rev.peak_compression,
-                   pin_peak_tension_N=rev.peak_tension,
-                   api618_pin_reversal="pass" if rev.passed else "FAIL",
-                   gas_rod_load_reversal_deg=gas.reversal_deg)  # fmt: skip
+    out: dict[str, float | str] = pin_reversal_summary(values, ds)
     grid = np.linspace(0.0, 2.0 * math.pi, 20_000, endpoint=False)
     if values.get("gas", "ideal") != "ideal":
         from .realgas import real_gas_states

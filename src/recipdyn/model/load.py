@@ -36,7 +36,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .cycle import cycle_force_kernel, pack_cycle, pressure_force
+from .cycle import CYCLE_PARAMS, cycle_data, cycle_force_kernel, pressure_force
 
 __all__ = [
     "mu_paper",
@@ -104,20 +104,6 @@ def pack_table(table) -> np.ndarray:
     return np.concatenate([[len(arr)], np.deg2rad(arr[:, 0]), arr[:, 1]])
 
 
-#: Parameter names of the compression-cycle load, in :func:`pack_cycle`'s keyword order.
-CYCLE_PARAMS = (
-    "bore",
-    "rod_diameter",
-    "clearance_fraction",
-    "suction_pressure",
-    "discharge_pressure",
-    "n_compression",
-    "n_expansion",
-    "frame_pressure",
-    "acting",
-)
-
-
 def pack_load(v) -> tuple[float, np.ndarray]:
     """``(kind, data)`` of the load for the compiled kernels from a mapping of parameter values
     (``load``, ``load_table`` and the cycle's parameters; the mechanism's ``r``, ``l``, ``d``)."""
@@ -128,7 +114,7 @@ def pack_load(v) -> tuple[float, np.ndarray]:
 
         return 1.0, pack_table(real_gas_force_table(v))
     if v.get("load", "paper") == "cycle":
-        return 2.0, pack_cycle(v["r"], v["l"], v["d"], **{k: v[k] for k in CYCLE_PARAMS})
+        return 2.0, cycle_data(v)
     return 0.0, pack_table(None)
 
 

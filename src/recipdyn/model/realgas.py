@@ -29,7 +29,7 @@ import functools
 
 import numpy as np
 
-from .cycle import cycle_states, pack_cycle, pressure_force
+from .cycle import CYCLE_PARAMS, cycle_data, cycle_states, pressure_force
 from .parameters import GASES  # noqa: F401  (re-exported)
 
 __all__ = [
@@ -45,9 +45,7 @@ STEP_DEG = 0.25
 #: Densities at which the isentrope is evaluated with CoolProp (then interpolated).
 ISENTROPE_NODES = 96
 
-_KEYS = ("r", "l", "d", "bore", "rod_diameter", "clearance_fraction", "suction_pressure",
-         "discharge_pressure", "n_compression", "n_expansion", "frame_pressure", "acting",
-         "gas", "suction_temperature")  # fmt: skip
+_KEYS = ("r", "l", "d", *CYCLE_PARAMS, "gas", "suction_temperature")
 
 
 def _key(v) -> tuple:
@@ -63,7 +61,7 @@ def _tables(key: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     v = dict(zip(_KEYS, key, strict=True))
     gas = v["gas"]
     ps, pd, Ts = v["suction_pressure"], v["discharge_pressure"], v["suction_temperature"]
-    c = pack_cycle(v["r"], v["l"], v["d"], **{k: v[k] for k in _KEYS[3:12]})
+    c = cycle_data(v)
     deg = np.arange(0.0, 360.0, STEP_DEG)
     st = cycle_states(np.deg2rad(deg), c)
     try:
@@ -137,8 +135,7 @@ def real_gas_states(theta1, values) -> dict[str, np.ndarray]:
     """Pressures and volumes at crank angles ``theta1`` (rad), interpolated periodically on
     the table (the volumes are exact: they follow the crank)."""
     deg, ph, pc, _, _ = _tables(_key(values))
-    c = pack_cycle(values["r"], values["l"], values["d"],
-                   **{k: values[k] for k in _KEYS[3:12]})  # fmt: skip
+    c = cycle_data(values)
     th = np.asarray(theta1, dtype=float)
     st = cycle_states(th, c)
     x = np.mod(np.degrees(th), 360.0)

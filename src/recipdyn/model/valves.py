@@ -65,9 +65,10 @@ from . import cycle as cy
 from .protocol import Param
 
 __all__ = [
-    "VALVE_PARAMS", "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
+    "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
     "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
     "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
+    "gas_outputs", "gas_scale",
 ]  # fmt: skip
 
 #: Rebound velocity (m/s) below which a plate comes to rest on its stop (no Zeno sequence of
@@ -75,13 +76,6 @@ __all__ = [
 V_REST = 1e-2
 #: ``1 - p_dn/p_u`` below which the nozzle flow is continued linearly to zero.
 EPS_LIN = 1e-3
-
-#: Parameter names of the valves, in :func:`pack_valves`'s order.
-VALVE_PARAMS = (
-    "valve_area_fraction", "valve_lift", "valve_mass", "valve_stiffness", "valve_preload",
-    "valve_damping", "valve_force_factor", "discharge_coefficient", "valve_restitution",
-    "gas_constant", "isentropic_exponent", "suction_temperature",
-)  # fmt: skip
 
 _ASSUMED = "assumed: a lumped plate valve of typical proportions (the paper gives no valves)"
 #: The valves' parameters, shared by every model with dynamic valves.
@@ -332,6 +326,18 @@ def state_force(y, g, c):
     return -y[g] * c[cy.C_AHE] + y[g + 6] * c[cy.C_ACE] + c[cy.C_PFRAME] * c[cy.C_AROD]
 
 
+@nb.njit(cache=True, inline="always")
+def _volume(x, xdot, j, c):
+    """Volume of chamber ``j`` (0 head end, 1 crank end) and its rate, for the crosshead at
+    ``x`` moving at ``xdot`` (:mod:`.cycle`'s chamber geometry)."""
+    stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
+    if j == 0:
+        return (c[cy.C_CLEAR] * c[cy.C_AHE] * stroke + c[cy.C_AHE] * (c[cy.C_XMAX] - x),
+                -c[cy.C_AHE] * xdot)  # fmt: skip
+    return (c[cy.C_CLEAR] * c[cy.C_ACE] * stroke + c[cy.C_ACE] * (x - c[cy.C_XMIN]),
+            c[cy.C_ACE] * xdot)  # fmt: skip
+
+
 @nb.njit(cache=True)
 def gas_rhs(x, xdot, y, g, a, c, v, out):
     """Derivatives of the gas states ``y[g:g+12]`` and the mass counters ``y[a:a+4]`` for the
@@ -340,9 +346,6 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
     A chamber that does not compress (single-acting) keeps its states (derivatives 0) and the
     frame pressure acts on its piston face."""
     acting = int(v[V_NCH])
-    ahe, ace = c[cy.C_AHE], c[cy.C_ACE]
-    stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-    force = c[cy.C_PFRAME] * c[cy.C_AROD]
     for j in range(2):
         b = g + 6 * j
         if not acting & (1 << j):
@@ -350,20 +353,12 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
                 out[b + i] = 0.0
             out[a + 2 * j] = 0.0
             out[a + 2 * j + 1] = 0.0
-            force += -c[cy.C_PFRAME] * ahe if j == 0 else c[cy.C_PFRAME] * ace
             continue
-        if j == 0:
-            V = c[cy.C_CLEAR] * ahe * stroke + ahe * (c[cy.C_XMAX] - x)
-            dV = -ahe * xdot
-            force -= y[b] * ahe
-        else:
-            V = c[cy.C_CLEAR] * ace * stroke + ace * (x - c[cy.C_XMIN])
-            dV = ace * xdot
-            force += y[b] * ace
+        V, dV = _volume(x, xdot, j, c)
         ms, md = _chamber(V, dV, y, b, c, v, out)
         out[a + 2 * j] = ms
         out[a + 2 * j + 1] = -md
-    return force
+    return state_force(y, g, c)
 
 
 @nb.njit(cache=True)
@@ -432,8 +427,38 @@ def gas_initial(values, c: np.ndarray, theta1: float) -> np.ndarray:
     return y
 
 
-def _last_revolution_mask(th: np.ndarray) -> np.ndarray:
-    return th >= th[-1] - 2.0 * math.pi
+def gas_outputs(values, x, y, dy, g: int, a: int, c: np.ndarray) -> dict[str, Any]:
+    """The chambers' signals over a record (crosshead ``x``, states ``y``, their derivatives
+    ``dy``; gas states from column ``g``, mass counters from ``a``): pressures, volumes,
+    temperatures and the mass flows through the valves."""
+    from .base import Signal
+
+    R = float(values["gas_constant"])
+    out = {}
+    for j, end in enumerate(("head", "crank")):
+        b = g + 6 * j
+        vol = _volume(x, 0.0, j, c)[0]
+        out[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
+        out[f"V_{end}"] = Signal(vol, "m**3", f"{end}-end cylinder volume")
+        out[f"T_{end}"] = Signal(y[:, b] * vol / (y[:, b + 1] * R), "K",
+                                 f"{end}-end gas temperature")  # fmt: skip
+        out[f"mdot_suction_{end}"] = Signal(dy[:, a + 2 * j], "kg/s",
+                                            f"{end}-end suction mass flow (in)")  # fmt: skip
+        out[f"mdot_discharge_{end}"] = Signal(dy[:, a + 2 * j + 1], "kg/s",
+                                              f"{end}-end discharge mass flow (out)")  # fmt: skip
+    return out
+
+
+def gas_scale(values, y0: np.ndarray, g: int, a: int, out: np.ndarray) -> np.ndarray:
+    """Typical sizes of the gas states in ``out`` (:meth:`Model.state_scale`): pressures and
+    masses at their initial values, lifts at the full lift, the mass counters at the initial
+    gas mass (plate velocities keep ``out``'s)."""
+    for j in range(2):
+        b = g + 6 * j
+        out[b], out[b + 1] = y0[b], y0[b + 1]
+        out[b + 2] = out[b + 4] = values["valve_lift"]
+        out[a + 2 * j] = out[a + 2 * j + 1] = y0[b + 1]
+    return out
 
 
 def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
@@ -441,16 +466,13 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
     the mass taken in, the mass balance of each chamber, and per valve the number of impacts,
     of separate openings (> 1: the plate flutters or reopens) and the crank angle of its final
     closing after the dead centre at which the ideal valve closes (> 0: late closing)."""
+    out: dict[str, Any] = cy.pin_reversal_summary(values, ds)
+    if not out:  # shorter than a revolution
+        return out
     ds = cy.last_revolution(ds, float(values["omega"]))
     th = np.asarray(ds["theta1"].values, dtype=float)
-    if th.size < 8 or not cy.covers_revolution(th):
-        return {}
-    last = _last_revolution_mask(th)
-    out: dict[str, Any] = {}
-    from .load import CYCLE_PARAMS
-
-    c = cy.pack_cycle(values["r"], values["l"], values["d"],
-                      **{k: values[k] for k in CYCLE_PARAMS})  # fmt: skip
+    last = th >= th[-1] - 2.0 * math.pi
+    c = cy.cycle_data(values)
     stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
     rho_s = values["suction_pressure"] / (values["gas_constant"] * values["suction_temperature"])
     work = 0.0
@@ -491,9 +513,4 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         out["valve_impacts_per_rev"] = int(np.count_nonzero(
             np.asarray(ds["impact_time"].values) >= float(ds["time"].values[-1])
             - 2.0 * math.pi / float(values["omega"])))  # fmt: skip
-    fg = np.asarray(ds["gas_force"].values, dtype=float)[last]
-    pin = float(values["m3"]) * np.asarray(ds["a"].values, dtype=float)[last] - fg
-    rev = cy.rod_load_reversal(th[last], pin)
-    out.update(pin_reversal_deg=rev.reversal_deg, pin_reverse_fraction=rev.reverse_fraction,
-               api618_pin_reversal="pass" if rev.passed else "FAIL")  # fmt: skip
     return out
