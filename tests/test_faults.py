@@ -873,3 +873,26 @@ def test_every_layer_uses_the_shared_defaults():
         assert default(fn, "rtol") == defaults.RTOL and default(fn, "atol") == defaults.ATOL
     assert DEFAULT_SETTINGS["rtol"] == SimulationConfig().rtol == SWEEP_DEFAULTS["rtol"]
     assert default(classify, "lyap_tol") == defaults.LYAP_TOL
+
+
+def test_orphaned_temporary_results_are_removed(tmp_path):
+    """A worker terminated inside atomic_path leaves its temporary folder; remove_orphans
+    removes the ones whose process is gone and keeps a live process's and every result."""
+    import subprocess
+    import sys
+
+    from recipdyn.io import atomic_path, remove_orphans
+
+    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)  # fmt: skip
+    dead = int(done.stdout)
+    orphan = tmp_path / f".run.nc.tmp-{dead}-abc"
+    orphan.mkdir()
+    (orphan / "run.nc").write_bytes(b"half")
+    (tmp_path / "kept.nc").write_bytes(b"result")
+    with atomic_path(tmp_path / "live.nc") as tmp:  # this process's: alive
+        tmp.write_bytes(b"x")
+        assert remove_orphans(tmp_path) == 1
+        assert tmp.exists() and not orphan.exists()
+    assert (tmp_path / "kept.nc").read_bytes() == b"result"
+    assert (tmp_path / "live.nc").read_bytes() == b"x"

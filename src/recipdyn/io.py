@@ -23,6 +23,7 @@ from .errors import ParameterError
 __all__ = [
     "DATASET_FORMATS", "check_output", "atomic_path", "write_dataset", "read_dataset",
     "write_text", "save_figure", "StreamWriter", "open_record", "forcing_frequency",
+    "remove_orphans",
 ]  # fmt: skip
 
 
@@ -81,11 +82,14 @@ def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; rename it to ``path`` if the block succeeds.
 
     On any exception (including an interruption) the temporary file is removed and the
-    previous content of ``path``, if any, is untouched.
+    previous content of ``path``, if any, is untouched. A process ended from outside while
+    inside the block (a pool worker terminated when a run is interrupted, ``kill -9``) cannot
+    clean up: the temporary folder carries its process id, and :func:`remove_orphans` removes
+    it once that process is gone.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.tmp-"))
+    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.tmp-{os.getpid()}-"))
     target = tmp / path.name if not directory else tmp / "data"
     try:
         yield target
@@ -101,6 +105,29 @@ def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
             os.replace(target, path)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def remove_orphans(folder: str | Path) -> int:
+    """Remove the temporary folders :func:`atomic_path` left in ``folder`` whose process no
+    longer runs (never a finished result, never another live process's work); returns how
+    many."""
+    import re
+
+    n = 0
+    for tmp in Path(folder).glob(".*.tmp-*"):
+        m = re.search(r"\.tmp-(\d+)-", tmp.name)
+        if m is None or not tmp.is_dir():
+            continue
+        try:
+            os.kill(int(m.group(1)), 0)
+            continue  # its process still runs
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            continue  # another user's live process
+        shutil.rmtree(tmp, ignore_errors=True)
+        n += 1
+    return n
 
 
 def write_dataset(ds, path: str | Path) -> Path:

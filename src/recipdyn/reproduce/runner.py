@@ -21,6 +21,7 @@ import xarray as xr
 from .. import __version__
 from ..defaults import ATOL, RTOL
 from ..errors import Interrupted, deferred_signals
+from ..io import remove_orphans
 from ..model.parameters import CompressorParams
 from ..parallel import run_unordered
 from .cases import Case
@@ -137,6 +138,7 @@ def run_all(
     finished so far stay in the cache and :class:`~recipdyn.errors.Interrupted` says so.
     """
     cache.mkdir(parents=True, exist_ok=True)
+    remove_orphans(cache)  # left by a run killed outright (kill -9, power loss)
     specs = list(specs)
     todo = []
     out: dict[tuple[str, str], xr.Dataset] = {}
@@ -168,6 +170,7 @@ def run_all(
             elif todo:
                 run_unordered(_compute_task, todo, jobs, finished, pending)
     except (KeyboardInterrupt, Interrupted) as exc:
+        remove_orphans(cache)  # results the terminated workers were writing
         intr = Interrupted.wrap(exc)
         intr.kept.append(f"{len(specs) - len(todo) + done} of {len(specs)} runs in {cache} "
                          "(rerun the same command: cached runs are reused)")  # fmt: skip
