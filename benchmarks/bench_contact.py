@@ -4,9 +4,10 @@ Python, the same event), at equal accuracy (issue 11; target >= 30x the better S
 
 Case: 20 rad/s, c = 1 mm, steel (Hertz pin-in-hole K), Lankarani-Nikravesh, the journal
 starting in the middle of the clearance (free flight, then impacts). Accuracy = the error of
-the final state against a reference at rtol 1e-12; recipdyn runs at rtol 1e-10, each SciPy
-method at the loosest rtol that reaches the same error (tried 1e-8 ... 1e-12), restarted
-after each impact's reset (SciPy's events can stop a run, not change the state).
+the final state against a reference at rtol 1e-13; recipdyn runs at rtol 1e-9 ... 1e-12, each
+SciPy method at rtol 1e-8 ... 1e-13 (restarted after each impact's reset: SciPy's events can
+stop a run, not change the state); each of our runs is set against the fastest SciPy run at
+least as accurate, and the median of these ratios is reported (work-precision comparison).
 """
 
 from __future__ import annotations
@@ -37,15 +38,13 @@ def main(argv=()) -> dict:
     s = m.system(v)
     y0 = m.initial_state(v)
     T = m.period(v)
-    ref = integrate(s, y0, (0.0, T), rtol=1e-12, atol=1e-16).y_final[[0, 1, 4, 5]]
+    ref = integrate(s, y0, (0.0, T), rtol=1e-13, atol=1e-17).y_final[[0, 1, 4, 5]]
     scale = np.abs(ref).max(axis=None)
 
     def err(y):
         return float(np.abs(y[[0, 1, 4, 5]] - ref).max() / scale)
 
     integrate(s, y0, (0.0, T))  # compile
-    t_ours, sol = _timed(lambda: integrate(s, y0, (0.0, T), rtol=1e-10, atol=1e-14))
-    e_ours = err(sol.y_final)
     ev = s.acting_event
 
     def g(t, y):
@@ -70,11 +69,22 @@ def main(argv=()) -> dict:
             n_ev += 1
             y[0:2] *= 1.0 + 1e-15  # just past the surface, so the restart does not stop at once
 
-    rows = {"recipdyn dop853": dict(seconds=t_ours, steps=sol.nsteps, error=e_ours,
-                                    impacts=int(sol.t_events.size))}  # fmt: skip
+    # Work-precision: with 9 impacts in the revolution the final state's error does not fall
+    # smoothly with the tolerance (a step sequence that lands an impact differently changes
+    # it by 10-100x), so one tolerance per method is a lottery. Each of our runs is compared
+    # with the fastest SciPy run at least as accurate (within 1.5x); the ratio reported is
+    # the median over our four tolerances, with the spread.
+    rows = {}
+    for rtol in (1e-9, 1e-10, 1e-11, 1e-12):
+        t_run, sol = _timed(lambda r=rtol: integrate(s, y0, (0.0, T), rtol=r, atol=r * 1e-4))
+        rows[f"recipdyn dop853 rtol {rtol:g}"] = dict(
+            seconds=t_run, steps=sol.nsteps, error=err(sol.y_final),
+            impacts=int(sol.t_events.size), nfev=sol.nfev)  # fmt: skip
+    ours = {k: r for k, r in rows.items() if k.startswith("recipdyn")}
+    e_min = min(r["error"] for r in ours.values())
     for method in ("DOP853", "Radau"):
-        for rtol in (1e-8, 1e-9, 1e-10, 1e-11, 1e-12):
-            kw = dict(method=method, rtol=rtol, atol=1e-14, events=g)
+        for rtol in (1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13):
+            kw = dict(method=method, rtol=rtol, atol=rtol * 1e-4, events=g)
             if method == "Radau":
                 kw["jac"] = s.jacobian
             t0 = time.perf_counter()
@@ -84,23 +94,33 @@ def main(argv=()) -> dict:
             rows[f"scipy {method} rtol {rtol:g}"] = dict(
                 seconds=dt, steps=int(steps), error=e, status=int(status), impacts=n_ev
             )
-            if e <= e_ours * 1.5 or dt > 120:
+            if e <= e_min or dt > 60:
                 break
-    # the fastest SciPy run at least as accurate as ours (within 1.5x), else the most accurate
     scipy = {k: r for k, r in rows.items() if k.startswith("scipy")}
-    ok = [r["seconds"] for r in scipy.values() if r["error"] <= 1.5 * e_ours]
-    best = min(ok) if ok else min(scipy.values(), key=lambda r: r["error"])["seconds"]
-    print(f"{'run':<28}{'seconds':>10}{'steps':>10}{'impacts':>9}{'rel. error':>12}")
+    print(f"{'run':<30}{'seconds':>9}{'steps':>8}{'impacts':>9}{'rel. error':>12}{'ratio':>8}")
+    ratios = []
     for k, r in rows.items():
-        print(f"{k:<28}{r['seconds']:>10.3f}{r['steps']:>10}{r['impacts']:>9}{r['error']:>12.2e}")
-    ratio = best / t_ours
+        tag = ""
+        if k.startswith("recipdyn"):
+            ok = [q["seconds"] for q in scipy.values() if q["error"] <= 1.5 * r["error"]]
+            if ok:  # else no SciPy run reached this accuracy: left out, not a made-up ratio
+                r["ratio"] = min(ok) / r["seconds"]
+                ratios.append(r["ratio"])
+                tag = f"{r['ratio']:.0f}x"
+            else:
+                tag = "(none)"
+        print(f"{k:<30}{r['seconds']:>9.3f}{r['steps']:>8}{r['impacts']:>9}{r['error']:>12.2e}"
+              f"{tag:>8}")  # fmt: skip
+    ratio = float(np.median(ratios)) if ratios else float("nan")
     print(
-        f"speed-up over the fastest SciPy run of equal accuracy: {ratio:.0f}x (target >= 30x; "
-        "SciPy calls the same compiled right-hand side)"
+        f"speed-up over the fastest SciPy run of equal accuracy: median {ratio:.0f}x over "
+        f"{len(ratios)} tolerances (range {min(ratios, default=np.nan):.0f}-"
+        f"{max(ratios, default=np.nan):.0f}x; target >= 30x; SciPy calls the same compiled "
+        "right-hand side)"
     )
-    summary = [dict(metric="contact: DOP853 vs SciPy DOP853, equal accuracy", value=ratio,
-                    unit="x", target=30.0, better="higher")]  # fmt: skip
-    return dict(rows=rows, speedup=ratio, summary=summary)
+    summary = [dict(metric="contact: DOP853 vs SciPy DOP853, equal accuracy (median)",
+                    value=ratio, unit="x", target=30.0, better="higher")]  # fmt: skip
+    return dict(rows=rows, speedup=ratio, ratios=ratios, summary=summary)
 
 
 if __name__ == "__main__":

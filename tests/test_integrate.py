@@ -105,6 +105,45 @@ def test_events_are_root_found_on_dense_output():
     assert np.all(rising.y_events[:, 1] > 0)
 
 
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def _near_crest(t, y, p):
+    return y[0] - 0.95
+
+
+@nb.njit(EVENT_SIGNATURE, cache=True)
+def _far(t, y, p):
+    return 100.0 + t
+
+
+@pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-6])
+def test_two_crossings_inside_one_step_are_both_found(rtol):
+    """x = cos 2t crosses 0.95 twice around each crest, 0.318 s apart; at rtol 1e-3 the steps
+    are ~0.8 s, so both crossings lie inside one step. The cheap screen (cubic Hermite, 4th
+    order) must still send these steps to the dense output: all 13 crossings in [0, 20] found,
+    within the dense output's error at that tolerance (measured 5e-3 at rtol 1e-3)."""
+    a = np.arccos(0.95) / 2
+    k = np.arange(8) * np.pi
+    exact = np.sort(np.r_[k + a, k[1:] - a])
+    exact = exact[exact < 20]
+    sol = integrate(OSC, [1.0, 0.0], (0, 20), event=_near_crest, rtol=rtol, atol=1e-9)
+    if rtol == 1e-3:
+        assert 20 / sol.nsteps > 2 * a  # the mean step is longer than a crossing pair
+    assert sol.t_events.size == exact.size
+    np.testing.assert_allclose(sol.t_events, exact, atol=5000 * rtol)
+
+
+def test_an_event_far_from_zero_costs_no_rhs_calls():
+    """Steps are screened on the free cubic interpolant: an event function that never turns
+    toward zero adds no right-hand side calls and changes no step (before the screen, every
+    step of a run with an event paid 3 calls for the dense output)."""
+    plain = integrate(OSC, [1.0, 0.0], (0, 20), rtol=1e-9, atol=1e-12)
+    ev = integrate(OSC, [1.0, 0.0], (0, 20), event=_far, rtol=1e-9, atol=1e-12)
+    assert ev.t_events.size == 0
+    assert ev.nsteps == plain.nsteps
+    assert ev.nfev == plain.nfev
+    np.testing.assert_array_equal(ev.y_final, plain.y_final)
+
+
 def test_failure_raises_with_partial_solution():
     """A solution that blows up fails cleanly, keeping what was computed."""
     sys_ = ODESystem(rhs=_blowup, params=np.zeros(1), state_names=("y",))

@@ -238,28 +238,98 @@ def vibration_section(x, fs, out, plt, *, revs=None, quantity="acceleration", zo
     return _plain(rep["summary"])
 
 
+def _stream_record(path, column, fs, keep: int, progress: bool):
+    """Read a long signal file block by block: the first ``keep`` samples (the excerpt the
+    detailed analyses run on) and the whole record's moments and Welch spectrum."""
+    from .analysis.streaming import RunningMoments, StreamingWelch
+    from .io_signal import MeasuredSignal, signal_blocks
+
+    rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
+    moments = RunningMoments()
+    welch = StreamingWelch(rate, WELCH_SEGMENT)
+    kept: list[np.ndarray] = []
+    n_kept = 0
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=total, unit="sample", desc=f"analyze {path.name}", leave=False)
+    try:
+        for block in blocks:
+            if not np.all(np.isfinite(block)):
+                raise ParameterError(f"{path}: column {name!r} has missing or non-finite "
+                                     f"values after sample {moments.n}; fill or cut them "
+                                     "first")  # fmt: skip
+            moments.feed(block)
+            welch.feed(block)
+            if n_kept < keep:
+                kept.append(block[: keep - n_kept].copy())
+                n_kept += kept[-1].size
+            if bar is not None:
+                bar.update(block.size)
+    finally:
+        if bar is not None:
+            bar.close()
+    x = np.concatenate(kept) if kept else np.empty(0)
+    notes = [f"long record ({moments.n} samples): read in blocks; the overall statistics and "
+             f"the spectrum (Welch, {welch.segments} Hann segments of {WELCH_SEGMENT}) cover "
+             f"all of it, the signal-based estimators and the vibration page its first "
+             f"{x.size} samples ({x.size / rate:.4g} s)"]  # fmt: skip
+    return MeasuredSignal(x, rate, name, path.name, "", notes), moments, welch
+
+
+#: Samples per Welch segment of a long record's spectrum (resolution fs / 65536: 0.15 Hz at
+#: 10 kHz) and the record length above which a file is read in blocks (analyze_signal).
+WELCH_SEGMENT = 1 << 16
+MAX_MEMORY_SAMPLES = 1 << 24
+#: The first samples of a long record that the detailed analyses use.
+EXCERPT_SAMPLES = 1 << 20
+
+
 def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
                    max_signal_samples: int = 40_000, tacho=None, speed=None,
-                   quantity: str = "acceleration", zones=None,
-                   band=None, phase=quiet) -> dict[str, Any]:  # fmt: skip
+                   quantity: str = "acceleration", zones=None, band=None, phase=quiet,
+                   max_memory_samples: int = MAX_MEMORY_SAMPLES,
+                   excerpt_samples: int = EXCERPT_SAMPLES,
+                   progress: bool = False) -> dict[str, Any]:  # fmt: skip
     """Analyse one channel of a measured (or any) signal file into folder ``out``: the signal,
     its spectrum, the exponents from the signal with their statuses, the 0-1 test, the
-    surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``)."""
-    from .analysis.signal import assess_signal as assess
+    surrogate test and the verdict with the evidence table (``summary.json``/``summary.md``).
+
+    A record longer than ``max_memory_samples`` is read in blocks (with a progress bar if
+    ``progress``): its overall statistics, band velocity RMS and spectrum (Welch) cover the
+    whole record; the figures of the signal, the vibration page and the signal-based chaos
+    estimators use its first ``excerpt_samples``, as the summary's notes say."""
+    from .analysis.spectrum import Spectrum
     from .io import check_output
-    from .io_signal import crank_revs, read_signal
+    from .io_signal import crank_revs, read_signal, record_length
 
     path, out = Path(path), Path(out)
-    with phase(f"analyze: reading {path.name}"):
-        sig = read_signal(path, column=column, fs=fs)
+    for name, value in (("max_memory_samples", max_memory_samples),
+                        ("excerpt_samples", excerpt_samples)):  # fmt: skip
+        if not int(value) >= 1000:
+            raise ParameterError(f"{name} = {value!r}; allowed: >= 1000")
+    moments = welch = None
+    if not path.is_file():
+        sig = read_signal(path, column=column, fs=fs)  # says what is wrong with the path
+    n_est = record_length(path, column=column)
+    if n_est is not None and n_est > max_memory_samples:
+        with phase(f"analyze: reading {path.name} in blocks"):
+            sig, moments, welch = _stream_record(path, column, fs,
+                                                 min(excerpt_samples, max_memory_samples),
+                                                 progress)  # fmt: skip
+    else:
+        with phase(f"analyze: reading {path.name}"):
+            sig = read_signal(path, column=column, fs=fs)
     if sig.x.size < 200:
         raise ParameterError(f"{path}: {sig.x.size} samples in {sig.name!r}; analyze needs at "
                              "least 200 for a signal without equations")  # fmt: skip
-    if np.ptp(sig.x) == 0:
+    if np.ptp(sig.x) == 0 and (moments is None or moments.hi == moments.lo):
         raise ParameterError(f"{path}: column {sig.name!r} is constant")
     check_output(out, formats=None, what="analysis folder")
     plt = _mpl()
     x, rate = sig.x, sig.fs
+    n_total = x.size if moments is None else moments.n
     t = np.arange(x.size) / rate
     fig, ax = plt.subplots(figsize=(10, 3.5), constrained_layout=True)
     shown = slice(0, min(x.size, 20_000))
@@ -268,14 +338,21 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     ax.set_ylabel(f"{sig.name} ({sig.units})" if sig.units else sig.name)
     ax.set_title(
         f"{sig.source}: {sig.name}, {rate:g} Hz"
-        + (f" (first {shown.stop} of {x.size} samples)" if shown.stop < x.size else "")
+        + (f" (first {shown.stop} of {n_total} samples)" if shown.stop < n_total else "")
     )
     ax.grid(alpha=0.3)
     save_figure(fig, out / "signal.png", dpi=110)
     plt.close(fig)
-    spec = amplitude_spectrum(x, rate)
+    if welch is None:
+        spec = amplitude_spectrum(x, rate)
+        title = f"spectrum of {sig.name}"
+    else:
+        f_w, a_w = welch.amplitude()
+        spec = Spectrum(f_w, a_w, rate / welch.nperseg, "hann", rate)
+        title = (f"spectrum of {sig.name}: whole record, Welch mean of {welch.segments} "
+                 f"segments")  # fmt: skip
     peaks = find_spectral_peaks(spec, n=8)
-    fig = plot_spectrum(spec, peaks, title=f"spectrum of {sig.name}")
+    fig = plot_spectrum(spec, peaks, title=title)
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
     revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
@@ -283,12 +360,15 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
         vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
                                 zones=parse_zones(zones), band=band,
                                 title=f"{sig.source}: {sig.name}")  # fmt: skip
+    if moments is not None:
+        vib["excerpt_samples"] = int(x.size)
+        vib["whole_record"] = _whole_record(moments, welch, quantity, parse_zones(zones))
     with phase(f"analyze: exponents from the signal, 0-1 test, surrogates "
                f"({min(x.size, max_signal_samples)} samples)"):  # fmt: skip
-        a = assess(x, rate, max_samples=max_signal_samples, revs=revs)
+        a = assess_signal(x, rate, max_samples=max_signal_samples, revs=revs)
         _divergence_figures(a, out, plt)
     summary: dict[str, Any] = {
-        "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(x.size),
+        "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(n_total),
         "fs_hz": rate, "notes": sig.notes + a.notes, "model": "none (measured signal)",
         "spectrum": {"resolution_hz": spec.resolution,
                      "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude,
@@ -301,6 +381,23 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     write_text(out / "summary.json", json.dumps(summary, indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
+
+
+def _whole_record(moments, welch, quantity, zones) -> dict[str, Any]:
+    """The vibration summary's overall numbers for a whole long record (streamed)."""
+    from .analysis.vibration import ISO20816_8_BAND_HZ, zone
+
+    res: dict[str, Any] = {"samples": int(moments.n), "indicators": moments.indicators(),
+                           "spectrum_segments": int(welch.segments),
+                           "spectrum_resolution_hz": welch.fs / welch.nperseg}  # fmt: skip
+    lo, hi = ISO20816_8_BAND_HZ
+    if quantity in ("acceleration", "velocity") and welch.fs > 2 * hi:  # as vibration_report
+        v = welch.band_rms((lo, hi), integrate=1 if quantity == "acceleration" else 0)
+        res["velocity_rms_band_hz"] = [lo, hi]
+        res["velocity_rms"] = v
+        if zones:
+            res["zone"] = zone(v, zones)
+    return res
 
 
 def is_record(path: str | Path) -> bool:
@@ -414,6 +511,20 @@ def _markdown(s: dict[str, Any]) -> str:
             z = f" (zone {vib['zone']})" if "zone" in vib else ""
             lines.append(f"- velocity RMS, 2-1000 Hz (ISO 20816-8 band): "
                          f"{vib['velocity_rms_2_1000hz']:.4g} m/s{z}")  # fmt: skip
+        whole = vib.get("whole_record")
+        if whole:
+            lines += [
+                "",
+                f"Whole record ({whole['samples']} samples, read in blocks; the "
+                f"lines above are from its first {vib['excerpt_samples']}):",
+                "",
+            ]
+            lines += [f"- {k}: {v:.4g}" for k, v in whole["indicators"].items()]
+            if "velocity_rms" in whole:
+                z = f" (zone {whole['zone']})" if "zone" in whole else ""
+                b = whole["velocity_rms_band_hz"]
+                lines.append(f"- velocity RMS, {b[0]:g}-{b[1]:g} Hz: "
+                             f"{whole['velocity_rms']:.4g} m/s{z}")  # fmt: skip
         imp = vib["impacts"]
         per = f", {imp['per_revolution']:.3g} per revolution" if imp["per_revolution"] else ""
         lines.append(f"- impacts: {imp['count']}{per}")

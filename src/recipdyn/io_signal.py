@@ -18,6 +18,7 @@ from .units import to_si
 __all__ = [
     "MeasuredSignal",
     "read_signal",
+    "record_length",
     "SIGNAL_SUFFIXES",
     "signal_blocks",
     "speed_hz",
@@ -329,9 +330,48 @@ def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000
             if rate is None:
                 raise ParameterError(f"{path}: the file does not give a sampling rate; pass "
                                      "--fs (e.g. --fs 10kHz)")  # fmt: skip
-            return MeasuredSignal(np.asarray(da.values[:rows], dtype=float), rate, name,
+            return MeasuredSignal(np.asarray(da[:rows].values, dtype=float), rate, name,
                                   path.name)  # fmt: skip
     return read_signal(path, column=column, fs=fs)
+
+
+def record_length(path: str | Path, *, column=None) -> int | None:
+    """The number of samples in ``path`` without reading its data: exact for Parquet, WAV,
+    NPY and NetCDF (metadata, memory map, lazy array), estimated for text from the file size
+    and the bytes per line of its first 256 kB; None for MAT (scipy reads it whole) or a file
+    that cannot be inspected (the full reader then says why)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    try:
+        if suffix in (".csv", ".txt", ".tsv"):
+            size = path.stat().st_size
+            with open(path, "rb") as fh:
+                head = fh.read(1 << 18)
+            lines = head.count(b"\n")
+            if lines < 2 or len(head) == size:
+                return max(lines - 1, 0) if len(head) == size else None
+            return int(size / (len(head) / lines))
+        if suffix == ".parquet":
+            import pyarrow.parquet as pq
+
+            return int(pq.ParquetFile(path).metadata.num_rows)
+        if suffix == ".wav":
+            from scipy.io import wavfile
+
+            return int(len(wavfile.read(path, mmap=True)[1]))
+        if suffix == ".npy":
+            return int(np.load(path, mmap_mode="r").shape[0])
+        if suffix == ".nc":
+            import xarray as xr
+
+            with xr.open_dataset(path) as ds:
+                names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
+                return int(ds[_pick(names, column, path, "variable")].shape[0])
+    except ParameterError:
+        raise
+    except Exception:  # noqa: BLE001 - the full reader reports a malformed file
+        return None
+    return None
 
 
 def speed_hz(speed) -> float | None:
@@ -345,15 +385,20 @@ def speed_hz(speed) -> float | None:
 
 
 def crank_revs(path: str | Path, n: int, fs: float, *, tacho=None, speed=None):
-    """The crank angle (revolutions) at each of ``n`` samples of ``path``: from its
-    once-per-revolution ``tacho`` column/channel, or a constant ``speed``; None with
-    neither."""
+    """The crank angle (revolutions) at each of the first ``n`` samples of ``path``: from its
+    once-per-revolution ``tacho`` column/channel (only its first ``n`` samples are read), or
+    a constant ``speed``; None with neither."""
     from .analysis.vibration import crank_angle, tacho_times
 
     if tacho is not None:
-        pulse = read_signal(path, column=tacho, fs=fs)
+        pulse = read_signal_head(path, column=tacho, fs=fs, rows=n)
+        if pulse.x.size < n:
+            raise ParameterError(f"tacho {tacho!r}: {pulse.x.size} samples, the signal {n}")
+        if not np.all(np.isfinite(pulse.x)):
+            raise ParameterError(f"tacho {tacho!r}: missing or non-finite values; fill or cut "
+                                 "them first")  # fmt: skip
         try:
-            return crank_angle(n, fs, pulses=tacho_times(pulse.x, fs))
+            return crank_angle(n, fs, pulses=tacho_times(pulse.x[:n], fs))
         except ValueError as exc:
             raise ParameterError(f"tacho {tacho!r}: {exc}") from None
     f_rev = speed_hz(speed)

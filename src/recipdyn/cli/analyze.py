@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import typer
@@ -43,6 +44,12 @@ def analyze(
     quantity: str = typer.Option(
         "acceleration", "--quantity", help="acceleration (m/s^2), velocity (m/s) or other."
     ),
+    max_memory_samples: int = typer.Option(
+        None,
+        "--max-memory-samples",
+        help="Signal file: longer records are read in blocks (whole-record statistics and "
+        "spectrum; detailed analyses on the first 2^20 samples). Default 2^24.",
+    ),
     zones: str = typer.Option(
         None,
         "--zones",
@@ -68,8 +75,10 @@ def analyze(
                                  "other")  # fmt: skip
         if tacho is not None and speed is not None:
             raise ParameterError("tacho and speed: give one of them")
+        extra = {} if max_memory_samples is None else {"max_memory_samples": max_memory_samples}
         s = analyze_signal(run, out, column=column, fs=fs, tacho=tacho, speed=speed,
-                           quantity=quantity, zones=zones, phase=phase)  # fmt: skip
+                           quantity=quantity, zones=zones, phase=phase,
+                           progress=sys.stderr.isatty(), **extra)  # fmt: skip
         for note in s["notes"]:
             typer.echo(f"note: {note}")
         for name, value, status in s["evidence"]:

@@ -29,6 +29,9 @@ SAFETY = 0.9
 #: Events are looked for at this many equally spaced points inside each step (on the dense
 #: output), so two crossings within one step are both seen unless they are closer than h/4.
 EVENT_SUBSTEPS = 4
+#: Before that, a step is screened at this many points on the cubic Hermite interpolant
+#: (free: no right-hand side calls); see ``_may_cross``.
+SCREEN_POINTS = 8
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 
@@ -63,6 +66,48 @@ def _dense_eval(x, y_old, F, out):
                 out[j] *= 1.0 - x
     for j in range(n):
         out[j] += y_old[j]
+
+
+@nb.njit(cache=True)
+def _hermite_eval(x, y_old, f_old, y_new, f_new, h, out):
+    """The cubic Hermite interpolant of one step at ``x`` in [0, 1] (no right-hand side calls:
+    it uses the values and slopes at both ends)."""
+    x2 = x * x
+    x3 = x2 * x
+    h00 = 2.0 * x3 - 3.0 * x2 + 1.0
+    h10 = (x3 - 2.0 * x2 + x) * h
+    h01 = 3.0 * x2 - 2.0 * x3
+    h11 = (x3 - x2) * h
+    for j in range(y_old.shape[0]):
+        out[j] = h00 * y_old[j] + h10 * f_old[j] + h01 * y_new[j] + h11 * f_new[j]
+
+
+@nb.njit(cache=True)
+def _may_cross(event, t, y, f, y_new, f_new, h, g_old, g_new, event_dir, p, ybuf):
+    """Whether the event function may cross zero in direction ``event_dir`` inside the step.
+
+    ``g`` is sampled at the two ends (exact) and at ``SCREEN_POINTS - 1`` inner points of the
+    cubic Hermite interpolant (free: no right-hand side calls). The step may cross if the
+    samples change sign, or if ``|g|`` has an inner local minimum: ``g`` turns back toward
+    zero, and a touch-and-return that the cubic (accurate to O(h^4) only) does not show may
+    lie there. Only such steps pay for the 7th-order dense output (3 right-hand side calls),
+    on which the crossings are then looked for and located."""
+    ga = g_old
+    prev = abs(g_old)  # |g| at the sample before ga
+    for q in range(1, SCREEN_POINTS + 1):
+        if q == SCREEN_POINTS:
+            gb = g_new
+        else:
+            x = q / SCREEN_POINTS
+            _hermite_eval(x, y, f, y_new, f_new, h, ybuf)
+            gb = event(t + x * h, ybuf, p)
+        if (ga < 0.0 <= gb and event_dir >= 0) or (ga > 0.0 >= gb and event_dir <= 0):
+            return True
+        if q > 1 and abs(ga) < prev and abs(ga) < abs(gb):
+            return True
+        prev = abs(ga)
+        ga = gb
+    return False
 
 
 @nb.njit(cache=True)
@@ -296,19 +341,23 @@ def dop853_kernel(
             status = -3
             break
         nsteps += 1
-        # dense output, only when needed (always with events: they are looked for inside
-        # the step on it, so a step that contains two crossings does not hide them)
+        # dense output, only when needed: for outputs inside the step, and for events when
+        # the cheap screen says the step may contain a crossing (they are then looked for on
+        # the dense output at h/4, so a step that contains two crossings does not hide them)
         need_dense = ie < n_eval and t_eval[ie] <= t_new
         g_new = 0.0
+        screened = False
         if use_event:
             g_new = event(t_new, y_new, p)
-            need_dense = True
+            screened = _may_cross(event, t, y, f, y_new, f_new, h, g_old, g_new, event_dir, p,
+                                  ydense)  # fmt: skip
+            need_dense = need_dense or screened
         if need_dense:
             _dense_coefficients(rhs, t, y, f, y_new, f_new, h, A, C, D, n_stages, K, p, ytmp, Fd)
             nfev += 3
             t_cut = t_new  # outputs up to here belong to this step's trajectory
             acting = False
-            if use_event:
+            if screened:
                 xa, ga = 0.0, g_old
                 for q in range(1, EVENT_SUBSTEPS + 1):
                     if n_ev >= max_events or acting:

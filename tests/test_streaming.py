@@ -1,0 +1,139 @@
+"""Records longer than memory: block-by-block statistics equal the whole-array ones, and analyze
+reads a long file in blocks (whole-record numbers, detailed analyses on an excerpt)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from scipy.signal import welch
+
+from recipdyn.analysis.streaming import RunningMoments, StreamingWelch
+from recipdyn.analysis.vibration import indicators
+from recipdyn.analyze import analyze_signal
+from recipdyn.cli import main
+from recipdyn.model.parameters import ParameterError
+
+
+def _signal(n, fs, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    x = 3.0 * np.sin(2 * np.pi * 50.0 * t) + 0.5 * rng.standard_normal(n) + 7.0
+    x[n // 2 :] += 40.0 * (rng.random(n - n // 2) < 1e-3)  # sparse spikes: kurtosis, crest
+    return x
+
+
+@pytest.mark.parametrize("block", [1000, 4097, 77_777, 10**6])
+def test_block_statistics_equal_the_whole_array(block):
+    """Any split into blocks (shorter or longer than a Welch segment) gives the whole array's
+    indicators and scipy's Welch PSD. The merges are exact in arithmetic, so the difference
+    is rounding: the central sums carry ~n eps relative error (n = 3e5: ~1e-10), the Welch
+    segments are the same numbers in another order (~1e-15)."""
+    fs, n = 5000.0, 300_001
+    x = _signal(n, fs)
+    rm, sw = RunningMoments(), StreamingWelch(fs, 8192)
+    for a in range(0, n, block):
+        rm.feed(x[a : a + block])
+        sw.feed(x[a : a + block])
+    want, got = indicators(x), rm.indicators()
+    assert got.keys() == want.keys()
+    for k in want:
+        assert got[k] == pytest.approx(want[k], rel=1e-9, abs=1e-12), k
+    f, p = welch(x, fs, nperseg=8192)
+    f2, p2 = sw.psd()
+    np.testing.assert_array_equal(f, f2)
+    np.testing.assert_allclose(p2, p, rtol=1e-12, atol=1e-14 * p.max())
+    assert sw.segments == (n - 8192) // 4096 + 1
+
+
+def test_welch_amplitude_and_band_rms_closed_forms():
+    """A sinusoid of amplitude 3 at 50 Hz, centred on a bin: the amplitude spectrum peaks at 3
+    (Hann on a bin centre) and the velocity RMS in 2-1000 Hz is 3 / (2 pi 50) / sqrt 2 (the
+    Hann main lobe spans +-2 bins of 1 Hz, over which 1/f^2 changes by +-8 %; the lobe is
+    symmetric, so the first order cancels and the second is ~(2/50)^2 / 2: below 1e-3)."""
+    fs, nper = 8192.0, 8192
+    f0 = 50 * fs / nper  # bin 50: 50 Hz
+    t = np.arange(40 * nper) / fs
+    sw = StreamingWelch(fs, nper)
+    sw.feed(3.0 * np.sin(2 * np.pi * f0 * t))
+    f, amp = sw.amplitude()
+    assert f[np.argmax(amp)] == pytest.approx(f0)
+    assert amp.max() == pytest.approx(3.0, rel=1e-6)
+    assert sw.band_rms((2.0, 1000.0), integrate=1) == pytest.approx(
+        3.0 / (2 * np.pi * f0) / np.sqrt(2), rel=1e-3
+    )
+    with pytest.raises(ValueError, match="shorter than one segment"):
+        StreamingWelch(fs, nper).psd()
+
+
+def test_analyze_a_long_record_in_blocks(tmp_path):
+    """A record twice the memory limit (NPY and CSV): read in blocks; the summary's whole-record
+    indicators equal those of the whole array (the spikes are in the second half, outside the
+    excerpt, so the excerpt's own kurtosis is ~1.5 and the whole record's is larger); the
+    spectrum peak is the 50 Hz line; the notes say what covers what; the sample count is the
+    record's."""
+    import pandas as pd
+
+    fs, n = 5000.0, 240_000
+    x = _signal(n, fs, seed=3)
+    np.save(tmp_path / "long.npy", x)
+    pd.DataFrame({"time": np.arange(n) / fs, "acc": x}).to_csv(tmp_path / "long.csv",
+                                                                 index=False)  # fmt: skip
+    want = indicators(x)
+    for name, kw in (("long.npy", dict(fs=fs)), ("long.csv", dict(column="acc"))):
+        out = tmp_path / f"an_{name}"
+        s = analyze_signal(tmp_path / name, out, max_memory_samples=120_000,
+                           excerpt_samples=50_000, **kw)  # fmt: skip
+        whole = s["vibration"]["whole_record"]
+        assert s["samples"] == n and whole["samples"] == n
+        assert s["vibration"]["excerpt_samples"] == 50_000
+        for k in want:
+            assert whole["indicators"][k] == pytest.approx(want[k], rel=1e-9), (name, k)
+        assert s["vibration"]["indicators"]["kurtosis"] < 2.0 < whole["indicators"]["kurtosis"]
+        assert any("long record" in note for note in s["notes"])
+        assert s["spectrum"]["peaks"][0]["frequency_hz"] == pytest.approx(50.0, abs=0.1)
+        assert "Whole record" in (out / "summary.md").read_text()
+        # a short record takes the in-memory path: no whole-record section
+    s = analyze_signal(tmp_path / "long.npy", tmp_path / "short", fs=fs)
+    assert "whole_record" not in s["vibration"]
+
+
+def test_long_record_bad_values_and_limits_exit_2(tmp_path, capsys):
+    """A NaN far beyond the excerpt is still found (every block is checked), with the sample
+    where it was found; a memory limit below 1000 names the option."""
+    fs, n = 5000.0, 30_000
+    x = _signal(n, fs)
+    x[25_000] = np.nan
+    p = tmp_path / "bad.npy"
+    np.save(p, x)
+    code = main(["analyze", str(p), "--fs", "5kHz", "--max-memory-samples", "10000",
+                 "-o", str(tmp_path / "o")])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "non-finite" in err and "Traceback" not in err
+    with pytest.raises(ParameterError, match="max_memory_samples"):
+        analyze_signal(p, tmp_path / "o2", fs=fs, max_memory_samples=10)
+
+
+def test_long_record_with_a_tacho_reads_only_the_excerpt_of_it(tmp_path, capsys):
+    """CLI on a long CSV with a tacho column: the orders and impacts come from the excerpt
+    (its own tacho pulses), one impact per revolution, exit 0."""
+    import pandas as pd
+
+    fs = 10_000.0
+    t = np.arange(int(12 * fs)) / fs
+    revs = 10.0 * t
+    acc = 3.0 * np.sin(2 * np.pi * revs)
+    tau = ((revs - 0.25) % 1.0) / 10.0
+    acc += 20.0 * np.exp(-tau / 4e-4) * np.sin(2 * np.pi * 2000 * tau) * (revs >= 0.25)
+    p = tmp_path / "m.csv"
+    pd.DataFrame({"time": t, "acc": acc, "key": 5.0 * ((revs % 1.0) < 0.05)}).to_csv(
+        p, index=False)  # fmt: skip
+    out = tmp_path / "an"
+    code = main(["analyze", str(p), "-c", "acc", "--tacho", "key", "--max-memory-samples",
+                 "60000", "-o", str(out)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    s = json.loads((out / "summary.json").read_text())
+    assert s["samples"] == t.size and s["vibration"]["excerpt_samples"] == 60_000
+    assert s["vibration"]["impacts"]["per_revolution"] == pytest.approx(1.0, abs=0.15)
+    assert s["vibration"]["whole_record"]["samples"] == t.size
