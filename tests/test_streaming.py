@@ -137,3 +137,62 @@ def test_long_record_with_a_tacho_reads_only_the_excerpt_of_it(tmp_path, capsys)
     assert s["samples"] == t.size and s["vibration"]["excerpt_samples"] == 60_000
     assert s["vibration"]["impacts"]["per_revolution"] == pytest.approx(1.0, abs=0.15)
     assert s["vibration"]["whole_record"]["samples"] == t.size
+
+
+@pytest.mark.parametrize("block", [997, 2500, 10**6])
+def test_tacho_edges_block_by_block_equal_the_whole_channel(block):
+    """Pulse edges found block by block (blocks of 997 samples cut through pulses and edges)
+    equal tacho_times on the whole channel with the same threshold (to rounding: the same
+    interpolation between the same samples). The default threshold comes from the first
+    block's percentiles, which the 0.01 V ripple shifts by < 0.02 V from the whole channel's;
+    at an edge of 5 V per sample that moves an edge by < 0.02 / 5 / fs = 8e-7 s."""
+    from recipdyn.analysis.streaming import TachoEdges
+    from recipdyn.analysis.vibration import tacho_times
+
+    fs = 5000.0
+    revs = 11.3 * np.arange(30_000) / fs + 0.37
+    key = 5.0 * ((revs % 1.0) < 0.1) + 0.01 * np.sin(np.arange(revs.size))
+    te = TachoEdges(fs)
+    for a in range(0, key.size, block):
+        te.feed(key[a : a + block])
+    want = tacho_times(key, fs)
+    assert want.size == int(revs[-1]) - int(revs[0])
+    np.testing.assert_allclose(te.times(), want, rtol=0, atol=1e-6)
+    same = tacho_times(key, fs, threshold=te.threshold)
+    np.testing.assert_allclose(te.times(), same, rtol=0, atol=1e-12)
+
+
+def test_features_windows_with_a_tacho_are_read_block_by_block(tmp_path, monkeypatch):
+    """features --window with --tacho streams both columns (blocks of 1000 samples, windows of
+    730): each row equals the features of the same window of the whole signal with the crank
+    angle from tacho_times + crank_angle on the whole tacho column (to 1e-9: the same PCHIP
+    through the same pulses); the speed is the tacho's."""
+    import pandas as pd
+
+    import recipdyn.io_signal as io_signal
+    from recipdyn.analysis.vibration import crank_angle, tacho_times
+    from recipdyn.features import file_features, signal_features
+
+    fs = 2000.0
+    n = 8000
+    revs_true = 11.3 * np.arange(n) / fs + 0.37
+    x = np.sin(2 * np.pi * revs_true) + 0.3 * np.sin(6 * np.pi * revs_true)
+    key = 5.0 * ((revs_true % 1.0) < 0.1)
+    p = tmp_path / "m.csv"
+    pd.DataFrame({"time": np.arange(n) / fs, "acc": x, "key": key}).to_csv(p, index=False)
+    orig = io_signal.signal_blocks
+    monkeypatch.setattr(io_signal, "signal_blocks",
+                        lambda *a, **k: orig(*a, **{**k, "block": 1000}))  # fmt: skip
+    rows = file_features(p, column="acc", window="0.365 s", tacho="key")
+    revs = crank_angle(n, fs, pulses=tacho_times(key, fs))
+    assert len(rows) == n // 730
+    for i, r in enumerate(rows):
+        a, b = i * 730, (i + 1) * 730
+        ref = signal_features(x[a:b], fs, revs=revs[a:b])
+        # a square pulse's edge is located to within a sample (1/fs = 0.5 ms) over ~1.3 s
+        # between the first and the last pulse: the mean speed to ~4e-4
+        assert r["speed_hz"] == pytest.approx(11.3, rel=5e-4)
+        for k in ("rms", "order_1", "order_3"):
+            if np.isfinite(ref[k]):
+                assert r[k] == pytest.approx(ref[k], rel=1e-9, abs=1e-12), (k, i)
+    assert np.isfinite(rows[3]["order_1"]) and rows[3]["order_1"] == pytest.approx(1.0, rel=0.02)

@@ -143,8 +143,8 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         f_rev = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
         name = vib
     else:
-        if window and tacho is None:  # window by window: files longer than memory are fine
-            return _streamed_rows(path, column, fs, window, speed, chaos, progress)
+        if window:  # window by window: files longer than memory are fine
+            return _streamed_rows(path, column, fs, window, speed, chaos, progress, tacho)
         sig = read_signal(path, column=column, fs=fs)
         x, rate, name = sig.x, sig.fs, sig.name
         f_rev = None
@@ -169,14 +169,57 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
     return rows
 
 
-def _streamed_rows(path, column, fs, window, speed, chaos, progress) -> list[dict[str, Any]]:
+def _tacho_pulses(path, tacho, fs, progress) -> np.ndarray:
+    """Pulse times of the ``tacho`` column of a file, read block by block."""
+    from .analysis.streaming import TachoEdges
+    from .io_signal import signal_blocks
+
+    rate, _, total, blocks = signal_blocks(path, column=tacho, fs=fs)
+    edges = TachoEdges(rate)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=total, unit="sample", desc=f"tacho {path.name}", leave=False)
+    try:
+        for block in blocks:
+            if not np.all(np.isfinite(block)):
+                raise ParameterError(f"tacho {tacho!r}: missing or non-finite values; fill or "
+                                     "cut them first")  # fmt: skip
+            edges.feed(block)
+            if bar is not None:
+                bar.update(block.size)
+    except ValueError as exc:
+        raise ParameterError(f"tacho {tacho!r}: {exc}") from None
+    finally:
+        if bar is not None:
+            bar.close()
+    pulses = edges.times()
+    if pulses.size < 3:
+        raise ParameterError(f"tacho {tacho!r}: {pulses.size} pulses; at least 3 needed")
+    return pulses
+
+
+def _streamed_rows(path, column, fs, window, speed, chaos, progress,
+                   tacho=None) -> list[dict[str, Any]]:  # fmt: skip
     """Feature rows of consecutive windows of a signal file read block by block (memory: a
-    block of 10^6 samples and one window, whatever the file's length)."""
+    block of 10^6 samples and one window, whatever the file's length). With a ``tacho``
+    column, its pulses are found in a first pass (block by block; a few numbers per
+    revolution are kept) and each window's crank angle interpolated from them (PCHIP, as
+    :func:`~recipdyn.analysis.vibration.crank_angle`: NaN outside the pulses)."""
     from .analysis.vibration import crank_angle
     from .io_signal import signal_blocks, speed_hz
 
     rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
     f_rev = speed_hz(speed)
+    angle = None
+    if tacho is not None:
+        from scipy.interpolate import PchipInterpolator
+
+        pulses = _tacho_pulses(path, tacho, fs if fs is not None else rate, progress)
+        angle = PchipInterpolator(pulses, np.arange(pulses.size, dtype=float),
+                                  extrapolate=False)  # fmt: skip
+        f_rev = (pulses.size - 1) / (pulses[-1] - pulses[0])
     m = _window_samples(window, rate, 1.0 / f_rev if f_rev else None)
     if total is not None and m > total:
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
@@ -198,7 +241,9 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress) -> list[dic
             while buf.size >= m:
                 w, buf = buf[:m], buf[m:]
                 revs = None
-                if f_rev:
+                if angle is not None:
+                    revs = angle((start + np.arange(m)) / rate)
+                elif f_rev:
                     revs = crank_angle(m, rate, speed_hz=f_rev, zero_rev=start / rate * f_rev)
                 row = {"file": path.name, "signal": name, "window_start_s": start / rate,
                        "window_s": m / rate, "fs_hz": rate,

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import get_window, welch
 
-__all__ = ["RunningMoments", "StreamingWelch"]
+__all__ = ["RunningMoments", "StreamingWelch", "TachoEdges"]
 
 
 @dataclass
@@ -131,3 +131,51 @@ class StreamingWelch:
         keep = (f >= band[0]) & (f <= band[1]) & (f > 0)
         df = self.fs / self.nperseg
         return float(np.sqrt(np.sum(p[keep] / (2 * np.pi * f[keep]) ** (2 * integrate)) * df))
+
+
+class TachoEdges:
+    """Rising edges of a once-per-revolution pulse channel fed block by block: the rule of
+    :func:`recipdyn.analysis.vibration.tacho_times` (threshold halfway between the 5th and
+    95th percentiles, or the minimum and maximum for narrow pulses; an edge re-arms after a
+    fall ``hysteresis`` of the span below the threshold), with the levels taken from the first
+    block (which must hold a few revolutions) and the re-arm state carried across blocks, so
+    an edge on a block boundary counts once."""
+
+    def __init__(self, fs: float, *, hysteresis: float = 0.1) -> None:
+        self.fs, self.hysteresis = float(fs), float(hysteresis)
+        self.threshold: float | None = None
+        self._rearm = 0.0
+        self._armed = True
+        self._last = math.nan
+        self._offset = 0  # index of the block's first sample in the record
+        self._edges: list[float] = []
+
+    def feed(self, block) -> None:
+        v = np.asarray(block, dtype=float).ravel()
+        if v.size == 0:
+            return
+        if self.threshold is None:
+            lo, hi = np.percentile(v, [5, 95])
+            if hi <= lo:
+                lo, hi = float(np.min(v)), float(np.max(v))
+            if hi <= lo:
+                raise ValueError("tacho channel is flat in its first block: no pulses")
+            self.threshold = 0.5 * (lo + hi)
+            self._rearm = self.threshold - self.hysteresis * (hi - lo)
+        w = np.r_[self._last, v]  # the previous block's last sample: edges across the seam
+        thr, rearm = self.threshold, self._rearm
+        ups = np.flatnonzero((w[1:] >= thr) & (w[:-1] < thr)) + 1
+        downs = np.flatnonzero((w[1:] < rearm) & (w[:-1] >= rearm)) + 1
+        for i, is_up in sorted([(int(u), True) for u in ups] + [(int(d), False) for d in downs]):
+            if not is_up:
+                self._armed = True
+            elif self._armed:
+                frac = (thr - w[i - 1]) / (w[i] - w[i - 1])
+                self._edges.append((self._offset + i - 2 + frac) / self.fs)
+                self._armed = False
+        self._last = float(v[-1])
+        self._offset += v.size
+
+    def times(self) -> np.ndarray:
+        """Edge times (s from the record's first sample)."""
+        return np.array(self._edges)
