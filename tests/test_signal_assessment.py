@@ -225,3 +225,72 @@ def test_embedding_choice():
     assert e.dim == 3 and 8 <= e.delay <= 25 and e.status == "ok"
     e = choose_embedding(signal("white")[0])
     assert e.status == "not_saturated" and e.delay == 1
+
+
+def test_noise_level_from_fourth_differences():
+    """White noise of sigma 0.01 on an oversampled two-tone signal (100 samples a period): the
+    estimate is within 5 % (MAD of 40 000 correlated 4th differences: ~1 % standard error);
+    one impact spike per 1000 samples moves it by < 5 % (the median ignores them)."""
+    from recipdyn.analysis.signal import noise_level
+
+    rng = np.random.default_rng(5)
+    t = np.arange(40_000) / 2000.0
+    x = np.sin(2 * np.pi * 20 * t) + 0.3 * np.sin(2 * np.pi * 3 * t)
+    noisy = x + 0.01 * rng.standard_normal(t.size)
+    assert noise_level(noisy) == pytest.approx(0.01, rel=0.05)
+    spiky = noisy.copy()
+    spiky[::1000] += 5.0
+    assert noise_level(spiky) == pytest.approx(noise_level(noisy), rel=0.05)
+    assert noise_level(x) < 1e-4  # the smooth part alone: (2 pi 20 / 2000)^4 ~ 1e-5
+
+
+def test_count_distinct_points_tells_a_noise_cloud_from_a_chain():
+    """200 points on a circle, spaced 0.031 apart: at tolerance 0.05 they chain into one group,
+    which max_extent counts as 200 points; 200 points of a Gaussian cloud (sigma 0.01) stay one
+    point at tolerance 0.04 and extent 0.12 (their span is ~6.5 sigma = 0.065)."""
+    from recipdyn.analysis.poincare import count_distinct_points
+
+    a = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    ring = np.c_[np.cos(a), np.sin(a)]
+    one = np.ones(2)
+    assert count_distinct_points(ring, rtol=0.05, scale=one) == 1
+    assert count_distinct_points(ring, rtol=0.05, scale=one, max_extent=0.15) == 200
+    cloud = 0.5 + 0.01 * np.random.default_rng(1).standard_normal((200, 2))
+    assert count_distinct_points(cloud, rtol=0.04, scale=one, max_extent=0.12) == 1
+
+
+@pytest.mark.parametrize("noise", [0.003, 0.01])
+def test_noisy_periodic_machine_signal_is_periodic(noise):
+    """A periodic signal once per revolution (orders 1 and 3, crank angle known) with
+    measurement noise of 0.3 % and 1 % of its amplitude: the section tolerance follows the
+    noise estimate, the section is one point, the verdict periodic. With the fixed tolerance of
+    1e-3 the same signals gave 70 and 98 distinct points and the verdicts 'undetermined' and
+    'quasi-periodic'. A quasi-periodic signal with the same noise stays many points and is not
+    called periodic."""
+    fs, n = 2000.0, 40_000
+    t = np.arange(n) / fs
+    revs = 5.0 * t
+    rng = np.random.default_rng(0)
+    x = np.sin(2 * np.pi * revs) + 0.4 * np.sin(6 * np.pi * revs + 0.3)
+    a = assess_signal(x + noise * rng.standard_normal(n), fs, revs=revs)
+    assert a.verdict.evidence["section_distinct"] == 1
+    assert a.verdict.verdict == "periodic", a.verdict.reasons
+    assert a.verdict.evidence["section_tolerance"] == pytest.approx(4 * noise / 1.057, rel=0.1)
+    q = np.sin(2 * np.pi * revs) + 0.5 * np.sin(2 * np.pi * np.sqrt(2) * revs)
+    b = assess_signal(q + noise * rng.standard_normal(n), fs, revs=revs)
+    assert b.verdict.evidence["section_distinct"] > 16
+    assert b.verdict.verdict != "periodic"
+
+
+def test_section_blurred_by_noise_is_left_out():
+    """Noise of 5 % of the amplitude blurs the once-per-revolution points by 4 sigma = 19 % of
+    the section's scale: beyond 5 % the section resolves nothing and is left out of the
+    verdict, with a note (it would otherwise count one point for any motion)."""
+    fs, n = 2000.0, 40_000
+    t = np.arange(n) / fs
+    revs = 5.0 * t
+    q = np.sin(2 * np.pi * revs) + 0.5 * np.sin(2 * np.pi * np.sqrt(2) * revs)
+    a = assess_signal(q + 0.05 * np.random.default_rng(2).standard_normal(n), fs, revs=revs)
+    assert "section_distinct" not in a.verdict.evidence
+    assert any("section left out" in note for note in a.notes)
+    assert a.verdict.verdict != "periodic"

@@ -108,13 +108,16 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
              section=None, spectrum: Spectrum | None = None, lyap_tol: float = LYAP_TOL,
              max_periodic_points: int = MAX_PERIODIC_POINTS, determinism=None,
              signal_lyapunov=None, time_scale: float = 1.0, signal_tol: float = LYAP_TOL,
-             section_rtol: float = 1e-6) -> Verdict:  # fmt: skip
+             section_rtol: float = 1e-6,
+             section_extent: float | None = None, section_scale=None) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
     :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
     (``signal_lyapunov``: :class:`~recipdyn.analysis.lyapunov_signal.SignalLyapunov` list).
     ``lyap_tol`` is in the exponent's units; ``section_rtol`` the relative distance under
-    which section points are one (1e-6 for an integration; larger for measured signals)."""
+    which section points are one (1e-6 for an integration; larger for measured signals),
+    ``section_extent`` the widest group that still counts as one point and ``section_scale``
+    the scale of both (:func:`~recipdyn.analysis.poincare.count_distinct_points`)."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
     deterministic = None
@@ -153,7 +156,8 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     n_distinct = None
     if section is not None:
         pts = np.atleast_2d(np.asarray(section, dtype=float))
-        n_distinct = count_distinct_points(pts, rtol=section_rtol)
+        n_distinct = count_distinct_points(pts, rtol=section_rtol, scale=section_scale,
+                                           max_extent=section_extent)  # fmt: skip
         ev["section_points"] = int(pts.shape[0])
         ev["section_distinct"] = int(n_distinct)
     if spectrum is not None:

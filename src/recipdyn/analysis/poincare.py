@@ -145,12 +145,18 @@ def hyperplane_section(
     return _dataset(system, sol.t_events, sol.y_events, outputs, attrs)
 
 
-def count_distinct_points(points, rtol: float = 1e-6, scale=None) -> int:
+def count_distinct_points(points, rtol: float = 1e-6, scale=None,
+                          max_extent: float | None = None) -> int:  # fmt: skip
     """Number of distinct points in a section: points closer than ``rtol * scale`` (per axis,
     default scale = the largest magnitude on that axis) are the same point.
 
     A period-n orbit gives n; quasi-periodic and chaotic motion give (nearly) as many as there
     are points. KD-tree pairs + connected components (scipy).
+
+    ``max_extent`` (in the same scaled units as ``rtol``): a group whose bounding box is wider
+    than this on some axis is not one point but a chain of neighbours along a curve (a
+    quasi-periodic or chaotic section with a tolerance near its point spacing), and counts as
+    its number of points. A noisy periodic point is a compact cloud and stays one.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -163,6 +169,15 @@ def count_distinct_points(points, rtol: float = 1e-6, scale=None) -> int:
     if scale is None:
         scale = np.max(np.abs(pts), axis=0)
     scale = np.where(np.asarray(scale, dtype=float) > 0, scale, 1.0)
-    pairs = cKDTree(pts / scale).query_pairs(rtol, p=np.inf, output_type="ndarray")
+    z = pts / scale
+    pairs = cKDTree(z).query_pairs(rtol, p=np.inf, output_type="ndarray")
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    return int(connected_components(graph, directed=False)[0])
+    n_groups, label = connected_components(graph, directed=False)
+    if max_extent is None:
+        return int(n_groups)
+    count = 0
+    for g in range(n_groups):
+        member = z[label == g]
+        wide = np.max(np.ptp(member, axis=0)) > max_extent
+        count += member.shape[0] if wide else 1
+    return int(count)

@@ -66,6 +66,21 @@ class SignalAssessment:
         return rows
 
 
+#: Largest section tolerance (relative to its scale) at which the section is still evidence.
+MAX_SECTION_RTOL = 0.05
+
+
+def noise_level(x) -> float:
+    """Standard deviation of white measurement noise on ``x``, from its 4th differences:
+    ``1.4826 MAD(diff4) / sqrt(70)`` (a 4th difference of white noise has variance
+    ``C(8, 4) sigma^2 = 70 sigma^2``; the median makes it blind to sparse impacts). A smooth
+    signal sampled at ``fs`` adds ``(2 pi f / fs)^4`` of its amplitude at frequency ``f``
+    (1e-6 at 20 samples a period): the estimate is the noise for an oversampled signal, and
+    too high for content near the Nyquist frequency."""
+    d = np.diff(np.asarray(x, dtype=float), 4)
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(70.0))
+
+
 def _once_per_revolution(x, revs) -> np.ndarray:
     """(x at angle 0, x 0.382 turn later) at every whole revolution covered (the second angle
     an irrational fraction of a turn, unlikely to sit on an impact)."""
@@ -124,11 +139,32 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
         sur = surrogate_test(head, dim=emb.dim, delay=emb.delay, seed=seed)
     spec = amplitude_spectrum(x, fs)
     # a section from a measured signal repeats only to the accuracy of the crank angle (tacho
-    # edges to a fraction of a sample): points within 1e-3 of the range are one
+    # edges to a fraction of a sample) and of the measurement noise: points within 1e-3 of
+    # the scale, or within 4 noise deviations, are one, if the group stays compact (a noisy
+    # point's cloud of N points spans ~2 sqrt(2 ln N) sigma: 6.5 sigma for 200; a chain along
+    # a chaotic or quasi-periodic section is wider than 3 tolerances and is not one point)
+    # (a tolerance above MAX_SECTION_RTOL of the scale resolves no structure: the section is
+    # then left out of the evidence, with a note)
+    rtol, extent, scale = 1e-6, None, None
+    if revs is not None and section is not None:
+        sigma = noise_level(x)
+        scale = float(np.max(np.abs(section))) or 1.0  # one scale for both axes (one signal)
+        rtol = max(1e-3, 4.0 * sigma / scale)
+        extent = 3.0 * rtol
+        if rtol > MAX_SECTION_RTOL:
+            notes.append(f"section left out of the verdict: the noise (estimate {sigma:.3g} "
+                         f"from the 4th differences) blurs its points by {rtol:.2g} of its "
+                         f"scale (resolvable up to {MAX_SECTION_RTOL:g})")  # fmt: skip
+            section, extent = None, None
+        else:
+            notes.append(f"section tolerance {rtol:.3g} of the scale (noise estimate "
+                         f"{sigma:.3g} from the 4th differences)")  # fmt: skip
     verdict = classify(k01=z01.K if z01.status == "ok" else None, spectrum=spec,
                        section=section, determinism=sur, signal_lyapunov=list(lyap.values()),
-                       time_scale=emb.delay * dt,
-                       section_rtol=1e-3 if revs is not None else 1e-6)  # fmt: skip
+                       time_scale=emb.delay * dt, section_rtol=rtol,
+                       section_extent=extent, section_scale=scale)  # fmt: skip
+    if extent is not None:
+        verdict.evidence["section_tolerance"] = rtol
     verdict.evidence["embedding_delay"] = emb.delay
     verdict.evidence["embedding_dim"] = emb.dim
     return SignalAssessment(verdict, emb, lyap, z01, sur, float(fs), int(x.size), notes)
