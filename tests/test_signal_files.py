@@ -55,6 +55,14 @@ def test_every_format_gives_the_same_samples_and_rate(tmp_path, henon_x):
         assert s.fs == pytest.approx(FS, rel=1e-9), kind
     assert read_signal(paths["wav"], column=1).x[5] == pytest.approx(-henon_x[5], rel=1e-6)
     assert read_signal(paths["csv"], column=1).name == "other"  # index among the data columns
+    for kind, p in paths.items():  # the first rows only: the same samples, name and rate (a
+        # rate from a time column: from the first 300 times, equal to rounding)
+        kw = {"column": "acc"} if kind in ("csv", "mat", "nc", "parquet") else {}
+        if kind == "npy":
+            kw["fs"] = "2 kHz"
+        whole, head = read_signal(p, **kw), read_signal(p, rows=300, **kw)
+        assert head.x.size == 300 and np.array_equal(head.x, whole.x[:300]), kind
+        assert head.name == whole.name and head.fs == pytest.approx(whole.fs, rel=1e-9), kind
 
 
 @pytest.mark.parametrize("kw, word", [

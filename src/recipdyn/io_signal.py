@@ -106,8 +106,12 @@ def _table(frame, path, column, fs):
     return frame[name].to_numpy(dtype=float), fs, str(name), notes
 
 
-def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
-    """Read one channel of ``path``.
+def read_signal(
+    path: str | Path, *, column=None, fs=None, rows: int | None = None
+) -> MeasuredSignal:
+    """Read one channel of ``path`` (its first ``rows`` samples only, if given: CSV/TSV/TXT
+    parse only those lines, Parquet its first batch, WAV and NPY are memory-mapped, NetCDF
+    sliced lazily; MAT files are read whole and cut).
 
     ``column``: column name or index (CSV, Parquet), variable name (MAT, NetCDF), channel
     index (WAV). ``fs``: sampling rate (number in Hz or text with units); needed unless the
@@ -133,20 +137,26 @@ def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
             import pandas as pd
 
             sep = _csv_sep(suffix)
-            frame = pd.read_csv(path, sep=sep, engine="python", comment="#")
+            frame = pd.read_csv(path, sep=sep, engine="python", comment="#", nrows=rows)
             x, fs, name, notes = _table(frame, path, column, fs)
         elif suffix == ".parquet":
             import pandas as pd
 
-            x, fs, name, notes = _table(pd.read_parquet(path), path, column, fs)
+            if rows is None:
+                frame = pd.read_parquet(path)
+            else:
+                import pyarrow.parquet as pq
+
+                frame = next(pq.ParquetFile(path).iter_batches(batch_size=rows)).to_pandas()
+            x, fs, name, notes = _table(frame, path, column, fs)
         elif suffix == ".wav":
             from scipy.io import wavfile
 
-            rate, data = wavfile.read(path)
+            rate, data = wavfile.read(path, mmap=rows is not None)
             data = data.reshape(len(data), -1)
             ch = _pick(list(range(data.shape[1])), 0 if column is None else column, path,
                        "channel")  # fmt: skip
-            x, name = data[:, ch].astype(float), f"channel {ch}"
+            x, name = np.asarray(data[:rows, ch], dtype=float), f"channel {ch}"
             if np.issubdtype(data.dtype, np.integer):
                 notes.append(f"integer samples ({data.dtype}), not scaled to physical units")
             if fs is None:
@@ -162,7 +172,7 @@ def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
                       and np.issubdtype(v.dtype, np.number)]  # fmt: skip
             tvar = next((k for k in arrays if k.lower() in TIME_NAMES), None)
             name = _pick([k for k in arrays if k != tvar], column, path, "variable")
-            x = np.asarray(mat[name], dtype=float)
+            x = np.asarray(mat[name], dtype=float)[:rows]
             if fs is None and fs_var is not None:
                 fs = float(mat[fs_var])
                 notes.append(f"sampling rate {fs:g} Hz from variable {fs_var!r}")
@@ -170,21 +180,30 @@ def read_signal(path: str | Path, *, column=None, fs=None) -> MeasuredSignal:
                 fs = _fs_from_time(mat[tvar], path, tvar)
                 notes.append(f"sampling rate {fs:.6g} Hz from variable {tvar!r}")
         elif suffix == ".nc":
+            import contextlib
+
+            import xarray as xr
+
             from .io import read_dataset
 
-            ds = read_dataset(path, expected="a NetCDF file with a 1-D signal")
-            names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
-            name = _pick(names, column, path, "variable")
-            da = ds[name]
-            x, units = np.asarray(da.values, dtype=float), str(da.attrs.get("units", ""))
-            if fs is None and da.dims[0] in ds.coords:
-                fs = _fs_from_time(ds[da.dims[0]].values, path, da.dims[0])
-                notes.append(f"sampling rate {fs:.6g} Hz from coordinate {da.dims[0]!r}")
+            with contextlib.ExitStack() as stack:
+                if rows is None:
+                    ds = read_dataset(path, expected="a NetCDF file with a 1-D signal")
+                else:  # lazily: only the first rows are read from disk
+                    ds = stack.enter_context(xr.open_dataset(path))
+                names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
+                name = _pick(names, column, path, "variable")
+                da = ds[name]
+                x = np.asarray(da[:rows].values, dtype=float)
+                units = str(da.attrs.get("units", ""))
+                if fs is None and da.dims[0] in ds.coords:
+                    fs = _fs_from_time(ds[da.dims[0]][:rows].values, path, da.dims[0])
+                    notes.append(f"sampling rate {fs:.6g} Hz from coordinate {da.dims[0]!r}")
         else:  # .npy: a plain array, one channel per column
-            data = np.load(path, allow_pickle=False)
+            data = np.load(path, allow_pickle=False, mmap_mode="r" if rows else None)
             data = data.reshape(len(data), -1)
             ch = _pick(list(range(data.shape[1])), 0 if data.shape[1] == 1 else column, path)
-            x, name = data[:, ch].astype(float), f"column {ch}"
+            x, name = np.asarray(data[:rows, ch], dtype=float), f"column {ch}"
     except ParameterError:
         raise
     except Exception as exc:  # parsers raise assorted errors on malformed files
@@ -277,62 +296,9 @@ def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_
 
 
 def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000):
-    """The channel name and sampling rate of a file, from its first ``rows`` rows where the
-    format allows it (a whole read otherwise)."""
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix in (".csv", ".txt", ".tsv") and path.is_file() and path.stat().st_size > 0:
-        import pandas as pd
-
-        sep = _csv_sep(suffix)
-        try:
-            frame = pd.read_csv(path, sep=sep, engine="python", comment="#", nrows=rows)
-        except Exception as exc:
-            raise ParameterError(f"input {path}: cannot be read as {suffix[1:].upper()} "
-                                 f"({type(exc).__name__}: {exc})") from None  # fmt: skip
-        x, rate, name, notes = _table(frame, path, column, _fs_option(fs))
-        return MeasuredSignal(x, rate, name, path.name, "", notes)
-    if suffix == ".parquet" and path.is_file():
-        import pyarrow.parquet as pq
-
-        first = next(pq.ParquetFile(path).iter_batches(batch_size=rows)).to_pandas()
-        x, rate, name, notes = _table(first, path, column, _fs_option(fs))
-        return MeasuredSignal(x, rate, name, path.name, "", notes)
-    if suffix in (".wav", ".npy") and path.is_file():
-        given = _fs_option(fs)
-        if suffix == ".wav":
-            from scipy.io import wavfile
-
-            rate, data = wavfile.read(path, mmap=True)
-            data = data.reshape(len(data), -1)
-            ch = _pick(list(range(data.shape[1])), 0 if column is None else column, path,
-                       "channel")  # fmt: skip
-            return MeasuredSignal(np.asarray(data[:rows, ch], dtype=float),
-                                  given or float(rate), f"channel {ch}", path.name)  # fmt: skip
-        data = np.load(path, mmap_mode="r")
-        data = data.reshape(len(data), -1)
-        ch = _pick(list(range(data.shape[1])), 0 if data.shape[1] == 1 else column, path)
-        if given is None:
-            raise ParameterError(f"{path}: the file does not give a sampling rate; pass --fs "
-                                 "(e.g. --fs 10kHz)")  # fmt: skip
-        return MeasuredSignal(np.asarray(data[:rows, ch], dtype=float), given, f"column {ch}",
-                              path.name)  # fmt: skip
-    if suffix == ".nc" and path.is_file():
-        import xarray as xr
-
-        with xr.open_dataset(path) as ds:
-            names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
-            name = _pick(names, column, path, "variable")
-            da = ds[name]
-            rate = _fs_option(fs)
-            if rate is None and da.dims[0] in ds.coords:
-                rate = _fs_from_time(ds[da.dims[0]].values[:rows], path, da.dims[0])
-            if rate is None:
-                raise ParameterError(f"{path}: the file does not give a sampling rate; pass "
-                                     "--fs (e.g. --fs 10kHz)")  # fmt: skip
-            return MeasuredSignal(np.asarray(da[:rows].values, dtype=float), rate, name,
-                                  path.name)  # fmt: skip
-    return read_signal(path, column=column, fs=fs)
+    """The first ``rows`` samples of a channel, with its name and sampling rate
+    (:func:`read_signal` with ``rows``)."""
+    return read_signal(path, column=column, fs=fs, rows=rows)
 
 
 def record_length(path: str | Path, *, column=None) -> int | None:
