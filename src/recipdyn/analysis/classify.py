@@ -177,13 +177,17 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     if conflict:
         return Verdict("undetermined", ev, reasons)
     if all_refused and lambda1 is None:
-        if deterministic and k01 is not None and k01 > 0.8:
+        few = n_distinct is not None and n_distinct <= max_periodic_points
+        if deterministic and k01 is not None and k01 > 0.8 and not few:
             reasons.append(f"deterministic and 0-1 test K = {k01:.2f} > 0.8 (no exponent could "
                            "be estimated)")  # fmt: skip
             return Verdict("chaotic", ev, reasons)
-        if n_distinct is None or n_distinct > max_periodic_points:
+        if not few:
             reasons.append("no exponent could be estimated from the signal")
             return Verdict("undetermined", ev, reasons)
+        if k01 is not None and k01 > 0.5:  # the section is a few noisy points: K measures
+            reasons.append(f"0-1 test K = {k01:.2f} on a section of {n_distinct} point(s): "
+                           "the test sees the noise around them")  # fmt: skip
     if pos and (k01 is None or k01 > 0.5):
         reasons.append("largest Lyapunov exponent positive beyond its uncertainty")
         if k01 is not None:

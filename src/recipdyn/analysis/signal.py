@@ -140,7 +140,7 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
     spec = amplitude_spectrum(x, fs)
     # a section from a measured signal repeats only to the accuracy of the crank angle (tacho
     # edges to a fraction of a sample) and of the measurement noise: points within 1e-3 of
-    # the scale, or within 4 noise deviations, are one, if the group stays compact (a noisy
+    # the signal's range, or within 4 noise deviations, are one, if the group stays compact (a noisy
     # point's cloud of N points spans ~2 sqrt(2 ln N) sigma: 6.5 sigma for 200; a chain along
     # a chaotic or quasi-periodic section is wider than 3 tolerances and is not one point)
     # (a tolerance above MAX_SECTION_RTOL of the scale resolves no structure: the section is
@@ -148,16 +148,18 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
     rtol, extent, scale = 1e-6, None, None
     if revs is not None and section is not None:
         sigma = noise_level(x)
-        scale = float(np.max(np.abs(section))) or 1.0  # one scale for both axes (one signal)
+        # one scale for both axes, the signal's range (a section point near a zero crossing
+        # of the signal would make the section's own magnitude a poor scale)
+        scale = float(np.ptp(x)) or 1.0
         rtol = max(1e-3, 4.0 * sigma / scale)
         extent = 3.0 * rtol
         if rtol > MAX_SECTION_RTOL:
             notes.append(f"section left out of the verdict: the noise (estimate {sigma:.3g} "
-                         f"from the 4th differences) blurs its points by {rtol:.2g} of its "
-                         f"scale (resolvable up to {MAX_SECTION_RTOL:g})")  # fmt: skip
+                         f"from the 4th differences) blurs its points by {rtol:.2g} of the "
+                         f"signal's range (resolvable up to {MAX_SECTION_RTOL:g})")  # fmt: skip
             section, extent = None, None
         else:
-            notes.append(f"section tolerance {rtol:.3g} of the scale (noise estimate "
+            notes.append(f"section tolerance {rtol:.3g} of the signal's range (noise estimate "
                          f"{sigma:.3g} from the 4th differences)")  # fmt: skip
     verdict = classify(k01=z01.K if z01.status == "ok" else None, spectrum=spec,
                        section=section, determinism=sur, signal_lyapunov=list(lyap.values()),
