@@ -244,32 +244,19 @@ def _stream_record(path, column, fs, keep: int, progress: bool):
     from .analysis.streaming import RunningMoments, StreamingWelch
     from .io_signal import MeasuredSignal, signal_blocks
 
-    rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
+    rate, name, _, blocks = signal_blocks(
+        path, column=column, fs=fs, progress=f"analyze {path.name}" if progress else None
+    )
     moments = RunningMoments()
     welch = StreamingWelch(rate, WELCH_SEGMENT)
     kept: list[np.ndarray] = []
     n_kept = 0
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=total, unit="sample", desc=f"analyze {path.name}", leave=False)
-    try:
-        for block in blocks:
-            if not np.all(np.isfinite(block)):
-                raise ParameterError(f"{path}: column {name!r} has missing or non-finite "
-                                     f"values after sample {moments.n}; fill or cut them "
-                                     "first")  # fmt: skip
-            moments.feed(block)
-            welch.feed(block)
-            if n_kept < keep:
-                kept.append(block[: keep - n_kept].copy())
-                n_kept += kept[-1].size
-            if bar is not None:
-                bar.update(block.size)
-    finally:
-        if bar is not None:
-            bar.close()
+    for block in blocks:
+        moments.feed(block)
+        welch.feed(block)
+        if n_kept < keep:
+            kept.append(block[: keep - n_kept].copy())
+            n_kept += kept[-1].size
     x = np.concatenate(kept) if kept else np.empty(0)
     notes = [f"long record ({moments.n} samples): read in blocks; the overall statistics and "
              f"the spectrum (Welch, {welch.segments} Hann segments of {WELCH_SEGMENT}) cover "
@@ -309,10 +296,9 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
                         ("excerpt_samples", excerpt_samples)):  # fmt: skip
         if not int(value) >= 1000:
             raise ParameterError(f"{name} = {value!r}; allowed: >= 1000")
+    zone_bounds = parse_zones(zones)
     moments = welch = None
-    if not path.is_file():
-        sig = read_signal(path, column=column, fs=fs)  # says what is wrong with the path
-    n_est = record_length(path, column=column)
+    n_est = record_length(path, column=column)  # None for a bad path: read_signal says why
     if n_est is not None and n_est > max_memory_samples:
         with phase(f"analyze: reading {path.name} in blocks"):
             sig, moments, welch = _stream_record(path, column, fs,
@@ -358,11 +344,11 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
     revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
     with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
         vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
-                                zones=parse_zones(zones), band=band,
+                                zones=zone_bounds, band=band,
                                 title=f"{sig.source}: {sig.name}")  # fmt: skip
     if moments is not None:
         vib["excerpt_samples"] = int(x.size)
-        vib["whole_record"] = _whole_record(moments, welch, quantity, parse_zones(zones))
+        vib["whole_record"] = _whole_record(moments, welch, quantity, zone_bounds)
     with phase(f"analyze: exponents from the signal, 0-1 test, surrogates "
                f"({min(x.size, max_signal_samples)} samples)"):  # fmt: skip
         a = assess_signal(x, rate, max_samples=max_signal_samples, revs=revs)

@@ -174,26 +174,14 @@ def _tacho_pulses(path, tacho, fs, progress) -> np.ndarray:
     from .analysis.streaming import TachoEdges
     from .io_signal import signal_blocks
 
-    rate, _, total, blocks = signal_blocks(path, column=tacho, fs=fs)
+    label = f"tacho {path.name}" if progress else None
+    rate, _, _, blocks = signal_blocks(path, column=tacho, fs=fs, progress=label)
     edges = TachoEdges(rate)
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=total, unit="sample", desc=f"tacho {path.name}", leave=False)
-    try:
-        for block in blocks:
-            if not np.all(np.isfinite(block)):
-                raise ParameterError(f"tacho {tacho!r}: missing or non-finite values; fill or "
-                                     "cut them first")  # fmt: skip
+    for block in blocks:
+        try:
             edges.feed(block)
-            if bar is not None:
-                bar.update(block.size)
-    except ValueError as exc:
-        raise ParameterError(f"tacho {tacho!r}: {exc}") from None
-    finally:
-        if bar is not None:
-            bar.close()
+        except ValueError as exc:  # a flat first block
+            raise ParameterError(f"tacho {tacho!r}: {exc}") from None
     pulses = edges.times()
     if pulses.size < 3:
         raise ParameterError(f"tacho {tacho!r}: {pulses.size} pulses; at least 3 needed")
@@ -210,7 +198,9 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress,
     from .analysis.vibration import crank_angle
     from .io_signal import signal_blocks, speed_hz
 
-    rate, name, total, blocks = signal_blocks(path, column=column, fs=fs)
+    rate, name, total, blocks = signal_blocks(
+        path, column=column, fs=fs, progress=f"features {path.name}" if progress else None
+    )
     f_rev = speed_hz(speed)
     angle = None
     if tacho is not None:
@@ -224,36 +214,22 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress,
     if total is not None and m > total:
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
                              f"({total})")  # fmt: skip
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=total, unit="sample", desc=f"features {path.name}", leave=False)
     rows, buf, start = [], np.empty(0), 0
-    try:
-        for block in blocks:
-            if bar is not None:
-                bar.update(block.size)
-            if not np.all(np.isfinite(block)):
-                raise ParameterError(f"{path}: column {name!r} has missing or non-finite "
-                                     "values; fill or cut them first")  # fmt: skip
-            buf = np.concatenate([buf, block])
-            while buf.size >= m:
-                w, buf = buf[:m], buf[m:]
-                revs = None
-                if angle is not None:
-                    revs = angle((start + np.arange(m)) / rate)
-                elif f_rev:
-                    revs = crank_angle(m, rate, speed_hz=f_rev, zero_rev=start / rate * f_rev)
-                row = {"file": path.name, "signal": name, "window_start_s": start / rate,
-                       "window_s": m / rate, "fs_hz": rate,
-                       "speed_hz": f_rev if f_rev else math.nan}  # fmt: skip
-                row.update(signal_features(w, rate, revs=revs, chaos=chaos))
-                rows.append(row)
-                start += m
-    finally:
-        if bar is not None:
-            bar.close()
+    for block in blocks:
+        buf = np.concatenate([buf, block])
+        while buf.size >= m:
+            w, buf = buf[:m], buf[m:]
+            revs = None
+            if angle is not None:
+                revs = angle((start + np.arange(m)) / rate)
+            elif f_rev:
+                revs = crank_angle(m, rate, speed_hz=f_rev, zero_rev=start / rate * f_rev)
+            row = {"file": path.name, "signal": name, "window_start_s": start / rate,
+                   "window_s": m / rate, "fs_hz": rate,
+                   "speed_hz": f_rev if f_rev else math.nan}  # fmt: skip
+            row.update(signal_features(w, rate, revs=revs, chaos=chaos))
+            rows.append(row)
+            start += m
     if not rows:
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
                              f"({start + buf.size})")  # fmt: skip

@@ -219,16 +219,47 @@ def read_signal(
     return MeasuredSignal(x, float(fs), str(name), path.name, units, notes)
 
 
-def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_000):
+def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_000,
+                  progress: str | None = None):  # fmt: skip
     """``(fs, name, total_or_None, blocks)`` for a file too long to hold in memory: ``blocks``
     yields consecutive arrays of at most ``block`` samples of the chosen channel.
 
     CSV/TSV/TXT are read in chunks (pandas), Parquet by row groups (pyarrow), WAV and NPY
     memory-mapped, NetCDF lazily; MAT files are read whole (scipy cannot stream them). A
-    time column must stay uniform across chunks (checked chunk by chunk)."""
+    time column must stay uniform across chunks, and every block free of missing values
+    (both checked block by block, as :func:`read_signal` checks a whole file). ``progress``:
+    the label of a progress bar over the samples (none without)."""
     path = Path(path)
+    rate, name, total, raw = _raw_blocks(path, column, fs, block)
+    return rate, name, total, _checked(raw, path, name, total, progress)
+
+
+def _checked(blocks, path: Path, name: str, total, progress: str | None):
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=total, unit="sample", desc=progress, leave=False)
+    n = 0
+    try:
+        for b in blocks:
+            if not np.all(np.isfinite(b)):
+                raise ParameterError(
+                    f"{path}: column {name!r} has missing or non-finite "
+                    f"values after sample {n}; fill or cut them first"
+                )
+            n += b.size
+            if bar is not None:
+                bar.update(b.size)
+            yield b
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _raw_blocks(path: Path, column, fs, block: int):
     suffix = path.suffix.lower()
-    head = read_signal_head(path, column=column, fs=fs)
+    head = read_signal(path, column=column, fs=fs, rows=1000)
     name, rate = head.name, head.fs
     if suffix in (".csv", ".txt", ".tsv"):
         import pandas as pd
@@ -295,12 +326,6 @@ def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_
     return rate, name, int(x.size), iter([x[a : a + block] for a in range(0, x.size, block)])
 
 
-def read_signal_head(path: str | Path, *, column=None, fs=None, rows: int = 1000):
-    """The first ``rows`` samples of a channel, with its name and sampling rate
-    (:func:`read_signal` with ``rows``)."""
-    return read_signal(path, column=column, fs=fs, rows=rows)
-
-
 def record_length(path: str | Path, *, column=None) -> int | None:
     """The number of samples in ``path`` without reading its data: exact for Parquet, WAV,
     NPY and NetCDF (metadata, memory map, lazy array), estimated for text from the file size
@@ -357,14 +382,11 @@ def crank_revs(path: str | Path, n: int, fs: float, *, tacho=None, speed=None):
     from .analysis.vibration import crank_angle, tacho_times
 
     if tacho is not None:
-        pulse = read_signal_head(path, column=tacho, fs=fs, rows=n)
+        pulse = read_signal(path, column=tacho, fs=fs, rows=n)  # checks missing values
         if pulse.x.size < n:
             raise ParameterError(f"tacho {tacho!r}: {pulse.x.size} samples, the signal {n}")
-        if not np.all(np.isfinite(pulse.x)):
-            raise ParameterError(f"tacho {tacho!r}: missing or non-finite values; fill or cut "
-                                 "them first")  # fmt: skip
         try:
-            return crank_angle(n, fs, pulses=tacho_times(pulse.x[:n], fs))
+            return crank_angle(n, fs, pulses=tacho_times(pulse.x, fs))
         except ValueError as exc:
             raise ParameterError(f"tacho {tacho!r}: {exc}") from None
     f_rev = speed_hz(speed)

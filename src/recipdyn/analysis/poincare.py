@@ -175,9 +175,9 @@ def count_distinct_points(points, rtol: float = 1e-6, scale=None,
     n_groups, label = connected_components(graph, directed=False)
     if max_extent is None:
         return int(n_groups)
-    count = 0
-    for g in range(n_groups):
-        member = z[label == g]
-        wide = np.max(np.ptp(member, axis=0)) > max_extent
-        count += member.shape[0] if wide else 1
-    return int(count)
+    order = np.argsort(label, kind="stable")
+    starts = np.r_[0, np.flatnonzero(np.diff(label[order])) + 1]
+    zs = z[order]
+    span = np.maximum.reduceat(zs, starts) - np.minimum.reduceat(zs, starts)
+    size = np.diff(np.r_[starts, n])
+    return int(np.where(span.max(axis=1) > max_extent, size, 1).sum())

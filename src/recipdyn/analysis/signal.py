@@ -138,13 +138,12 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
     if surrogates:
         sur = surrogate_test(head, dim=emb.dim, delay=emb.delay, seed=seed)
     spec = amplitude_spectrum(x, fs)
-    # a section from a measured signal repeats only to the accuracy of the crank angle (tacho
-    # edges to a fraction of a sample) and of the measurement noise: points within 1e-3 of
-    # the signal's range, or within 4 noise deviations, are one, if the group stays compact (a noisy
-    # point's cloud of N points spans ~2 sqrt(2 ln N) sigma: 6.5 sigma for 200; a chain along
-    # a chaotic or quasi-periodic section is wider than 3 tolerances and is not one point)
-    # (a tolerance above MAX_SECTION_RTOL of the scale resolves no structure: the section is
-    # then left out of the evidence, with a note)
+    # A section from a measured signal repeats only to the accuracy of the crank angle (tacho
+    # edges to a fraction of a sample) and to the measurement noise: points within 1e-3 of the
+    # signal's range, or within 4 noise deviations, are one, if the group stays compact (a
+    # noisy point's cloud of N points spans ~2 sqrt(2 ln N) sigma: 6.5 sigma for 200; a chain
+    # along a chaotic or quasi-periodic section is wider than 3 tolerances). A tolerance above
+    # MAX_SECTION_RTOL resolves no structure: the section is then left out, with a note.
     rtol, extent, scale = 1e-6, None, None
     if revs is not None and section is not None:
         sigma = noise_level(x)

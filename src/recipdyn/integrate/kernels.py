@@ -68,6 +68,13 @@ def _dense_eval(x, y_old, F, out):
         out[j] += y_old[j]
 
 
+@nb.njit(cache=True, inline="always")
+def _crosses(ga, gb, event_dir):
+    """Whether ``g`` crosses zero from ``ga`` to ``gb`` in direction ``event_dir`` (+1 rising,
+    -1 falling, 0 both)."""
+    return (ga < 0.0 <= gb and event_dir >= 0) or (ga > 0.0 >= gb and event_dir <= 0)
+
+
 @nb.njit(cache=True)
 def _hermite_eval(x, y_old, f_old, y_new, f_new, h, out):
     """The cubic Hermite interpolant of one step at ``x`` in [0, 1] (no right-hand side calls:
@@ -101,7 +108,7 @@ def _may_cross(event, t, y, f, y_new, f_new, h, g_old, g_new, event_dir, p, ybuf
             x = q / SCREEN_POINTS
             _hermite_eval(x, y, f, y_new, f_new, h, ybuf)
             gb = event(t + x * h, ybuf, p)
-        if (ga < 0.0 <= gb and event_dir >= 0) or (ga > 0.0 >= gb and event_dir <= 0):
+        if _crosses(ga, gb, event_dir):
             return True
         if q > 1 and abs(ga) < prev and abs(ga) < abs(gb):
             return True
@@ -368,7 +375,7 @@ def dop853_kernel(
                     else:
                         _dense_eval(xb, y, Fd, ydense)
                         gb = event(t + xb * h, ydense, p)
-                    if (ga < 0.0 <= gb and event_dir >= 0) or (ga > 0.0 >= gb and event_dir <= 0):
+                    if _crosses(ga, gb, event_dir):
                         xm = _locate_event(event, t, y, h, xa, xb, ga, gb, Fd, p, ydense)
                         ev_t[n_ev] = t + xm * h
                         _dense_eval(xm, y, Fd, ydense)
