@@ -200,12 +200,12 @@ def _joints(t, y, p, cfg, f):
     p_crank = 0.0
     f[:, :] = 0.0
     if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
-        _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], y[8], p, f[0])
+        _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], abs(y[8]), p, f[0])
         th1 = p[P_TH10] + w * t
         vjx, vjy = -p[P_R] * w * math.sin(th1), p[P_R] * w * math.cos(th1)
         p_crank = f[0, 0] * vjx + f[0, 1] * vjy - f[0, 3] * w
     if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
-        _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], y[9], p, f[1])
+        _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], abs(y[9]), p, f[1])
     return p_crank, f[0, 6] + f[1, 6], th2d, v3, c2
 
 
@@ -382,19 +382,59 @@ def onset_crosshead(t, y, p):
     return math.sqrt(y[2] * y[2] + y[3] * y[3]) - p[P_C2]
 
 
-@compiled(EVENT_SIGNATURE)
-def onset_both(t, y, p):
-    """Changes sign whenever either joint's penetration does (the integrator locates one
-    event function): (delta1 / c1) (delta2 / c2)."""
-    d1 = math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[P_C1] - 1.0
-    d2 = math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[P_C2] - 1.0
-    return d1 * d2
+#: In contact, a phased factor is ``delta/c + PHASE_MARGIN``: just after an onset it is already
+#: on its positive side, so the event function leaves zero at once and a crossing of another
+#: factor right after is seen. A separation is located at ``delta = -PHASE_MARGIN c`` (1 pm
+#: at c = 1 mm), where the contact force is already 0.
+PHASE_MARGIN = 1e-9
+
+
+@nb.njit(cache=True, inline="always")
+def phased_factor(y, i, k, c):
+    """The contact factor of one joint for an event that tracks onsets *and* separations.
+
+    The joint's phase is the sign of its recorded approach velocity ``y[k]``: positive in
+    contact, negative in free flight (its magnitude is then the last impact's). The factor is
+    ``-delta/c`` in flight and ``delta/c + PHASE_MARGIN`` in contact: positive in both, it falls
+    through 0 at an onset and at a separation, and the reset (:func:`_flip`) makes it positive
+    again. So several joints and the valves share one event function, their minimum, and no two
+    crossings can cancel (as they could in a product of signed factors)."""
+    d = math.sqrt(y[i] * y[i] + y[i + 1] * y[i + 1]) / c - 1.0
+    return d + PHASE_MARGIN if y[k] > 0.0 else -d
 
 
 @nb.njit(cache=True)
 def _record(y, ix, iy, iu, iv, k, p, out):
     rho = math.sqrt(y[ix] * y[ix] + y[iy] * y[iy])
     out[k] = max((y[ix] * y[iu] + y[iy] * y[iv]) / rho, p[P_VMIN])
+
+
+@nb.njit(cache=True)
+def _flip(y, j, p, out):
+    """The reset of joint ``j`` (0 crank pin, 1 crosshead pin) at a zero of its phased factor:
+    from free flight, an onset (the approach velocity is recorded, > 0); in contact, a
+    separation (the recorded velocity turns negative: free flight)."""
+    ix, iy, iu, iv, k = (0, 1, 4, 5, 8) if j == 0 else (2, 3, 6, 7, 9)
+    if y[k] > 0.0:
+        out[k] = -y[k]
+    else:
+        _record(y, ix, iy, iu, iv, k, p, out)
+
+
+@nb.njit(cache=True)
+def contact_factor(y, p, cfg):
+    """The smallest phased factor of the worn joint(s) (``cfg`` 0 crank, 1 crosshead, 2 both)
+    and the joint it belongs to."""
+    f1 = phased_factor(y, 0, 8, p[P_C1]) if cfg != 1 else math.inf
+    f2 = phased_factor(y, 2, 9, p[P_C2]) if cfg != 0 else math.inf
+    return (f1, 0) if f1 <= f2 else (f2, 1)
+
+
+@compiled(EVENT_SIGNATURE)
+def onset_both(t, y, p):
+    """Falls through 0 at an onset or a separation of either joint: the smaller of their
+    phased factors (:func:`phased_factor`)."""
+    return contact_factor(y, p, 2)[0]
 
 
 @compiled(RHS_SIGNATURE)
@@ -413,17 +453,11 @@ def record_crosshead(t, y, p, out):
 
 @compiled(RHS_SIGNATURE)
 def record_both(t, y, p, out):
-    """At a sign change of :func:`onset_both`: the joint on its surface (the smaller relative
-    |delta|), if approaching, records its approach velocity; a separation changes nothing."""
+    """At a zero of :func:`onset_both`: the joint whose factor it is changes phase
+    (:func:`_flip`: an onset records its approach velocity)."""
     for i in range(y.shape[0]):
         out[i] = y[i]
-    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[P_C1] - 1.0)
-    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[P_C2] - 1.0)
-    if d1 <= d2:
-        if y[0] * y[4] + y[1] * y[5] > 0.0:
-            _record(y, 0, 1, 4, 5, 8, p, out)
-    elif y[2] * y[6] + y[3] * y[7] > 0.0:
-        _record(y, 2, 3, 6, 7, 9, p, out)
+    _flip(y, contact_factor(y, p, 2)[1], p, out)
 
 
 KERNELS = {  # joints -> (rhs, jac, event, reset, config code)
@@ -620,10 +654,10 @@ class CompressorContact(Model):
         joints = values["clearance_joints"]
         _, _, onset, record, _ = KERNELS[joints]
         if joints == "both":
-            return (Event("impact", onset, direction=0, action="reset", reset=record,
+            return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
-                          "sign of delta1 delta2 changes): at an onset the approach velocity "
-                          "is recorded for the damping law"),)  # fmt: skip
+                          "smaller phased factor falls through 0): at an onset the approach "
+                          "velocity is recorded for the damping law"),)  # fmt: skip
         where = "|e| = rc" if joints == "crank" else "|e_crosshead| = rc_crosshead"
         return (Event("impact", onset, direction=1, action="reset", reset=record,
                       description=f"contact onset ({where}, approaching): the approach "
@@ -668,7 +702,15 @@ class CompressorContact(Model):
             e = values["e0_ratio"] * values["rc_crosshead"]
             y[[2, 3]] = e * math.cos(ang2), e * math.sin(ang2)
         y[8] = y[9] = values["v_impact_min"]
+        if self.tracks_separations(values):  # the phase: + in contact, - in free flight
+            sign = 1.0 if values["e0_ratio"] >= 1.0 else -1.0
+            y[8] = y[9] = sign * values["v_impact_min"]
         return y
+
+    def tracks_separations(self, values: Mapping[str, Any]) -> bool:
+        """Whether the event also locates separations (the phase is then the sign of
+        ``v_impact``; :func:`phased_factor`): with clearance at both pins."""
+        return values["clearance_joints"] == "both"
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["omega"])

@@ -11,13 +11,14 @@ double-acting cycle needs: its rod load reverses twice a revolution, where the m
 State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
 mass counters of :mod:`.valves`.
 
-Events: the integrator locates one event function, so the contact onset and the valve impacts
-share one: the product of the contact function (``delta/c``, or ``(delta1/c1)(delta2/c2)``
-with both joints worn) and the valves' smallest normalised distance to a stop, located in both
-directions. The reset acts on whichever factor is on its surface (the smaller in relative
-terms): a contact onset records the approach velocity (a separation changes nothing), a valve
-impact rebounds or rests. Two crossings inside one event sub-step (1/8 of a step) would cancel;
-at the steps of this model (a few microseconds in contact) that has not been seen.
+Events: the integrator locates one event function, so the contact onsets and separations and
+the valve impacts share one: the minimum of the joints' phased contact factors
+(:func:`~.compressor_contact.phased_factor`) and the valves' normalised distances to the stop
+each moving plate moves toward. Every factor is positive between its events and falls through
+0 at one, and its reset makes it positive again (a joint changes phase, an onset recording the
+approach velocity; a plate rebounds or rests), so the minimum falls through 0 at each event and
+two events however close are both located. (A product of signed factors, used before
+2026-11-24, lost both events of a pair closer than a quarter step.)
 
 The Jacobian is the contact model's fourth-order central difference over the whole state;
 Benettin's method is refused as for both parent models.
@@ -25,7 +26,6 @@ Benettin's method is refused as for both parent models.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -48,44 +48,21 @@ P_VALVE = cc.P_TABLE + cy.N_CYCLE
 
 
 @nb.njit(cache=True, inline="always")
-def _contact(y, p, cfg):
-    """The contact factor of the event: delta/c of the worn joint(s) (product for both)."""
-    d1 = math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0
-    d2 = math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0
-    if cfg == 0:
-        return d1
-    if cfg == 1:
-        return d2
-    return d1 * d2
-
-
-@nb.njit(cache=True)
-def _contact_distance(y, p, cfg):
-    """|delta|/c of the joint nearest its surface (the one an event belongs to)."""
-    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0)
-    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0)
-    return d1 if cfg == 0 else (d2 if cfg == 1 else min(d1, d2))
-
-
-@nb.njit(cache=True, inline="always")
 def _event(y, p, cfg):
-    return _contact(y, p, cfg) * va.valve_event(y, G0, p[P_VALVE:])
+    return min(cc.contact_factor(y, p, cfg)[0], va.valve_event(y, G0, p[P_VALVE:]))
 
 
 @nb.njit(cache=True)
 def _reset(y, p, cfg, out):
+    """The factor at zero acts: a valve plate rebounds or rests, a joint changes phase."""
     valve = va.valve_event(y, G0, p[P_VALVE:])
-    if abs(valve) < _contact_distance(y, p, cfg):
+    f, j = cc.contact_factor(y, p, cfg)
+    if abs(valve) < abs(f):
         va.valve_reset(y, G0, p[P_VALVE:], out)
         return
     for i in range(y.shape[0]):
         out[i] = y[i]
-    d1 = abs(math.sqrt(y[0] * y[0] + y[1] * y[1]) / p[cc.P_C1] - 1.0)
-    d2 = abs(math.sqrt(y[2] * y[2] + y[3] * y[3]) / p[cc.P_C2] - 1.0)
-    first = cfg == 0 or (cfg == 2 and d1 <= d2)
-    ix, iy, iu, iv, k = (0, 1, 4, 5, 8) if first else (2, 3, 6, 7, 9)
-    if y[ix] * y[iu] + y[iy] * y[iv] > 0.0:  # approaching the wall: an onset
-        cc._record(y, ix, iy, iu, iv, k, p, out)
+    cc._flip(y, j, p, out)
 
 
 @compiled(EVENT_SIGNATURE)
@@ -154,10 +131,18 @@ class CompressorContactValves(cc.CompressorContact):
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         fn, reset = EVENTS[values["clearance_joints"]]
-        return (Event("impact", fn, direction=0, action="reset", reset=reset,
-                      description="a contact onset or separation, or a valve plate reaching "
-                      "its seat or guard (one event function: their product): an onset records "
-                      "the approach velocity, a plate rebounds or rests"),)  # fmt: skip
+        return (
+            Event(
+                "impact",
+                fn,
+                direction=-1,
+                action="reset",
+                reset=reset,
+                description="a contact onset or separation, or a valve plate reaching "
+                "its seat or guard (one event function: the minimum of the factors): "
+                "an onset records the approach velocity, a plate rebounds or rests",
+            ),
+        )
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         rhs, jac, *_ = cc.KERNELS[values["clearance_joints"]]
@@ -167,6 +152,9 @@ class CompressorContactValves(cc.CompressorContact):
 
     def check(self, values: Mapping[str, Any]) -> None:
         super().check(self._values(values))
+
+    def tracks_separations(self, values: Mapping[str, Any]) -> bool:
+        return True
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         """The contact model's initial state (journal along the ideal cycle's rod load), the
@@ -202,7 +190,7 @@ class CompressorContactValves(cc.CompressorContact):
             ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
                                                        for k in STATE_NAMES]))  # fmt: skip
             cfg = cc.KERNELS[values["clearance_joints"]][4]
-            contact = np.array([_contact_distance(e, p, cfg) for e in ev])
+            contact = np.array([abs(cc.contact_factor(e, p, cfg)[0]) for e in ev])
             valve = np.array([abs(va.valve_event(e, G0, p[P_VALVE:])) for e in ev])
             is_valve = valve < contact
             ds_contact = ds.isel(impact_event=np.flatnonzero(~is_valve))
