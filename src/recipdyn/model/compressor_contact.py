@@ -19,7 +19,9 @@ F_gas dx3/dq_k``, computed in the compiled right-hand side.
 
 State: ``(ex, ey, ex', ey', v_impact, W_in, W_loss)``. The last three are auxiliary (no
 degrees of freedom; ``ODESystem.aux_states``): the approach velocity of the current impact
-(set by the contact-onset event, used by the damping laws), and two work integrals for the
+(set by the contact-onset event, used by the damping laws; where the event also tracks
+separations, with both pins worn or with the valves, its sign is the joint's phase, negative in
+free flight: :func:`phased_factor`), and two work integrals for the
 energy balance, ``E + U = E0 + U0 + W_in - W_loss`` (``E`` kinetic + gravity energy of rod and
 crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic energy, ``W_in`` the work of the gas
 force and of the crank through the journal, ``W_loss`` the work lost in the joint: contact
