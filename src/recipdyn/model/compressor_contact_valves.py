@@ -131,18 +131,11 @@ class CompressorContactValves(cc.CompressorContact):
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         fn, reset = EVENTS[values["clearance_joints"]]
-        return (
-            Event(
-                "impact",
-                fn,
-                direction=-1,
-                action="reset",
-                reset=reset,
-                description="a contact onset or separation, or a valve plate reaching "
-                "its seat or guard (one event function: the minimum of the factors): "
-                "an onset records the approach velocity, a plate rebounds or rests",
-            ),
-        )
+        return (Event("impact", fn, direction=-1, action="reset", reset=reset,
+                      description="a contact onset or separation, or a valve plate reaching "
+                      "its seat or guard (one event function: the minimum of the factors): "
+                      "an onset records the approach velocity, a plate rebounds or "
+                      "rests"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         rhs, jac, *_ = cc.KERNELS[values["clearance_joints"]]

@@ -38,16 +38,17 @@ spring preload, ``c_v = 2 zeta sqrt(k_v m_v)``. The seat (``y = 0``) and the gua
 (``y = y_max``) are rigid stops: an impact reverses the plate's velocity with the restitution
 ``e`` (an event with a state reset), and a plate whose rebound is below ``V_REST`` = 1 cm/s
 rests there, as does a plate that is pressed onto a stop (its derivatives are 0), until the
-net force pulls it away. Known limit: the right-hand side switches on the stop itself, so at
-very tight tolerances (rtol 1e-12) a step that crosses a stop may never be accepted (the error
-estimate sees the switch) and the run stops with a step-size underflow (a clear
-``IntegrationError`` with the partial record; the default rtol 1e-10 is not affected in the
-tests and benchmarks). Letting fast plates move on through the stop until the event acts
-removes it, but then a plate that slows below ``V_REST`` beyond its stop makes the event
-function jump; that change is not made yet.
-This is the classical impact treatment of valve plates (Soedel 1984, ch. 5); it needs no
-stiff stop springs, so an explicit integrator steps through the cycle at the gas's own time
-scales.
+net force pulls it away. This is the classical impact treatment of valve plates (Soedel 1984,
+ch. 5); it needs no stiff stop springs, so an explicit integrator steps through the cycle at
+the gas's own time scales.
+
+Known limit: the right-hand side switches on the stop itself, so at very tight tolerances
+(rtol 1e-12) a step that crosses a stop may never be accepted (the error estimate sees the
+switch) and the run stops with a step-size underflow (a clear ``IntegrationError`` with the
+partial record; the default rtol 1e-10 is not affected in the tests and benchmarks). Letting
+fast plates move on through the stop until the event acts removes it, but then a plate that
+slows below ``V_REST`` beyond its stop makes the event function jump; that change is not made
+yet.
 
 **Force on the mechanism**: ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod`` as in
 :mod:`.cycle`, with the pressures of the states. The chamber volumes follow the crosshead
