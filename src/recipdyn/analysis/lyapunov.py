@@ -59,6 +59,7 @@ _BENETTIN_SIG = nb.int64(
     nb.float64, nb.float64, nb.float64, nb.float64, nb.float64[:, ::1], nb.float64[::1],
     nb.float64[::1], EVENT_TYPE, nb.boolean, nb.int64, RHS_TYPE, nb.float64[:, ::1],
     nb.float64[::1], nb.float64[::1], nb.float64[::1], nb.float64[::1], nb.float64[:, ::1],
+    nb.int64[::1],
 )  # fmt: skip
 
 #: One interval's growth spread ``log(R_11 / R_kk)`` beyond which the interval is halved
@@ -71,11 +72,18 @@ _EVENT_BATCH = 256
 
 @nb.njit(cache=True)  # compiled for _BENETTIN_SIG on first use (base.typed)
 def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, hist, times,
-                     info, event, use_event, event_dir, treset, A, B, C, E3, E5, D):  # fmt: skip
+                     info, event, use_event, event_dir, treset, A, B, C, E3, E5, D,
+                     rows):  # fmt: skip
     """Benettin loop, compiled: DOP853 over each interval, then QR; records running means.
 
     With ``use_event``, crossings of ``event`` reset the augmented state through ``treset``
     (the state's reset and the tangent vectors' saltation matrix); ``info[3]`` counts them.
+    The vectors are measured and orthonormalised on the degree-of-freedom ``rows`` only
+    (``W_dof = Q R``, then ``W <- W R^-1``): auxiliary components (an impact's recorded
+    approach velocity) follow linearly without entering the norms. Measured with them, a
+    vector could turn into an auxiliary direction that the next impact's reset wipes out,
+    and the exponents lost their meaning (a -inf seen at 150 rad/s with a worn crank pin).
+    Returns -5 if the rows' parts become dependent.
     """
     t = t0
     t_end = t0 + t_total
@@ -94,12 +102,21 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
     n_events = 0
     stats = np.zeros(5, dtype=np.int64)
     fstate = np.zeros(2)
-    W = np.empty((n, k))
+    nr = rows.shape[0]
+    is_row = np.zeros(n, dtype=np.bool_)
+    for a in range(nr):
+        is_row[rows[a]] = True
+    W = np.empty((nr, k))
+    x = np.empty(k)
+    z_start = z.copy()
     dt_min = dt / 16.0
+    dt_floor = dt / 2.0**20
     t_settle = min(8.0 * dt, 0.1 * t_total)  # averaging before the mean rate is trusted
     while t < t_end - 1e-12 * max(1.0, abs(t_end)):
         t1 = min(t + dt, t_end)
         ts = t
+        z_start[:] = z
+        h_start, ev_start = h_abs, n_events
         while True:  # one call, repeated only when the event buffer fills up
             status = _ik.dop853_kernel(
                 trhs, event, ts, z, t1, t1, p, rtol, atol, h_abs, np.inf, empty1, 1 << 40,
@@ -114,34 +131,55 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
         if status < 0:
             info[0] = t
             return status
-        t = t1
-        for i in range(n):
+        for a in range(nr):
             for j in range(k):
-                W[i, j] = z[n + i * k + j]
+                W[a, j] = z[n + rows[a] * k + j]
         Q, R = np.linalg.qr(W)
-        l0 = 0.0
-        lk = 0.0
+        singular = False
         for j in range(k):
-            r = R[j, j]
-            lg = math.log(abs(r))
-            sums[j] += lg
-            if j == 0:
-                l0 = lg
-            if j == k - 1:
-                lk = lg
-            sgn = 1.0 if r >= 0 else -1.0
-            for i in range(n):
-                z[n + i * k + j] = Q[i, j] * sgn
+            if not (R[j, j] != 0.0 and math.isfinite(R[j, j])):
+                singular = True
+        l0 = 0.0 if singular else math.log(abs(R[0, 0]))
+        lk = 0.0 if singular else math.log(abs(R[k - 1, k - 1]))
+        # An interval so long that the smallest vector lost its significance (R_kk ~ eps
+        # exp(spread)) or fell into the others' span (R_kk = 0: a strongly contracting mode,
+        # such as a stiff contact's, over the first interval of one period) is done again
+        # with half the interval, instead of adding a meaningless log R_kk to the sums.
+        if singular or (k > 1 and dt > dt_min and l0 - lk > _HARD_SPREAD):
+            if dt <= dt_floor:
+                info[0] = t
+                return -5
+            z[:] = z_start
+            h_abs, n_events = h_start, ev_start
+            dt *= 0.5
+            continue
+        t = t1
+        for j in range(k):
+            sums[j] += math.log(abs(R[j, j]))
+        # the rows measured become Q; the others (auxiliary values carried along) W R^-1:
+        # x R = w_i, R upper triangular; the signs make R's diagonal positive
+        for i in range(n):
+            if is_row[i]:
+                continue
+            for j in range(k):
+                acc = z[n + i * k + j]
+                for m in range(j):
+                    acc -= x[m] * R[m, j]
+                x[j] = acc / R[j, j]
+            for j in range(k):
+                z[n + i * k + j] = x[j] * (1.0 if R[j, j] >= 0 else -1.0)
+        for a in range(nr):
+            for j in range(k):
+                z[n + rows[a] * k + j] = Q[a, j] * (1.0 if R[j, j] >= 0 else -1.0)
         if k > 1 and dt > dt_min:
             # halve dt when the mean growth spread over one interval is too large (a rate, so
-            # only after a period of averaging), or when one interval's spread leaves the
-            # smallest vector with fewer than ~5 significant digits after the QR (relative
-            # rounding of R_kk ~ eps exp(spread)). The spread within one interval also
+            # only after a period of averaging). The spread within one interval also
             # contains the ratio of the state components' units, which no interval removes,
-            # so the mean rate, not the single interval, is the criterion.
+            # so the mean rate, not the single interval, is the criterion (the single
+            # interval's spread only until dt_min, above).
             elapsed = t - t0
             rate = (sums[0] - sums[k - 1]) / elapsed
-            if (elapsed >= t_settle and rate * dt > max_spread) or l0 - lk > _HARD_SPREAD:
+            if elapsed >= t_settle and rate * dt > max_spread:
                 dt *= 0.5
         if (t >= next_rec or t >= t_end - 1e-12 * max(1.0, abs(t_end))) and filled < n_hist:
             hist[filled] = sums / (t - t0)
@@ -232,11 +270,13 @@ def _initial_basis(n: int, k: int) -> np.ndarray:
     return np.ascontiguousarray(q)
 
 
-#: Cached by (rhs, jac, rhs_jac, n, k): numba compiles a closure on
+#: Cached by (rhs, jac, rhs_jac, n, k, passive): numba compiles a closure on
 #: its first call (~0.5 s), so a sweep that asks for exponents at every point compiles once per
 #: worker process instead of once per point.
 @functools.cache
-def _tangent_rhs(rhs, jac, both, n: int, k: int):
+def _tangent_rhs(rhs, jac, both, n: int, k: int, passive: tuple[int, ...] = ()):
+    active = np.ones(n, dtype=np.bool_)
+    active[list(passive)] = False  # their tangent components are held at 0
     if both is not None:  # right-hand side and Jacobian share work: one call
 
         @nb.njit(RHS_JAC_SIGNATURE)
@@ -258,24 +298,33 @@ def _tangent_rhs(rhs, jac, both, n: int, k: int):
         for i in range(n):
             for j in range(k):
                 s = 0.0
-                for m in range(n):
-                    s += J[i, m] * z[n + m * k + j]
+                if active[i]:
+                    for m in range(n):
+                        s += J[i, m] * z[n + m * k + j]
                 out[n + i * k + j] = s
 
     return trhs
 
 
 @functools.cache  # compiled once per process, like _tangent_rhs
-def _tangent_reset(rhs, event, reset, n: int, k: int):
+def _tangent_reset(rhs, event, reset, n: int, k: int, passive: tuple[int, ...] = ()):
     r"""The reset of the augmented state ``[y, W]`` at an event: ``y+ = R(t, y)`` and
     ``W+ = S W`` with the saltation matrix (Müller 1995; Leine & Nijmeijer 2004)
 
     .. math:: S = R_y + \frac{(f^+ - R_y f^- - R_t)\,g_y^\top}{g_y f^- + g_t},
 
     ``f-``/``f+`` the vector field before/after the reset. ``g_y``, ``g_t``, ``R_y`` and
-    ``R_t`` are central differences with steps ``1e-6 max(1, |y_i|)`` (truncation ~1e-12 and
-    rounding ~1e-10 relative: far below what the exponents' finite-time scatter resolves).
+    ``R_t`` are central differences with steps ``1e-9 max(1, |y_i|)``: states far below 1 in
+    SI units (a clearance joint's eccentricity, ~1e-4 m) need a step far below their size,
+    and an event function that is a minimum of factors (two joints) must not switch factor
+    inside the step. (A step of 1e-6 spanned a thousandth of a 1 mm clearance, and the tangent
+    flow of two worn pins lost all agreement with differences of the flow after four events;
+    measured: tests/test_contact.py.) Rounding is then ~1e-7 of the gradient for an event
+    function of size 1, truncation negligible.
+    The ``passive`` rows stay 0, as in :func:`_tangent_rhs`.
     """
+    active = np.ones(n, dtype=np.bool_)
+    active[list(passive)] = False
 
     @nb.njit(RHS_SIGNATURE)
     def treset(t, z, p, out):
@@ -292,7 +341,7 @@ def _tangent_reset(rhs, event, reset, n: int, k: int):
         r2 = np.empty(n)
         yh = y.copy()
         for i in range(n):
-            hi = 1e-6 * max(1.0, abs(y[i]))
+            hi = 1e-9 * max(1.0, abs(y[i]))
             yh[i] = y[i] + hi
             g1 = event(t, yh, p)
             reset(t, yh, p, r1)
@@ -303,7 +352,7 @@ def _tangent_reset(rhs, event, reset, n: int, k: int):
             grad[i] = (g1 - g2) / (2.0 * hi)
             for j in range(n):
                 Ry[j, i] = (r1[j] - r2[j]) / (2.0 * hi)
-        ht = 1e-6 * max(1.0, abs(t))
+        ht = 1e-9 * max(1.0, abs(t))
         gt = (event(t + ht, y, p) - event(t - ht, y, p)) / (2.0 * ht)
         reset(t + ht, y, p, r1)
         reset(t - ht, y, p, r2)
@@ -321,8 +370,9 @@ def _tangent_reset(rhs, event, reset, n: int, k: int):
         for i in range(n):
             for c in range(k):
                 acc = 0.0
-                for m in range(n):
-                    acc += (Ry[i, m] + v[i] * grad[m]) * z[n + m * k + c]
+                if active[i]:
+                    for m in range(n):
+                        acc += (Ry[i, m] + v[i] * grad[m]) * z[n + m * k + c]
                 out[n + i * k + c] = acc
 
     return treset
@@ -334,7 +384,7 @@ def tangent_system(system: ODESystem, k: int | None = None) -> ODESystem:
         raise ValueError(f"system {system.name!r} has no Jacobian; Benettin's method needs one")
     n = system.dim
     k = n if k is None else int(k)
-    trhs = _tangent_rhs(system.rhs, system.jac, system.rhs_jac, n, k)
+    trhs = _tangent_rhs(system.rhs, system.jac, system.rhs_jac, n, k, tuple(system.passive))
     names = system.state_names + tuple(f"w{i}{j}" for i in range(n) for j in range(k))
     return ODESystem(rhs=trhs, params=system.params, state_names=names, period=system.period,
                      name=f"{system.name}-tangent")  # fmt: skip
@@ -368,9 +418,14 @@ def lyapunov_spectrum(
     t_total : float
         Averaging time (after ``t_transient``).
     k : int, optional
-        Number of exponents (default: all, ``system.dim - system.aux_states``). The tangent
-        vectors start without components along auxiliary states; values an event records
-        (an impact's approach velocity) then follow the state through the saltation matrix.
+        Number of exponents (default: all, one per degree-of-freedom component: not the
+        ``system.aux_states`` last ones, not the ``system.passive`` ones). The tangent vectors
+        start without components along auxiliary and passive states; values an event records
+        (an impact's approach velocity) then follow the state through the saltation matrix,
+        and passive components (a rigid joint's eccentricity, constant 0; work integrals that
+        nothing depends on) get none: they would add to the vectors' norms without acting
+        on the motion (a work integral's perturbation tends to a constant while the motion's
+        decays, which reads as a zero exponent).
     dt : float, optional
         Re-orthonormalisation interval; default one forcing period for forced systems, else
         0.1 time units; halved automatically while ``(lambda_1 - lambda_k) dt`` exceeds
@@ -386,7 +441,9 @@ def lyapunov_spectrum(
     """
     y = np.asarray(y0, dtype=float).copy()
     n = system.dim
-    n_dof = n - system.aux_states  # auxiliary states (recorded values, work integrals) last
+    # auxiliary states (recorded values, work integrals) last; fixed ones anywhere
+    dof = [i for i in range(n - system.aux_states) if i not in system.passive]
+    n_dof = len(dof)
     k = n_dof if k is None else int(k)
     if not (1 <= k <= n_dof):
         raise ValueError(f"k = {k}; allowed: 1..{n_dof}")
@@ -414,7 +471,7 @@ def lyapunov_spectrum(
     tsys = tangent_system(system, k)
     t_start, y_start = t, y.copy()
     basis = np.zeros((n, k))
-    basis[:n_dof] = _initial_basis(n_dof, k)  # no components along the auxiliary states
+    basis[dof] = _initial_basis(n_dof, k)  # no components along auxiliary or passive states
     z = np.concatenate([y, basis.ravel()])
     n_hist = max(1, int(n_history))
     hist = np.zeros((n_hist, k))
@@ -425,12 +482,17 @@ def lyapunov_spectrum(
         ev, ev_dir, treset = _ik.no_event, 0, tsys.rhs
         if use_event:
             ev, ev_dir = event.function, int(event.direction)
-            treset = _tangent_reset(system.rhs, event.function, event.reset, n, k)
+            treset = _tangent_reset(system.rhs, event.function, event.reset, n, k,
+                                    tuple(system.passive))  # fmt: skip
         status = typed(_benettin_dop853, _BENETTIN_SIG)(
             tsys.rhs, z, system.params, n, k, t, t_total, dt, rtol, atol, max_log_spread,
             hist, times, info, ev, use_event, ev_dir, treset, _DOP.A, _DOP.B, _DOP.C, _DOP.E3,
-            _DOP.E5, _DOP.D,
+            _DOP.E5, _DOP.D, np.asarray(dof, dtype=np.int64),
         )  # fmt: skip
+        if status == -5:
+            raise IntegrationError(f"Benettin's tangent vectors became dependent at t = "
+                                   f"{info[0]:.6g} (a singular saltation matrix?): no "
+                                   f"exponents")  # fmt: skip
         if status < 0:
             raise IntegrationError(f"Benettin integration failed (status {status}) at "
                                    f"t = {info[0]:.6g}")  # fmt: skip

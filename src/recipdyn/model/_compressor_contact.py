@@ -4,9 +4,8 @@ Mechanism of the compressor with contact-impact clearance joints (recipdyn.model
 M qdd = b for clearance at the crank pin, the crosshead pin, or both.
 """
 
-import math
-
 import numba as nb
+import numpy as np
 
 @nb.njit(cache=True)
 def crank_system(t, y, p, M, b):
@@ -36,14 +35,14 @@ def crank_system(t, y, p, M, b):
     x2 = _p3*x1
     x3 = _p4 + x2
     x4 = _p8*t + _p9
-    x5 = math.sin(x4)
+    x5 = np.sin(x4)
     x6 = _p0*x5
     x7 = _p7 + _q1 + x6
     x8 = (1.0/(_p1**2))
     x9 = x7**2
     x10 = x8*x9
     x11 = 1 - x10
-    x12 = (1.0/(math.sqrt(x11)))
+    x12 = (1.0/(np.sqrt(x11)))
     x13 = x0*x12
     x14 = x13*x7
     x15 = -x14*x3
@@ -54,7 +53,7 @@ def crank_system(t, y, p, M, b):
     x20 = 1 - x1
     x21 = (1.0/(_p1**4))
     x22 = x21*x9
-    x23 = math.cos(x4)
+    x23 = np.cos(x4)
     x24 = _p8*x23
     x25 = _p0*x24
     x26 = _qd1 + x25
@@ -64,7 +63,7 @@ def crank_system(t, y, p, M, b):
     x30 = _p0*_p8
     x31 = x23**2*x30
     x32 = _p8*x5
-    x33 = (1.0/(math.sqrt(x11)**3))
+    x33 = (1.0/(np.sqrt(x11)**3))
     x34 = _qd1*x23
     x35 = x33*x34
     x36 = (1.0/(_p1**3))
@@ -120,7 +119,7 @@ def crosshead_system(t, y, p, M, b):
     _p14 = p[14]
     _p15 = p[15]
     x0 = _p8*t + _p9
-    x1 = math.sin(x0)
+    x1 = np.sin(x0)
     x2 = _p0*x1
     x3 = _p7 - _q1 + x2
     x4 = (1.0/(_p1))
@@ -128,7 +127,7 @@ def crosshead_system(t, y, p, M, b):
     x6 = x3**2
     x7 = x5*x6
     x8 = 1 - x7
-    x9 = (1.0/(math.sqrt(x8)))
+    x9 = (1.0/(np.sqrt(x8)))
     x10 = x4*x9
     x11 = x10*x3
     x12 = _p4*x11
@@ -141,10 +140,10 @@ def crosshead_system(t, y, p, M, b):
     x19 = x18**2
     x20 = x19*x5
     x21 = 1 - x20
-    x22 = (1.0/(math.sqrt(x21)))
+    x22 = (1.0/(np.sqrt(x21)))
     x23 = (1.0/(x21))
     x24 = x20*x23
-    x25 = math.cos(x0)
+    x25 = np.cos(x0)
     x26 = _p8*x25
     x27 = _p0*x26
     x28 = -_qd1 + x27
@@ -155,7 +154,7 @@ def crosshead_system(t, y, p, M, b):
     x33 = _p8*x1
     x34 = _qd1*x25
     x35 = (1.0/(_p1**3))
-    x36 = (1.0/(math.sqrt(x8)**3))
+    x36 = (1.0/(np.sqrt(x8)**3))
     x37 = x35*x36
     x38 = x37*x6
     x39 = _p2*x4
@@ -175,7 +174,7 @@ def crosshead_system(t, y, p, M, b):
     x53 = _p2*x5
     x54 = x48*x53
     x55 = -_p0*_p2*_p8*x18*x22*x25*x5 + _qd1*x54 + x45
-    x56 = (1.0/(math.sqrt(x21)**3))
+    x56 = (1.0/(np.sqrt(x21)**3))
     x57 = x35*x56
     x58 = x19*x34
     x59 = x19*x32
@@ -222,14 +221,14 @@ def both_system(t, y, p, M, b):
     x2 = _p3*x1
     x3 = _p4 + x2
     x4 = _p8*t + _p9
-    x5 = math.sin(x4)
+    x5 = np.sin(x4)
     x6 = _p0*x5
     x7 = _p7 + _q1 - _q3 + x6
     x8 = (1.0/(_p1**2))
     x9 = x7**2
     x10 = x8*x9
     x11 = 1 - x10
-    x12 = (1.0/(math.sqrt(x11)))
+    x12 = (1.0/(np.sqrt(x11)))
     x13 = x0*x12
     x14 = x13*x7
     x15 = x14*x3
@@ -249,7 +248,7 @@ def both_system(t, y, p, M, b):
     x29 = x0*(_p2*_p3*(-_p2*x25*x28 - x1 + 1) - x0*x19 - x0*x27)
     x30 = -x26
     x31 = _qd3*x0
-    x32 = math.cos(x4)
+    x32 = np.cos(x4)
     x33 = _p8*x32
     x34 = _p0*x33
     x35 = _qd1 - _qd3 + x34
@@ -266,7 +265,7 @@ def both_system(t, y, p, M, b):
     x46 = x38*x45
     x47 = x34*x42
     x48 = x10*x43 + x35 + x44*x46 - x46*x47
-    x49 = (1.0/(math.sqrt(x41)))
+    x49 = (1.0/(np.sqrt(x41)))
     x50 = _qd1*x0
     x51 = x49*x50
     x52 = x32*x49
@@ -277,7 +276,7 @@ def both_system(t, y, p, M, b):
     x57 = x38*x49
     x58 = x56*x57
     x59 = _qd3*x32
-    x60 = (1.0/(math.sqrt(x41)**3))
+    x60 = (1.0/(np.sqrt(x41)**3))
     x61 = x28*x60
     x62 = x39*x61
     x63 = x61*x7
@@ -296,7 +295,7 @@ def both_system(t, y, p, M, b):
     x76 = _p10*x14
     x77 = _p5/x41**2
     x78 = x35**2*x77
-    x79 = (1.0/(math.sqrt(x11)**3))
+    x79 = (1.0/(np.sqrt(x11)**3))
     x80 = _p5*x35
     x81 = x49*x80
     x82 = x34*x72*x79*x81

@@ -223,6 +223,10 @@ class ODESystem:
     #: event records, work integrals): their derivatives do not depend on them, and Lyapunov
     #: exponents are computed for the other components only.
     aux_states: int = 0
+    #: Components left out of the tangent space of the Lyapunov integration (their tangent
+    #: components are held at 0): ones that stay 0 by construction (the eccentricity of a
+    #: joint modelled as rigid) and ones nothing depends on (work integrals).
+    passive: tuple[int, ...] = ()
 
     @property
     def acting_event(self) -> Event | None:

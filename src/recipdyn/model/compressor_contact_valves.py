@@ -20,8 +20,9 @@ approach velocity; a plate rebounds or rests), so the minimum falls through 0 at
 two events however close are both located. (A product of signed factors, used before
 2026-11-24, lost both events of a pair closer than a quarter step.)
 
-The Jacobian is the contact model's fourth-order central difference over the whole state;
-Benettin's method is refused as for both parent models.
+The Jacobian is a fourth-order central difference over the whole state (the valve laws are
+not written for the contact model's complex-step Jacobian); Benettin's method is refused as
+for the massless link with dynamic valves.
 """
 
 from __future__ import annotations
@@ -122,8 +123,10 @@ class CompressorContactValves(cc.CompressorContact):
     state_units = STATE_UNITS
     schema = SCHEMA
     event_example = {}  # the valves hit their stops at the defaults
-    lyapunov_refusal = cc.CompressorContact.lyapunov_refusal + (
-        "; the valve plates' rests are resets with singular saltation matrices"
+    lyapunov_refusal = (
+        "the valve plates come to rest on their stops in resets with a singular saltation "
+        "matrix (Benettin's QR is undefined there); use the signal estimators, or --model "
+        "compressor-contact with load=cycle (ideal valves)"
     )
 
     def _values(self, values: Mapping[str, Any]) -> dict[str, Any]:

@@ -70,6 +70,7 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 __all__ = [
     "LAWS", "FRICTION_LAWS", "hysteresis_factor", "delivered_restitution", "hertz_stiffness",
@@ -122,13 +123,17 @@ def hertz_stiffness(R_j: float, R_b: float, E_j: float, nu_j: float, E_b: float,
     return 4.0 / (3.0 * s) * math.sqrt(R_j * R_b / (R_b - R_j))
 
 
+# The kernels below take real or complex arguments (numpy's scalar functions, branches on the
+# real part): the contact model's Jacobian is the complex step of its right-hand side.
+
+
 @nb.njit(cache=True)
 def normal_force(delta, ddelta, v_impact, K, chi):
     """``F_n >= 0`` for penetration ``delta`` (m), its rate and the approach velocity."""
-    if delta <= 0.0:
+    if delta.real <= 0.0:
         return 0.0
-    f = K * delta * math.sqrt(delta) * (1.0 + chi * ddelta / v_impact)
-    return f if f > 0.0 else 0.0
+    f = K * delta * np.sqrt(delta) * (1.0 + chi * ddelta / v_impact)
+    return f if f.real > 0.0 else 0.0
 
 
 @nb.njit(cache=True)
@@ -137,12 +142,15 @@ def friction_factor(vt, mu, v0, v1, law):
     if mu == 0.0:
         return 0.0
     if law == 1:
-        return -mu * math.tanh(vt / v0)
-    a = abs(vt)
-    if a <= v0:
+        x = vt / v0
+        if abs(x.real) > 20.0:  # tanh = +-1 to 1e-17 (a complex tanh would overflow here)
+            return -mu if x.real > 0.0 else mu
+        return -mu * np.tanh(x)
+    a = vt if vt.real > 0.0 else -vt
+    if a.real <= v0:
         return 0.0
-    cd = 1.0 if a >= v1 else (a - v0) / (v1 - v0)
-    return -mu * cd * (1.0 if vt > 0.0 else -1.0)
+    cd = 1.0 if a.real >= v1 else (a - v0) / (v1 - v0)
+    return -mu * cd * (1.0 if vt.real > 0.0 else -1.0)
 
 
 @nb.njit(cache=True)
@@ -150,7 +158,7 @@ def short_bearing_forces(eps, deps, dgamma, omega_sum, mu_oil, L, R, c, eps_dry)
     """Film forces on the journal (radial, tangential), N; ``eps`` is clipped at ``eps_dry``."""
     if mu_oil == 0.0:
         return 0.0, 0.0
-    e = eps if eps < eps_dry else eps_dry
+    e = eps if eps.real < eps_dry else eps_dry
     k = mu_oil * L**3 * R / (2.0 * c * c)
     s = 1.0 - e * e
     w = omega_sum - 2.0 * dgamma
