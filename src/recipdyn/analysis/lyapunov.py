@@ -14,7 +14,8 @@ Notes
   ``(lambda_1 - lambda_k) dt`` from the running sums, exceeds ``max_log_spread`` (default 5:
   the tangent vectors would become indistinguishable in floating point), ``dt`` is halved,
   down to 1/16 of its initial value. One interval's spread ``log(R_11 / R_kk)`` is not the
-  criterion (only beyond 25, where ``R_kk`` keeps ~5 digits): it also contains the ratio of the
+  criterion (only beyond 25, where ``R_kk`` keeps ~5 digits, or where a diagonal of ``R`` is 0:
+  that interval is then done again with half the length): it also contains the ratio of the
   state components' units (rad vs rad/s at the compressor's kHz clearance frequency gives ~18),
   which no interval removes. Re-orthonormalising more often than needed costs a truncated step
   and a QR per interval; once per forcing period is the default.
@@ -62,8 +63,9 @@ _BENETTIN_SIG = nb.int64(
     nb.int64[::1],
 )  # fmt: skip
 
-#: One interval's growth spread ``log(R_11 / R_kk)`` beyond which the interval is halved
-#: whatever the mean rate: the relative rounding error of ``R_kk`` is then ~eps e^25 ~ 2e-5.
+#: One interval's growth spread ``log(R_11 / R_kk)`` beyond which the interval is done again
+#: with half the length whatever the mean rate: the relative rounding error of ``R_kk`` is then
+#: ~eps e^25 ~ 2e-5.
 _HARD_SPREAD = 25.0
 
 #: Events located per kernel call in the Benettin loop (the call is repeated when full).
