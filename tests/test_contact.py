@@ -159,8 +159,7 @@ def _newton_euler_rhs(t, y, p, out):  # y = (theta2, x3, theta2', x3', v_impact)
     ey = r * math.sin(th1) + l * s2 + d
     u = -r * w * math.sin(th1) - l * s2 * w2 - v3
     v = r * w * math.cos(th1) + l * c2 * w2
-    f = np.empty(7)
-    cc._pair(ex, ey, u, v, 0.0, w2, p[cc.P_C2], p[cc.P_K2], p[cc.P_RJ2], y[4], p, f)
+    f = cc._pair(ex, ey, u, v, 0.0, w2, p[cc.P_C2], p[cc.P_K2], p[cc.P_RJ2], y[4], p)
     aax, aay = -r * w * w * math.cos(th1), -r * w * w * math.sin(th1)
     # moments about the crank pin A: (J2 + m2 ls^2) theta2'' = -m2 ls (rGA x aA) + rPA x F2
     #   + rGA x m2 g + T_b

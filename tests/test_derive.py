@@ -117,3 +117,50 @@ def test_stray_symbols_are_refused():
     t, q, w, k, z = sp.symbols("t q w k z")
     with pytest.raises(ValueError, match="without a value"):
         derive(w**2 / 2, k * q**2 / 2 + z, (q,), (w,), t, (k,))
+
+
+def _compiled(source: str, name: str):
+    import numba as nb
+
+    ns = {"nb": nb, "np": np, "math": math}
+    exec(compile(source.replace("cache=True", "cache=False"), f"<generated {name}>", "exec"), ns)
+    return ns[name]
+
+
+def test_allocation_free_accelerations_match_the_generated_rhs(rng):
+    """``accelerations_source`` (scalar L D L^T, the last parameters from a tuple) against the
+    array kernel of the same Lagrangian (``numpy.linalg.solve`` path), 50 random states: the
+    two differ only by rounding in the solve (|M| is well conditioned here), so 1e-10."""
+    from recipdyn.model.derive import accelerations_source
+
+    m = get_model("double-pendulum")
+    lag = dp.lagrangian()
+    acc = _compiled(accelerations_source(lag, "dp", inputs=2), "dp_accelerations")
+    for _ in range(50):
+        v = m.parameters(m1=rng.uniform(0.2, 3), m2=rng.uniform(0.2, 3), c=rng.uniform(0, 1))
+        s = m.system(v)
+        y = rng.uniform(-3, 3, 4)
+        p = s.params
+        k = len(lag.params) - 2
+        a = acc(0.0, y, p[:k].copy(), (p[k], p[k + 1]))
+        assert np.allclose(a, s.f(0.0, y)[2:], rtol=1e-10, atol=1e-10)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_straight_line_ldl_solves_spd_systems(n, rng):
+    """The unrolled L D L^T of the generated kernels against numpy.linalg.solve on random
+    symmetric positive definite matrices (condition numbers up to ~1e6): the residual is at
+    rounding level, |M x - b| <= 1e-9 |M| |x|."""
+    from recipdyn.model.derive import _ldl_solve
+
+    args = [f"m{i}{j}" for i in range(n) for j in range(i + 1)] + [f"b{i}" for i in range(n)]
+    src = "\n".join([f"def solve({', '.join(args)}):", *_ldl_solve(n),
+                     "    return (" + ", ".join(f"a{i}" for i in range(n)) + ",)"])  # fmt: skip
+    solve = _compiled(src, "solve")
+    for _ in range(20):
+        q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+        M = q @ np.diag(np.logspace(0, rng.uniform(0, 6), n)) @ q.T
+        b = rng.normal(size=n)
+        x = np.array(solve(*[M[i, j] for i in range(n) for j in range(i + 1)], *b))
+        assert np.abs(M @ x - b).max() <= 1e-9 * np.abs(M).max() * np.abs(x).max()
+        assert np.allclose(x, np.linalg.solve(M, b), rtol=1e-6 * 10 ** (n / 2))
