@@ -223,3 +223,10 @@ def test_numba_cache_folder_follows_the_sources(tmp_path):
                           "print(os.environ['NUMBA_CACHE_DIR'])"], env=env, check=True,
                          capture_output=True, text=True).stdout.strip()  # fmt: skip
     assert out == os.path.join(str(tmp_path), "recipdyn", "numba", fp)
+    # numba imported before recipdyn (a script, a test module) reads the variable only when
+    # it compiles: the kernels must still be cached in that folder, not beside the sources
+    out = subprocess.run([sys.executable, "-c", "import numba, recipdyn; "
+                          "from recipdyn.model import valves; "
+                          "print(valves.state_force._cache._cache_path)"], env=env, check=True,
+                         capture_output=True, text=True).stdout.strip()  # fmt: skip
+    assert out.startswith(os.path.join(str(tmp_path), "recipdyn", "numba", fp))

@@ -43,6 +43,8 @@ def _source_fingerprint() -> str:
 # setting wins.
 os.environ.setdefault("NUMBA_CACHE_DIR",
                       os.path.join(_cache_dir(), "numba", _source_fingerprint()))  # fmt: skip
+if "numba.core.config" in sys.modules:  # numba came first (a script, a test module): it reads
+    sys.modules["numba.core.config"].reload_config()  # the variable again only when compiling
 
 _LAZY = {
     "simulate": "simulate",
