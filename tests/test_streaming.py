@@ -196,3 +196,24 @@ def test_features_windows_with_a_tacho_are_read_block_by_block(tmp_path, monkeyp
             if np.isfinite(ref[k]):
                 assert r[k] == pytest.approx(ref[k], rel=1e-9, abs=1e-12), (k, i)
     assert np.isfinite(rows[3]["order_1"]) and rows[3]["order_1"] == pytest.approx(1.0, rel=0.02)
+
+
+def test_features_of_a_whole_file_longer_than_memory_is_refused_with_the_remedy(tmp_path, capsys):
+    """features without --window makes one row from the whole signal: a file longer than
+    --max-memory-samples is refused before it is read (exit 2, the limit and --window named,
+    no traceback); the same file with a higher limit, or with a window, gives its rows."""
+    fs, n = 5000.0, 30_000
+    p = tmp_path / "long.npy"
+    np.save(p, _signal(n, fs))
+    out = tmp_path / "t.csv"
+    code = main(["features", str(p), "--fs", "5kHz", "--max-memory-samples", "20000",
+                 "-o", str(out), "--no-progress"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "max_memory_samples = 20000" in err and "--window" in err, err
+    assert "Traceback" not in err and not out.exists()
+    code = main(["features", str(p), "--fs", "5kHz", "--max-memory-samples", "40000",
+                 "-o", str(out), "--no-progress"])  # fmt: skip
+    assert code == 0 and len(out.read_text().strip().splitlines()) == 2
+    code = main(["features", str(p), "--fs", "5kHz", "--max-memory-samples", "20000",
+                 "--window", "2 s", "-o", str(out), "--no-progress"])  # fmt: skip
+    assert code == 0 and len(out.read_text().strip().splitlines()) == 1 + n // 10_000

@@ -21,7 +21,7 @@ from .analysis import (
 )
 from .analysis.plots import plot_divergence, plot_lyapunov_history, plot_phase, plot_spectrum
 from .analysis.signal import assess_signal
-from .defaults import ATOL, LYAP_TOL, RTOL
+from .defaults import ATOL, LYAP_TOL, MAX_MEMORY_SAMPLES, RTOL
 from .io import forcing_frequency, save_figure, write_text
 from .io import jsonable as _plain
 from .model.compressor import compressor_model
@@ -266,9 +266,8 @@ def _stream_record(path, column, fs, keep: int, progress: bool):
 
 
 #: Samples per Welch segment of a long record's spectrum (resolution fs / 65536: 0.15 Hz at
-#: 10 kHz) and the record length above which a file is read in blocks (analyze_signal).
+#: 10 kHz); the record length above which a file is read in blocks is MAX_MEMORY_SAMPLES.
 WELCH_SEGMENT = 1 << 16
-MAX_MEMORY_SAMPLES = 1 << 24
 #: The first samples of a long record that the detailed analyses use.
 EXCERPT_SAMPLES = 1 << 20
 

@@ -51,3 +51,6 @@ RC_MIN = 1e-7
 #: A run may plan to use at most this fraction of the memory available when it starts
 #: (``--max-memory`` overrides).
 MEMORY_FRACTION = 0.5
+#: Signal files longer than this many samples are read block by block (``analyze``), or
+#: refused by ``features`` without ``--window`` (a whole-file row would need the whole file).
+MAX_MEMORY_SAMPLES = 1 << 24

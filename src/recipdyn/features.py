@@ -16,6 +16,7 @@ import numpy as np
 
 from .analysis.spectrum import amplitude_spectrum
 from .analysis.vibration import angle_resample, indicators, order_spectrum_angle, velocity_rms
+from .defaults import MAX_MEMORY_SAMPLES
 from .model.parameters import ParameterError
 
 __all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS",
@@ -120,14 +121,19 @@ def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
 
 
 def file_features(path: str | Path, *, column=None, fs=None, window: str | None = None,
-                  speed=None, tacho=None, chaos: bool = False,
-                  progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+                  speed=None, tacho=None, chaos: bool = False, progress: bool = False,
+                  max_memory_samples: int = MAX_MEMORY_SAMPLES,
+                  ) -> list[dict[str, Any]]:  # fmt: skip
     """Rows for one file: a recipdyn run (its vibration signal, speed and parameters) or a
     measured signal (``column``/``fs`` as for analyze; ``speed`` or a ``tacho`` column for
-    the orders)."""
+    the orders).
+
+    With ``window``, a signal file is read block by block, whatever its length. Without, its
+    one row needs the whole signal in memory: a file longer than ``max_memory_samples`` is
+    refused (a :class:`ParameterError` that says to give a window) before anything is read."""
     from .analysis.vibration import crank_angle
     from .analyze import is_record
-    from .io_signal import crank_revs, read_signal, speed_hz
+    from .io_signal import crank_revs, read_signal, record_length, speed_hz
 
     path = Path(path)
     labels: dict[str, Any] = {}
@@ -145,6 +151,14 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
     else:
         if window:  # window by window: files longer than memory are fine
             return _streamed_rows(path, column, fs, window, speed, chaos, progress, tacho)
+        n_est = record_length(path, column=column)
+        if n_est is not None and n_est > max_memory_samples:
+            raise ParameterError(
+                f"{path.name}: about {n_est} samples, more than max_memory_samples = "
+                f"{max_memory_samples} for one row of the whole file; give --window (e.g. "
+                "'10 s' or '20 rev': read block by block, one row per window) or raise "
+                "--max-memory-samples"
+            )
         sig = read_signal(path, column=column, fs=fs)
         x, rate, name = sig.x, sig.fs, sig.name
         f_rev = None

@@ -37,6 +37,12 @@ def features(
         help="Add the 0-1 test and the Rosenstein exponent with their statuses (slower).",
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
+    max_memory_samples: int = typer.Option(
+        None,
+        "--max-memory-samples",
+        help="Signal files without --window: longer ones are refused (their one row needs the "
+        "whole file in memory; with --window any length is read block by block). Default 2^24.",
+    ),
 ) -> None:
     """Time-domain statistics, spectral and order features, chaos indicators: one row per
     run or window, labelled with the run's parameters."""
@@ -53,7 +59,10 @@ def features(
             if path.is_dir():
                 rows += [{"store": path.name, **r} for r in sweep_features(path)]
             else:
+                extra = {} if max_memory_samples is None else {
+                    "max_memory_samples": max_memory_samples}  # fmt: skip
                 rows += file_features(path, column=column, fs=fs, window=window, speed=speed,
-                                      tacho=tacho, chaos=chaos, progress=progress)  # fmt: skip
+                                      tacho=tacho, chaos=chaos, progress=progress,
+                                      **extra)  # fmt: skip
     write_table(rows, out)
     typer.echo(f"wrote {len(rows)} row(s) to {out}")
