@@ -80,17 +80,24 @@ def assessed(name, stride=1):
 
 def test_published_exponents_hold_for_the_equations():
     """The reference values the estimators are judged against, recomputed from the equations
-    (QR over 2e5 iterations: standard error ~1e-3; Benettin over 5000 time units): within
-    2 % of the published numbers, so the table below tests the estimators, not the
-    references."""
+    (QR over 2e5 iterations: standard error ~1e-3): the maps within 2 % of the published
+    numbers, so the table below tests the estimators, not the references.
+
+    The hyperchaotic Rossler flow's finite-time exponent scatters: 48 Benettin runs of 5000
+    time units from starts 1e-6 apart (independent samples after the transient; another CPU's
+    rounding draws one such sample) gave lambda1 = 0.101 ... 0.123, mean 0.1126, standard
+    deviation 0.0038 (3.4 %). One run held to 3 % failed on a machine whose rounding drew
+    0.1154. The mean of eight runs (~7 s) has sigma 0.0013: bound 0.006 (4 sigma plus the
+    0.0006 by which the mean of 48 differs from the published 0.112)."""
     for make, x0, lam in MAPS.values():
         r = lyapunov_spectrum_map(make(), x0, 200_000)
         assert r.exponents[0] == pytest.approx(lam, rel=0.02)
-    r = lyapunov_spectrum(S.rossler_hyper(), [-10, -6, 0, 10], 5000.0, t_transient=200.0)
-    assert r.exponents[0] == pytest.approx(0.1120, rel=0.03)
-    # the second positive exponent (hyperchaos; published 0.019) converges slowly: 0.0247
-    # after 5000 time units, 0.0206 after 20000 on this machine
-    assert 0.012 < r.exponents[1] < 0.032
+    runs = [lyapunov_spectrum(S.rossler_hyper(), np.array([-10, -6, 0, 10]) * (1 + 1e-6 * i),
+                              5000.0, t_transient=200.0).exponents for i in range(8)]  # fmt: skip
+    assert np.mean([r[0] for r in runs]) == pytest.approx(0.1120, abs=0.006)
+    # the second positive exponent (hyperchaos; published 0.019) converges slowly: 0.0178 ...
+    # 0.0253 after 5000 time units in the 48 runs above (sigma 0.0019), 0.0206 after 20000
+    assert all(0.012 < r[1] < 0.032 for r in runs)
 
 
 CHAOTIC = [*MAPS, *FLOWS]

@@ -163,18 +163,24 @@ def _ldl_solve(n: int) -> list[str]:
     return out
 
 
-def accelerations_source(lag: Lagrangian, name: str, inputs: int) -> str:
+def accelerations_source(lag: Lagrangian, name: str, inputs: int, given=()) -> str:
     """Python source of ``{name}_accelerations(t, y, p, u)``: ``qdd`` of ``M qdd = b`` as a
     tuple, allocating nothing (for a right-hand side called ~10^5 times a revolution).
 
     ``y`` holds ``(q, qd)`` (an array or a tuple), ``p`` the parameters except the last
     ``inputs``, which come from the tuple ``u`` (forces computed per call, e.g. contact laws).
     The solve is the straight-line ``L D L^T`` of the symmetric positive definite mass matrix.
-    No imports: the caller's module provides ``nb`` and ``math`` (or ``np``)."""
+    ``given``: subexpressions the caller has computed already (e.g. ``sin`` and ``cos`` of the
+    crank angle), read from ``u`` after the inputs, in order. No imports: the caller's module
+    provides ``nb`` and ``math`` (or ``np``)."""
     n = lag.n
     n_p = len(lag.params) - inputs
     low = [(i, j) for i in range(n) for j in range(i + 1)]
-    head, vals = _body(lag, [lag.M[i, j] for i, j in low] + [lag.b[i] for i in range(n)])
+    names = [sp.Symbol(f"_g{i}") for i in range(len(given))]
+    exprs = [lag.M[i, j] for i, j in low] + [lag.b[i] for i in range(n)]
+    exprs = [e.subs(dict(zip(given, names, strict=True))) for e in exprs]
+    head, vals = _body(lag, exprs)
+    head[:0] = [f"    _g{i} = u[{inputs + i}]" for i in range(len(given))]
     for i in range(n_p, len(lag.params)):  # the inputs: from u, not p
         head[head.index(f"    _p{i} = p[{i}]")] = f"    _p{i} = u[{i - n_p}]"
     lines = ["@nb.njit(cache=True)", f"def {name}_accelerations(t, y, p, u):",
