@@ -70,7 +70,7 @@ from .joints.contact import (
     normal_force,
     short_bearing_forces,
 )
-from .load import CYCLE_PARAMS, gas_force_kernel, pack_load
+from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -255,7 +255,10 @@ G_AUX = G_GAS + va.N_GAS
 
 
 @nb.njit(cache=True)
-def _gas(t, y, p):
+def _gas(t, y, p, s1, c1):
+    """The gas force on the crosshead (``s1``, ``c1``: sin and cos of the crank angle)."""
+    if p[P_LOADKIND] == 0.0:  # the paper's load
+        return p[P_LOADSIGN] * p[P_LOADAMP] * mu_sincos(s1, c1)
     if p[P_LOADKIND] == LOAD_STATE:
         return va.state_force(y, G_GAS, p[P_TABLE:])
     th1 = p[P_TH10] + p[P_OMEGA] * t
@@ -286,7 +289,7 @@ def _mechanism(t, y, p, out, cfg):
     """The mechanism's derivatives ``out[:12]`` (real or complex ``y``, ``out``; no arrays
     allocated); returns (crosshead velocity, cos theta2) for the gas."""
     f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = _joints(t, y, p, cfg)
-    fg = _gas(t, y, p)
+    fg = _gas(t, y, p, s1, c1)
     # the generated kernels' INPUTS, then sin and cos of the crank angle
     u = (fg, f1[0], f1[1], f2[0], f2[1], f1[2] + f2[2], s1, c1)
     for i in range(4):
@@ -683,7 +686,8 @@ def _joint_series(cfg, t, y, p):
         out[i, 14:18] = d[4:8]
         out[i, 18] = th2d
         out[i, 19] = v3
-        out[i, 20] = _gas(t[i], yi, p)
+        th1 = p[P_TH10] + p[P_OMEGA] * t[i]
+        out[i, 20] = _gas(t[i], yi, p, math.sin(th1), math.cos(th1))
     return out
 
 

@@ -64,6 +64,24 @@ def mu_kernel(theta1: float) -> float:
     return 1.0
 
 
+_SIN16, _COS16 = math.sin(_PI / 16.0), math.cos(_PI / 16.0)
+_COS7, _COS23 = math.cos(7.0 * _PI / 16.0), math.cos(23.0 * _PI / 16.0)
+
+
+@nb.njit(cache=True)
+def mu_sincos(s1: float, c1: float) -> float:
+    """:func:`mu_kernel` from ``sin`` and ``cos`` of the crank angle (a caller that has them
+    saves the angle's reduction and a sine): ``sin(pi/2 - phi) = cos theta1``,
+    ``sin(phi + pi/16)`` by the addition theorem, the branches by the signs and ``cos`` (it
+    decreases on [0, pi], increases on [pi, 2 pi]). Equal to :func:`mu_kernel` to rounding:
+    mu is continuous at every branch point."""
+    if s1 >= 0.0:
+        return c1 if c1 >= _COS7 else _SIN16
+    if c1 <= _COS23:
+        return -(s1 * _COS16 + c1 * _SIN16)
+    return 1.0
+
+
 def mu_paper(theta1) -> np.ndarray:
     """Cylinder pressure coefficient mu of Eq. (2) at crank angle(s) theta1 (rad)."""
     th = np.asarray(theta1, dtype=np.float64)
