@@ -118,16 +118,23 @@ def _may_cross(event, t, y, f, y_new, f_new, h, g_old, g_new, event_dir, p, ybuf
 
 
 @nb.njit(cache=True)
-def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp):
+def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp, acc):
+    """The stages ``K[1:n_stages]`` (``K[0] = f``). The sums over earlier stages run stage by
+    stage over contiguous rows of ``K`` (they vectorise; ``acc`` is scratch), in the same order
+    as before, so the results are the same to the bit; zero coefficients are skipped."""
     n = y.shape[0]
     for j in range(n):
         K[0, j] = f[j]
     for s in range(1, n_stages):
         for j in range(n):
-            acc = 0.0
-            for k in range(s):
-                acc += A[s, k] * K[k, j]
-            ytmp[j] = y[j] + h * acc
+            acc[j] = 0.0
+        for k in range(s):
+            a = A[s, k]
+            if a != 0.0:
+                for j in range(n):
+                    acc[j] += a * K[k, j]
+        for j in range(n):
+            ytmp[j] = y[j] + h * acc[j]
         rhs(t + C[s] * h, ytmp, p, K[s])
 
 
@@ -288,6 +295,7 @@ def dop853_kernel(
     f_new = np.empty(n)
     Fd = np.empty((7, n))
     ydense = np.empty(n)
+    sacc = np.empty(n)
     err_exp = -1.0 / 8.0
     while t < t_stop:
         if nsteps >= max_steps:
@@ -312,12 +320,16 @@ def dop853_kernel(
                 t_new = t1
             h = t_new - t
             h_abs = abs(h)
-            _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp)
+            _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp, sacc)
             for j in range(n):
-                acc = 0.0
-                for k in range(n_stages):
-                    acc += B[k] * K[k, j]
-                y_new[j] = y[j] + h * acc
+                sacc[j] = 0.0
+            for k in range(n_stages):
+                b = B[k]
+                if b != 0.0:
+                    for j in range(n):
+                        sacc[j] += b * K[k, j]
+            for j in range(n):
+                y_new[j] = y[j] + h * sacc[j]
             rhs(t + h, y_new, p, f_new)
             nfev += n_stages
             for j in range(n):
