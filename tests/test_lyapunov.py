@@ -10,29 +10,52 @@ from recipdyn.model import CompressorParams, compressor_model
 from recipdyn.model.reference import systems as S
 
 
+#: Finite-time exponents of a chaotic flow scatter from start to start, and another CPU's
+#: rounding is such a change of start: each published value is checked on the mean of
+#: ``ENSEMBLE`` runs from starts 1e-6 apart (independent samples after the transient), with a
+#: bound of 4 standard deviations of that mean plus the measured offset of the mean of 40 runs.
+#: Single runs held to the old bounds failed for 1 in 40 starts each (Lorenz 0.8951 against
+#: 0.9056 +- 0.01, Rossler 0.0775 against 0.0714 +- 0.005, Ueda 0.1082 against 0.103 +- 0.005).
+ENSEMBLE = 8
+
+
+def _ensemble(system, x0, t_total, **kw):
+    return [lyapunov_spectrum(system, np.asarray(x0, float) * (1 + 1e-6 * i), t_total, **kw)
+            for i in range(ENSEMBLE)]  # fmt: skip
+
+
 def test_lorenz():
-    """Lorenz (10, 28, 8/3): (0.9056, 0, -14.572) within 0.01/0.01/0.05; the sum is the
-    divergence -(sigma + 1 + beta) to 1e-3."""
-    r = lyapunov_spectrum(S.lorenz(), [1.0, 1.0, 1.0], 2000.0, t_transient=50.0, dt=0.1)
-    assert r.exponents[0] == pytest.approx(0.9056, abs=0.01)
-    assert r.exponents[1] == pytest.approx(0.0, abs=0.01)
-    assert r.exponents[2] == pytest.approx(-14.572, abs=0.05)
-    assert r.sum == pytest.approx(-(10 + 1 + 8 / 3), abs=1e-3)
-    assert r.history.shape[1] == 3 and r.times[-1] == pytest.approx(2000.0)
+    """Lorenz (10, 28, 8/3): (0.9056, 0, -14.572); the sum is the divergence
+    -(sigma + 1 + beta) to 1e-3 in every run. 40 runs of 2000 time units: lambda1 mean 0.9048,
+    sigma 0.0037 (0.895 ... 0.912), lambda2 sigma 0.0008, lambda3 mean -14.571, sigma 0.0037.
+    Bounds on the mean of 8: 0.007, 0.004, 0.02."""
+    runs = _ensemble(S.lorenz(), [1.0, 1.0, 1.0], 2000.0, t_transient=50.0, dt=0.1)
+    mean = np.mean([r.exponents for r in runs], axis=0)
+    assert mean[0] == pytest.approx(0.9056, abs=0.007)
+    assert mean[1] == pytest.approx(0.0, abs=0.004)
+    assert mean[2] == pytest.approx(-14.572, abs=0.02)
+    for r in runs:
+        assert r.sum == pytest.approx(-(10 + 1 + 8 / 3), abs=1e-3)
+    assert runs[0].history.shape[1] == 3 and runs[0].times[-1] == pytest.approx(2000.0)
 
 
 def test_rossler():
-    r = lyapunov_spectrum(S.rossler(), [1.0, 1.0, 1.0], 5000.0, t_transient=100.0, dt=0.5)
-    assert r.exponents[0] == pytest.approx(0.0714, abs=0.005)
+    """Rossler (0.2, 0.2, 5.7): lambda1 = 0.0714. 40 runs of 5000 time units: mean 0.0713,
+    sigma 0.0019 (0.0665 ... 0.0775); bound on the mean of 8: 0.003."""
+    runs = _ensemble(S.rossler(), [1.0, 1.0, 1.0], 5000.0, t_transient=100.0, dt=0.5)
+    assert np.mean([r.exponents[0] for r in runs]) == pytest.approx(0.0714, abs=0.003)
 
 
 def test_ueda_forced_oscillator():
-    """Ueda x'' + 0.05 x' + x^3 = 7.5 cos t: lambda1 = 0.103 +- 0.005, sum = -0.05."""
+    """Ueda x'' + 0.05 x' + x^3 = 7.5 cos t: lambda1 = 0.103, sum = -0.05 in every run. 40 runs
+    of 3000 periods: mean 0.1031, sigma 0.0023 (0.099 ... 0.108); bound on the mean of 8:
+    0.0035."""
     sysm = S.ueda()
-    r = lyapunov_spectrum(sysm, [2.5, 0.0], 3000 * sysm.period, t_transient=50 * sysm.period)
-    assert r.exponents[0] == pytest.approx(0.103, abs=0.005)
-    assert r.sum == pytest.approx(-0.05, abs=1e-4)
-    np.testing.assert_allclose(r.per_period, r.exponents * 2 * np.pi)
+    runs = _ensemble(sysm, [2.5, 0.0], 3000 * sysm.period, t_transient=50 * sysm.period)
+    assert np.mean([r.exponents[0] for r in runs]) == pytest.approx(0.103, abs=0.0035)
+    for r in runs:
+        assert r.sum == pytest.approx(-0.05, abs=1e-4)
+        np.testing.assert_allclose(r.per_period, r.exponents * 2 * np.pi)
 
 
 def test_linear_system_exact():
