@@ -9,7 +9,6 @@ from recipdyn.analysis import lyapunov_spectrum, lyapunov_spectrum_map
 from recipdyn.model import CompressorParams, compressor_model
 from recipdyn.model.reference import systems as S
 
-
 #: Finite-time exponents of a chaotic flow scatter from start to start, and another CPU's
 #: rounding is such a change of start: each published value is checked on the mean of
 #: ``ENSEMBLE`` runs from starts 1e-6 apart (independent samples after the transient), with a
