@@ -19,20 +19,33 @@ LAMBDA_LORENZ = 0.9056
 
 @pytest.fixture(scope="module")
 def lorenz_x():
+    """The Lorenz x-signal (20 000 samples at dt = 0.01 after a transient of 50) from four
+    starts 1e-6 apart: four independent samples of the chaotic signal, as four CPUs' rounding
+    would give."""
     dt = 0.01
-    sol = integrate(S.lorenz(), [1.0, 1.0, 1.0], (0, 50 + 20000 * dt),
-                    t_eval=50 + np.arange(20000) * dt, rtol=1e-10)  # fmt: skip
-    return sol.y[:, 0], dt
+    runs = [integrate(S.lorenz(), np.array([1.0, 1.0, 1.0]) * (1 + 1e-6 * i),
+                      (0, 50 + 20000 * dt), t_eval=50 + np.arange(20000) * dt, rtol=1e-10)
+            for i in range(4)]  # fmt: skip
+    return [r.y[:, 0] for r in runs], dt
+
+
+#: Bounds on the mean relative error of the four signals' estimates. Measured on 16 signals
+#: (relative to 0.9056): Wolf +11.2 % mean, sigma 4.7 % (+5 ... +24 %: one signal held to 15 %
+#: failed for some starts, i.e. on some CPUs); Rosenstein +1.3 %, sigma 3.8 %; Kantz +5.2 %,
+#: sigma 3.0 %. Bound = |mean| + 4 sigma / 2.
+BOUNDS = {"lyap_wolf": 0.21, "lyap_rosenstein": 0.10, "lyap_kantz": 0.12}
 
 
 @pytest.mark.parametrize("method", [lyap_wolf, lyap_rosenstein, lyap_kantz])
-def test_lorenz_within_15_percent(lorenz_x, method):
+def test_lorenz_within_their_measured_accuracy(lorenz_x, method):
     """Default settings (everything estimated from the data) give lambda1 of the Lorenz
-    x-signal within 15 % of 0.906."""
-    x, dt = lorenz_x
-    r = method(x, dt)
-    assert r.exponent == pytest.approx(LAMBDA_LORENZ, rel=0.15)
-    assert r.params["dim"] >= 2 and r.params["delay"] >= 1
+    x-signal within each estimator's measured accuracy of 0.906 (all within the 25 % that the
+    chaotic test signals are held to)."""
+    xs, dt = lorenz_x
+    rs = [method(x, dt) for x in xs]
+    err = np.mean([r.exponent for r in rs]) / LAMBDA_LORENZ - 1.0
+    assert abs(err) < BOUNDS[method.__name__], err
+    assert all(r.params["dim"] >= 2 and r.params["delay"] >= 1 for r in rs)
 
 
 @pytest.mark.parametrize("method", [lyap_wolf, lyap_rosenstein, lyap_kantz])
@@ -56,23 +69,25 @@ def test_zero_distances_do_not_give_minus_inf():
 
 
 def test_fit_stops_before_saturation(lorenz_x):
-    """The automatic Rosenstein fit ends before the divergence curve saturates."""
-    x, dt = lorenz_x
-    r = lyap_rosenstein(x, dt)
-    lo, hi = r.fit
-    c = r.curve
-    assert c[hi] < c[0] + 0.75 * (np.nanmax(c) - c[0])
-    assert hi > lo + 3
+    """The automatic Rosenstein fit ends before the divergence curve saturates (each signal)."""
+    xs, dt = lorenz_x
+    for x in xs:
+        r = lyap_rosenstein(x, dt)
+        lo, hi = r.fit
+        c = r.curve
+        assert c[hi] < c[0] + 0.75 * (np.nanmax(c) - c[0])
+        assert hi > lo + 3
 
 
 def test_embedding_helpers(lorenz_x):
-    x, _ = lorenz_x
+    xs, _ = lorenz_x
     X = delay_embed(np.arange(10.0), 3, 2)
     np.testing.assert_array_equal(X[0], [0, 2, 4])
     assert X.shape == (6, 3)
-    tau = estimate_delay(x)
-    assert 8 <= tau <= 25  # ~0.16 s for Lorenz x at dt = 0.01 (first AMI minimum)
-    assert 2 <= estimate_dimension(x, tau) <= 4
+    for x in xs:
+        tau = estimate_delay(x)
+        assert 8 <= tau <= 25  # ~0.16 s for Lorenz x at dt = 0.01 (first AMI minimum)
+        assert 2 <= estimate_dimension(x, tau) <= 4
     with pytest.raises(ValueError):
         delay_embed(np.arange(5.0), 4, 2)
 
