@@ -174,7 +174,7 @@ def test_contact_joint_takes_the_cycle_load():
     for t in (0.0, 0.05, 0.2):
         th1 = values["theta1_0"] + values["omega"] * t
         y = m.initial_state(values)  # the state matters only to the dynamic valves
-        assert _gas(t, y, sysm.params) == cycle_force_kernel(th1, c)
+        assert _gas(t, y, sysm.params, np.sin(th1), np.cos(th1)) == cycle_force_kernel(th1, c)
 
 
 def test_cycle_figure_shows_the_cycle(tmp_path):

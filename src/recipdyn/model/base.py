@@ -193,7 +193,8 @@ class ODESystem:
         ``jac(t, y, p, out)``, the exact Jacobian ``df/dy``. Needed for Benettin's method.
     rhs_jac : numba dispatcher, optional
         ``rhs_jac(t, y, p, out, out2d)``: right-hand side and Jacobian in one call, when they
-        share work (used by the tangent-space integration instead of ``rhs`` + ``jac``).
+        share work (used by the tangent-space integration instead of ``rhs`` + ``jac``). The
+        columns of ``passive`` components may be left 0: tangent vectors have none.
     period : float, optional
         Period (in ``t``) of the explicit time dependence, if the system is periodically forced
         (the compressor's crank period ``2*pi/omega``). Used for stroboscopic sections.

@@ -364,18 +364,18 @@ CS_STEP = 1e-60
 
 
 @nb.njit(cache=True)
-def _cs_columns(t, y, p, f, J, cfg):
+def _cs_columns(t, y, p, f, J, cfg, skip_rigid):
     """The right-hand side ``f`` and the Jacobian ``J`` by the complex step (Squire & Trapp
     1998, SIAM Rev. 40, 110-112; Martins, Sturdza & Alonso 2003, ACM TOMS 29, 245-262):
     ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding since no difference is taken, on the
     branch of each switch (contact, clamp, friction law) that the real state takes; ``f`` is
-    the real part of the same evaluations (exact: ``Re f(y + i h e_k) = f(y) + O(h^2)``, h =
-    1e-60), so it costs nothing extra.
+    the real part of the same evaluations (``Re f(y + i h e_k) = f(y) + O(h^2)``, h = 1e-60:
+    equal to the real right-hand side to rounding), so it costs nothing extra.
 
-    Columns computed: the moving joints' coordinates, rates and recorded approach velocities.
-    The others are 0: the work integrals act on nothing, and a rigid joint's eccentricity and
-    rate are constant 0 (their rates are 0), so no tangent or Newton increment has components
-    along them (they are ``ODESystem.passive``); half the columns of a one-pin model."""
+    The work integrals act on nothing (their columns are 0). With ``skip_rigid`` the columns
+    of a rigid joint's states (eccentricity, rate, approach velocity: constant 0, passive in
+    Benettin's method, whose tangent vectors have no components along them) are left 0 too:
+    half the evaluations of a one-pin model."""
     n = y.shape[0]
     yc = np.empty(n, np.complex128)
     fc = np.empty(n, np.complex128)
@@ -384,10 +384,10 @@ def _cs_columns(t, y, p, f, J, cfg):
     J[:, :] = 0.0
     first = True
     for k in range(I_WIN):
-        rigid = (cfg == 0 and (k == 2 or k == 3 or k == 6 or k == 7 or k == 9)) or (
-            cfg == 1 and (k == 0 or k == 1 or k == 4 or k == 5 or k == 8)
-        )
-        if rigid:
+        if skip_rigid and (
+            (cfg == 0 and (k == 2 or k == 3 or k == 6 or k == 7 or k == 9))
+            or (cfg == 1 and (k == 0 or k == 1 or k == 4 or k == 5 or k == 8))
+        ):
             continue
         yc[k] = complex(y[k], CS_STEP)
         _mechanism(t, yc, p, fc, cfg)
@@ -402,9 +402,9 @@ def _cs_columns(t, y, p, f, J, cfg):
 
 @nb.njit(cache=True)
 def _cs_jac(t, y, p, J, cfg):
-    """The Jacobian of :func:`_cs_columns`."""
+    """The full Jacobian of :func:`_cs_columns` (exact at any state, rigid states too)."""
     f = np.empty(y.shape[0])
-    _cs_columns(t, y, p, f, J, cfg)
+    _cs_columns(t, y, p, f, J, cfg, False)
 
 
 @nb.njit(cache=True)
@@ -434,17 +434,17 @@ def jac_both(t, y, p, J):
 
 @compiled(RHS_JAC_SIGNATURE)
 def rhs_jac_crank(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 0)
+    _cs_columns(t, y, p, f, J, 0, True)
 
 
 @compiled(RHS_JAC_SIGNATURE)
 def rhs_jac_crosshead(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 1)
+    _cs_columns(t, y, p, f, J, 1, True)
 
 
 @compiled(RHS_JAC_SIGNATURE)
 def rhs_jac_both(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 2)
+    _cs_columns(t, y, p, f, J, 2, True)
 
 
 @compiled(EVENT_SIGNATURE)
@@ -536,7 +536,8 @@ def record_both(t, y, p, out):
 
 
 #: The rigid joint's eccentricity and its rate (constant 0: no degrees of freedom).
-RIGID = {"crank": (2, 3, 6, 7), "crosshead": (0, 1, 4, 5), "both": ()}
+#: A rigid joint's states (eccentricity, rate, approach velocity): constant 0.
+RIGID = {"crank": (2, 3, 6, 7, 9), "crosshead": (0, 1, 4, 5, 8), "both": ()}
 KERNELS = {  # joints -> (rhs, jac, event, reset, config code, rhs and jac in one call)
     "crank": (rhs_crank, jac_crank, onset_crank, record_crank, 0, rhs_jac_crank),
     "crosshead": (
