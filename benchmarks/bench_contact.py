@@ -38,6 +38,7 @@ def main(argv=()) -> dict:
     s = m.system(v)
     y0 = m.initial_state(v)
     T = m.period(v)
+    c = v["rc"]
     ref = integrate(s, y0, (0.0, T), rtol=1e-13, atol=1e-17).y_final[[0, 1, 4, 5]]
     scale = np.abs(ref).max(axis=None)
 
@@ -67,7 +68,11 @@ def main(argv=()) -> dict:
             ev.reset(t, y, s.params, out)
             y = out
             n_ev += 1
-            y[0:2] *= 1.0 + 1e-15  # just past the surface, so the restart does not stop at once
+            # just past the surface, so the restart does not stop at once: SciPy locates the
+            # root to ~1e-17 on either side, and a fixed relative nudge of 1e-15 (1e-18 m)
+            # left it below, so the same onset was found again up to 30 times in a row
+            rho = float(np.hypot(y[0], y[1]))
+            y[0:2] *= max(1.0 + 1e-15, (1.0 + 4e-16) * c / rho)
 
     # Work-precision: with 9 impacts in the revolution the final state's error does not fall
     # smoothly with the tolerance (a step sequence that lands an impact differently changes
