@@ -2,8 +2,6 @@
 
 import json
 
-import pytest
-
 from recipdyn.cli import main
 
 
@@ -60,8 +58,12 @@ def test_finite_time_exponent_of_a_regular_orbit_is_extrapolated_away():
     largest exponent is ln(bounded growth)/T, 0.20 1/s after 100 revolutions (2.5x its
     running spread: the old verdict said 'positive'), decaying like 8/T (0.06 at 400, 0.015
     at 1600 revolutions). The a + b/T fit of the running estimate puts the limit at 0 within
-    its error; on the chaotic offset case (lambda1 ~ 3-5 1/s) the limit stays within 25 % of
-    the finite-time value. Both orbits are robust to rounding (a torus; a chaotic average)."""
+    its error. On the chaotic offset case the limit stays clearly positive. Measured over 32
+    starts 1e-9 apart (another CPU's rounding draws one such sample): the limit / finite-time
+    ratio 0.85 +- 0.14 (0.49 ... 1.0; the old bound of 25 % failed for 3 of the first 8,
+    whose finite-time lambda1 was 2.3 ... 3.8 1/s), the limit at least 15 times its error
+    (mean 30, over 24 of the starts). Bounds: ratio > 0.25 (4 sigma), limit > 5 errors. The
+    base case's torus gives the same numbers from every start tried (4)."""
     from recipdyn.analysis import lyapunov_spectrum
     from recipdyn.model import CompressorParams
     from recipdyn.model.compressor import compressor_model
@@ -75,8 +77,8 @@ def test_finite_time_exponent_of_a_regular_orbit_is_extrapolated_away():
     p2 = CompressorParams(theta_c_offset=0.3)
     m2 = compressor_model(p2)
     r2 = lyapunov_spectrum(m2, m2.initial_state(), 100 * p2.crank_period)
-    lam2, _ = r2.largest_limit()
-    assert r2.exponents[0] > 1.0 and lam2 == pytest.approx(r2.exponents[0], rel=0.25)
+    lam2, err2 = r2.largest_limit()
+    assert r2.exponents[0] > 1.0 and lam2 > 0.25 * r2.exponents[0] and lam2 > 5 * err2
 
 
 def test_analyze_says_what_it_is_doing(tmp_path):
