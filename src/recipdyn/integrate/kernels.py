@@ -117,24 +117,37 @@ def _may_cross(event, t, y, f, y_new, f_new, h, g_old, g_new, event_dir, p, ybuf
     return False
 
 
+#: From this many states on, the stage sums run stage by stage over contiguous rows of ``K``
+#: (they vectorise: 12 states of the contact model, 263 -> 225 ns per evaluation); below, state
+#: by state (2 states of the paper's model: 100 ns per evaluation, 120 the other way). Both
+#: sum in the order of the stages: the same results to the bit.
+ROW_SUMS_FROM = 8
+
+
 @nb.njit(cache=True)
 def _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp, acc):
-    """The stages ``K[1:n_stages]`` (``K[0] = f``). The sums over earlier stages run stage by
-    stage over contiguous rows of ``K`` (they vectorise; ``acc`` is scratch), in the same order
-    as before, so the results are the same to the bit; zero coefficients are skipped."""
+    """The stages ``K[1:n_stages]`` (``K[0] = f``; ``acc`` is scratch; zero coefficients are
+    skipped in the row sums)."""
     n = y.shape[0]
     for j in range(n):
         K[0, j] = f[j]
     for s in range(1, n_stages):
-        for j in range(n):
-            acc[j] = 0.0
-        for k in range(s):
-            a = A[s, k]
-            if a != 0.0:
-                for j in range(n):
-                    acc[j] += a * K[k, j]
-        for j in range(n):
-            ytmp[j] = y[j] + h * acc[j]
+        if n >= ROW_SUMS_FROM:
+            for j in range(n):
+                acc[j] = 0.0
+            for k in range(s):
+                a = A[s, k]
+                if a != 0.0:
+                    for j in range(n):
+                        acc[j] += a * K[k, j]
+            for j in range(n):
+                ytmp[j] = y[j] + h * acc[j]
+        else:
+            for j in range(n):
+                sj = 0.0
+                for k in range(s):
+                    sj += A[s, k] * K[k, j]
+                ytmp[j] = y[j] + h * sj
         rhs(t + C[s] * h, ytmp, p, K[s])
 
 
@@ -321,15 +334,22 @@ def dop853_kernel(
             h = t_new - t
             h_abs = abs(h)
             _rk_stages(rhs, t, y, f, h, A, C, n_stages, K, p, ytmp, sacc)
-            for j in range(n):
-                sacc[j] = 0.0
-            for k in range(n_stages):
-                b = B[k]
-                if b != 0.0:
-                    for j in range(n):
-                        sacc[j] += b * K[k, j]
-            for j in range(n):
-                y_new[j] = y[j] + h * sacc[j]
+            if n >= ROW_SUMS_FROM:
+                for j in range(n):
+                    sacc[j] = 0.0
+                for k in range(n_stages):
+                    b = B[k]
+                    if b != 0.0:
+                        for j in range(n):
+                            sacc[j] += b * K[k, j]
+                for j in range(n):
+                    y_new[j] = y[j] + h * sacc[j]
+            else:
+                for j in range(n):
+                    sj = 0.0
+                    for k in range(n_stages):
+                        sj += B[k] * K[k, j]
+                    y_new[j] = y[j] + h * sj
             rhs(t + h, y_new, p, f_new)
             nfev += n_stages
             for j in range(n):
