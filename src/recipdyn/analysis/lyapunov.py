@@ -110,6 +110,7 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
         is_row[rows[a]] = True
     W = np.empty((nr, k))
     x = np.empty(k)
+    sgn = np.empty(k)
     z_start = z.copy()
     dt_min = dt / 16.0
     dt_floor = dt / 2.0**20
@@ -158,8 +159,9 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
         t = t1
         for j in range(k):
             sums[j] += math.log(abs(R[j, j]))
+            sgn[j] = 1.0 if R[j, j] >= 0 else -1.0  # makes R's diagonal positive
         # the rows measured become Q; the others (auxiliary values carried along) W R^-1:
-        # x R = w_i, R upper triangular; the signs make R's diagonal positive
+        # x R = w_i, R upper triangular
         for i in range(n):
             if is_row[i]:
                 continue
@@ -169,10 +171,10 @@ def _benettin_dop853(trhs, z, p, n, k, t0, t_total, dt, rtol, atol, max_spread, 
                     acc -= x[m] * R[m, j]
                 x[j] = acc / R[j, j]
             for j in range(k):
-                z[n + i * k + j] = x[j] * (1.0 if R[j, j] >= 0 else -1.0)
+                z[n + i * k + j] = x[j] * sgn[j]
         for a in range(nr):
             for j in range(k):
-                z[n + rows[a] * k + j] = Q[a, j] * (1.0 if R[j, j] >= 0 else -1.0)
+                z[n + rows[a] * k + j] = Q[a, j] * sgn[j]
         if k > 1 and dt > dt_min:
             # halve dt when the mean growth spread over one interval is too large (a rate, so
             # only after a period of averaging). The spread within one interval also
@@ -275,10 +277,16 @@ def _initial_basis(n: int, k: int) -> np.ndarray:
 #: Cached by (rhs, jac, rhs_jac, n, k, passive): numba compiles a closure on
 #: its first call (~0.5 s), so a sweep that asks for exponents at every point compiles once per
 #: worker process instead of once per point.
+def _active_rows(n: int, passive: tuple[int, ...]) -> np.ndarray:
+    """Rows of the tangent vectors that evolve: the ``passive`` ones are held at 0."""
+    active = np.ones(n, dtype=np.bool_)
+    active[list(passive)] = False
+    return active
+
+
 @functools.cache
 def _tangent_rhs(rhs, jac, both, n: int, k: int, passive: tuple[int, ...] = ()):
-    active = np.ones(n, dtype=np.bool_)
-    active[list(passive)] = False  # their tangent components are held at 0
+    active = _active_rows(n, passive)
     if both is not None:  # right-hand side and Jacobian share work: one call
 
         @nb.njit(RHS_JAC_SIGNATURE)
@@ -325,8 +333,7 @@ def _tangent_reset(rhs, event, reset, n: int, k: int, passive: tuple[int, ...] =
     function of size 1, truncation negligible.
     The ``passive`` rows stay 0, as in :func:`_tangent_rhs`.
     """
-    active = np.ones(n, dtype=np.bool_)
-    active[list(passive)] = False
+    active = _active_rows(n, passive)
 
     @nb.njit(RHS_SIGNATURE)
     def treset(t, z, p, out):

@@ -98,6 +98,10 @@ STATE_NAMES = ("ex", "ey", "ex_crosshead", "ey_crosshead", "ex_dot", "ey_dot",
                "W_loss")  # fmt: skip
 STATE_UNITS = ("m",) * 4 + ("m/s",) * 6 + ("J", "J")
 I_WIN, I_WLOSS = 10, 11
+#: A rigid joint's states (eccentricity, rate, approach velocity): constant 0.
+RIGID = {"crank": (2, 3, 6, 7, 9), "crosshead": (0, 1, 4, 5, 8), "both": ()}
+#: The same by configuration code (0 crank, 1 crosshead, 2 both), for the compiled kernels.
+_RIGID_MASK = np.array([[i in RIGID[j] for i in range(len(STATE_NAMES))] for j in JOINTS])
 
 
 @lru_cache(maxsize=3)
@@ -384,10 +388,7 @@ def _cs_columns(t, y, p, f, J, cfg, skip_rigid):
     J[:, :] = 0.0
     first = True
     for k in range(I_WIN):
-        if skip_rigid and (
-            (cfg == 0 and (k == 2 or k == 3 or k == 6 or k == 7 or k == 9))
-            or (cfg == 1 and (k == 0 or k == 1 or k == 4 or k == 5 or k == 8))
-        ):
+        if skip_rigid and _RIGID_MASK[cfg, k]:
             continue
         yc[k] = complex(y[k], CS_STEP)
         _mechanism(t, yc, p, fc, cfg)
@@ -536,8 +537,6 @@ def record_both(t, y, p, out):
 
 
 #: The rigid joint's eccentricity and its rate (constant 0: no degrees of freedom).
-#: A rigid joint's states (eccentricity, rate, approach velocity): constant 0.
-RIGID = {"crank": (2, 3, 6, 7, 9), "crosshead": (0, 1, 4, 5, 8), "both": ()}
 KERNELS = {  # joints -> (rhs, jac, event, reset, config code, rhs and jac in one call)
     "crank": (rhs_crank, jac_crank, onset_crank, record_crank, 0, rhs_jac_crank),
     "crosshead": (
