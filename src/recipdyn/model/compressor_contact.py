@@ -74,7 +74,8 @@ from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
-__all__ = ["CompressorContact", "COMPRESSOR_CONTACT", "lagrangian", "generate", "energy"]
+__all__ = ["CompressorContact", "COMPRESSOR_CONTACT", "lagrangian", "generate", "energy",
+           "overlap_half_angle"]  # fmt: skip
 
 _INF = math.inf
 #: Where the clearance is: the crank pin, the crosshead pin, or both (``clearance_joints``).
@@ -634,6 +635,20 @@ def stiffness(values: Mapping[str, Any], joint: str = "crank") -> float:
                            values["nu_bearing"])  # fmt: skip
 
 
+def overlap_half_angle(R_j: float, c: float, delta: float) -> float:
+    """Half-angle (degrees) of the arc over which a journal of radius ``R_j`` overlaps its
+    bearing (radius ``R_j + c``) at penetration ``delta``, seen from the bearing centre: from
+    the two circles' intersection, ``cos phi = (R_b^2 + |e|^2 - R_j^2) / (2 R_b |e|)`` with
+    ``|e| = c + delta``; ``1 - cos phi ~ delta / (c + delta)`` for ``R_j >> c``. 0 without
+    contact. Hertz's law (and the damping laws built on it) assume a contact small against the
+    radii: an arc of tens of degrees means the real, conformal contact is far from it."""
+    if delta <= 0.0:
+        return 0.0
+    rb, e = R_j + c, c + delta
+    cos_phi = (rb * rb + e * e - R_j * R_j) / (2.0 * rb * e)
+    return math.degrees(math.acos(min(1.0, max(-1.0, cos_phi))))
+
+
 def pack(values: Mapping[str, Any]) -> np.ndarray:
     v = values
     head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
@@ -862,9 +877,12 @@ class CompressorContact(Model):
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Per clearance joint (suffix ``_crosshead`` for the crosshead pin): impacts (count,
-        per revolution, approach velocities), maximum penetration, contact fraction (free
-        flight is the rest), peak and RMS joint force; the energy lost in the joints and the
-        energy-balance residual over the recorded interval; the peak crosshead acceleration."""
+        per revolution, approach velocities), maximum penetration (in m and as a fraction of
+        the clearance) with the half-angle of the overlap arc there (:func:`overlap_half_angle`:
+        how far the contact is from the small contact the point-contact law assumes), contact
+        fraction (free flight is the rest), peak and RMS joint force; the energy lost in the
+        joints and the energy-balance residual over the recorded interval; the peak crosshead
+        acceleration."""
         out: dict[str, float] = {}
         t = ds["time"].values
         revs = (t[-1] - t[0]) / self.period(values) if t.size > 1 else float("nan")
@@ -880,7 +898,7 @@ class CompressorContact(Model):
                                           / values["rc_crosshead"] - 1.0)])  # fmt: skip
             owner = np.argmin(rel, axis=1) if joints == "both" else np.full(
                 len(ev), 0 if joints == "crank" else 1)  # fmt: skip
-        for key, ix, iy, iu, iv, _rc in active:
+        for key, ix, iy, iu, iv, rc in active:
             if has_ev:
                 mine = owner == (0 if key == "" else 1)
                 vr = (ev[mine, ix] * ev[mine, iu] + ev[mine, iy] * ev[mine, iv]) / np.hypot(
@@ -889,12 +907,17 @@ class CompressorContact(Model):
             else:
                 vr = np.empty(0)
             force = ds["joint_force" + key].values
+            pen = float(max(ds["delta" + key].values.max(), 0.0))
+            c = float(values[rc])
+            rj = float(values["journal_radius" if key == "" else "crosshead_pin_radius"])
             out.update({
                 f"impacts{key}": float(vr.size),
                 f"impacts_per_revolution{key}": vr.size / revs if revs > 0 else float("nan"),
                 f"impact_velocity_mean{key}_m_s": float(vr.mean()) if vr.size else 0.0,
                 f"impact_velocity_max{key}_m_s": float(vr.max()) if vr.size else 0.0,
-                f"max_penetration{key}_m": float(max(ds["delta" + key].values.max(), 0.0)),
+                f"max_penetration{key}_m": pen,
+                f"max_penetration_ratio{key}": pen / c,
+                f"contact_arc{key}_deg": overlap_half_angle(rj, c, pen),
                 f"contact_fraction{key}": float(ds["contact" + key].values.mean()),
                 f"peak_joint_force{key}_N": float(force.max()),
                 f"rms_joint_force{key}_N": float(np.sqrt(np.mean(force**2))),
