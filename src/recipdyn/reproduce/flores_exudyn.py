@@ -10,7 +10,8 @@ by an implicit generalised-alpha (here Newmark's trapezoidal rule, spectral radi
 order, no numerical damping) with Newton iterations, at a fixed step. recipdyn uses two
 minimal coordinates (the eccentricity), equations from its Lagrange generator, DOP853 and
 located contact-onset events. The only thing the two share is the benchmark's definition:
-the bodies, the joints, the contact law — written here again from its formula, not imported.
+the bodies, the joints and the contact law, whose force is written here again from its formula
+(only the stiffness value K is taken from the model's parameters).
 
 The clearance joint is a Cartesian connector between the slider pin and the rod's small end
 whose force is a Python function of their relative position and velocity
@@ -61,8 +62,9 @@ def simulate_exudyn(values: dict[str, Any], t_end: float, step: float,
     if values["clearance_joints"] != "crosshead" or float(values["e0_ratio"]) != 0.0:
         raise ValueError("the Exudyn rebuild is the benchmark: clearance at the crosshead pin, "
                          "journal starting at the bearing centre")  # fmt: skip
-    if float(values["friction"]) != 0.0 or float(values["load_amplitude"]) != 0.0:
-        raise ValueError("the Exudyn rebuild has no friction and no gas load")
+    if (float(values["friction"]) != 0.0 or float(values["load_amplitude"]) != 0.0
+            or values["joint"] != "dry"):  # fmt: skip
+        raise ValueError("the Exudyn rebuild has no friction, no oil film and no gas load")
     r, l, ls, m2, J2, m3, g, w, d, th1 = (float(values[k]) for k in (
         "r", "l", "ls", "m2", "J2", "m3", "g", "omega", "d", "theta1_0"))  # fmt: skip
     c = float(values["rc_crosshead"])
