@@ -329,3 +329,19 @@ def test_reset_events_through_simulate_and_a_lyapunov_sweep(tmp_path):
     assert float(res.poincare_x.max()) <= 1e-9
     # the exponent sum is below -2 zeta: the impacts contract phase volume by r**2 each
     assert np.all(res.lambda_sum.values < -2 * 0.05 - 1e-3)
+
+
+@pytest.mark.parametrize("columns", [80, 100, 200])
+def test_models_table_cuts_no_value_at_any_width(columns, capsys, monkeypatch):
+    """`recipdyn models NAME` at 80-100 columns put seven columns side by side, cut defaults
+    with an ellipsis ("lankarani-…") and squeezed the descriptions to a dozen characters; a
+    narrow console now gets one row per parameter with the values on one line and the
+    description under it, a wide one the seven columns. No value is cut at any width."""
+    monkeypatch.setenv("COLUMNS", str(columns))
+    assert main(["models", "compressor-contact"]) == 0
+    shown = capsys.readouterr().out
+    assert "…" not in shown
+    assert "lankarani-nikravesh" in shown
+    for p in get_model("compressor-contact").schema:
+        assert p.name in shown
+    assert ("┃ description" in shown) == (columns >= 150)

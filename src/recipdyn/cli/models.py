@@ -6,6 +6,9 @@ import typer
 
 from . import app
 
+#: From this console width on, the parameter table has a column per field.
+WIDE = 150
+
 
 @app.command()
 def models(
@@ -14,6 +17,7 @@ def models(
     """List the registered models, or print one model's parameters (default, unit, range,
     description, assumed or not)."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Column, Table
 
     from ..model.registry import DEFAULT_MODEL, get_model, model_names
@@ -30,12 +34,24 @@ def models(
         return
     m = get_model(name)
     width = max(len(p.name) for p in m.schema)  # names are never cut: users type them
-    table = Table(Column("name", no_wrap=True, min_width=width), "default", "unit", "allowed",
-                  "group", "assumed", "description",
-                  title=f"{m.name}: {m.description}")  # fmt: skip
-    for row in m.schema.table():
-        table.add_row(row["name"], row["default"], row["unit"], row["range"], row["group"],
-                      row["assumed"], row["description"])  # fmt: skip
+    rows = m.schema.table()
+    title = f"{m.name}: {m.description}"
+    if console.width >= WIDE:  # one column per field
+        table = Table(Column("name", no_wrap=True, min_width=width), "default", "unit",
+                      "allowed", "group", "assumed", "description", title=title)  # fmt: skip
+        for row in rows:
+            table.add_row(row["name"], row["default"], row["unit"], row["range"], row["group"],
+                          row["assumed"], row["description"])  # fmt: skip
+    else:  # narrower: the values on one line, the description under them (nothing cut)
+        table = Table(Column("name", no_wrap=True, min_width=width),
+                      Column("default, allowed range, group; description", overflow="fold"),
+                      title=title, show_lines=True)  # fmt: skip
+        for raw in rows:
+            row = {k: escape(str(v)) for k, v in raw.items()}  # text, not markup
+            unit = "" if row["unit"] in ("-", "") else f" {row['unit']}"
+            assumed = ", [bold]assumed[/bold]" if row["assumed"] else ""
+            table.add_row(row["name"], f"{row['default']}{unit}; allowed {row['range']}; "
+                          f"{row['group']}{assumed}\n[dim]{row['description']}[/dim]")  # fmt: skip
     console.print(table)
     state = ", ".join(f"{s} ({u})" for s, u in zip(m.state_names, m.state_units, strict=True))
     console.print(f"state: {state}; kind: {m.kind}; time unit: {m.time_unit}")
