@@ -34,7 +34,7 @@ def models(
         return
     m = get_model(name)
     width = max(len(p.name) for p in m.schema)  # names are never cut: users type them
-    rows = m.schema.table()
+    rows = [{k: escape(str(v)) for k, v in row.items()} for row in m.schema.table()]  # text
     title = f"{m.name}: {m.description}"
     if console.width >= WIDE:  # one column per field
         table = Table(Column("name", no_wrap=True, min_width=width), "default", "unit",
@@ -46,8 +46,7 @@ def models(
         table = Table(Column("name", no_wrap=True, min_width=width),
                       Column("default, allowed range, group; description", overflow="fold"),
                       title=title, show_lines=True)  # fmt: skip
-        for raw in rows:
-            row = {k: escape(str(v)) for k, v in raw.items()}  # text, not markup
+        for row in rows:
             unit = "" if row["unit"] in ("-", "") else f" {row['unit']}"
             assumed = ", [bold]assumed[/bold]" if row["assumed"] else ""
             table.add_row(row["name"], f"{row['default']}{unit}; allowed {row['range']}; "
