@@ -327,7 +327,8 @@ def test_the_contact_figure_shows_impacts_orbits_and_forces_per_joint():
 
 def test_sweep_records_the_contact_fraction(tmp_path):
     """A contact-loss map: sweeps of the contact-impact joint with -m peak store the time
-    fraction in contact at each point (the mean of the run's 0/1 ``contact`` output). It equals
+    fraction in contact at each point (the mean of the run's 0/1 ``contact`` output) and the
+    largest eccentricity ratio (the deepest penetration, 1 + delta/c). The fraction equals
     what simulate gives for the same point (the same integration; one sample of tolerance for
     a flag that could flip on a rounding difference at a contact transition), the crosshead
     pin's is NaN when that joint is not modelled, and the map is drawn."""
@@ -348,7 +349,12 @@ def test_sweep_records_the_contact_fraction(tmp_path):
                             transient=0, fs=5000.0)  # fmt: skip
     n = run.sizes["time"]
     assert abs(frac[1, 1] - float(run["contact"].mean())) <= 1.0 / n
-    assert any(p.name == "map_contact_fraction.png" for p in sweep_figures(ds, tmp_path / "f"))
+    # the deepest penetration: 1 + the run summary's ratio (the same samples; rounding only)
+    ecc = ds["max_eccentricity_ratio"].values
+    assert ecc[1, 1] == pytest.approx(1.0 + run.attrs["max_penetration_ratio"], rel=1e-12)
+    assert np.isnan(ds["max_eccentricity_ratio_crosshead"].values).all()
+    names = {p.name for p in sweep_figures(ds, tmp_path / "f")}
+    assert {"map_contact_fraction.png", "map_max_eccentricity_ratio.png"} <= names
 
 
 def test_two_onsets_at_both_pins_a_fraction_of_a_step_apart_are_both_located():

@@ -714,6 +714,10 @@ class CompressorContact(Model):
         ("contact", "contact_fraction", "1"),
         ("contact_crosshead", "contact_fraction_crosshead", "1"),
     )
+    max_signals = (
+        ("eccentricity_ratio", "max_eccentricity_ratio", "1"),
+        ("eccentricity_ratio_crosshead", "max_eccentricity_ratio_crosshead", "1"),
+    )
     name = "compressor-contact"
     description = ("compressor with contact-impact clearance joints at the crank pin, the "
                    "crosshead pin or both (free flight, impacts, friction, oil film; Flores et "

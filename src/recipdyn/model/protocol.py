@@ -232,6 +232,10 @@ class Model(ABC):
     #: stored name, unit), e.g. the contact-impact joint's time fraction in contact; NaN for a
     #: point whose run lacks the output.
     mean_signals: tuple[tuple[str, str, str], ...] = ()
+    #: Outputs whose largest value over a run sweeps store with the ``peak`` measure, in the
+    #: same form, e.g. the contact-impact joint's largest eccentricity ratio (above 1: the
+    #: deepest penetration as a fraction of the clearance).
+    max_signals: tuple[tuple[str, str, str], ...] = ()
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         """Events to locate during a simulation (at most one today: the integrator locates

@@ -84,17 +84,18 @@ def _mark_invalid(ax, ds, x, y, done) -> None:
         ax.legend(fontsize=7, loc="best")
 
 
-def _mean_signals(ds) -> list[tuple[str, str]]:
-    """(variable, label) of the model's run means stored in ``ds`` (e.g. the time fraction in
-    contact), skipping variables that are NaN everywhere (a joint that is not modelled)."""
+def _run_signals(ds) -> list[tuple[str, str]]:
+    """(variable, label) of the model's run means and maxima stored in ``ds`` (e.g. the time
+    fraction in contact, the largest eccentricity ratio), skipping variables that are NaN
+    everywhere (a joint that is not modelled)."""
     from ..model.registry import get_model
 
     try:
-        means = get_model(ds.attrs.get("model", "compressor")).mean_signals
+        m = get_model(ds.attrs.get("model", "compressor"))
     except Exception:  # a store from a model that is not installed here
         return []
     out = []
-    for _o, name, unit in means:
+    for _o, name, unit in (*m.mean_signals, *m.max_signals):
         if name in ds and np.isfinite(ds[name].values).any():
             label = name.replace("_", " ")
             out.append((name, f"{label} ({unit})" if unit not in ("", "1") else label))
@@ -143,7 +144,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                  for k in ds.data_vars if k.startswith("peak_") and ds[k].ndim == 1]  # fmt: skip
         lam = ("lambda1", f"largest Lyapunov exponent ({ds['lambda1'].attrs.get('units', '1/s')})"
                if "lambda1" in ds else "")  # fmt: skip
-        for var, ylab in (lam, *peaks, *_mean_signals(ds)):
+        for var, ylab in (lam, *peaks, *_run_signals(ds)):
             if var in ds:
                 fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
                 ax.plot(x[done], ds[var].values[done], "o-", ms=3)
@@ -165,7 +166,7 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 what, sig = k.split("_", 1)
                 maps.append((k, f"{'peak |' + sig + '|' if what == 'peak' else 'RMS ' + sig} "
                                 f"({unit_tex(ds[k].attrs.get('units', ''))})"))  # fmt: skip
-        maps += _mean_signals(ds)
+        maps += _run_signals(ds)
         maps.append(("poincare_distinct", "distinct section points"))
         for var, clabel in maps:
             if var not in ds:

@@ -75,7 +75,7 @@ def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | N
         v[f"rms_{sig}"] = ("f8", (), None, sig_unit)
         for name, unit, *_ in m.validity_bounds:  # where the model holds (e.g. contact >= 0)
             v[f"min_{name}"] = ("f8", (), None, unit)
-        for _out, name, unit in m.mean_signals:  # e.g. the time fraction in contact
+        for _out, name, unit in (*m.mean_signals, *m.max_signals):  # e.g. the contact fraction
             v[name] = ("f8", (), None, unit)
     if "spectrum" in spec.measures:
         v["peak_freq"] = ("f8", ("peak",), N_PEAKS, per_time)

@@ -120,6 +120,8 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
             res[f"min_{name}"] = float(np.min(outs[name].values))
         for out, name, _unit in pt.model.mean_signals:
             res[name] = float(np.mean(outs[out].values)) if out in outs else float("nan")
+        for out, name, _unit in pt.model.max_signals:
+            res[name] = float(np.max(outs[out].values)) if out in outs else float("nan")
         res[f"peak_{pt.vib}"] = float(np.max(np.abs(a)))
         res[f"rms_{pt.vib}"] = float(np.sqrt(np.mean(a**2)))
         if "features" in measures:
