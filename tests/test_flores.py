@@ -72,8 +72,9 @@ def test_exudyn_converges_to_recipdyn_on_the_benchmark(law):
     A wrong sign, a missed term, a mis-recorded approach velocity or a different mechanism would
     leave a difference that does not shrink with the step (before the approach velocity was
     interpolated to the crossing, Lankarani-Nikravesh's converged to 1.7e-5 c, not to 0).
-    Rounding cannot matter: over this window the runs' sensitivity multiplies a 1e-16 change
-    by less than 1e6, against differences of 1e-6 of the clearance."""
+    Rounding cannot matter: over this window a change of 1e-10 m/s in the initial rate moves e
+    by at most 1.2e-10 m (Hertz; 4e-13 m with Lankarani-Nikravesh; measured), so rounding-level
+    changes stay near 1e-15 m, against distances of 1e-10 m and more between the codes."""
     pytest.importorskip("exudyn")
     from recipdyn.reproduce.flores_exudyn import compare
 
