@@ -483,11 +483,18 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
 
 def _markdown(s: dict[str, Any]) -> str:
     v = s["verdict"]
+    measured = s.get("model") == "none (measured signal)"
+    what = s.get("signal", "signal") if measured else "crosshead acceleration"
+    unit = (s.get("units") or "signal units") if measured else "m/s^2"
+    peaks = s["spectrum"]["peaks"]
+    orders = not measured or any(p["crank_order"] for p in peaks)  # a speed was known
     lines = [f"# Analysis of {s['input']}", "", f"**Verdict: {v['verdict']}** — "
-             + "; ".join(v["reasons"]), "", "## Spectrum peaks (crosshead acceleration)", "",
-             "| f (Hz) | amplitude (m/s^2) | crank order |", "|---|---|---|"]  # fmt: skip
-    for p in s["spectrum"]["peaks"]:
-        lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} | {p['crank_order']} |")
+             + "; ".join(v["reasons"]), "", f"## Spectrum peaks ({what})", "",
+             f"| f (Hz) | amplitude ({unit}) |" + (" crank order |" if orders else ""),
+             "|---|---|" + ("---|" if orders else "")]  # fmt: skip
+    for p in peaks:
+        order = f" {p['crank_order']} |" if orders else ""
+        lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} |{order}")
     vib = s.get("vibration")
     if vib:
         lines += ["", "## Vibration", ""]

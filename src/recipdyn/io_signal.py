@@ -30,6 +30,14 @@ TIME_NAMES = ("time", "t", "time_s", "time (s)", "t (s)", "seconds")
 FS_NAMES = ("fs", "Fs", "FS", "sampling_rate", "sample_rate", "sr", "SampleRate")
 
 
+def _is_rate_name(name: str) -> bool:
+    """A scalar holding the sampling rate: one of ``FS_NAMES``, or a name that ends in
+    sample rate / sampling rate / sampling frequency whatever its case and separators (data
+    loggers write e.g. ``Time_Sample_Rate``)."""
+    flat = "".join(ch for ch in name.lower() if ch.isalpha())
+    return name in FS_NAMES or flat.endswith(("samplerate", "samplingrate", "samplingfrequency"))
+
+
 @dataclass
 class MeasuredSignal:
     """One uniformly sampled channel: values, sampling rate (Hz), and where they came from."""
@@ -166,7 +174,9 @@ def read_signal(
             from scipy.io import loadmat
 
             mat = loadmat(path, squeeze_me=True)
-            fs_var = next((k for k in FS_NAMES if k in mat and np.size(mat[k]) == 1), None)
+            scalars = [k for k in mat if not k.startswith("__") and np.size(mat[k]) == 1]
+            fs_var = next((k for k in FS_NAMES if k in scalars), None)
+            fs_var = fs_var or next((k for k in scalars if _is_rate_name(k)), None)
             arrays = [k for k, v in mat.items() if not k.startswith("__")
                       and isinstance(v, np.ndarray) and v.ndim == 1 and v.size > 1
                       and np.issubdtype(v.dtype, np.number)]  # fmt: skip

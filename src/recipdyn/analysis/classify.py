@@ -6,11 +6,14 @@ Rules (each piece of evidence is optional; the verdict says which were used):
   (``lambda1 > max(lyap_tol, 2 * lambda1_err)``) and, when given, the 0-1 test agrees
   (``K > 0.5``); or if K > 0.8 and the section is scattered (no exponent given).
 * **periodic** if the Poincaré section has few distinct points (<= ``max_periodic_points``)
-  or, without a section, if the spectrum's strong lines are all harmonics of one fundamental.
+  or, without a section, if the spectrum's strong lines are all harmonics of one fundamental
+  (the lowest line at least ``MIN_FUNDAMENTAL_TOLS`` tolerances above 0 Hz: a line in the
+  first bins, a drift, would make every frequency its harmonic).
 * **quasi-periodic** otherwise when the exponent is ~0 and K < 0.5 (a closed curve in the
   section, incommensurate spectral lines).
 * **undetermined** when the evidence conflicts (e.g. positive exponent but K ~ 0): the
-  evidence dict then shows why.
+  evidence dict then shows why; and for a signal that is not stationary (``rms_ratio``: its
+  quarters' RMS differ by more than ``MAX_RMS_RATIO``, e.g. the free decay of a hammer test).
 
 For a measured signal (no equations) two more pieces enter:
 
@@ -36,11 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS
+from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS, MAX_RMS_RATIO
 from .poincare import count_distinct_points
 from .spectrum import Spectrum, find_spectral_peaks
 
-__all__ = ["Verdict", "classify"]
+__all__ = ["Verdict", "classify", "quarter_rms_ratio"]
 
 
 @dataclass
@@ -62,15 +65,38 @@ class Verdict:
         return d
 
 
+#: A line counts as a harmonic within this many frequency bins of a multiple of the fundamental.
+HARMONIC_TOL_BINS = 1.5
+#: The fundamental must lie at least this many tolerances above 0 Hz. Any frequency falls
+#: within ``tol`` of a multiple of ``f0`` with probability ``2 tol / f0``: 1/2 at this limit,
+#: so k other lines pass together by chance with probability ``2^-k``. Lower lines (a drift,
+#: a component the record is too short to resolve) stay out of the test and are counted.
+MIN_FUNDAMENTAL_TOLS = 4.0
+
+
 def _line_structure(spec: Spectrum, n: int = 12) -> dict[str, Any]:
-    """Are the strong spectral lines harmonics of the strongest low line?"""
+    """Are the strong spectral lines harmonics of the lowest resolved one?"""
     peaks = find_spectral_peaks(spec, n=n, min_rel_height=0.02)
-    if not peaks:
-        return {"lines": 0, "harmonic_fraction": float("nan")}
-    f0 = min(p.frequency for p in peaks if p.frequency > 0) if peaks else 0.0
-    tol = 1.5 * spec.resolution
-    harm = [abs(p.frequency / f0 - round(p.frequency / f0)) * f0 <= tol for p in peaks]
-    return {"lines": len(peaks), "fundamental_hz": f0, "harmonic_fraction": float(np.mean(harm))}
+    tol = HARMONIC_TOL_BINS * spec.resolution
+    resolved = [p for p in peaks if p.frequency >= MIN_FUNDAMENTAL_TOLS * tol]
+    out: dict[str, Any] = {"lines": len(resolved)}
+    if len(resolved) < len(peaks):
+        out["unresolved_lines"] = len(peaks) - len(resolved)
+    if not resolved:
+        out["harmonic_fraction"] = float("nan")
+        return out
+    f0 = min(p.frequency for p in resolved)
+    harm = [abs(p.frequency / f0 - round(p.frequency / f0)) * f0 <= tol for p in resolved]
+    return out | {"fundamental_hz": f0, "harmonic_fraction": float(np.mean(harm))}
+
+
+def quarter_rms_ratio(x) -> float:
+    """Largest over smallest RMS (about the whole record's mean) of the record's four quarters:
+    ~1 for a stationary signal, large for a decay, a run-up or a burst (inf if a quarter is
+    constant at the mean)."""
+    x = np.asarray(x, dtype=float)
+    r = np.array([np.sqrt(np.mean(q**2)) for q in np.array_split(x - x.mean(), 4)])
+    return float(r.max() / r.min()) if r.min() > 0 else float("inf")
 
 
 def _signal_exponent(estimates, time_scale, tol, ev, reasons):
@@ -108,8 +134,8 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
              section=None, spectrum: Spectrum | None = None, lyap_tol: float = LYAP_TOL,
              max_periodic_points: int = MAX_PERIODIC_POINTS, determinism=None,
              signal_lyapunov=None, time_scale: float = 1.0, signal_tol: float = LYAP_TOL,
-             section_rtol: float = 1e-6,
-             section_extent: float | None = None, section_scale=None) -> Verdict:  # fmt: skip
+             section_rtol: float = 1e-6, section_extent: float | None = None,
+             section_scale=None, rms_ratio: float | None = None) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
     :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
@@ -117,9 +143,13 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     ``lyap_tol`` is in the exponent's units; ``section_rtol`` the relative distance under
     which section points are one (1e-6 for an integration; larger for measured signals),
     ``section_extent`` the widest group that still counts as one point and ``section_scale``
-    the scale of both (:func:`~recipdyn.analysis.poincare.count_distinct_points`)."""
+    the scale of both (:func:`~recipdyn.analysis.poincare.count_distinct_points`).
+    ``rms_ratio`` (:func:`quarter_rms_ratio` of a signal) above ``MAX_RMS_RATIO`` makes the
+    verdict undetermined: every estimator here assumes a stationary record."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
+    if rms_ratio is not None:
+        ev["quarter_rms_ratio"] = float(rms_ratio)
     deterministic = None
     if determinism is not None:
         deterministic = bool(getattr(determinism, "nonlinear", determinism))
@@ -162,6 +192,12 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
         ev["section_distinct"] = int(n_distinct)
     if spectrum is not None:
         ev.update({f"spectrum_{k}": v for k, v in _line_structure(spectrum).items()})
+    if rms_ratio is not None and not rms_ratio <= MAX_RMS_RATIO:
+        reasons.insert(0, f"not stationary: the RMS of the record's quarters differs "
+                       f"{rms_ratio:.3g}x (> {MAX_RMS_RATIO:g}; a decay, a run-up or a burst), "
+                       "and the exponents, the 0-1 test, the surrogates and the section all "
+                       "assume a stationary record")  # fmt: skip
+        return Verdict("undetermined", ev, reasons)
     pos = lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err)
     flat = lambda1 == 0.0 and (k01 is None or k01 < 0.5)  # no divergence: noise never is
     if deterministic is False and not flat:
@@ -216,7 +252,17 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
                        "(its lines are not all harmonics of one fundamental)")  # fmt: skip
         return Verdict("undetermined", ev, reasons)
     if k01 is None or k01 < 0.5:
+        if n_distinct is None and ev.get("spectrum_lines") == 0:  # nothing says "lines"
+            reasons.append("no spectral line resolved (none above "
+                           f"{MIN_FUNDAMENTAL_TOLS * HARMONIC_TOL_BINS:g} bins: a drift, or a "
+                           "record shorter than a few periods)")  # fmt: skip
+            return Verdict("stochastic" if deterministic is False else "undetermined", ev,
+                           reasons)  # fmt: skip
         reasons.append("no positive exponent" if lambda1 is not None else "no exponent given")
+        frac = ev.get("spectrum_harmonic_fraction")
+        if n_distinct is None and frac is not None and frac < 1:
+            reasons.append(f"{frac:.0%} of the strong spectral lines are harmonics of "
+                           f"{ev['spectrum_fundamental_hz']:.4g} Hz")  # fmt: skip
         if k01 is not None:
             reasons.append(f"0-1 test K = {k01:.2f} < 0.5")
         return Verdict("quasi-periodic", ev, reasons)

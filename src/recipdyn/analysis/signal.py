@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from .classify import Verdict, classify
+from ..defaults import MAX_RMS_RATIO
+from .classify import Verdict, classify, quarter_rms_ratio
 from .embedding import Embedding, choose_embedding
 from .lyapunov_signal import SignalLyapunov, _gate, lyap_kantz, lyap_rosenstein, lyap_wolf
 from .spectrum import amplitude_spectrum
@@ -51,8 +52,14 @@ class SignalAssessment:
 
     def evidence_table(self) -> list[tuple[str, str, str]]:
         """(evidence, value, status) rows, as printed by the CLI."""
-        rows = [("embedding", f"delay {self.embedding.delay}, dimension {self.embedding.dim}",
-                 self.embedding.status)]  # fmt: skip
+        rows = []
+        ratio = self.verdict.evidence.get("quarter_rms_ratio")
+        if ratio is not None:
+            rows.append(("stationarity", f"quarters' RMS ratio {ratio:.3g}",
+                         "ok" if ratio <= MAX_RMS_RATIO else
+                         f"not stationary (> {MAX_RMS_RATIO:g})"))  # fmt: skip
+        rows.append(("embedding", f"delay {self.embedding.delay}, dimension {self.embedding.dim}",
+                     self.embedding.status))  # fmt: skip
         for k, r in self.lyapunov.items():
             val = f"{r.exponent:.4g} /s" if r.ok else "-"
             rows.append((f"lambda1 ({k})", val, r.status + (f": {r.reason}" if r.reason else "")))
@@ -163,7 +170,8 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
     verdict = classify(k01=z01.K if z01.status == "ok" else None, spectrum=spec,
                        section=section, determinism=sur, signal_lyapunov=list(lyap.values()),
                        time_scale=emb.delay * dt, section_rtol=rtol,
-                       section_extent=extent, section_scale=scale)  # fmt: skip
+                       section_extent=extent, section_scale=scale,
+                       rms_ratio=quarter_rms_ratio(x))  # fmt: skip
     if extent is not None:
         verdict.evidence["section_tolerance"] = rtol
     verdict.evidence["embedding_delay"] = emb.delay
