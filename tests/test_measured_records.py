@@ -83,6 +83,11 @@ def test_a_line_in_the_first_bins_is_not_a_fundamental():
     assert out["harmonic_fraction"] < 1
     v = classify(spectrum=amplitude_spectrum(x, fs), k01=0.0, lambda1=0.0)
     assert v.verdict == "quasi-periodic", v.reasons
+    # a record of 5 periods (a 5-revolution sweep point): its fundamental, at 5 bins, is kept
+    short = sum(a * np.sin(2 * np.pi * 5 * k / n * t) for k, a in ((1, 1.0), (2, 0.5), (3, 0.3)))
+    out = _line_structure(amplitude_spectrum(short, fs))
+    assert out["fundamental_hz"] == pytest.approx(5 / n) and out["harmonic_fraction"] == 1
+    assert "unresolved_lines" not in out
 
 
 def test_quarter_rms_ratio_of_a_decay_and_of_noise():

@@ -67,11 +67,13 @@ class Verdict:
 
 #: A line counts as a harmonic within this many frequency bins of a multiple of the fundamental.
 HARMONIC_TOL_BINS = 1.5
-#: The fundamental must lie at least this many tolerances above 0 Hz. Any frequency falls
-#: within ``tol`` of a multiple of ``f0`` with probability ``2 tol / f0``: 1/2 at this limit,
-#: so k other lines pass together by chance with probability ``2^-k``. Lower lines (a drift,
-#: a component the record is too short to resolve) stay out of the test and are counted.
-MIN_FUNDAMENTAL_TOLS = 4.0
+#: The fundamental must lie at least this many tolerances (3 bins) above 0 Hz. A line in the
+#: first two bins is the record's drift or offset leaking through the window, or a component
+#: with fewer than 3 periods in the record: taken as the fundamental, it would make every line
+#: its harmonic. Such lines stay out of the test and are counted. (Any frequency falls within
+#: ``tol`` of a multiple of ``f0`` with probability ``2 tol / f0``: the test is weak for a
+#: fundamental of a few bins, e.g. 0.6 per line at 5 bins, a 5-period record.)
+MIN_FUNDAMENTAL_TOLS = 2.0
 
 
 def _line_structure(spec: Spectrum, n: int = 12) -> dict[str, Any]:
