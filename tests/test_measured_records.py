@@ -106,3 +106,26 @@ def test_quarter_rms_ratio_of_a_decay_and_of_noise():
     v = classify(lambda1=5.0, k01=0.95, rms_ratio=MAX_RMS_RATIO * 1.01)
     assert v.verdict == "undetermined" and v.reasons[0].startswith("not stationary")
     assert classify(lambda1=5.0, k01=0.95, rms_ratio=MAX_RMS_RATIO).verdict == "chaotic"
+
+
+def test_a_runup_with_a_tacho_gets_no_verdict_and_speed_ripple_does_not_count():
+    """A 5 -> 15 Hz linear run-up over 4 s (orders 3 and 7.5): the quarters' mean speeds are
+    f0 + (f1 - f0)(k + 1/2)/4, ratio 13.75/6.25 = 2.2 exactly for the continuous ramp (the
+    sampled quarters' ends shift it by O(1/n) = 1e-4). Its RMS hardly changes (ratio < 1.1),
+    so only the speed says it is not stationary. A constant 10 Hz with a 5 % speed ripple
+    at the rotation frequency, normal for a reciprocating machine, keeps the ratio at 1 to
+    the ripple's unfinished period over a 10-revolution quarter (0.05 / (2 pi 10) < 1e-3): its
+    verdict comes from its once-per-revolution section (periodic)."""
+    fs, T, f0, f1 = 2000.0, 4.0, 5.0, 15.0
+    t = np.arange(int(T * fs)) / fs
+    revs = f0 * t + (f1 - f0) * t**2 / (2 * T)
+    x = np.sin(2 * np.pi * 3 * revs) + 0.4 * np.sin(2 * np.pi * 7.5 * revs)
+    a = assess_signal(x, fs, revs=revs)
+    assert a.verdict.evidence["quarter_speed_ratio"] == pytest.approx(2.2, rel=1e-3)
+    assert a.verdict.evidence["quarter_rms_ratio"] < 1.1
+    assert a.verdict.verdict == "undetermined"
+    assert "mean speed" in a.verdict.reasons[0]
+    revs = 10.0 * t + 0.05 / (2 * np.pi) * np.sin(2 * np.pi * 10.0 * t)
+    b = assess_signal(np.sin(2 * np.pi * 2 * revs), fs, revs=revs)
+    assert b.verdict.evidence["quarter_speed_ratio"] < 1.001
+    assert b.verdict.verdict == "periodic", b.verdict.reasons

@@ -9,7 +9,7 @@ from __future__ import annotations
 __all__ = [
     "RTOL", "ATOL", "CALIBRATION_RTOL", "CALIBRATION_ATOL", "FS", "SIMULATION",
     "RK4_STEPS_PER_REVOLUTION", "SWEEP", "ANALYZE", "LYAP_TOL", "MAX_PERIODIC_POINTS", "RC_MIN",
-    "MEMORY_FRACTION", "RTOL_RANGE", "ATOL_RANGE", "MAX_RMS_RATIO",
+    "MEMORY_FRACTION", "RTOL_RANGE", "ATOL_RANGE", "MAX_RMS_RATIO", "MAX_SPEED_RATIO",
 ]  # fmt: skip
 
 #: DOP853 tolerances for every trajectory (simulate, sections, sweeps, Benettin). At 1e-10 the
@@ -50,6 +50,11 @@ MAX_PERIODIC_POINTS = 16
 #: drawn from it. Stationary test signals (noise, AR(1), maps, flows, periodic and quasi-periodic
 #: signals of 20 000 samples) give at most 1.07; a measured hammer-test decay 7.9.
 MAX_RMS_RATIO = 3.0
+#: ... and, with a crank angle (tacho or speed), one whose quarters' mean speeds differ by more
+#: than this factor (a run-up or a coast-down; the vibration page switches to a Campbell
+#: diagram at the same 5 %). Mean speeds over quarters, not the instantaneous speed, whose
+#: ripple within a revolution is normal for a reciprocating machine.
+MAX_SPEED_RATIO = 1.05
 #: Smallest non-zero clearance, m. The free link oscillates at ~sqrt(F / (m rc)); at 0.1 um the
 #: integrator already needs ~0.5 million steps per revolution (rc = 0 is the ideal joint).
 RC_MIN = 1e-7

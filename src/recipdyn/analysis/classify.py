@@ -13,7 +13,8 @@ Rules (each piece of evidence is optional; the verdict says which were used):
   section, incommensurate spectral lines).
 * **undetermined** when the evidence conflicts (e.g. positive exponent but K ~ 0): the
   evidence dict then shows why; and for a signal that is not stationary (``rms_ratio``: its
-  quarters' RMS differ by more than ``MAX_RMS_RATIO``, e.g. the free decay of a hammer test).
+  quarters' RMS differ by more than ``MAX_RMS_RATIO``, e.g. the free decay of a hammer test;
+  ``speed_ratio``: their mean speeds by more than ``MAX_SPEED_RATIO``, a run-up).
 
 For a measured signal (no equations) two more pieces enter:
 
@@ -39,11 +40,11 @@ from typing import Any
 
 import numpy as np
 
-from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS, MAX_RMS_RATIO
+from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS, MAX_RMS_RATIO, MAX_SPEED_RATIO
 from .poincare import count_distinct_points
 from .spectrum import Spectrum, find_spectral_peaks
 
-__all__ = ["Verdict", "classify", "quarter_rms_ratio"]
+__all__ = ["Verdict", "classify", "quarter_rms_ratio", "quarter_speed_ratio"]
 
 
 @dataclass
@@ -101,6 +102,21 @@ def quarter_rms_ratio(x) -> float:
     return float(r.max() / r.min()) if r.min() > 0 else float("inf")
 
 
+def quarter_speed_ratio(revs, fs: float) -> float:
+    """Largest over smallest mean speed of the record's four quarters, from the crank angle
+    ``revs`` (revolutions at each sample, NaN where unknown): 1 at constant speed whatever the
+    ripple within a revolution, > 1 in a run-up or a coast-down."""
+    r = np.asarray(revs, dtype=float)
+    idx = np.flatnonzero(np.isfinite(r))
+    speeds = []
+    for q in np.array_split(idx, 4):
+        if q.size > 1 and q[-1] > q[0]:
+            speeds.append(abs(r[q[-1]] - r[q[0]]) * fs / (q[-1] - q[0]))
+    if len(speeds) < 4 or min(speeds) <= 0:
+        return float("nan")
+    return float(max(speeds) / min(speeds))
+
+
 def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     """(lambda1, err, all_refused) from signal estimates; records the evidence."""
     usable = [e for e in estimates if e.ok]
@@ -137,7 +153,8 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
              max_periodic_points: int = MAX_PERIODIC_POINTS, determinism=None,
              signal_lyapunov=None, time_scale: float = 1.0, signal_tol: float = LYAP_TOL,
              section_rtol: float = 1e-6, section_extent: float | None = None,
-             section_scale=None, rms_ratio: float | None = None) -> Verdict:  # fmt: skip
+             section_scale=None, rms_ratio: float | None = None,
+             speed_ratio: float | None = None) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
     :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
@@ -146,12 +163,15 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
     which section points are one (1e-6 for an integration; larger for measured signals),
     ``section_extent`` the widest group that still counts as one point and ``section_scale``
     the scale of both (:func:`~recipdyn.analysis.poincare.count_distinct_points`).
-    ``rms_ratio`` (:func:`quarter_rms_ratio` of a signal) above ``MAX_RMS_RATIO`` makes the
-    verdict undetermined: every estimator here assumes a stationary record."""
+    ``rms_ratio`` (:func:`quarter_rms_ratio` of a signal) above ``MAX_RMS_RATIO``, or
+    ``speed_ratio`` (:func:`quarter_speed_ratio` of its crank angle) above ``MAX_SPEED_RATIO``,
+    makes the verdict undetermined: every estimator here assumes a stationary record."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
     if rms_ratio is not None:
         ev["quarter_rms_ratio"] = float(rms_ratio)
+    if speed_ratio is not None and np.isfinite(speed_ratio):
+        ev["quarter_speed_ratio"] = float(speed_ratio)
     deterministic = None
     if determinism is not None:
         deterministic = bool(getattr(determinism, "nonlinear", determinism))
@@ -199,6 +219,12 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
                        f"{rms_ratio:.3g}x (> {MAX_RMS_RATIO:g}; a decay, a run-up or a burst), "
                        "and the exponents, the 0-1 test, the surrogates and the section all "
                        "assume a stationary record")  # fmt: skip
+        return Verdict("undetermined", ev, reasons)
+    if ev.get("quarter_speed_ratio", 1.0) > MAX_SPEED_RATIO:
+        reasons.insert(0, f"not stationary: the mean speed of the record's quarters differs "
+                       f"{ev['quarter_speed_ratio']:.3g}x (> {MAX_SPEED_RATIO:g}; a run-up or a "
+                       "coast-down), and the exponents, the 0-1 test, the surrogates and the "
+                       "section all assume a stationary record")  # fmt: skip
         return Verdict("undetermined", ev, reasons)
     pos = lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err)
     flat = lambda1 == 0.0 and (k01 is None or k01 < 0.5)  # no divergence: noise never is

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ..defaults import MAX_RMS_RATIO
-from .classify import Verdict, classify, quarter_rms_ratio
+from ..defaults import MAX_RMS_RATIO, MAX_SPEED_RATIO
+from .classify import Verdict, classify, quarter_rms_ratio, quarter_speed_ratio
 from .embedding import Embedding, choose_embedding
 from .lyapunov_signal import SignalLyapunov, _gate, lyap_kantz, lyap_rosenstein, lyap_wolf
 from .spectrum import amplitude_spectrum
@@ -58,6 +58,11 @@ class SignalAssessment:
             rows.append(("stationarity", f"quarters' RMS ratio {ratio:.3g}",
                          "ok" if ratio <= MAX_RMS_RATIO else
                          f"not stationary (> {MAX_RMS_RATIO:g})"))  # fmt: skip
+        speed = self.verdict.evidence.get("quarter_speed_ratio")
+        if speed is not None:
+            rows.append(("steady speed", f"quarters' speed ratio {speed:.4g}",
+                         "ok" if speed <= MAX_SPEED_RATIO else
+                         f"not stationary (> {MAX_SPEED_RATIO:g})"))  # fmt: skip
         rows.append(("embedding", f"delay {self.embedding.delay}, dimension {self.embedding.dim}",
                      self.embedding.status))  # fmt: skip
         for k, r in self.lyapunov.items():
@@ -167,11 +172,13 @@ def assess_signal(x, fs: float, *, methods=("wolf", "rosenstein", "kantz"),
         else:
             notes.append(f"section tolerance {rtol:.3g} of the signal's range (noise estimate "
                          f"{sigma:.3g} from the 4th differences)")  # fmt: skip
+    speed_ratio = None if revs is None else quarter_speed_ratio(revs, fs)
     verdict = classify(k01=z01.K if z01.status == "ok" else None, spectrum=spec,
                        section=section, determinism=sur, signal_lyapunov=list(lyap.values()),
                        time_scale=emb.delay * dt, section_rtol=rtol,
                        section_extent=extent, section_scale=scale,
-                       rms_ratio=quarter_rms_ratio(x))  # fmt: skip
+                       rms_ratio=quarter_rms_ratio(x),
+                       speed_ratio=speed_ratio)  # fmt: skip
     if extent is not None:
         verdict.evidence["section_tolerance"] = rtol
     verdict.evidence["embedding_delay"] = emb.delay
