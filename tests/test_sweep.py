@@ -124,3 +124,39 @@ def test_cli_sweep_and_plot(tmp_path):
     (out / "map_peak_a.png").unlink()
     assert main(["plot", str(out / "sweep.zarr")]) == 0
     assert (out / "map_peak_a.png").exists()
+
+
+def test_campbell_diagram_of_a_speed_sweep_and_old_stores_refused(tmp_path):
+    """A 1-D sweep over the crank speed with --measure spectrum stores each point's forcing
+    frequency (omega / 2 pi, exactly: it is computed from the parameters) and its strongest
+    lines, and draws the Campbell diagram. At rc = 0 the motion is the ideal slider-crank's,
+    periodic at the crank frequency, so every stored line is an order of it to within the
+    record's frequency bin (fs / n = 1 / (revolutions T) = forcing_hz / revolutions). A store
+    that lacks a variable this version writes (made by an older version) is refused on
+    --resume, not crashed into."""
+    import zarr
+
+    from recipdyn.sweep.plots import campbell_figure
+
+    revs = 4.0
+    spec = SweepSpec(
+        axes=(parse_axis("omega=15,25,35"),),
+        measures=("spectrum",),
+        base=CompressorParams(rc=0.0),
+        settings={**SETTINGS, "revolutions": revs},
+    )
+    path = run_sweep(spec, tmp_path / "c", backend="serial", progress=False)
+    ds = open_sweep(path).load()
+    fc = ds.forcing_hz.values
+    assert np.allclose(fc, ds.omega.values / (2 * np.pi), rtol=1e-12, atol=0)
+    f = ds.peak_freq.values
+    ok = np.isfinite(f)
+    assert ok.sum(axis=1).min() >= 2  # the crank frequency and at least one harmonic
+    fcs = np.broadcast_to(fc[:, None], f.shape)
+    off = np.abs(f / fcs - np.round(f / fcs)) * fcs  # Hz from the nearest order
+    assert np.all(off[ok] <= fcs[ok] / revs)  # within one frequency bin
+    p = campbell_figure(ds, tmp_path / "fig")
+    assert p.name == "campbell_omega.png" and p.stat().st_size > 0
+    zarr.open_group(str(path), mode="a").__delitem__("forcing_hz")
+    with pytest.raises(ParameterError, match="older version"):
+        run_sweep(spec, tmp_path / "c", resume=True, progress=False)

@@ -1,4 +1,5 @@
-"""Sweep figures: bifurcation diagram, lambda1 vs parameter, fault-map heatmaps."""
+"""Sweep figures: bifurcation diagram, lambda1 vs parameter, Campbell diagram, fault-map
+heatmaps."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import xarray as xr
 from ..io import save_figure
 from ..plotting import _mpl, axis_label, unit_tex
 
-__all__ = ["sweep_figures", "cell_edges", "wrap_around_mean"]
+__all__ = ["sweep_figures", "campbell_figure", "cell_edges", "wrap_around_mean"]
 
 _LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
            "omega": ("crank speed omega", 1.0, "rad/s")}  # fmt: skip
@@ -102,6 +103,49 @@ def _run_signals(ds) -> list[tuple[str, str]]:
     return out
 
 
+#: Orders of the forcing frequency drawn in the Campbell diagram (1x ... this).
+MAX_ORDER_LINES = 10
+
+
+def campbell_figure(ds: xr.Dataset, out: Path, plt=None) -> Path:
+    """Campbell diagram of a 1-D sweep with ``--measure spectrum``: the strongest spectral lines
+    of the vibration signal at each point over the swept parameter (marker colour and area by
+    amplitude) and, for a forced model, the orders ``k * forcing_hz`` (dashed). Over the crank
+    speed the orders are lines through the origin; a line that stays put while they fan out is
+    a resonance, and lines between the orders are sub- or non-harmonic response."""
+    plt = plt or _mpl()
+    dim = ds.attrs["sweep_axes"].split(",")[0]
+    x, xlabel = _axis(ds, dim)
+    done = ds.done.values.astype(bool)
+    f, a = ds.peak_freq.values[done], ds.peak_amp.values[done]
+    xs = np.repeat(x[done][:, None], f.shape[1], axis=1)
+    ok = np.isfinite(f) & np.isfinite(a) & (a > 0)
+    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
+    if ok.any():
+        big = a[ok].max()
+        sc = ax.scatter(xs[ok], f[ok], c=np.log10(a[ok]), s=12 + 60 * a[ok] / big,
+                        cmap="viridis", edgecolors="k", linewidths=0.3, zorder=3)  # fmt: skip
+        unit = unit_tex(ds.peak_amp.attrs.get("units", ""))
+        fig.colorbar(sc, ax=ax, label=f"log10 amplitude ({unit})" if unit else "log10 amplitude")
+    fc = ds.forcing_hz.values[done] if "forcing_hz" in ds else np.full(done.sum(), np.nan)
+    if np.isfinite(fc).any() and ok.any():
+        top = np.nanmax(f[ok])
+        for k in range(1, min(MAX_ORDER_LINES, int(np.ceil(top / np.nanmin(fc)))) + 1):
+            ax.plot(x[done], k * fc, "--", color="0.55", lw=0.7, zorder=1)
+            ax.annotate(f"{k}\u00d7", (x[done][-1], k * fc[-1]), fontsize=7, color="0.4",
+                        xytext=(2, 0), textcoords="offset points", va="center")  # fmt: skip
+        ax.set_ylim(0, 1.05 * top)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(f"frequency ({unit_tex(ds.peak_freq.attrs.get('units', 'Hz'))})")
+    ax.set_title(f"Campbell diagram ({f.shape[1]} strongest lines per point"
+                 + ("; dashed: orders" if np.isfinite(fc).any() else "") + ")")  # fmt: skip
+    ax.grid(alpha=0.3)
+    p = out / f"campbell_{dim}.png"
+    save_figure(fig, p, dpi=130)
+    plt.close(fig)
+    return p
+
+
 def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
     """Write every figure the store supports; returns their paths."""
     plt = _mpl()
@@ -140,6 +184,8 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 save_figure(fig, p, dpi=130)
                 plt.close(fig)
                 paths.append(p)
+        if "peak_freq" in ds:
+            paths.append(campbell_figure(ds, out, plt))
         peaks = [(k, f"peak |{k.removeprefix('peak_')}| ({unit_tex(ds[k].attrs.get('units', ''))})")
                  for k in ds.data_vars if k.startswith("peak_") and ds[k].ndim == 1]  # fmt: skip
         lam = ("lambda1", f"largest Lyapunov exponent ({ds['lambda1'].attrs.get('units', '1/s')})"

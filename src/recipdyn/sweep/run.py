@@ -80,6 +80,7 @@ def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | N
     if "spectrum" in spec.measures:
         v["peak_freq"] = ("f8", ("peak",), N_PEAKS, per_time)
         v["peak_amp"] = ("f8", ("peak",), N_PEAKS, sig_unit)
+        v["forcing_hz"] = ("f8", (), None, per_time)  # the crank (forcing) frequency: orders
     if "lyapunov" in spec.measures or "verdict" in spec.measures:
         lam_unit = "1" if m.kind == "map" else ("1/s" if m.time_unit == "s" else per_time)
         v["lambda1"] = ("f8", (), None, lam_unit)
@@ -453,6 +454,15 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
         if digest != spec.digest:
             raise ParameterError(f"{store} was made with a different sweep spec; "
                                  "refusing to resume (use --force to start over)")  # fmt: skip
+        stored = set(g.array_keys())
+        differ = sorted(name for name, (_d, extra, size, _u) in _variables(spec).items()
+                        if name not in stored
+                        or g[name].shape != spec.shape + ((size,) if extra else ()))  # fmt: skip
+        if differ:
+            raise ParameterError(f"{store} lacks the variable(s) {', '.join(differ)} in the "
+                                 "layout this version of recipdyn stores for the same spec (it "
+                                 "was made by an older version); refusing to resume (use "
+                                 "--force to start over)")  # fmt: skip
         done, rejected = _verified_done(g, spec)
     else:
         if store.exists():

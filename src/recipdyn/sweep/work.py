@@ -27,7 +27,8 @@ from ..model.registry import get_model
 
 __all__ = ["run_point", "N_PEAKS"]
 
-N_PEAKS = 3
+#: Spectral lines stored per point (``--measure spectrum``; the Campbell diagram's markers).
+N_PEAKS = 8
 
 
 def run_point(task: dict[str, Any]) -> dict[str, Any]:
@@ -135,6 +136,7 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
             for i, pk in enumerate(peaks):
                 f[i], amp[i] = pk.frequency, pk.amplitude
             res["peak_freq"], res["peak_amp"] = f, amp
+            res["forcing_hz"] = float(pt.fc) if pt.fc else float("nan")
         if not need_section:
             y_end, t_end = sol.y_final, sol.t_final
     if "lyapunov" in measures or "verdict" in measures:
@@ -197,6 +199,7 @@ def _compute_map(pt: _Point, measures, s, y0) -> dict[str, Any]:
         for i, pk in enumerate(peaks):
             f[i], amp[i] = pk.frequency, pk.amplitude
         res["peak_freq"], res["peak_amp"] = f, amp
+        res["forcing_hz"] = float("nan")  # a map has no forcing
     if "lyapunov" in measures or "verdict" in measures:
         r = lyapunov_spectrum_map(pt.system, y, max(1, int(s["lyap_revolutions"])),
                                   n_transient=n0)  # fmt: skip
