@@ -181,7 +181,8 @@ SCHEMA = Schema((
 
 
 def _cparams(values: Mapping[str, Any]) -> CompressorParams:
-    keys = set(CompressorParams.__dataclass_fields__) & set(LINK_SCHEMA.names)
+    # the mechanism's load is the valves' (their "gas" is not the cycle load's table)
+    keys = set(CompressorParams.__dataclass_fields__) & set(LINK_SCHEMA.names) - {"gas"}
     return CompressorParams(load="cycle", **{k: values[k] for k in keys if k in values})
 
 

@@ -26,6 +26,7 @@ Chem. Res. 53(6), 2498-2508.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -156,4 +157,112 @@ def isentrope_pressure(values, rho) -> np.ndarray:
     for r in np.atleast_1d(rho):
         state.update(CoolProp.DmassSmass_INPUTS, float(r), s_s)
         out.append(state.p())
+    return np.array(out)
+
+
+# --- The property table of the dynamic valves' chambers (real gas) ---------------------------
+
+#: Nodes per axis of the chamber property table (ln(p/rho) x ln p).
+CHAMBER_NODES = 48
+#: The table spans these multiples of the suction and discharge pressures ...
+CHAMBER_P_RANGE = (0.25, 2.5)
+#: ... and, in p/rho (Z R T), of the suction state's and the isentropic discharge state's.
+CHAMBER_T_RANGE = (0.75, 1.6)
+#: Layout of the table header (then four blocks of CHAMBER_NODES^2 values: phi_u, phi_A,
+#: phi_B, phi_T, row = ln(p/rho) index).
+(T_NX, T_NP, T_LX0, T_DLX, T_LP0, T_DLP, T_HS, T_HD, T_RTS, T_RTD, T_KAPPA) = range(11)
+T_HEADER = 11
+
+
+@functools.lru_cache(maxsize=16)
+def chamber_table(gas: str, ps: float, pd: float, Ts: float) -> np.ndarray:
+    r"""Real-gas properties of a chamber on a grid of ``(ln(p/rho), ln p)``, for
+    :func:`recipdyn.model.valves.gas_rhs` (layout: the ``T_*`` constants).
+
+    The first law of the open, adiabatic chamber in the states ``p`` and ``m`` needs, at
+    ``rho = m / V``: the specific internal energy ``u`` and the derivatives
+    ``A = (dp/drho)_u`` and ``B = (dp/du)_rho``. They are stored scaled so that an ideal gas
+    with constant heat capacities gives constants, which bilinear interpolation reproduces
+    exactly: ``phi_u = (u - u0) rho / p`` (``u0 = u_s - c_v,s T_s``: ``1/(k-1)`` for that
+    gas), ``phi_A = A rho / p`` (1), ``phi_B = B / rho`` (``k - 1``), ``phi_T = p / (rho T)``
+    (``R``). ``p/rho`` (``Z R T``) is the grid's first axis, so the chamber's states, between
+    a little below the suction temperature and a little above the discharge temperature at
+    any pressure, fill it. Energies are relative to ``u0``. The header holds the grid, the
+    enthalpies of the suction gas and of the discharge line's gas (``p_d`` on the suction
+    isentrope), ``p/rho`` of both (the nozzle's ``Z R T``) and the isentropic exponent
+    ``rho c^2 / p`` at suction (the nozzle's). Nodes that CoolProp cannot evaluate or that
+    are not gas (two-phase) take the values of the nearest valid node of their pressure."""
+    import CoolProp
+
+    from .parameters import ParameterError
+
+    st = CoolProp.AbstractState("HEOS", gas)
+    try:
+        st.update(CoolProp.PT_INPUTS, ps, Ts)
+        rho_s, u_s, h_s, s_s = st.rhomass(), st.umass(), st.hmass(), st.smass()
+        u0 = u_s - st.cvmass() * Ts
+        kappa = rho_s * st.speed_sound() ** 2 / ps  # (rho/p)(dp/drho)_s
+        st.update(CoolProp.PSmass_INPUTS, pd, s_s)
+        rho_d, h_d = st.rhomass(), st.hmass()
+    except ValueError as exc:
+        raise ParameterError(
+            f"gas = {gas!r} at suction {ps:g} Pa, {Ts:g} K and discharge {pd:g} Pa: CoolProp "
+            f"cannot evaluate it ({exc})"
+        ) from None
+    n = CHAMBER_NODES
+    lx = np.linspace(math.log(CHAMBER_T_RANGE[0] * ps / rho_s),
+                     math.log(CHAMBER_T_RANGE[1] * pd / rho_d), n)  # fmt: skip
+    lp = np.linspace(math.log(CHAMBER_P_RANGE[0] * ps), math.log(CHAMBER_P_RANGE[1] * pd), n)
+    phi = np.full((4, n, n), np.nan)
+    for i, x in enumerate(np.exp(lx)):
+        for j, p in enumerate(np.exp(lp)):
+            r = p / x
+            try:
+                st.update(CoolProp.DmassP_INPUTS, float(r), float(p))
+                if 0.0 <= st.Q() <= 1.0:  # two-phase: not a gas
+                    continue
+                A = st.first_partial_deriv(CoolProp.iP, CoolProp.iDmass, CoolProp.iUmass)
+                B = st.first_partial_deriv(CoolProp.iP, CoolProp.iUmass, CoolProp.iDmass)
+                phi[:, i, j] = ((st.umass() - u0) / x, A / x, B / r, x / st.T())
+            except ValueError:
+                continue
+    ok = np.isfinite(phi).all(axis=0)
+    if not ok.any(axis=0).all():
+        raise ParameterError(f"gas = {gas!r}: CoolProp cannot evaluate the gas at some chamber "
+                             f"pressure between {math.exp(lp[0]):g} and {math.exp(lp[-1]):g} "
+                             "Pa; choose other pressures")  # fmt: skip
+    for j in range(n):  # fill invalid nodes from the nearest valid one of their pressure
+        good = np.flatnonzero(ok[:, j])
+        for i in np.flatnonzero(~ok[:, j]):
+            phi[:, i, j] = phi[:, good[np.argmin(np.abs(good - i))], j]
+    head = np.zeros(T_HEADER)
+    head[[T_NX, T_NP]] = n
+    head[T_LX0], head[T_DLX] = lx[0], lx[1] - lx[0]
+    head[T_LP0], head[T_DLP] = lp[0], lp[1] - lp[0]
+    head[T_HS], head[T_HD] = h_s - u0, h_d - u0
+    head[T_RTS], head[T_RTD] = ps / rho_s, pd / rho_d
+    head[T_KAPPA] = kappa
+    return np.concatenate([head, phi.ravel()])
+
+
+def suction_density(gas: str, ps: float, Ts: float) -> float:
+    """Density of the suction gas (kg/m^3)."""
+    import CoolProp
+
+    st = CoolProp.AbstractState("HEOS", gas)
+    st.update(CoolProp.PT_INPUTS, ps, Ts)
+    return float(st.rhomass())
+
+
+def isentropic_density(gas: str, ps: float, Ts: float, p) -> np.ndarray:
+    """Densities on the suction isentrope at pressures ``p`` (kg/m^3)."""
+    import CoolProp
+
+    st = CoolProp.AbstractState("HEOS", gas)
+    st.update(CoolProp.PT_INPUTS, ps, Ts)
+    s_s = st.smass()
+    out = []
+    for q in np.atleast_1d(p):
+        st.update(CoolProp.PSmass_INPUTS, float(q), s_s)
+        out.append(st.rhomass())
     return np.array(out)

@@ -20,6 +20,14 @@ while it grows, so that with closed valves ``p V^n`` is constant and the closed 
 at ``(p_s, T_s)``; the discharge line at ``p_d`` and (for back-flow) at the isentropic discharge
 temperature ``T_d = T_s (p_d/p_s)^((n_c-1)/n_c)``.
 
+**Real gas** (``gas`` a CoolProp fluid): the first law of the open, adiabatic chamber with
+real-gas properties, ``dp/dt = (dp/drho)_u (mdot - rho dV/dt)/V + (dp/du)_rho (sum mdot_i
+(h_i - u) - p dV/dt)/m`` (``h_i``: the suction gas's, the discharge line's on the suction
+isentrope, or the chamber's own ``u + p/rho`` for gas that leaves), the properties
+interpolated in :func:`recipdyn.model.realgas.chamber_table` (the equation above with ``n = k``
+for an ideal gas). The nozzle then takes ``Z R T = p/rho`` of the upstream gas and the suction
+gas's isentropic exponent.
+
 **Flow** through a valve of lift ``y`` (max ``y_max``, the guard): an isentropic nozzle of
 effective area ``C_d A_v min(max(y, 0) / y_max, 1)`` (``A_v`` the flow area at full lift),
 exponent ``k`` (``isentropic_exponent``), choked below the critical pressure ratio::
@@ -72,12 +80,15 @@ import numba as nb
 import numpy as np
 
 from . import cycle as cy
+from . import realgas as rg
+from .parameters import GASES
 from .protocol import Param
 
 __all__ = [
     "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
     "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
     "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
+    "real_properties",
     "gas_outputs", "gas_scale",
 ]  # fmt: skip
 
@@ -188,6 +199,16 @@ SCHEMA_PARAMS = (
         group="valves",
     ),
     Param(
+        "gas",
+        "",
+        "ideal",
+        "gas in the cylinder: 'ideal' (gas_constant, isentropic_exponent and the polytropes "
+        "n_compression, n_expansion) or a CoolProp fluid (the first law of the adiabatic "
+        "chamber with real-gas properties from a table; those four are then not used)",
+        choices=GASES,
+        group="valves",
+    ),
+    Param(
         "gas_constant",
         "J/(kg*K)",
         287.05,
@@ -250,8 +271,16 @@ def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
     out[V_TS] = t_s
     out[V_TD] = t_s * ratio ** ((nc - 1.0) / nc)
     out[V_NCH] = cycle_data[cy.C_ACTING]
-    out[V_CRIT:] = _nozzle_constants(float(values["isentropic_exponent"]))
-    return out
+    gas = values.get("gas", "ideal")
+    if gas == "ideal":
+        out[V_CRIT:] = _nozzle_constants(float(values["isentropic_exponent"]))
+        return out
+    # a real gas: the chamber property table follows (realgas.chamber_table), and the nozzle
+    # takes the isentropic exponent of the suction gas
+    tab = rg.chamber_table(gas, float(values["suction_pressure"]),
+                           float(values["discharge_pressure"]), t_s)  # fmt: skip
+    out[V_CRIT:] = _nozzle_constants(float(tab[rg.T_KAPPA]))
+    return np.concatenate([out, tab])
 
 
 def _nozzle_constants(kappa: float) -> tuple[float, float, float, float]:
@@ -278,16 +307,17 @@ def flow_function(ratio: float, kappa: float) -> float:
 
 
 @nb.njit(cache=True, inline="always")
-def _mdot(p_line, t_line, p, t, area, v):
-    """Mass flow into the chamber from a line through an effective area (< 0: out of it)."""
+def _mdot(p_line, rt_line, p, rt, area, v):
+    """Mass flow into the chamber from a line through an effective area (< 0: out of it);
+    ``rt``: ``p / rho`` of the gas upstream (``R T`` for an ideal gas, ``Z R T`` for a real
+    one)."""
     if area <= 0.0 or p_line == p:
         return 0.0
-    R = v[V_R]
     if p_line > p:
         psi = _psi(p / p_line, v[V_CRIT], v[V_E1], v[V_E2], v[V_COEF])
-        return area * p_line * psi / math.sqrt(R * t_line)
+        return area * p_line * psi / math.sqrt(rt_line)
     psi = _psi(p_line / p, v[V_CRIT], v[V_E1], v[V_E2], v[V_COEF])
-    return -area * p * psi / math.sqrt(R * t)
+    return -area * p * psi / math.sqrt(rt)
 
 
 @nb.njit(cache=True, inline="always")
@@ -313,19 +343,55 @@ def _area(lift, v):
     return v[V_CD] * v[V_AREA] * min(max(lift, 0.0), v[V_LIFT]) / v[V_LIFT]
 
 
+@nb.njit(cache=True, inline="always")
+def _bilinear(tab, k, i, j, wx, wp):
+    n = int(tab[rg.T_NP])
+    o = rg.T_HEADER + k * int(tab[rg.T_NX]) * n + i * n + j
+    return ((1.0 - wx) * ((1.0 - wp) * tab[o] + wp * tab[o + 1])
+            + wx * ((1.0 - wp) * tab[o + n] + wp * tab[o + n + 1]))  # fmt: skip
+
+
+@nb.njit(cache=True)
+def real_properties(p, rt, tab):
+    """``(u - u0, (dp/drho)_u, (dp/du)_rho, T)`` of the real gas at pressure ``p`` and
+    ``p/rho = rt``, bilinear on :func:`recipdyn.model.realgas.chamber_table` (its scaled
+    values, held constant beyond the table's edges)."""
+    fx = (math.log(rt) - tab[rg.T_LX0]) / tab[rg.T_DLX]
+    fp = (math.log(p) - tab[rg.T_LP0]) / tab[rg.T_DLP]
+    fx = min(max(fx, 0.0), tab[rg.T_NX] - 1.0 - 1e-9)
+    fp = min(max(fp, 0.0), tab[rg.T_NP] - 1.0 - 1e-9)
+    i, j = int(fx), int(fp)
+    wx, wp = fx - i, fp - j
+    u = _bilinear(tab, 0, i, j, wx, wp) * rt
+    a = _bilinear(tab, 1, i, j, wx, wp) * rt
+    b = _bilinear(tab, 2, i, j, wx, wp) * p / rt
+    return u, a, b, rt / _bilinear(tab, 3, i, j, wx, wp)
+
+
 @nb.njit(cache=True)
 def _chamber(V, dV, y, b, c, v, out):
     """Derivatives of one chamber's six states at ``y[b:b+6]``; returns (mdot_s, mdot_d)."""
     p, m = y[b], y[b + 1]
-    R = v[V_R]
-    T = p * V / (m * R)
     ps, pd = c[cy.C_PS], c[cy.C_PD]
-    ms = _mdot(ps, v[V_TS], p, T, _area(y[b + 2], v), v)
-    md = _mdot(pd, v[V_TD], p, T, _area(y[b + 4], v), v)
-    n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
-    ts = v[V_TS] if ms > 0.0 else T
-    td = v[V_TD] if md > 0.0 else T
-    out[b] = n / V * (R * (ts * ms + td * md) - p * dV)
+    if v.shape[0] > N_VALVE:  # a real gas: the first law with the tabulated properties
+        tab = v[N_VALVE:]
+        rt = p * V / m
+        ms = _mdot(ps, tab[rg.T_RTS], p, rt, _area(y[b + 2], v), v)
+        md = _mdot(pd, tab[rg.T_RTD], p, rt, _area(y[b + 4], v), v)
+        u, dp_drho, dp_du, _t = real_properties(p, rt, tab)
+        hs = tab[rg.T_HS] if ms > 0.0 else u + rt
+        hd = tab[rg.T_HD] if md > 0.0 else u + rt
+        out[b] = (dp_drho * (ms + md - m / V * dV) / V
+                  + dp_du / m * (ms * (hs - u) + md * (hd - u) - p * dV))  # fmt: skip
+    else:
+        R = v[V_R]
+        T = p * V / (m * R)
+        ms = _mdot(ps, R * v[V_TS], p, R * T, _area(y[b + 2], v), v)
+        md = _mdot(pd, R * v[V_TD], p, R * T, _area(y[b + 4], v), v)
+        n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
+        ts = v[V_TS] if ms > 0.0 else T
+        td = v[V_TD] if md > 0.0 else T
+        out[b] = n / V * (R * (ts * ms + td * md) - p * dV)
     out[b + 1] = ms + md
     _plate(y, ps - p, v, out, b + 2)
     _plate(y, p - pd, v, out, b + 4)
@@ -440,11 +506,15 @@ def gas_initial(values, c: np.ndarray, theta1: float) -> np.ndarray:
     R = float(values["gas_constant"])
     ts, ps = float(values["suction_temperature"]), float(values["suction_pressure"])
     nc = float(values["n_compression"])
+    gas = values.get("gas", "ideal")
     y = np.zeros(N_GAS)
     for j, (p, V) in enumerate(((p_he, v_he), (p_ce, v_ce))):
-        T = ts * (p / ps) ** ((nc - 1.0) / nc)
         y[6 * j] = p
-        y[6 * j + 1] = p * V / (R * T)
+        if gas == "ideal":
+            T = ts * (p / ps) ** ((nc - 1.0) / nc)
+            y[6 * j + 1] = p * V / (R * T)
+        else:  # on the suction isentrope
+            y[6 * j + 1] = float(rg.isentropic_density(gas, ps, ts, p)[0]) * V
     return y
 
 
@@ -455,18 +525,33 @@ def gas_outputs(values, x, y, dy, g: int, a: int, c: np.ndarray) -> dict[str, An
     from .base import Signal
 
     R = float(values["gas_constant"])
+    gas = values.get("gas", "ideal")
+    tab = None if gas == "ideal" else rg.chamber_table(
+        gas, float(values["suction_pressure"]), float(values["discharge_pressure"]),
+        float(values["suction_temperature"]))  # fmt: skip
     out = {}
     for j, end in enumerate(("head", "crank")):
         b = g + 6 * j
         vol = _volume(x, 0.0, j, c)[0]
         out[f"p_{end}"] = Signal(y[:, b], "Pa", f"{end}-end cylinder pressure (absolute)")
         out[f"V_{end}"] = Signal(vol, "m**3", f"{end}-end cylinder volume")
-        out[f"T_{end}"] = Signal(y[:, b] * vol / (y[:, b + 1] * R), "K",
-                                 f"{end}-end gas temperature")  # fmt: skip
+        if tab is None:
+            temp = y[:, b] * vol / (y[:, b + 1] * R)
+        else:
+            temp = _real_temperatures(y[:, b], y[:, b] * vol / y[:, b + 1], tab)
+        out[f"T_{end}"] = Signal(temp, "K", f"{end}-end gas temperature")
         out[f"mdot_suction_{end}"] = Signal(dy[:, a + 2 * j], "kg/s",
                                             f"{end}-end suction mass flow (in)")  # fmt: skip
         out[f"mdot_discharge_{end}"] = Signal(dy[:, a + 2 * j + 1], "kg/s",
                                               f"{end}-end discharge mass flow (out)")  # fmt: skip
+    return out
+
+
+@nb.njit(cache=True)
+def _real_temperatures(p, rt, tab):
+    out = np.empty(p.shape[0])
+    for k in range(p.shape[0]):
+        out[k] = real_properties(p[k], rt[k], tab)[3]
     return out
 
 
@@ -495,7 +580,12 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
     last = th >= th[-1] - 2.0 * math.pi
     c = cy.cycle_data(values)
     stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-    rho_s = values["suction_pressure"] / (values["gas_constant"] * values["suction_temperature"])
+    gas = values.get("gas", "ideal")
+    if gas == "ideal":
+        rho_s = values["suction_pressure"] / (values["gas_constant"]
+                                              * values["suction_temperature"])  # fmt: skip
+    else:
+        rho_s = rg.suction_density(gas, values["suction_pressure"], values["suction_temperature"])
     work = 0.0
     for j, end in enumerate(("head", "crank")):
         if not int(c[cy.C_ACTING]) & (1 << j):
