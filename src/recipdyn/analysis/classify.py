@@ -214,18 +214,19 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
         ev["section_distinct"] = int(n_distinct)
     if spectrum is not None:
         ev.update({f"spectrum_{k}": v for k, v in _line_structure(spectrum).items()})
-    if rms_ratio is not None and not rms_ratio <= MAX_RMS_RATIO:
-        reasons.insert(0, f"not stationary: the RMS of the record's quarters differs "
-                       f"{rms_ratio:.3g}x (> {MAX_RMS_RATIO:g}; a decay, a run-up or a burst), "
-                       "and the exponents, the 0-1 test, the surrogates and the section all "
-                       "assume a stationary record")  # fmt: skip
-        return Verdict("undetermined", ev, reasons)
-    if ev.get("quarter_speed_ratio", 1.0) > MAX_SPEED_RATIO:
-        reasons.insert(0, f"not stationary: the mean speed of the record's quarters differs "
-                       f"{ev['quarter_speed_ratio']:.3g}x (> {MAX_SPEED_RATIO:g}; a run-up or a "
-                       "coast-down), and the exponents, the 0-1 test, the surrogates and the "
-                       "section all assume a stationary record")  # fmt: skip
-        return Verdict("undetermined", ev, reasons)
+    for key, limit, what, cause in (
+        ("quarter_rms_ratio", MAX_RMS_RATIO, "RMS", "a decay, a run-up or a burst"),
+        ("quarter_speed_ratio", MAX_SPEED_RATIO, "mean speed", "a run-up or a coast-down"),
+    ):
+        value = ev.get(key)
+        if value is not None and not value <= limit:  # inf (a constant quarter) included
+            reasons.insert(
+                0,
+                f"not stationary: the {what} of the record's quarters differs "
+                f"{value:.3g}x (> {limit:g}; {cause}), and the exponents, the 0-1 "
+                "test, the surrogates and the section all assume a stationary record",
+            )
+            return Verdict("undetermined", ev, reasons)
     pos = lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err)
     flat = lambda1 == 0.0 and (k01 is None or k01 < 0.5)  # no divergence: noise never is
     if deterministic is False and not flat:

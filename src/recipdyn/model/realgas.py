@@ -145,14 +145,22 @@ def real_gas_states(theta1, values) -> dict[str, np.ndarray]:
             "V_head": st["V_head"], "V_crank": st["V_crank"]}  # fmt: skip
 
 
+def _suction_state(gas: str, ps: float, Ts: float):
+    """A CoolProp state of ``gas`` at the suction state, and its specific entropy."""
+    import CoolProp
+
+    state = CoolProp.AbstractState("HEOS", gas)
+    state.update(CoolProp.PT_INPUTS, ps, Ts)
+    return state, state.smass()
+
+
 def isentrope_pressure(values, rho) -> np.ndarray:
     """CoolProp's pressure on the suction isentrope at densities ``rho`` (kg/m^3), flash by
     flash (the reference the tabulated isentrope is tested against)."""
     import CoolProp
 
-    state = CoolProp.AbstractState("HEOS", values["gas"])
-    state.update(CoolProp.PT_INPUTS, values["suction_pressure"], values["suction_temperature"])
-    s_s = state.smass()
+    state, s_s = _suction_state(values["gas"], values["suction_pressure"],
+                                values["suction_temperature"])  # fmt: skip
     out = []
     for r in np.atleast_1d(rho):
         state.update(CoolProp.DmassSmass_INPUTS, float(r), s_s)
@@ -245,22 +253,11 @@ def chamber_table(gas: str, ps: float, pd: float, Ts: float) -> np.ndarray:
     return np.concatenate([head, phi.ravel()])
 
 
-def suction_density(gas: str, ps: float, Ts: float) -> float:
-    """Density of the suction gas (kg/m^3)."""
-    import CoolProp
-
-    st = CoolProp.AbstractState("HEOS", gas)
-    st.update(CoolProp.PT_INPUTS, ps, Ts)
-    return float(st.rhomass())
-
-
 def isentropic_density(gas: str, ps: float, Ts: float, p) -> np.ndarray:
     """Densities on the suction isentrope at pressures ``p`` (kg/m^3)."""
     import CoolProp
 
-    st = CoolProp.AbstractState("HEOS", gas)
-    st.update(CoolProp.PT_INPUTS, ps, Ts)
-    s_s = st.smass()
+    st, s_s = _suction_state(gas, ps, Ts)
     out = []
     for q in np.atleast_1d(p):
         st.update(CoolProp.PSmass_INPUTS, float(q), s_s)

@@ -249,6 +249,17 @@ AUX_STATE_UNITS = ("kg",) * 4
 N_AUX = len(AUX_STATE_NAMES)
 
 
+def _gas_table(values) -> np.ndarray | None:
+    """The chamber property table of a real gas (:func:`recipdyn.model.realgas.chamber_table`,
+    cached per parameter set), or None for the ideal gas."""
+    gas = values.get("gas", "ideal")
+    if gas == "ideal":
+        return None
+    return rg.chamber_table(gas, float(values["suction_pressure"]),
+                            float(values["discharge_pressure"]),
+                            float(values["suction_temperature"]))  # fmt: skip
+
+
 def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
     """Valve data for :func:`gas_rhs` (layout: the ``V_*`` constants)."""
     area = float(values["valve_area_fraction"]) * cycle_data[cy.C_AHE]
@@ -271,14 +282,12 @@ def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
     out[V_TS] = t_s
     out[V_TD] = t_s * ratio ** ((nc - 1.0) / nc)
     out[V_NCH] = cycle_data[cy.C_ACTING]
-    gas = values.get("gas", "ideal")
-    if gas == "ideal":
+    tab = _gas_table(values)
+    if tab is None:
         out[V_CRIT:] = _nozzle_constants(float(values["isentropic_exponent"]))
         return out
-    # a real gas: the chamber property table follows (realgas.chamber_table), and the nozzle
-    # takes the isentropic exponent of the suction gas
-    tab = rg.chamber_table(gas, float(values["suction_pressure"]),
-                           float(values["discharge_pressure"]), t_s)  # fmt: skip
+    # a real gas: the chamber property table follows, and the nozzle takes the isentropic
+    # exponent of the suction gas
     out[V_CRIT:] = _nozzle_constants(float(tab[rg.T_KAPPA]))
     return np.concatenate([out, tab])
 
@@ -507,14 +516,15 @@ def gas_initial(values, c: np.ndarray, theta1: float) -> np.ndarray:
     ts, ps = float(values["suction_temperature"]), float(values["suction_pressure"])
     nc = float(values["n_compression"])
     gas = values.get("gas", "ideal")
+    real = None if gas == "ideal" else rg.isentropic_density(gas, ps, ts, [p_he, p_ce])
     y = np.zeros(N_GAS)
     for j, (p, V) in enumerate(((p_he, v_he), (p_ce, v_ce))):
         y[6 * j] = p
-        if gas == "ideal":
+        if real is None:  # on the polytrope from the suction state
             T = ts * (p / ps) ** ((nc - 1.0) / nc)
             y[6 * j + 1] = p * V / (R * T)
         else:  # on the suction isentrope
-            y[6 * j + 1] = float(rg.isentropic_density(gas, ps, ts, p)[0]) * V
+            y[6 * j + 1] = float(real[j]) * V
     return y
 
 
@@ -525,10 +535,7 @@ def gas_outputs(values, x, y, dy, g: int, a: int, c: np.ndarray) -> dict[str, An
     from .base import Signal
 
     R = float(values["gas_constant"])
-    gas = values.get("gas", "ideal")
-    tab = None if gas == "ideal" else rg.chamber_table(
-        gas, float(values["suction_pressure"]), float(values["discharge_pressure"]),
-        float(values["suction_temperature"]))  # fmt: skip
+    tab = _gas_table(values)
     out = {}
     for j, end in enumerate(("head", "crank")):
         b = g + 6 * j
@@ -580,12 +587,9 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
     last = th >= th[-1] - 2.0 * math.pi
     c = cy.cycle_data(values)
     stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
-    gas = values.get("gas", "ideal")
-    if gas == "ideal":
-        rho_s = values["suction_pressure"] / (values["gas_constant"]
-                                              * values["suction_temperature"])  # fmt: skip
-    else:
-        rho_s = rg.suction_density(gas, values["suction_pressure"], values["suction_temperature"])
+    tab = _gas_table(values)
+    rt_s = values["gas_constant"] * values["suction_temperature"] if tab is None else tab[rg.T_RTS]
+    rho_s = values["suction_pressure"] / rt_s
     work = 0.0
     for j, end in enumerate(("head", "crank")):
         if not int(c[cy.C_ACTING]) & (1 << j):
