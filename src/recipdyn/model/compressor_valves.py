@@ -100,7 +100,7 @@ def _acc(th1, thc, thcd, F, p):
                                   p[P_J2], p[P_G], p[P_RC], p[P_D], p[P_OMEGA])  # fmt: skip
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _gas(t, y, p, out):
     th1 = p[P_TH10] + p[P_OMEGA] * t
     x, xd = _crosshead(th1, y[0], y[1], p)
