@@ -320,7 +320,7 @@ def _mdot(p_line, rt_line, p, rt, area, v):
     """Mass flow into the chamber from a line through an effective area (< 0: out of it);
     ``rt``: ``p / rho`` of the gas upstream (``R T`` for an ideal gas, ``Z R T`` for a real
     one)."""
-    if area <= 0.0 or p_line == p:
+    if area == 0.0 or p_line == p:
         return 0.0
     if p_line > p:
         psi = _psi(p / p_line, v[V_CRIT], v[V_E1], v[V_E2], v[V_COEF])
@@ -348,8 +348,13 @@ def _plate(y, dp, v, out, i):
 
 
 @nb.njit(cache=True, inline="always")
-def _area(lift, v):
-    return v[V_CD] * v[V_AREA] * min(max(lift, 0.0), v[V_LIFT]) / v[V_LIFT]
+def _area(lift, u, v):
+    ymax = v[V_LIFT]
+    if (lift < 0.0 and u <= -V_REST) or (lift > ymax and u >= V_REST):
+        x = lift  # a fast plate through its stop: continued smoothly until its impact acts
+    else:
+        x = min(max(lift, 0.0), ymax)
+    return v[V_CD] * v[V_AREA] * x / ymax
 
 
 @nb.njit(cache=True, inline="always")
@@ -385,8 +390,8 @@ def _chamber(V, dV, y, b, c, v, out):
     if v.shape[0] > N_VALVE:  # a real gas: the first law with the tabulated properties
         tab = v[N_VALVE:]
         rt = p * V / m
-        ms = _mdot(ps, tab[rg.T_RTS], p, rt, _area(y[b + 2], v), v)
-        md = _mdot(pd, tab[rg.T_RTD], p, rt, _area(y[b + 4], v), v)
+        ms = _mdot(ps, tab[rg.T_RTS], p, rt, _area(y[b + 2], y[b + 3], v), v)
+        md = _mdot(pd, tab[rg.T_RTD], p, rt, _area(y[b + 4], y[b + 5], v), v)
         u, dp_drho, dp_du, _t = real_properties(p, rt, tab)
         hs = tab[rg.T_HS] if ms > 0.0 else u + rt
         hd = tab[rg.T_HD] if md > 0.0 else u + rt
@@ -395,8 +400,8 @@ def _chamber(V, dV, y, b, c, v, out):
     else:
         R = v[V_R]
         T = p * V / (m * R)
-        ms = _mdot(ps, R * v[V_TS], p, R * T, _area(y[b + 2], v), v)
-        md = _mdot(pd, R * v[V_TD], p, R * T, _area(y[b + 4], v), v)
+        ms = _mdot(ps, R * v[V_TS], p, R * T, _area(y[b + 2], y[b + 3], v), v)
+        md = _mdot(pd, R * v[V_TD], p, R * T, _area(y[b + 4], y[b + 5], v), v)
         n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
         ts = v[V_TS] if ms > 0.0 else T
         td = v[V_TD] if md > 0.0 else T
