@@ -144,11 +144,17 @@ def main(argv: list[str] | None = None) -> dict:
              ("rc_0", "compressor-valves", 0.0, None),
              ("rc_0_air", "compressor-valves", 0.0, "Air"),
              ("contact", "compressor-contact-valves", 1e-3, None),
-             ("contact_ideal_valves", "compressor-contact", 1e-3, None))  # fmt: skip
+             ("contact_ideal_valves", "compressor-contact", 1e-3, None),
+             ("contact_paper_load", "compressor-contact", 1e-3, None))  # fmt: skip
+    # the paper's load on the contact joint: the 3x compared on the joint model that
+    # holds under the cycle's reversing rod load (the massless link does not: its run warns)
     for label, name, rc, gas in cases:
         mv = get_model(name)
-        vals = mv.parameters({"rc": rc, "load": "cycle"} if name == "compressor-contact"
-                             else {"rc": rc, **({"gas": gas} if gas else {})})  # fmt: skip
+        if label == "contact_ideal_valves":
+            over = {"rc": rc, "load": "cycle"}
+        else:
+            over = {"rc": rc, **({"gas": gas} if gas else {})}
+        vals = mv.parameters(over)
         sv, ev = mv.system(vals), mv.events(vals)[0]
         yv = mv.initial_state(vals)
         kw = dict(rtol=1e-10, atol=1e-12, event=ev.function, event_direction=ev.direction,
@@ -185,13 +191,16 @@ def main(argv: list[str] | None = None) -> dict:
         dict(metric="dynamic valves, rc = 1 mm: time per revolution / paper load's", unit="x",
              target=3.0, value=valves["rc_1mm"]["vs_paper"], better="lower"),
         dict(metric="dynamic valves, ideal mechanism: time per revolution / paper load's",
-             unit="x", target=None, value=valves["rc_0"]["vs_paper"], better="lower"),
+             unit="x", target=3.0, value=valves["rc_0"]["vs_paper"], better="lower"),
         dict(metric="dynamic valves, real gas (CoolProp air), ideal mechanism: time / paper "
              "load's", unit="x", target=10.0, value=valves["rc_0_air"]["vs_paper"],
              better="lower"),
         dict(metric="dynamic valves: real gas (air) / ideal gas, ideal mechanism", unit="x",
              target=None, value=valves["rc_0_air"]["seconds"] / valves["rc_0"]["seconds"],
              better="lower"),
+        dict(metric="dynamic valves, contact joint rc = 1 mm: time / paper load's on that "
+             "joint", unit="x", target=3.0, better="lower", value=valves["contact"]["seconds"]
+             / valves["contact_paper_load"]["seconds"]),
         dict(metric="dynamic valves, contact joint: time / contact joint with ideal valves",
              unit="x", target=None, better="lower", value=valves["contact"]["seconds"]
              / valves["contact_ideal_valves"]["seconds"]),
