@@ -116,6 +116,38 @@ def test_integrate_sink_gets_every_sample_once_in_order():
     assert np.array_equal(grid[0:3], 0.0 + np.arange(3) / grid.rate)
 
 
+def test_no_link_no_link_bound(tmp_path):
+    """Without clearance (rc = 0) the crank pin is an ideal two-way joint: the massless
+    link's bound (it can only push) does not apply, so a reversing pin load (the cycle's
+    rod-load reversal with dynamic valves; the paper's load at 1 kN) is not flagged and a
+    sweep stores no minimum for it (NaN, so its figure marks nothing); with clearance the same
+    reversal is flagged and stored."""
+    import warnings
+
+    import recipdyn
+    from recipdyn.errors import ModelValidityWarning
+    from recipdyn.model.parameters import CompressorParams
+    from recipdyn.sweep.run import open_sweep, run_sweep
+    from recipdyn.sweep.spec import SweepSpec, parse_axis
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelValidityWarning)
+        for kw in (dict(model="compressor-valves", params={"rc": 0.0}),
+                   dict(params=CompressorParams(rc=0.0, load_amplitude=1000.0))):  # fmt: skip
+            ds = recipdyn.simulate(revolutions=1.0, fs=5000.0, **kw)
+            assert ds.attrs["validity"] == "ok"
+            assert float(ds["contact_force"].min()) < 0  # the reversal itself is recorded
+    with pytest.warns(ModelValidityWarning):
+        recipdyn.simulate(model="compressor-valves", params={"rc": 1e-3}, revolutions=1.0,
+                          fs=5000.0)  # fmt: skip
+    spec = SweepSpec(axes=(parse_axis("rc=0mm:1mm:2"),), measures=("peak",),
+                     base=CompressorParams(load_amplitude=1000.0),
+                     settings=dict(revolutions=1, transient=0, fs=5000.0))  # fmt: skip
+    sw = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False))
+    mins = sw["min_contact_force"].values
+    assert np.isnan(mins[0]) and mins[1] < 0
+
+
 def test_negative_contact_force_is_flagged(tmp_path, capsys):
     """A light gas load (1 kN amplitude) lets inertia pull the massless link (min contact
     force about -1.8 kN): simulate warns (ModelValidityWarning, the record's 'validity'

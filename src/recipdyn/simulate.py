@@ -85,10 +85,10 @@ def _track_minima(model, outs, minima: dict[str, float]) -> None:
             minima[name] = min(minima.get(name, math.inf), float(np.min(outs[name].values)))
 
 
-def _check_validity(model, minima: dict[str, float], attrs: dict) -> None:
+def _check_validity(model, minima: dict[str, float], attrs: dict, values) -> None:
     """Record (``attrs["validity"]``) and warn (:class:`ModelValidityWarning`) when an output
-    crossed the model's validity bound."""
-    warning = validity_warning(model, minima)
+    crossed the model's validity bound (where the bounds apply at ``values``)."""
+    warning = validity_warning(model, minima) if model.validity_applies(values) else ""
     attrs["validity"] = warning or "ok"
     if warning:
         warnings.warn(warning, ModelValidityWarning, stacklevel=3)
@@ -318,7 +318,7 @@ def simulate(
     attrs["config_toml"] = dump_config(COMPRESSOR, vars(p), dict(
         revolutions=revolutions, transient=transient, fs=fs, method=method, rtol=rtol,
         atol=atol, h=h))  # fmt: skip
-    _check_validity(COMPRESSOR, minima, attrs)
+    _check_validity(COMPRESSOR, minima, attrs, vars(p))
     recent = ds if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
         attrs.update(clean_attrs(COMPRESSOR.run_summary(vars(p), recent)))
@@ -486,7 +486,7 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     if m.validity_bounds:
         minima: dict[str, float] = {}
         _track_minima(m, ds, minima)
-        _check_validity(m, minima, ds.attrs)
+        _check_validity(m, minima, ds.attrs, values)
     if events:
         ds = _with_events(ds, m, events[0], sol, t_start)
     if sol.t.size:

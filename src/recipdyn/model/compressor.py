@@ -340,6 +340,11 @@ class Compressor(Model):
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics
 
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        """The link's bound (it can only push) needs a link: with rc = 0 the crank pin is an
+        ideal joint that carries a reversing load (the cycle load's rod-load reversal)."""
+        return float(values["rc"]) > 0.0
+
     @staticmethod
     def params(values: Mapping[str, Any]) -> CompressorParams:
         return CompressorParams(**values)

@@ -261,6 +261,11 @@ class Model(ABC):
         than 1 in SI units (a valve lift in m, a gas mass in kg) says so here."""
         return np.maximum(1.0, np.abs(self.initial_state(values)))
 
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        """Whether :attr:`validity_bounds` apply at ``values`` (e.g. not to the compressor
+        without clearance, whose pin is an ideal two-way joint). Default: always."""
+        return True
+
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov
         exponents are then reported as 0 without integrating."""

@@ -6,6 +6,7 @@ not depend on the backend. Nothing here uses random numbers or global state.
 
 from __future__ import annotations
 
+import math
 import traceback
 from typing import Any
 
@@ -72,6 +73,7 @@ class _Point:
             self.outputs = self.system.outputs
             self.fc = p.crank_frequency
             self.dynamic = p.rc > 0
+            self.bounded = p.rc > 0  # the link's validity bound needs a link
         else:
             self.system = m.system(p)
             period = m.period(p)
@@ -80,6 +82,7 @@ class _Point:
             self.outputs = lambda t, y, _m=m, _p=p: _m.outputs(_p, t, y)
             self.fc = 1.0 / period if period else None
             self.dynamic = m.has_dynamics(p)
+            self.bounded = m.validity_applies(p)
         self.sections = [k for k, _ in m.sections()]
         self.pair = m.pair()
         self.vib = m.vibration()[0]
@@ -117,8 +120,8 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
         sol = integrate(m, y, (0.0, te[-1]), t_eval=te, **solver)
         outs = pt.outputs(sol.t, sol.y)
         a = outs[pt.vib].values
-        for name, *_ in pt.model.validity_bounds:
-            res[f"min_{name}"] = float(np.min(outs[name].values))
+        for name, *_ in pt.model.validity_bounds:  # NaN where the bound does not apply
+            res[f"min_{name}"] = float(np.min(outs[name].values)) if pt.bounded else math.nan
         for out, name, _unit in pt.model.mean_signals:
             res[name] = float(np.mean(outs[out].values)) if out in outs else float("nan")
         for out, name, _unit in pt.model.max_signals:
