@@ -73,7 +73,7 @@ class _Point:
             self.outputs = self.system.outputs
             self.fc = p.crank_frequency
             self.dynamic = p.rc > 0
-            self.bounded = p.rc > 0  # the link's validity bound needs a link
+            self.bounded = m.validity_applies(vars(p))
         else:
             self.system = m.system(p)
             period = m.period(p)
