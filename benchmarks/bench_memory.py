@@ -45,6 +45,10 @@ def main(argv: list[str] | None = None) -> dict:
     lengths = (100, 1000) if args.quick else (100, 1000, 10_000)
     res: dict = {"rows": []}
     with tempfile.TemporaryDirectory() as tmp:
+        # a first run fills numba's cache (a new one after any change of the sources): the
+        # rows then measure a run, not the compilation (725 MB peak in every row of a run
+        # whose cache was cold, 306-383 MB warm, 2026-11-25)
+        _child(1, "streamed", f"{tmp}/warm.nc")
         for revs in lengths:
             for mode in ("memory", "streamed"):
                 if mode == "memory" and revs > 1000:
