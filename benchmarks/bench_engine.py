@@ -140,20 +140,16 @@ def main(argv: list[str] | None = None) -> dict:
     valves = {}
     # and the dynamic valves with a real gas (CoolProp air through the chamber table, built
     # once per parameter set, before the timing)
-    cases = (("rc_1mm", "compressor-valves", 1e-3, None),
-             ("rc_0", "compressor-valves", 0.0, None),
-             ("rc_0_air", "compressor-valves", 0.0, "Air"),
-             ("contact", "compressor-contact-valves", 1e-3, None),
-             ("contact_ideal_valves", "compressor-contact", 1e-3, None),
-             ("contact_paper_load", "compressor-contact", 1e-3, None))  # fmt: skip
-    # the paper's load on the contact joint: the 3x compared on the joint model that
-    # holds under the cycle's reversing rod load (the massless link does not: its run warns)
-    for label, name, rc, gas in cases:
+    # (the paper's load on the contact joint: the 3x compared on the joint model that
+    # holds under the cycle's reversing rod load; the massless link does not, its run warns)
+    cases = (("rc_1mm", "compressor-valves", {"rc": 1e-3}),
+             ("rc_0", "compressor-valves", {"rc": 0.0}),
+             ("rc_0_air", "compressor-valves", {"rc": 0.0, "gas": "Air"}),
+             ("contact", "compressor-contact-valves", {"rc": 1e-3}),
+             ("contact_ideal_valves", "compressor-contact", {"rc": 1e-3, "load": "cycle"}),
+             ("contact_paper_load", "compressor-contact", {"rc": 1e-3}))  # fmt: skip
+    for label, name, over in cases:
         mv = get_model(name)
-        if label == "contact_ideal_valves":
-            over = {"rc": rc, "load": "cycle"}
-        else:
-            over = {"rc": rc, **({"gas": gas} if gas else {})}
         vals = mv.parameters(over)
         sv, ev = mv.system(vals), mv.events(vals)[0]
         yv = mv.initial_state(vals)

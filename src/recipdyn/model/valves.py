@@ -348,11 +348,21 @@ def _plate(y, dp, v, out, i):
 
 
 @nb.njit(cache=True, inline="always")
+def _stop_factor(lift, u, ymax):
+    """:func:`_distance` of a plate at ``lift`` moving at ``u``: negative exactly where a plate
+    faster than :data:`V_REST` is beyond the stop it moves toward (its impact to act on)."""
+    if u < 0.0:
+        return max(lift / ymax, (u + V_REST) / V_REST)
+    if u > 0.0:
+        return max((ymax - lift) / ymax, (V_REST - u) / V_REST)
+    return 1.0
+
+
+@nb.njit(cache=True, inline="always")
 def _area(lift, u, v):
     ymax = v[V_LIFT]
-    if (lift < 0.0 and u <= -V_REST) or (lift > ymax and u >= V_REST):
-        x = lift  # a fast plate through its stop: continued smoothly until its impact acts
-    else:
+    x = lift  # a fast plate through its stop: continued smoothly until its impact event acts
+    if _stop_factor(lift, u, ymax) >= 0.0:  # elsewhere the plate's opening, within its stops
         x = min(max(lift, 0.0), ymax)
     return v[V_CD] * v[V_AREA] * x / ymax
 
@@ -471,12 +481,7 @@ def _distance(y, i, ymax):
     and the event function leaves its surface at once (a crossing of another factor just
     after the rebound is not hidden); it jumps where the plate turns, between two positive
     values, which is no crossing."""
-    lift, u = y[i], y[i + 1]
-    if u < 0.0:
-        return max(lift / ymax, (u + V_REST) / V_REST)
-    if u > 0.0:
-        return max((ymax - lift) / ymax, (V_REST - u) / V_REST)
-    return 1.0
+    return _stop_factor(y[i], y[i + 1], ymax)
 
 
 @nb.njit(cache=True)
