@@ -1,13 +1,17 @@
 """Compiled integrators: agreement with SciPy, convergence order, events, failure handling."""
 
+import dataclasses
+import warnings
+
 import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from recipdyn.errors import KernelAllocatesWarning
 from recipdyn.integrate import IntegrationError, integrate
 from recipdyn.model import CompressorParams, ODESystem, compressor_model
-from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE
+from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE, compiled
 
 
 @nb.njit(RHS_SIGNATURE, cache=True)
@@ -230,3 +234,67 @@ def test_numba_cache_folder_follows_the_sources(tmp_path):
                           "print(valves.state_force._cache._cache_path)"], env=env, check=True,
                          capture_output=True, text=True).stdout.strip()  # fmt: skip
     assert out.startswith(os.path.join(str(tmp_path), "recipdyn", "numba", fp))
+
+
+@compiled(RHS_SIGNATURE)
+def _oscillator_allocating(t, y, p, out):
+    tmp = np.empty(2)  # an allocation: not possible without reference counting
+    tmp[0] = y[1]
+    tmp[1] = -p[0] * p[0] * y[0]
+    out[0] = tmp[0]
+    out[1] = tmp[1]
+
+
+@compiled(RHS_SIGNATURE, allocates=True)
+def _oscillator_declared(t, y, p, out):
+    tmp = np.empty(2)
+    tmp[0] = y[1]
+    tmp[1] = -p[0] * p[0] * y[0]
+    out[0] = tmp[0]
+    out[1] = tmp[1]
+
+
+def test_a_kernel_that_allocates_still_works():
+    """compiled() kernels are compiled without numba's reference counting (model/base.py),
+    where allocation is impossible. One that allocates without saying so is compiled with
+    counting instead, with a KernelAllocatesWarning naming it, and integrates like the same
+    equations without allocation (to the bit: the same operations); declared with
+    allocates=True it compiles without a warning."""
+    y0 = np.array([1.0, 0.0])
+    ref = integrate(OSC, y0, (0.0, 3.0), rtol=1e-10, atol=1e-12)
+    alloc = ODESystem(rhs=_oscillator_allocating, params=OSC.params, state_names=("x", "v"))
+    with pytest.warns(KernelAllocatesWarning, match="_oscillator_allocating allocates"):
+        sol = integrate(alloc, y0, (0.0, 3.0), rtol=1e-10, atol=1e-12)
+    assert _oscillator_allocating.targetoptions["_nrt"] is True
+    np.testing.assert_array_equal(sol.y_final, ref.y_final)
+    declared = ODESystem(rhs=_oscillator_declared, params=OSC.params, state_names=("x", "v"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", KernelAllocatesWarning)
+        sol = integrate(declared, y0, (0.0, 3.0), rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(sol.y_final, ref.y_final)
+
+
+def test_contact_kernels_run_without_reference_counting():
+    """The contact model's right-hand side and event run without reference counting (they
+    allocate nothing; pyproject turns a fallback anywhere in the tests into an error), and
+    a run gives, to the bit, what the same right-hand side compiled with counting gives: the
+    flag removes the atomic counts of the array arguments, not arithmetic."""
+    from recipdyn.model import compressor_contact as cc
+    from recipdyn.model.registry import get_model
+
+    @nb.njit(RHS_SIGNATURE)  # numba's default: with reference counting
+    def counted(t, y, p, out):
+        cc._rhs(t, y, p, out, 0)
+
+    m = get_model("compressor-contact")
+    v = m.parameters(dict(e0_ratio=0.0))
+    s = m.system(v)
+    y0 = m.initial_state(v)
+    span = (0.0, 0.02)  # free flight, then impacts and sustained contact
+    ours = integrate(s, y0, span, rtol=1e-10, atol=1e-14)
+    plain = integrate(dataclasses.replace(s, rhs=counted), y0, span, rtol=1e-10, atol=1e-14)
+    assert s.rhs.targetoptions["_nrt"] is False
+    assert s.acting_event.function.targetoptions["_nrt"] is False
+    assert ours.t_events.size >= 3 and ours.nsteps == plain.nsteps
+    np.testing.assert_array_equal(ours.y_final, plain.y_final)
+    np.testing.assert_array_equal(ours.t_events, plain.t_events)

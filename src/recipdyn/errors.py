@@ -36,6 +36,12 @@ class ModelValidityWarning(UserWarning):
     machine there."""
 
 
+class KernelAllocatesWarning(UserWarning):
+    """A compiled kernel declared without ``allocates=True`` allocates arrays, so it was
+    compiled with numba's reference counting after all: correct, but slower
+    (:func:`recipdyn.model.base.compiled`)."""
+
+
 class IntegrationError(RuntimeError):
     """The integrator failed; ``partial`` holds what was computed before the failure."""
 

@@ -41,12 +41,22 @@ def no_event(t, y, p):  # pragma: no cover - trivial
     return 1.0
 
 
+@nb.njit(cache=True, inline="always")
+def _copy(src, dst):
+    """``dst[:] = src`` as a loop (a slice assignment may copy its source first, which
+    allocates: not allowed without reference counting)."""
+    for j in range(src.shape[0]):
+        dst[j] = src[j]
+
+
 @nb.njit(cache=True)
-def _rms(x):
+def _rms_ratio(a, b, scale):
+    """The root mean square of ``(a - b) / scale`` (no temporaries)."""
     s = 0.0
-    for v in x:
+    for j in range(a.shape[0]):
+        v = (a[j] - b[j]) / scale[j]
         s += v * v
-    return math.sqrt(s / x.shape[0])
+    return math.sqrt(s / a.shape[0])
 
 
 @nb.njit(cache=True)
@@ -258,18 +268,38 @@ def dop853_kernel(
     Returns the status code.
     """
     n = y0.shape[0]
-    max_events = ev_t.shape[0]
-    n_stages = 12
     K = np.empty((17, n))  # 12 stages + f_new + 3 extra dense stages (+1 spare)
-    ytmp = np.empty(n)
+    W = np.empty((6, n))  # ytmp, y_new, f_new, ydense, sacc, scratch of the first step
+    Fd = np.empty((7, n))
     y = y0.copy()
     f = np.empty(n)
+    zero = np.zeros(n)
+    return _dop853_run(
+        rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
+        A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2,
+        stats, fstate, K, W, Fd, y, f, zero,
+    )  # fmt: skip
+
+
+@nb.njit(cache=True, _nrt=False)
+def _dop853_run(
+    rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
+    A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2, stats,
+    fstate, K, W, Fd, y, f, zero,
+):  # fmt: skip
+    """:func:`dop853_kernel`'s loop, given its work arrays, compiled without reference
+    counting (with it, the atomic counts of the array arguments at every call and view cost
+    ~0.3 us a step)."""
+    n = y0.shape[0]
+    max_events = ev_t.shape[0]
+    n_stages = 12
+    ytmp, y_new, f_new, ydense, sacc, scale = W[0], W[1], W[2], W[3], W[4], W[5]
     rhs(t0, y, p, f)
     nfev = 1
     n_eval = t_eval.shape[0]
     ie = 0
     while ie < n_eval and t_eval[ie] <= t0:
-        Y[ie] = y
+        _copy(y, Y[ie])
         ie += 1
     n_ev = 0
     g_old = event(t0, y, p) if use_event else 0.0
@@ -282,18 +312,17 @@ def dop853_kernel(
     elif interval == 0.0:
         h_abs = 0.0
     else:
-        scale = np.empty(n)
         for j in range(n):
             scale[j] = atol + abs(y[j]) * rtol
-        d0 = _rms(y / scale)
-        d1 = _rms(f / scale)
+        d0 = _rms_ratio(y, zero, scale)
+        d1 = _rms_ratio(f, zero, scale)
         h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
         h0 = min(h0, interval)
-        y1 = y + h0 * direction * f
-        f1 = np.empty(n)
-        rhs(t0 + h0 * direction, y1, p, f1)
+        for j in range(n):
+            ytmp[j] = y[j] + h0 * direction * f[j]
+        rhs(t0 + h0 * direction, ytmp, p, y_new)  # y_new: scratch for f(y1) here
         nfev += 1
-        d2 = _rms((f1 - f) / scale) / h0
+        d2 = _rms_ratio(y_new, f, scale) / h0
         if d1 <= 1e-15 and d2 <= 1e-15:
             h1 = max(1e-6, h0 * 1e-3)
         else:
@@ -304,11 +333,6 @@ def dop853_kernel(
     nsteps = 0
     nrej = 0
     status = 0
-    y_new = np.empty(n)
-    f_new = np.empty(n)
-    Fd = np.empty((7, n))
-    ydense = np.empty(n)
-    sacc = np.empty(n)
     err_exp = -1.0 / 8.0
     while t < t_stop:
         if nsteps >= max_steps:
@@ -411,8 +435,8 @@ def dop853_kernel(
                         xm = _locate_event(event, t, y, h, xa, xb, ga, gb, Fd, p, ydense)
                         ev_t[n_ev] = t + xm * h
                         _dense_eval(xm, y, Fd, ydense)
-                        ev_y[n_ev] = ydense
-                        ev_y2[n_ev] = ydense
+                        _copy(ydense, ev_y[n_ev])
+                        _copy(ydense, ev_y2[n_ev])
                         if event_action != 0:  # terminal or reset: the step ends here
                             acting = True
                             t_cut = ev_t[n_ev]
@@ -421,20 +445,20 @@ def dop853_kernel(
                     xa, ga = xb, gb
             while ie < n_eval and t_eval[ie] <= t_cut:
                 if t_eval[ie] == t_new:
-                    Y[ie] = y_new
+                    _copy(y_new, Y[ie])
                 elif acting and t_eval[ie] == t_cut:
-                    Y[ie] = ev_y[n_ev]
+                    _copy(ev_y[n_ev], Y[ie])
                 else:
                     _dense_eval((t_eval[ie] - t) / h, y, Fd, ydense)
-                    Y[ie] = ydense
+                    _copy(ydense, Y[ie])
                 ie += 1
             if acting:
                 t_new = ev_t[n_ev]
                 if event_action == 2:  # reset the state, continue from the event
                     reset(t_new, ev_y[n_ev], p, y_new)
-                    ev_y2[n_ev] = y_new
+                    _copy(y_new, ev_y2[n_ev])
                 else:
-                    y_new[:] = ev_y[n_ev]
+                    _copy(ev_y[n_ev], y_new)
                     status = 1
                 rhs(t_new, y_new, p, f_new)
                 nfev += 1
@@ -449,12 +473,12 @@ def dop853_kernel(
                 n_ev += 1
         g_old = g_new
         t = t_new
-        y[:] = y_new
-        f[:] = f_new
+        _copy(y_new, y)
+        _copy(f_new, f)
         if status == 1 or (use_event and n_ev >= max_events):
             status = 1
             break
-    y0[:] = y
+    _copy(y, y0)
     stats[0] = nfev
     stats[1] = nsteps
     stats[2] = nrej
@@ -480,11 +504,20 @@ def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, s
     ``y0`` is updated in place; ``stats = [nfev, nsteps, 0, n_out, 0]``,
     ``fstate = [t_final, h]``.
     """
+    K = np.empty((B.shape[0], y0.shape[0]))
+    yt = np.empty(y0.shape[0])
+    y = y0.copy()
+    return _fixed_step_run(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats,
+                           fstate, A, B, C, K, yt, y)  # fmt: skip
+
+
+@nb.njit(cache=True, _nrt=False)
+def _fixed_step_run(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate,
+                    A, B, C, K, yt, y):  # fmt: skip
+    """:func:`fixed_step_kernel`'s loop, given its work arrays, without reference counting
+    (as :func:`_dop853_run`)."""
     n = y0.shape[0]
     s = B.shape[0]
-    y = y0.copy()
-    K = np.empty((s, n))
-    yt = np.empty(n)
     n_eval = t_eval.shape[0]
     ie = 0
     t = t0
@@ -493,7 +526,7 @@ def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, s
     status = 0
     while True:
         while ie < n_eval and t_eval[ie] <= t:
-            Y[ie] = y
+            _copy(y, Y[ie])
             ie += 1
         if t >= t1 or t >= t_stop:
             break
@@ -527,7 +560,7 @@ def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, s
         if nsteps > max_steps:
             status = -2
             break
-    y0[:] = y
+    _copy(y, y0)
     stats[0] = nfev
     stats[1] = nsteps
     stats[3] = ie

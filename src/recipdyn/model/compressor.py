@@ -116,7 +116,7 @@ def rhs_jac_exact(t, y, p, out, J):
     _rhs_jac_exact(t, y, p, out, J, _force_paper)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_exact(t, y, p, out):
     f = np.empty(2)
     _rhs_jac_exact(t, y, p, f, out, _force_paper)
@@ -139,7 +139,7 @@ def rhs_jac_exact_cycle(t, y, p, out, J):
     _rhs_jac_exact(t, y, p, out, J, _force_cycle)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_exact_cycle(t, y, p, out):
     f = np.empty(2)
     _rhs_jac_exact(t, y, p, f, out, _force_cycle)
@@ -156,7 +156,7 @@ def rhs_jac_exact_table(t, y, p, out, J):
     _rhs_jac_exact(t, y, p, out, J, _force)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_exact_table(t, y, p, out):
     f = np.empty(2)
     _rhs_jac_exact(t, y, p, f, out, _force)

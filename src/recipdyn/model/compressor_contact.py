@@ -425,32 +425,32 @@ def _jac(t, y, p, J, cfg):
         _cs_jac(t, y, p, J, cfg)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_crank(t, y, p, J):
     _jac(t, y, p, J, 0)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_crosshead(t, y, p, J):
     _jac(t, y, p, J, 1)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_both(t, y, p, J):
     _jac(t, y, p, J, 2)
 
 
-@compiled(RHS_JAC_SIGNATURE)
+@compiled(RHS_JAC_SIGNATURE, allocates=True)
 def rhs_jac_crank(t, y, p, f, J):
     _cs_columns(t, y, p, f, J, 0, True)
 
 
-@compiled(RHS_JAC_SIGNATURE)
+@compiled(RHS_JAC_SIGNATURE, allocates=True)
 def rhs_jac_crosshead(t, y, p, f, J):
     _cs_columns(t, y, p, f, J, 1, True)
 
 
-@compiled(RHS_JAC_SIGNATURE)
+@compiled(RHS_JAC_SIGNATURE, allocates=True)
 def rhs_jac_both(t, y, p, f, J):
     _cs_columns(t, y, p, f, J, 2, True)
 

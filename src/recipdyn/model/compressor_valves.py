@@ -115,7 +115,7 @@ def rhs_valves(t, y, p, out):
     out[1] = 0.0 if p[P_RC] == 0.0 else _acc(th1, y[0], y[1], F, p)
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def jac_valves(t, y, p, J):
     n = y.shape[0]
     for i in range(n):

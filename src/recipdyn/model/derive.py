@@ -222,7 +222,8 @@ def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True
         solve = ("    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]\n"
                  "    acc[0] = (b[0] * M[1, 1] - M[0, 1] * b[1]) / det\n"
                  "    acc[1] = (M[0, 0] * b[1] - M[1, 0] * b[0]) / det")  # fmt: skip
-    rhs_lines = ["", "", "@compiled(RHS_SIGNATURE)", f"def {name}_rhs(t, y, p, out):",
+    rhs_lines = ["", "", "@compiled(RHS_SIGNATURE, allocates=True)",
+                 f"def {name}_rhs(t, y, p, out):",
                  '    """(qd, qdd) with M qdd = b."""',
                  f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})",
                  f"    acc = np.empty({n})", f"    {name}_system(t, y, p, M, b)", solve,
@@ -250,7 +251,7 @@ def kernel_source(lag: Lagrangian, name: str, doc: str, *, jacobian: bool = True
         for i in range(n):
             lines.append(f"    db[{k}, {i}] = {vals[off + k * n + i]}")
     lines += rhs_lines
-    lines += ["", "", "@compiled(JAC_SIGNATURE)", f"def {name}_jac(t, y, p, J):",
+    lines += ["", "", "@compiled(JAC_SIGNATURE, allocates=True)", f"def {name}_jac(t, y, p, J):",
               '    """Exact Jacobian: dqdd/dy_k = M^-1 (db/dy_k - dM/dy_k qdd)."""',
               f"    M = np.empty(({n}, {n}))", f"    b = np.empty({n})", f"    acc = np.empty({n})",
               f"    dM = np.empty(({2 * n}, {n}, {n}))", f"    db = np.empty(({2 * n}, {n}))",

@@ -93,7 +93,7 @@ def double_pendulum_partials(t, y, p, dM, db):
     db[3, 1] = x11
 
 
-@compiled(RHS_SIGNATURE)
+@compiled(RHS_SIGNATURE, allocates=True)
 def double_pendulum_rhs(t, y, p, out):
     """(qd, qdd) with M qdd = b."""
     M = np.empty((2, 2))
@@ -108,7 +108,7 @@ def double_pendulum_rhs(t, y, p, out):
         out[2 + i] = acc[i]
 
 
-@compiled(JAC_SIGNATURE)
+@compiled(JAC_SIGNATURE, allocates=True)
 def double_pendulum_jac(t, y, p, J):
     """Exact Jacobian: dqdd/dy_k = M^-1 (db/dy_k - dM/dy_k qdd)."""
     M = np.empty((2, 2))
