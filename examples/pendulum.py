@@ -30,7 +30,9 @@ from recipdyn.model.base import JAC_SIGNATURE, RHS_SIGNATURE, ODESystem, compile
 from recipdyn.model.protocol import Model, Param, Schema
 
 
-@compiled(RHS_SIGNATURE)  # numba, compiled on first use and cached on disk
+# numba, compiled on first use and cached on disk; a kernel that allocates arrays (np.empty)
+# says @compiled(SIGNATURE, allocates=True), see docs/architecture.md, Compiled kernels
+@compiled(RHS_SIGNATURE)
 def _rhs(t, y, p, out):
     out[0] = y[1]
     out[1] = -p[0] * y[1] - p[1] * math.sin(y[0]) + p[2] * math.cos(p[3] * t)

@@ -90,7 +90,7 @@ def compiled(signature, *, allocates: bool = False):
     def deco(func):
         dispatcher = _nb.njit(cache=True, _nrt=allocates)(func)
         dispatcher.recipdyn_signature = signature
-        if not allocates:
+        if not allocates and hasattr(dispatcher, "targetoptions"):  # not NUMBA_DISABLE_JIT
             _fall_back_to_counting(dispatcher)
         return dispatcher
 
