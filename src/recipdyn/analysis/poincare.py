@@ -106,7 +106,7 @@ def stroboscopic_section(
 
 
 def _plane_event(index: int, value: float):
-    @nb.njit(EVENT_SIGNATURE)
+    @nb.njit(EVENT_SIGNATURE, _nrt=False)  # no reference counting, like model.base.compiled
     def event(t, y, p):
         return y[index] - value
 
