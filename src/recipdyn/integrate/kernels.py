@@ -50,13 +50,13 @@ def _copy(src, dst):
 
 
 @nb.njit(cache=True)
-def _rms_ratio(a, b, scale):
-    """The root mean square of ``(a - b) / scale`` (no temporaries)."""
+def _rms_scaled(x, scale):
+    """The root mean square of ``x / scale`` (no temporaries)."""
     s = 0.0
-    for j in range(a.shape[0]):
-        v = (a[j] - b[j]) / scale[j]
+    for j in range(x.shape[0]):
+        v = x[j] / scale[j]
         s += v * v
-    return math.sqrt(s / a.shape[0])
+    return math.sqrt(s / x.shape[0])
 
 
 @nb.njit(cache=True)
@@ -273,11 +273,10 @@ def dop853_kernel(
     Fd = np.empty((7, n))
     y = y0.copy()
     f = np.empty(n)
-    zero = np.zeros(n)
     return _dop853_run(
         rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
         A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2,
-        stats, fstate, K, W, Fd, y, f, zero,
+        stats, fstate, K, W, Fd, y, f,
     )  # fmt: skip
 
 
@@ -285,11 +284,12 @@ def dop853_kernel(
 def _dop853_run(
     rhs, event, t0, y0, t1, t_stop, p, rtol, atol, h_abs0, max_step, t_eval, max_steps,
     A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2, stats,
-    fstate, K, W, Fd, y, f, zero,
+    fstate, K, W, Fd, y, f,
 ):  # fmt: skip
     """:func:`dop853_kernel`'s loop, given its work arrays, compiled without reference
     counting (with it, the atomic counts of the array arguments at every call and view cost
-    ~0.3 us a step)."""
+    ~0.1 us a step: the contact model's revolution at rtol 1e-10, 8.0 -> 7.5 ms for 5 536
+    steps)."""
     n = y0.shape[0]
     max_events = ev_t.shape[0]
     n_stages = 12
@@ -314,15 +314,17 @@ def _dop853_run(
     else:
         for j in range(n):
             scale[j] = atol + abs(y[j]) * rtol
-        d0 = _rms_ratio(y, zero, scale)
-        d1 = _rms_ratio(f, zero, scale)
+        d0 = _rms_scaled(y, scale)
+        d1 = _rms_scaled(f, scale)
         h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
         h0 = min(h0, interval)
         for j in range(n):
             ytmp[j] = y[j] + h0 * direction * f[j]
         rhs(t0 + h0 * direction, ytmp, p, y_new)  # y_new: scratch for f(y1) here
         nfev += 1
-        d2 = _rms_ratio(y_new, f, scale) / h0
+        for j in range(n):
+            ytmp[j] = y_new[j] - f[j]
+        d2 = _rms_scaled(ytmp, scale) / h0
         if d1 <= 1e-15 and d2 <= 1e-15:
             h1 = max(1e-6, h0 * 1e-3)
         else:
