@@ -31,6 +31,15 @@ def test_generated_code_is_up_to_date():
     assert committed == derivation.generate_code()
 
 
+def test_generated_drive_code_is_up_to_date():
+    """The committed _generated_drive.py (the free crank of a motor drive) is exactly what the
+    derivation prints now."""
+    from pathlib import Path
+
+    committed = Path(derivation.__file__).with_name("_generated_drive.py").read_text()
+    assert committed == derivation.generate_drive_code()
+
+
 def test_structured_equals_brute_force_lagrangian(rng):
     """Hypothesis: the paper-structured derivation (exact partials, Eq. 38-42 form) and a
     brute-force Lagrangian with theta2 = -asin(...) substituted give the same theta_c''."""

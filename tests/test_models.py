@@ -20,15 +20,47 @@ from recipdyn.model.base import DiscreteMap, ODESystem
 from recipdyn.model.registry import get_model, model_names
 
 EXAMPLE = str(Path(__file__).parents[1] / "examples" / "pendulum.py") + ":PENDULUM"
-MODELS = [*model_names(), EXAMPLE]
+#: Component combinations of the assembled compressor (model/components) that pass the same
+#: tests as the registered models: every drive and torque law, loads, the ideal joint.
+PRESETS = {
+    "compressor[load=cycle]": {"load": "cycle"},
+    "compressor[drive=motor]": {"drive": "motor"},
+    "compressor[drive=motor,motor=constant,load=cycle]": {"drive": "motor", "motor": "constant",
+                                                          "load": "cycle"},
+    "compressor[drive=motor,rc=0]": {"drive": "motor", "rc": 0.0},
+}  # fmt: skip
+MODELS = [*model_names(), EXAMPLE, *PRESETS]
 
 
 def _ids(x):
     return Path(x.split(":")[0]).stem if ":" in x else x
 
 
+def _preset(over):
+    """The compressor with other defaults: the same model class, its schema's defaults
+    replaced, so every test below runs the combination as it runs a registered model."""
+    from dataclasses import replace
+
+    from recipdyn.model.protocol import Schema
+
+    base = get_model("compressor")
+    schema = Schema(tuple(replace(p, default=over.get(p.name, p.default)) for p in base.schema),
+                    base.schema.aliases)  # fmt: skip
+    model = type(base)()
+    model.schema = schema
+    model.preset = over
+    return model
+
+
+def _set_args(model):
+    """``--set`` options that select a preset's components on the command line."""
+    return [a for k, v in getattr(model, "preset", {}).items() for a in ("--set", f"{k}={v}")]
+
+
 @pytest.fixture(params=MODELS, ids=_ids)
 def model(request):
+    if request.param in PRESETS:
+        return _preset(PRESETS[request.param])
     return get_model(request.param)
 
 
@@ -56,6 +88,7 @@ def test_schema_is_complete_and_defaults_valid(model):
         with pytest.raises(ParameterError, match=p.name):
             model.parameters({p.name: "not a value" if p.choices is None else "nope"})
     assert len(model.state_names) == len(model.state_units)
+    assert all(len(x) == 2 for x in model.states(values))
 
 
 def test_parameter_round_trips(model, tmp_path):
@@ -86,7 +119,7 @@ def test_kernels_deterministic_and_jacobian_exact(model, rng):
     and at most 2 % of the entries may be set aside so."""
     values = model.parameters()
     s = model.system(values)
-    assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == model.dim
+    assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == len(model.states(values))
     y0 = model.initial_state(values)
     fn = s.f if isinstance(s, ODESystem) else s.g
     scale = model.state_scale(values)
@@ -131,7 +164,7 @@ def test_cli_simulate_and_models(model, tmp_path, capsys):
     spec = EXAMPLE if model.name == "pendulum" else model.name
     out = tmp_path / "r.nc"
     assert main(["simulate", "--model", spec, "-n", "2", "--fs", "100 Hz", "-o", str(out),
-                 "--no-progress"]) == 0  # fmt: skip
+                 "--no-progress", *_set_args(model)]) == 0  # fmt: skip
     assert out.exists() and out.with_suffix(".png").stat().st_size > 5000
     assert main(["models", spec]) == 0
     shown = capsys.readouterr().out
@@ -195,7 +228,9 @@ def test_sweep_any_model(model, tmp_path):
         with pytest.raises(ParameterError, match="not available"):
             SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name)
         measures = ("poincare", "peak")
-    spec = SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name)
+    base = model.parameters() if hasattr(model, "preset") else None
+    spec = SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name,
+                     **({} if base is None else {"base": base}))  # fmt: skip
     ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False)).load()
     assert ds.done.values.all() and not any(ds.error.values), ds.error.values
     assert ds.attrs["model"] == model.name
@@ -265,7 +300,7 @@ def test_declared_events_are_recorded_consistently(model):
     assert ds.time.values[0] <= t_ev[0] and t_ev[-1] <= ds.time.values[-1]
     s = model.system(v)
     for k in range(t_ev.size):
-        y = np.array([ds[f"{e.name}_{n}"].values[k] for n in model.state_names])
+        y = np.array([ds[f"{e.name}_{n}"].values[k] for n, _ in model.states(v)])
         assert abs(e.function(float(t_ev[k]), y, s.params)) < 1e-9 * max(1.0, np.abs(y).max())
     assert ds[f"{e.name}_time"].attrs["units"] == model.time_unit
     # an event that acts is part of the dynamics: the compiled system carries it, so every

@@ -429,13 +429,14 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         m.check(values)
     except (ParameterError, TypeError, ValueError) as exc:
         raise ParameterError(f"{path}: the recorded parameters are not valid ({exc})") from None
-    missing = [s for s in m.state_names if s not in ds]
+    state_names = tuple(s for s, _ in m.states(values))
+    missing = [s for s in state_names if s not in ds]
     if missing:
         raise ParameterError(f"{path}: state variable(s) {', '.join(missing)} missing")
     system = m.system(values)
-    y0 = np.array([float(ds[s].values[0]) for s in m.state_names])
+    y0 = np.array([float(ds[s].values[0]) for s in state_names])
     t0 = float(ds[dim].values[0])
-    pair = m.state_names[:2] if m.dim >= 2 else m.state_names * 2
+    pair = state_names[:2] if len(state_names) >= 2 else state_names * 2
     lam, lam_err, section, k01 = None, 0.0, None, None
     supported = m.lyapunov_supported(values)
     if not supported:

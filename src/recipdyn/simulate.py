@@ -199,6 +199,8 @@ def simulate(
             fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
             max_memory=max_memory, spec=model if isinstance(model, str) else get_model(model).name,
         )  # fmt: skip
+    if params is None and model is not None and not isinstance(model, str):
+        params = model.parameters()  # a Model object's own defaults (a preset of components)
     p = _coerce_params(params, overrides)
     _check_run_settings(revolutions, transient, fs, method, rtol, atol)
     T = p.crank_period
@@ -488,7 +490,7 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
         _track_minima(m, ds, minima)
         _check_validity(m, minima, ds.attrs, values)
     if events:
-        ds = _with_events(ds, m, events[0], sol, t_start)
+        ds = _with_events(ds, m, values, events[0], sol, t_start)
     if sol.t.size:
         ds.attrs.update(clean_attrs(m.run_summary(values, ds)))
     if failure is not None:
@@ -497,13 +499,13 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
     return ds
 
 
-def _with_events(ds: xr.Dataset, m: Model, e, sol, t_start: float) -> xr.Dataset:
+def _with_events(ds: xr.Dataset, m: Model, values, e, sol, t_start: float) -> xr.Dataset:
     """The event records of the recorded interval, over an ``NAME_event`` dimension."""
     keep = sol.t_events >= t_start
     dim = f"{e.name}_event"
     ds[f"{e.name}_time"] = (dim, sol.t_events[keep], {"units": m.time_unit,
                             "long_name": f"time of {e.name}: {e.description}"})  # fmt: skip
-    for i, (s, u) in enumerate(zip(m.state_names, m.state_units, strict=True)):
+    for i, (s, u) in enumerate(m.states(values)):
         ds[f"{e.name}_{s}"] = (dim, sol.y_events[keep, i], {"units": u,
                                "long_name": f"{s} at {e.name}"})  # fmt: skip
         if e.action == "reset":
@@ -517,7 +519,7 @@ def _dataset(m: Model, values, t, y, dim: str, t_units: str, attrs) -> xr.Datase
     outs = m.outputs(values, t, y)
     data_vars = {k: (dim, s.values, {"units": s.units, "long_name": s.long_name})
                  for k, s in outs.items()}  # fmt: skip
-    for i, (name, unit) in enumerate(zip(m.state_names, m.state_units, strict=True)):
+    for i, (name, unit) in enumerate(m.states(values)):
         if name not in data_vars:  # the whole state is always recorded (analyze rebuilds it)
             data_vars[name] = (dim, np.asarray(y[:, i]), {"units": unit, "long_name": name})
     ds = xr.Dataset(data_vars, coords={dim: (dim, t, {"units": t_units, "long_name": dim})})

@@ -18,25 +18,17 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
-import numba as nb
 import numpy as np
 
-from ._generated import clearance_acceleration, clearance_acceleration_jac
-from .base import (
-    JAC_SIGNATURE,
-    RHS_JAC_SIGNATURE,
-    RHS_SIGNATURE,
-    ODESystem,
-    Signal,
-    compiled,
-    rhs_series,
-)
-from .cycle import cycle_force_kernel, cycle_states, cycle_summary
+from .base import ODESystem, Signal, rhs_series
+from .components import DRIVES, MOTORS, Assembly, Component, glue_module, load_component
+from .components.mechanism import HEAD, N_HEAD, glue_source
+from .cycle import cycle_states, cycle_summary
 from .kinematics import joint_forces, kinematics
-from .load import gas_force, gas_force_kernel, mu_kernel, pack_load
-from .paper_printed import paper_acceleration
+from .load import gas_force, pack_load
 from .parameters import SCHEMA, CompressorParams, ParameterError
 from .protocol import Model
 
@@ -45,13 +37,15 @@ __all__ = [
     "COMPRESSOR",
 ]  # fmt: skip
 
-# Layout of the packed parameter vector.
+# The packed layout of the dynamic-valve model (compressor_valves.py), whose kernels are not yet
+# assembled from components; this model's own vector is pack_assembled's.
 P_R, P_RS, P_L, P_LS, P_M1, P_M2, P_M3, P_J1, P_J2, P_G = range(10)
 P_RC, P_D, P_OMEGA, P_TH10, P_LOADKIND, P_LOADAMP, P_LOADSIGN, P_TABLE = range(10, 18)
 
 
 def pack_params(p: CompressorParams) -> np.ndarray:
-    """Flat float64 vector for the compiled kernels (layout: the ``P_*`` constants)."""
+    """Flat float64 vector of the dynamic-valve model's kernels (layout: the ``P_*``
+    constants)."""
     kind, data = pack_load(vars(p))
     head = [p.r, p.rs, p.l, p.ls, p.m1, p.m2, p.m3, p.J1, p.J2, p.g, p.rc, p.d, p.omega]
     head += [p.theta1_0, kind, p.load_amplitude]
@@ -59,135 +53,42 @@ def pack_params(p: CompressorParams) -> np.ndarray:
     return np.concatenate([np.asarray(head, dtype=np.float64), data])
 
 
-@nb.njit(cache=True)
-def _force(t, p):
-    th1 = p[P_TH10] + p[P_OMEGA] * t
-    if p[P_LOADKIND] == 0.0:  # the paper's load: no table slice in the hot path
-        return th1, p[P_LOADSIGN] * p[P_LOADAMP] * mu_kernel(th1)
-    return th1, gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
+def assembly(p: CompressorParams) -> tuple[Assembly, dict[str, Component]]:
+    """The components ``p`` chooses and their assembly (drive, its torque law, load: the
+    load last, since a table's length varies)."""
+    v = vars(p)
+    parts = {"drive": DRIVES[p.drive], "load": load_component(v)}
+    if p.drive == "motor":
+        parts["motor"] = MOTORS[p.motor]
+    order = [parts[f] for f in ("drive", "motor", "load") if f in parts]
+    return Assembly(N_HEAD, tuple(order)), parts
 
 
-@nb.njit(cache=True, inline="always")
-def _force_paper(t, p):
-    th1 = p[P_TH10] + p[P_OMEGA] * t
-    return th1, p[P_LOADSIGN] * p[P_LOADAMP] * mu_kernel(th1)
+def pack_assembled(p: CompressorParams) -> tuple[np.ndarray, dict[str, int], dict]:
+    """The parameter vector of the assembled kernels, each part's offset, the parts."""
+    asm, parts = assembly(p)
+    head = np.array([getattr(p, k) for k in HEAD], dtype=np.float64)
+    vec, offsets = asm.pack(head, vars(p))
+    return vec, offsets, parts
 
 
-# The load is chosen when the model is built, not tested at every call: the mere presence of the
-# table branch costs the paper-load right-hand side ~10 % (measured: 109 vs 99 ns a call).
-@nb.njit(cache=True, inline="always")
-def _rhs_exact(t, y, p, out, force):
-    out[0] = y[1]
-    if p[P_RC] == 0.0:
-        out[1] = 0.0
-        return
-    th1, F = force(t, p)
-    out[1] = clearance_acceleration(
-        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
-        p[P_RC], p[P_D], p[P_OMEGA],
-    )  # fmt: skip
+@lru_cache(maxsize=64)
+def _kernels(equations: str, drive: str, motor: str | None, load: str,
+             offsets: tuple[tuple[str, int], ...]):  # fmt: skip
+    """The generated glue's kernels for one combination (cached per process; on disk by
+    numba)."""
+    from .components.load import LOADS
 
-
-@nb.njit(cache=True, inline="always")
-def _rhs_jac_exact(t, y, p, out, J, force):
-    out[0] = y[1]
-    J[0, 0] = 0.0
-    J[0, 1] = 1.0
-    if p[P_RC] == 0.0:
-        out[1] = 0.0
-        J[1, 0] = 0.0
-        J[1, 1] = 0.0
-        return
-    th1, F = force(t, p)
-    out[1], J[1, 0], J[1, 1] = clearance_acceleration_jac(
-        th1, y[0], y[1], F, p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_J2], p[P_G],
-        p[P_RC], p[P_D], p[P_OMEGA],
-    )  # fmt: skip
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_exact(t, y, p, out):
-    """Exact equation, the paper's load."""
-    _rhs_exact(t, y, p, out, _force_paper)
-
-
-@compiled(RHS_JAC_SIGNATURE)
-def rhs_jac_exact(t, y, p, out, J):
-    _rhs_jac_exact(t, y, p, out, J, _force_paper)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_exact(t, y, p, out):
-    f = np.empty(2)
-    _rhs_jac_exact(t, y, p, f, out, _force_paper)
-
-
-@nb.njit(cache=True, inline="always")
-def _force_cycle(t, p):
-    th1 = p[P_TH10] + p[P_OMEGA] * t
-    return th1, cycle_force_kernel(th1, p[P_TABLE:])
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_exact_cycle(t, y, p, out):
-    """Exact equation, the compression-cycle load."""
-    _rhs_exact(t, y, p, out, _force_cycle)
-
-
-@compiled(RHS_JAC_SIGNATURE)
-def rhs_jac_exact_cycle(t, y, p, out, J):
-    _rhs_jac_exact(t, y, p, out, J, _force_cycle)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_exact_cycle(t, y, p, out):
-    f = np.empty(2)
-    _rhs_jac_exact(t, y, p, f, out, _force_cycle)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_exact_table(t, y, p, out):
-    """Exact equation, a tabulated load."""
-    _rhs_exact(t, y, p, out, _force)
-
-
-@compiled(RHS_JAC_SIGNATURE)
-def rhs_jac_exact_table(t, y, p, out, J):
-    _rhs_jac_exact(t, y, p, out, J, _force)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_exact_table(t, y, p, out):
-    f = np.empty(2)
-    _rhs_jac_exact(t, y, p, f, out, _force)
-
-
-@nb.njit(cache=True)
-def _paper_acc(t, q, qd, p):
-    th1, F = _force(t, p)
-    return paper_acceleration(
-        th1, q, qd, F, p[P_R], p[P_L], p[P_M2], p[P_M3], p[P_J2], p[P_RC], p[P_D], p[P_OMEGA]
+    src = glue_source(
+        equations=equations,
+        drive=DRIVES[drive],
+        load=LOADS[load],
+        motor=None if motor is None else MOTORS[motor],
+        offsets=dict(offsets),
     )
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_paper(t, y, p, out):
-    out[0] = y[1]
-    out[1] = 0.0 if p[P_RC] == 0.0 else _paper_acc(t, y[0], y[1], p)
-
-
-@compiled(JAC_SIGNATURE)
-def jac_paper(t, y, p, out):
-    out[0, 0] = 0.0
-    out[0, 1] = 1.0
-    if p[P_RC] == 0.0:
-        out[1, 0] = 0.0
-        out[1, 1] = 0.0
-        return
-    h = 1e-6
-    out[1, 0] = (_paper_acc(t, y[0] + h, y[1], p) - _paper_acc(t, y[0] - h, y[1], p)) / (2 * h)
-    hd = 1e-6 * max(1.0, abs(y[1]))
-    out[1, 1] = (_paper_acc(t, y[0], y[1] + hd, p) - _paper_acc(t, y[0], y[1] - hd, p)) / (2 * hd)
+    stem = f"compressor_{drive}_{load}_{equations}".replace("-", "_")  # fmt: skip
+    mod = glue_module(src, stem if motor is None else f"{stem}_{motor}")
+    return mod.rhs, mod.jac, mod.rhs_jac
 
 
 def equilibrium_theta_c(p: CompressorParams, t: float = 0.0) -> float:
@@ -216,30 +117,60 @@ def equilibrium_theta_c(p: CompressorParams, t: float = 0.0) -> float:
 
 @dataclass(frozen=True)
 class CompressorModel(ODESystem):
-    """The compressor as a 2-state ODE with crosshead outputs (see module docstring)."""
+    """The compressor as an ODE with crosshead outputs (see module docstring)."""
 
     cparams: CompressorParams = field(default_factory=CompressorParams)
 
     def initial_state(self) -> np.ndarray:
-        """``(theta_c0, thetadot_c0)``; default theta_c0: :func:`equilibrium_theta_c` + offset."""
+        """``(theta_c0, thetadot_c0)`` (with a motor, then ``theta1_0, omega, 0, 0``);
+        default theta_c0: :func:`equilibrium_theta_c` + offset."""
         p = self.cparams
         thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
-        return np.array([thc0 + p.theta_c_offset, p.thetadot_c0])
+        y0 = [thc0 + p.theta_c_offset, p.thetadot_c0]
+        if p.drive == "motor":
+            y0 += [p.theta1_0, p.omega, 0.0, 0.0]
+        return np.array(y0)
 
     def accelerations(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Clearance-angle acceleration at each sample, from the equation of motion."""
         return rhs_series(self.rhs, self.params, t, y)[:, 1]
 
     def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, Signal]:
-        """Crosshead motion, rod angle, clearance state, gas force and joint forces."""
+        """Crosshead motion, rod angle, clearance state, gas force and joint forces (with a
+        motor: crank speed and acceleration, motor torque, energies)."""
         p = self.cparams
-        thc, thcd = y[:, 0], y[:, 1]
-        thcdd = self.accelerations(t, y)
-        k = kinematics(p, t, thc, thcd, thcdd)
-        return {
-            **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(k.theta1, p)),
-            **cycle_outputs(vars(p), k.theta1),
-        }
+        f = rhs_series(self.rhs, self.params, t, y)
+        thc, thcd, thcdd = y[:, 0], y[:, 1], f[:, 1]
+        if p.drive != "motor":
+            k = kinematics(p, t, thc, thcd, thcdd)
+            return {
+                **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(k.theta1, p)),
+                **cycle_outputs(vars(p), k.theta1),
+            }
+        th1, w1, a1 = y[:, 2], y[:, 3], f[:, 3]
+        k = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=w1, alpha1=a1)
+        out = {
+            **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(th1, p)),
+            **cycle_outputs(vars(p), th1),
+            "omega1": Signal(w1, "rad/s", "crank speed"),
+            "alpha1": Signal(a1, "rad/s**2", "crank angular acceleration"),
+            "motor_torque": Signal(f[:, 4] / w1, "N*m", "motor torque at the crank"),
+            "W_motor": Signal(y[:, 4], "J", "work done by the motor since t = 0"),
+            "W_gas": Signal(y[:, 5], "J", "work done by the gas on the crosshead since t = 0"),
+            "energy": Signal(mechanism_energy_series(p, y), "J",
+                             "kinetic + potential energy of the mechanism and the drive"),
+        }  # fmt: skip
+        return out
+
+
+def mechanism_energy_series(p: CompressorParams, y: np.ndarray) -> np.ndarray:
+    """``T + V`` of crank (with ``J_drive``), rod and crosshead at each sample of a motor-driven
+    run, J (the generated expression of the free-crank derivation)."""
+    from ._generated_drive import mechanism_energy
+
+    args = [getattr(p, k) for k in HEAD] + [p.J_drive]
+    return np.array([mechanism_energy(a, c, w, cd, *args)
+                     for c, cd, a, w in y[:, :4]])  # fmt: skip
 
 
 def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str, Signal]:
@@ -286,29 +217,36 @@ def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Si
 
 
 def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
-    """Build the ODE model for ``p`` (default: the paper's base case)."""
+    """Build the ODE model for ``p`` (default: the paper's base case), assembled from the
+    components ``p`` chooses (:func:`assembly`)."""
     p = CompressorParams() if p is None else p
     if not isinstance(p, CompressorParams):
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
-    if p.equations != "exact":
-        rhs, jac, rhs_jac = rhs_paper, jac_paper, None
-    elif p.load_table is None and p.load == "paper":
-        rhs, jac, rhs_jac = rhs_exact, jac_exact, rhs_jac_exact
-    elif p.load_table is None and p.gas == "ideal":
-        rhs, jac, rhs_jac = rhs_exact_cycle, jac_exact_cycle, rhs_jac_exact_cycle
-    else:
-        rhs, jac, rhs_jac = rhs_exact_table, jac_exact_table, rhs_jac_exact_table
+    vec, offsets, parts = pack_assembled(p)
+    motor = parts.get("motor")
+    rhs, jac, rhs_jac = _kernels(p.equations, p.drive, None if motor is None else motor.name,
+                                 parts["load"].name, tuple(sorted(offsets.items())))  # fmt: skip
+    names, units = ("theta_c", "thetadot_c"), ("rad", "rad/s")
+    extra: dict[str, Any] = {}
+    if p.drive == "motor":
+        names += ("theta1", "omega1", "W_motor", "W_gas")
+        units += ("rad", "rad/s", "J", "J")
+        # the crank is a state: the system is autonomous; with rc = 0 the clearance angle
+        # never moves
+        extra = dict(period=None, aux_states=2,
+                     passive=(4, 5) if p.rc > 0 else (0, 1, 4, 5))  # fmt: skip
     return CompressorModel(
         rhs=rhs,
         jac=jac,
         rhs_jac=rhs_jac,
-        params=pack_params(p),
-        state_names=("theta_c", "thetadot_c"),
-        state_units=("rad", "rad/s"),
-        period=p.crank_period,
+        params=vec,
+        state_names=names,
+        state_units=units,
+        period=extra.pop("period", p.crank_period),
         name=f"compressor-{p.equations}",
         attrs=p.to_attrs(),
         cparams=p,
+        **extra,
     )
 
 
@@ -337,8 +275,17 @@ class Compressor(Model):
         "the contact-impact joint (--model compressor-contact)",
     ),)  # fmt: skip
 
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """``theta_c, thetadot_c``; a motor drive adds the crank angle and speed and the work
+        integrals of the motor and the gas."""
+        out = super().states(values)
+        if values.get("drive", "prescribed") == "motor":
+            out += (("theta1", "rad"), ("omega1", "rad/s"), ("W_motor", "J"), ("W_gas", "J"))
+        return out
+
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
-        return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics
+        # rc = 0 with a prescribed crank: the ideal mechanism, nothing moves but the crank
+        return float(values["rc"]) > 0.0 or values.get("drive", "prescribed") == "motor"
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
         """The link's bound (it can only push) needs a link: with rc = 0 the crank pin is an

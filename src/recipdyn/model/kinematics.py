@@ -69,21 +69,26 @@ def _rod_angle(p: CompressorParams, th1, thc):
     return np.arcsin(s2), s2, np.sqrt(1.0 - s2 * s2)
 
 
-def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c) -> Kinematics:
+def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c, *, theta1=None,
+               omega1=None, alpha1=None) -> Kinematics:  # fmt: skip
     """Exact positions, velocities and accelerations for a clearance-angle trajectory.
 
     Parameters
     ----------
     p : CompressorParams
     t : array_like
-        Times, s; the crank angle is ``theta1_0 + omega t``.
+        Times, s; the crank angle is ``theta1_0 + omega t`` unless ``theta1`` is given.
     theta_c, thetadot_c, thetaddot_c : array_like
         Clearance angle (rad), its rate (rad/s) and acceleration (rad/s^2) at ``t``; the
         acceleration comes from the equation of motion (not finite differences).
+    theta1, omega1, alpha1 : array_like, optional
+        The crank's angle, speed and acceleration when the crank is free (a motor drive);
+        then ``p' = p_1 omega1 + p_c theta_c'`` and ``p''`` gains ``p_1 alpha1``.
     """
     t = np.asarray(t, dtype=float)
-    w = p.omega
-    th1 = p.theta1_0 + w * t
+    free = theta1 is not None
+    w = np.asarray(omega1, dtype=float) if free else p.omega
+    th1 = np.asarray(theta1, dtype=float) if free else p.theta1_0 + w * t
     thc, thcd, thcdd = (np.asarray(a, dtype=float) for a in (theta_c, thetadot_c, thetaddot_c))
     th2, s2, c2 = _rod_angle(p, th1, thc)
     s1, c1, sc, cc = np.sin(th1), np.cos(th1), np.sin(thc), np.cos(thc)
@@ -95,6 +100,8 @@ def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c) -> Kine
     q1c = t2 * q1 * qc
     th2d = q1 * w + qc * thcd
     th2dd = q11 * w**2 + 2 * q1c * w * thcd + qcc * thcd**2 + qc * thcdd
+    if free:
+        th2dd = th2dd + q1 * np.asarray(alpha1, dtype=float)
 
     def point(lam):
         # position, p_1, p_c, p_11, p_1c, p_cc as (x, y) pairs
@@ -115,6 +122,8 @@ def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c) -> Kine
             a * w**2 + 2 * b * w * thcd + c * thcd**2 + e * thcdd
             for a, b, c, e in zip(p11, p1c, pcc, pc, strict=True)
         ]
+        if free:
+            acc = [x + a * np.asarray(alpha1, dtype=float) for x, a in zip(acc, p1, strict=True)]
         return pos, vel, acc
 
     (x2, y2), _, (ax2, ay2) = point(p.ls)

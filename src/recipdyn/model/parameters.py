@@ -25,6 +25,7 @@ from typing import Any, Literal
 
 from ..defaults import RC_MIN
 from ..errors import ParameterError
+from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .protocol import Param, Schema
 
 __all__ = [
@@ -147,6 +148,13 @@ SCHEMA = Schema((
     Param("suction_temperature", "K", 293.15, "suction temperature (load = cycle with a real "
           "gas)", 0.0, 5000.0, low_open=True, assumed=ASSUMED_CYCLE["suction_temperature"],
           group="cycle"),
+    # the drive (components.drive): the family's choice, then each component's fragment
+    Param("drive", "", "prescribed", "what turns the crank: 'prescribed' (constant omega) or "
+          "'motor' (crank angle and speed as states; omega is the initial speed)",
+          choices=tuple(DRIVES), group="drive"),
+    Param("motor", "", "induction", "the motor's torque law (drive = motor): 'induction' "
+          "(Kloss's curve) or 'constant'", choices=tuple(MOTORS), group="drive"),
+    *MOTOR.params, *CONSTANT_TORQUE.params, *INDUCTION.params,
 ), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
@@ -237,6 +245,12 @@ class CompressorParams:
         ``rod_diameter``, ``clearance_fraction``, ``suction_pressure``, ``discharge_pressure``
         (absolute, Pa), ``n_compression``, ``n_expansion``, ``acting`` and ``frame_pressure``;
         ``load_amplitude`` and ``load_sign`` do not apply to it.
+    drive : {"prescribed", "motor"}
+        ``"prescribed"``: ``theta1 = theta1_0 + omega t``. ``"motor"``: the crank angle and
+        speed are states driven by the torque law ``motor`` (``"induction"``: Kloss's curve
+        with ``motor_sync_speed``, ``motor_breakdown_torque``, ``motor_breakdown_slip``;
+        ``"constant"``: ``motor_torque``) on the inertia ``J_drive``; ``omega`` is then the
+        initial speed (:mod:`recipdyn.model.components.drive`).
     """
 
     r: float = 0.12
@@ -271,6 +285,13 @@ class CompressorParams:
     frame_pressure: float = 101325.0
     gas: str = "ideal"
     suction_temperature: float = 293.15
+    drive: Literal["prescribed", "motor"] = "prescribed"
+    motor: Literal["induction", "constant"] = "induction"
+    J_drive: float = 3000.0
+    motor_torque: float | None = None
+    motor_sync_speed: float = 21.0
+    motor_breakdown_torque: float = 11000.0
+    motor_breakdown_slip: float = 0.15
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
@@ -296,6 +317,15 @@ class CompressorParams:
                 raise ParameterError("load = 'cycle' and a load table exclude each other: "
                                      "drop the table or set load = 'paper'")  # fmt: skip
         _check("rod_diameter", self.rod_diameter, 0.0, self.bore, hi_open=True)
+        if self.drive == "motor":
+            if self.equations != "exact":
+                raise ParameterError(
+                    "equations = 'paper-printed' exists for a prescribed crank "
+                    "only; allowed with drive = 'motor': equations = 'exact'"
+                )
+            check = MOTORS[self.motor].check
+            if check is not None:
+                check(asdict(self))
         if self.discharge_pressure < self.suction_pressure:
             raise ParameterError(
                 f"discharge_pressure = {self.discharge_pressure!r} Pa is out of range; allowed: "

@@ -213,6 +213,12 @@ class Model(ABC):
     #: Two section signals whose points are counted for periodicity (default: the first two).
     section_pair: tuple[str, str] = ()
 
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """``(name, unit)`` of each state component at ``values`` (default: the class's
+        ``state_names`` and ``state_units``; an assembled model whose components add states,
+        such as a motor drive, says so here)."""
+        return tuple(zip(self.state_names, self.state_units, strict=True))
+
     def sections(self) -> tuple[tuple[str, str], ...]:
         return self.section_signals or tuple(zip(self.state_names, self.state_units,
                                                  strict=True))  # fmt: skip

@@ -33,7 +33,7 @@ import shutil
 import sys
 import time
 import zlib
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -87,7 +87,8 @@ def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | N
         v["lambda_sum"] = ("f8", (), None, lam_unit)
     if "verdict" in spec.measures:
         v["verdict"] = ("str", (), None, "")
-    v["y_final"] = ("f8", ("state",), m.dim, "")
+    base = spec.base if isinstance(spec.base, Mapping) else vars(spec.base)
+    v["y_final"] = ("f8", ("state",), len(m.states(base)), "")
     return v
 
 

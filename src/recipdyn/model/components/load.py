@@ -1,0 +1,94 @@
+r"""Load components: the force of the gas on the crosshead along +x, ``F(theta1)``.
+
+* ``paper``: the piecewise load of the paper's Eq. (1)-(2), ``F = s P mu(theta1)``
+  (:mod:`recipdyn.model.load`), slice ``load_amplitude, s``;
+* ``table``: a periodic table of crank angle and force, linear between nodes (a measured
+  indicator diagram through :func:`recipdyn.model.load.read_pressure_table`, or the real-gas
+  cycle tabulated once from CoolProp), slice ``n, angles (rad), forces (N)``;
+* ``cycle``: the compression cycle with ideal valves and polytropic gas
+  (:mod:`recipdyn.model.cycle`), slice :func:`recipdyn.model.cycle.cycle_data`.
+
+Each is one compiled function ``force(theta1, p, o)`` reading its slice at offset ``o``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+from ..cycle import cycle_data, cycle_force_kernel
+from ..load import mu_kernel, pack_table
+from .contract import Component
+
+__all__ = ["PAPER", "TABLE", "CYCLE", "LOADS", "load_component"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+@nb.njit(cache=True, inline="always")
+def paper_force(th1, p, o):
+    """The paper's load (slice ``amplitude, sign``)."""
+    return p[o + 1] * p[o] * mu_kernel(th1)
+
+
+@nb.njit(cache=True)
+def table_force(th1, p, o):
+    """Periodic linear interpolation of ``(angle, force)`` nodes (slice ``n, angles,
+    forces``)."""
+    n = int(p[o])
+    ang = p[o + 1 : o + 1 + n]
+    val = p[o + 1 + n : o + 1 + 2 * n]
+    phi = th1 % _TWO_PI
+    j = np.searchsorted(ang, phi)  # ang[j-1] < phi <= ang[j]
+    if j == 0 or j == n:  # wrap-around segment between the last and the first node
+        a0, f0 = ang[n - 1], val[n - 1]
+        a1, f1 = ang[0] + _TWO_PI, val[0]
+        if phi < a0:
+            phi += _TWO_PI
+    else:
+        a0, f0, a1, f1 = ang[j - 1], val[j - 1], ang[j], val[j]
+    return f0 + (f1 - f0) * (phi - a0) / (a1 - a0)
+
+
+@nb.njit(cache=True, inline="always")
+def cycle_force(th1, p, o):
+    """The ideal-valve compression cycle (slice :func:`~recipdyn.model.cycle.cycle_data`)."""
+    return cycle_force_kernel(th1, p[o:])
+
+
+def _paper(values: Mapping[str, Any]) -> np.ndarray:
+    sign = -1.0 if values.get("load_sign", "physical") == "physical" else 1.0
+    return np.array([values["load_amplitude"], sign], dtype=np.float64)
+
+
+def _table(values: Mapping[str, Any]) -> np.ndarray:
+    table = values.get("load_table")
+    if table is None:  # the real gas: its cycle tabulated once from CoolProp
+        from ..realgas import real_gas_force_table
+
+        table = real_gas_force_table(values)
+    return pack_table(table)
+
+
+PAPER = Component("load", "paper", "the paper's piecewise load, Eq. (1)-(2)",
+                  module=__name__, kernels={"force": "paper_force"}, pack=_paper)  # fmt: skip
+TABLE = Component("load", "table", "a periodic force table (measured p-theta, or a real gas)",
+                  module=__name__, kernels={"force": "table_force"}, pack=_table)  # fmt: skip
+CYCLE = Component("load", "cycle", "the compression cycle, ideal valves, polytropic gas",
+                  module=__name__, kernels={"force": "cycle_force"}, pack=cycle_data)  # fmt: skip
+
+LOADS = {c.name: c for c in (PAPER, TABLE, CYCLE)}
+
+
+def load_component(values: Mapping[str, Any]) -> Component:
+    """The load component the values choose: a table when one is given (or for a real gas's
+    cycle, tabulated from CoolProp), else the ``load`` parameter's."""
+    if values.get("load_table") is not None:
+        return TABLE
+    if values.get("load", "paper") == "cycle" and values.get("gas", "ideal") != "ideal":
+        return TABLE
+    return LOADS[values.get("load", "paper")]
