@@ -1,11 +1,12 @@
-r"""The single-cylinder compressor with a crank-pin clearance as an :class:`ODESystem`.
+r"""The single-cylinder compressor with a crank-pin clearance as an
+[`ODESystem`][recipdyn.model.base.ODESystem].
 
 State ``y = (theta_c, theta_c')``; time ``t`` in s; crank angle ``theta1 = theta1_0 + omega t``.
 The right-hand side is ``(theta_c', theta_c'')`` with ``theta_c''`` from
 
 * ``equations="exact"``: Lagrange's equation derived without approximation
-  (:mod:`.derivation`, compiled code in :mod:`._generated`), with an exact Jacobian;
-* ``equations="paper-printed"``: Eq. (43)-(47) as printed (:mod:`.paper_printed`), whose
+  (`derivation`, compiled code in `_generated`), with an exact Jacobian;
+* ``equations="paper-printed"``: Eq. (43)-(47) as printed (`paper_printed`), whose
   Jacobian's ``d/d theta_c`` column is a central difference (the printed coefficients are a
   comparison variant only).
 
@@ -221,7 +222,7 @@ class CompressorModel(ODESystem):
     cparams: CompressorParams = field(default_factory=CompressorParams)
 
     def initial_state(self) -> np.ndarray:
-        """``(theta_c0, thetadot_c0)``; default theta_c0: :func:`equilibrium_theta_c` + offset."""
+        """``(theta_c0, thetadot_c0)``; default theta_c0: `equilibrium_theta_c` + offset."""
         p = self.cparams
         thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
         return np.array([thc0 + p.theta_c_offset, p.thetadot_c0])
@@ -243,8 +244,9 @@ class CompressorModel(ODESystem):
 
 
 def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str, Signal]:
-    """The massless-link mechanism's signals from its kinematics ``k`` (:func:`kinematics`)
-    and the gas force ``fg`` on the crosshead, whatever load gives it."""
+    """The massless-link mechanism's signals from its kinematics ``k``
+    ([`kinematics`][recipdyn.model.kinematics.kinematics]) and the gas force ``fg`` on the
+    crosshead, whatever load gives it."""
     jf = joint_forces(p, k, thc, fg)
     return {
         "x": Signal(k.x3, "m", "crosshead displacement x3"),
@@ -313,7 +315,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
 
 
 class Compressor(Model):
-    """The paper's compressor as a registered model (schema: :data:`parameters.SCHEMA`).
+    """The paper's compressor as a registered model (schema: `parameters.SCHEMA`).
 
     ``equations`` selects the exact derivation or the paper's printed Eq. (43)-(47).
     """
@@ -367,7 +369,8 @@ class Compressor(Model):
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """With ``load = "cycle"``: the API 618 pin-load reversal and the cycle's indicated
-        power and volumetric efficiencies (:func:`recipdyn.model.cycle.cycle_summary`)."""
+        power and volumetric efficiencies
+        ([`recipdyn.model.cycle.cycle_summary`][recipdyn.model.cycle.cycle_summary])."""
         return cycle_summary(values, ds)
 
 
