@@ -114,11 +114,13 @@ def test_docs_site_builds_strict(tmp_path):
         pytest.fail("mkdocs is not installed: it is part of the dev extras (make test installs)")
     site = tmp_path / "site"
     env = {"NO_MKDOCS_2_WARNING": "1", "PATH": "/usr/bin:/bin"}
-    if "PYTHONPATH" in os.environ:
-        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
-    proc = subprocess.run(
-        [str(Path(sys.executable).parent / "mkdocs"), "build", "--strict", "-d", str(site)],
-        cwd=ROOT, capture_output=True, text=True, timeout=600, env=env,
+    for name in ("PYTHONPATH", "JUPYTER_PATH"):  # a checkout's sources, nbconvert's templates
+        if name in os.environ:
+            env[name] = os.environ[name]
+    mkdocs = str(Path(sys.executable).parent / "mkdocs")
+    proc = subprocess.run(  # run elsewhere: mkdocs-jupyter leaves a .cache folder in the cwd
+        [mkdocs, "build", "--strict", "-f", str(ROOT / "mkdocs.yml"), "-d", str(site)],
+        cwd=tmp_path, capture_output=True, text=True, timeout=600, env=env,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "WARNING" not in proc.stderr, proc.stderr[-3000:]
