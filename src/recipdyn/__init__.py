@@ -58,6 +58,21 @@ _LAZY = {
     "DiscreteMap": "model",
     "ParameterError": "model",
     "ASSUMED": "model",
+    # the rest of the public API, as the tutorials (examples/notebooks) use it
+    "get_model": "model.registry",
+    "model_names": "model.registry",
+    "analyze_signal": "analyze",
+    "SweepSpec": "sweep",
+    "parse_axis": "sweep",
+    "run_sweep": "sweep",
+    "open_sweep": "sweep",
+    "sweep_figures": "sweep",
+    "amplitude_spectrum": "analysis",
+    "lyapunov_spectrum": "analysis",
+    "model_figure": "plotting",
+    "response_figure": "plotting",
+    "cycle_figure": "plotting",
+    "PAPER_VALUES": "reproduce",
 }
 
 __all__ = ["__version__", *_LAZY]

@@ -1,6 +1,7 @@
 """Analyse a simulation result: spectrum, phase portraits, Poincaré section, Lyapunov
 exponents (equation-based and signal-based), 0-1 test and a verdict, written as figures and a
-JSON/Markdown summary. This is the application layer over the generic :mod:`recipdyn.analysis`.
+JSON/Markdown summary. This is the application layer over the generic
+[`recipdyn.analysis`][recipdyn.analysis].
 """
 
 from __future__ import annotations
@@ -45,8 +46,8 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     over ``lyap_revolutions``) are computed when the file records recipdyn parameters; the
     signal-based ones (spectrum, Wolf, Rosenstein on the crosshead acceleration) always.
     ``phase(message)`` is entered around each step that can take long (a context manager:
-    :func:`recipdyn.progress.phase` says what is running). Returns the summary dict (also
-    written as ``summary.json`` and ``summary.md``).
+    [`recipdyn.progress.phase`][recipdyn.progress.phase] says what is running). Returns the summary
+    dict (also written as ``summary.json`` and ``summary.md``).
     """
     from .io import check_output, read_dataset
 

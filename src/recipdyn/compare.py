@@ -1,8 +1,8 @@
 """Compare runs: what differs in their inputs, and how their responses differ.
 
-:func:`compare_runs` reads two or more records of ``recipdyn simulate`` (NetCDF), lists the
-parameters and settings that differ between them, overlays the vibration signal, its
-amplitude spectrum and the once-per-revolution section, and tabulates the main measures of
+[`compare_runs`][recipdyn.compare.compare_runs] reads two or more records of ``recipdyn simulate``
+(NetCDF), lists the parameters and settings that differ between them, overlays the vibration signal,
+its amplitude spectrum and the once-per-revolution section, and tabulates the main measures of
 each run with its difference from the first (the reference):
 
 ========================  ===============================================================

@@ -46,7 +46,7 @@ _STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
 
 
 class SimulationConfig(BaseModel):
-    """Settings of :func:`recipdyn.simulate` (quantities allowed where units apply)."""
+    """Settings of `recipdyn.simulate` (quantities allowed where units apply)."""
 
     model_config = ConfigDict(extra="forbid")
     revolutions: float | str = SIMULATION["revolutions"]

@@ -26,7 +26,7 @@ CALIBRATION_RTOL = 1e-8
 CALIBRATION_ATOL = 1e-10
 #: Output sampling rate, Hz.
 FS = 10_000.0
-#: Defaults of :func:`recipdyn.simulate` (recorded in every result).
+#: Defaults of `recipdyn.simulate` (recorded in every result).
 SIMULATION: dict = dict(
     revolutions=10.0, transient=0.0, fs=FS, method="dop853", rtol=RTOL, atol=ATOL, h=None
 )

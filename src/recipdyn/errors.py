@@ -2,9 +2,11 @@
 
 The command line maps them to exit statuses (``docs/reliability.md``):
 
-* :class:`ParameterError` (bad input: a parameter, setting, path or file) -> 2;
-* :class:`~recipdyn.integrate.IntegrationError` (the integrator failed) -> 1;
-* :class:`Interrupted` (SIGINT / SIGTERM) -> 128 + signal number (130 / 143).
+* [`ParameterError`][recipdyn.errors.ParameterError] (bad input: a parameter, setting, path or file)
+  -> 2;
+* [`IntegrationError`][recipdyn.errors.IntegrationError] (the integrator failed) -> 1;
+* [`Interrupted`][recipdyn.errors.Interrupted] (SIGINT / SIGTERM) -> 128 + signal number (130 /
+  143).
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ class ModelValidityWarning(UserWarning):
 class KernelAllocatesWarning(UserWarning):
     """A compiled kernel declared without ``allocates=True`` allocates arrays, so it was
     compiled with numba's reference counting after all: correct, but slower
-    (:func:`recipdyn.model.base.compiled`)."""
+    ([`recipdyn.model.base.compiled`][recipdyn.model.base.compiled])."""
 
 
 class IntegrationError(RuntimeError):
@@ -54,14 +56,15 @@ class IntegrationError(RuntimeError):
 class Interrupted(BaseException):
     """Work was stopped by a signal.
 
-    Like :class:`KeyboardInterrupt` it derives from :class:`BaseException`, so ``except
+    Like `KeyboardInterrupt` it derives from `BaseException`, so ``except
     Exception`` does not swallow it; it is not a KeyboardInterrupt subclass, so that command
     frameworks that turn KeyboardInterrupt into a bare exit status (click, typer) let it reach
     recipdyn's own handler, which reports what was kept.
 
     Layers that catch it on the way up add what they kept (``kept``: one line each, e.g. "12 of
     40 sweep points in out/sweep.zarr; rerun with --resume") and re-raise it; ``partial`` may
-    carry a partial result (an integrator :class:`~recipdyn.integrate.Solution` or a Dataset).
+    carry a partial result (an integrator [`Solution`][recipdyn.integrate.solve.Solution] or a
+    Dataset).
     """
 
     def __init__(self, signum: int = signal.SIGINT, message: str = ""):
@@ -77,8 +80,8 @@ class Interrupted(BaseException):
 
     @classmethod
     def wrap(cls, exc: BaseException) -> Interrupted:
-        """``exc`` itself if it is an :class:`Interrupted`, else one for SIGINT (for a plain
-        :class:`KeyboardInterrupt`)."""
+        """``exc`` itself if it is an [`Interrupted`][recipdyn.errors.Interrupted], else one for
+        SIGINT (for a plain `KeyboardInterrupt`)."""
         return exc if isinstance(exc, Interrupted) else cls(signal.SIGINT)
 
 
@@ -87,18 +90,20 @@ def _raise(signum, _frame):
 
 
 def raise_on_signals() -> None:
-    """Turn SIGINT and SIGTERM into :class:`Interrupted` in this (main) thread."""
+    """Turn SIGINT and SIGTERM into [`Interrupted`][recipdyn.errors.Interrupted] in this (main)
+    thread."""
     signal.signal(signal.SIGINT, _raise)
     signal.signal(signal.SIGTERM, _raise)
 
 
 class _Pending:
-    """The first signal received inside :func:`deferred_signals` (0 = none)."""
+    """The first signal received inside [`deferred_signals`][recipdyn.errors.deferred_signals] (0 =
+    none)."""
 
     signum: int = 0
 
     def check(self) -> None:
-        """Raise :class:`Interrupted` if a signal arrived."""
+        """Raise [`Interrupted`][recipdyn.errors.Interrupted] if a signal arrived."""
         if self.signum:
             raise Interrupted(self.signum)
 

@@ -28,7 +28,7 @@ N_ORDERS = 10
 
 def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
                     chaos: bool = False) -> dict[str, Any]:  # fmt: skip
-    """Features of one window: :func:`~recipdyn.analysis.vibration.indicators`, the
+    """Features of one window: [`indicators`][recipdyn.analysis.vibration.indicators], the
     ISO 20816-8 band velocity RMS (for an acceleration), dominant frequency, spectral
     centroid, spread and normalised entropy; with a crank angle (``revs``), the amplitudes of
     orders 1..``N_ORDERS``; with ``chaos``, the 0-1 test K and the Rosenstein exponent, each
@@ -74,9 +74,9 @@ def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
 
 def feature_units(signal_unit: str, *, orders: bool = True,
                   quantity: str = "acceleration") -> dict[str, str]:  # fmt: skip
-    """The numeric features of :func:`signal_features` (chaos indicators aside) and their
-    units, in its order, for a signal in ``signal_unit``: what a sweep's ``features`` measure
-    stores per point."""
+    """The numeric features of [`signal_features`][recipdyn.features.signal_features] (chaos
+    indicators aside) and their units, in its order, for a signal in ``signal_unit``: what a sweep's
+    ``features`` measure stores per point."""
     length = signal_unit.split("/")[0] if "/" in signal_unit else signal_unit
     units = {"rms": signal_unit, "peak": signal_unit, "peak_to_peak": signal_unit,
              "crest_factor": "1", "kurtosis": "1", "skewness": "1"}  # fmt: skip
@@ -130,7 +130,8 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
 
     With ``window``, a signal file is read block by block, whatever its length. Without, its
     one row needs the whole signal in memory: a file longer than ``max_memory_samples`` is
-    refused (a :class:`ParameterError` that says to give a window) before anything is read."""
+    refused (a [`ParameterError`][recipdyn.errors.ParameterError] that says to give a window) before
+    anything is read."""
     from .analysis.vibration import crank_angle
     from .analyze import is_record
     from .io_signal import crank_revs, read_signal, record_length, speed_hz
@@ -208,7 +209,7 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress,
     block of 10^6 samples and one window, whatever the file's length). With a ``tacho``
     column, its pulses are found in a first pass (block by block; a few numbers per
     revolution are kept) and each window's crank angle interpolated from them (PCHIP, as
-    :func:`~recipdyn.analysis.vibration.crank_angle`: NaN outside the pulses)."""
+    [`crank_angle`][recipdyn.analysis.vibration.crank_angle]: NaN outside the pulses)."""
     from .analysis.vibration import crank_angle
     from .io_signal import signal_blocks, speed_hz
 

@@ -1,12 +1,13 @@
 """Reading and writing result files safely.
 
-* Outputs are checked *before* any work (:func:`check_output`): a known format from the file
-  extension, a folder that exists or can be made, and permission to write there.
+* Outputs are checked *before* any work ([`check_output`][recipdyn.io.check_output]): a known format
+  from the file extension, a folder that exists or can be made, and permission to write there.
 * Every file is written to a temporary name in the same folder and renamed when complete
-  (:func:`atomic_path`): an interrupted or failed write never destroys the previous file and
-  never leaves a half-written one under the final name.
-* Inputs are read with clear refusals (:func:`read_dataset`): missing, empty, not the expected
-  format, or missing variables -> :class:`~recipdyn.errors.ParameterError` naming what is wrong.
+  ([`atomic_path`][recipdyn.io.atomic_path]): an interrupted or failed write never destroys the
+  previous file and never leaves a half-written one under the final name.
+* Inputs are read with clear refusals ([`read_dataset`][recipdyn.io.read_dataset]): missing, empty,
+  not the expected format, or missing variables ->
+  [`ParameterError`][recipdyn.errors.ParameterError] naming what is wrong.
 """
 
 from __future__ import annotations
@@ -84,8 +85,8 @@ def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
     On any exception (including an interruption) the temporary file is removed and the
     previous content of ``path``, if any, is untouched. A process ended from outside while
     inside the block (a pool worker terminated when a run is interrupted, ``kill -9``) cannot
-    clean up: the temporary folder carries its process id, and :func:`remove_orphans` removes
-    it once that process is gone.
+    clean up: the temporary folder carries its process id, and
+    [`remove_orphans`][recipdyn.io.remove_orphans] removes it once that process is gone.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -108,9 +109,9 @@ def atomic_path(path: str | Path, *, directory: bool = False) -> Iterator[Path]:
 
 
 def remove_orphans(folder: str | Path) -> int:
-    """Remove the temporary folders :func:`atomic_path` left in ``folder`` whose process no
-    longer runs (never a finished result, never another live process's work); returns how
-    many."""
+    """Remove the temporary folders [`atomic_path`][recipdyn.io.atomic_path] left in ``folder``
+    whose process no longer runs (never a finished result, never another live process's work);
+    returns how many."""
     import re
 
     n = 0
@@ -282,7 +283,7 @@ class StreamWriter:
     Blocks (Datasets over ``time``) are appended as they are computed: to a NetCDF-4 file with
     an unlimited ``time`` dimension (netCDF4, one write per variable and block) for ``.nc``, to
     a Zarr store (``to_zarr(append_dim="time")``) for ``.zarr``. Both are built beside the
-    output and moved into place by :meth:`finish`, so nothing is at ``path`` until the record
+    output and moved into place by `finish`, so nothing is at ``path`` until the record
     is complete; ``finish(partial=True)`` keeps an incomplete record as ``NAME.partial.EXT``.
     ``float32`` stores the signals (not time) in single precision; ``compress`` adds zlib
     compression to NetCDF (Zarr is always compressed).
@@ -385,7 +386,8 @@ ORDER_ATTR = "data_variables"
 
 
 def open_record(path: str | Path):
-    """A record written by :class:`StreamWriter`, opened lazily (dask, chunk by chunk).
+    """A record written by [`StreamWriter`][recipdyn.io.StreamWriter], opened lazily (dask, chunk by
+    chunk).
 
     Without a default index on ``time``: xarray would read the whole time coordinate into a
     pandas index (16 bytes a sample, twice over while it is built: 500 MB at 10^4

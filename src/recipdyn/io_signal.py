@@ -1,7 +1,7 @@
 """Read a measured signal: one channel and its sampling rate from CSV, WAV, MAT, NetCDF,
 Parquet or NumPy files (``recipdyn analyze`` on data from elsewhere).
 
-Every failure is a :class:`~recipdyn.model.parameters.ParameterError` that names the file,
+Every failure is a [`ParameterError`][recipdyn.errors.ParameterError] that names the file,
 the option and what is allowed (the columns the file has, the rates it implies).
 """
 
@@ -237,8 +237,8 @@ def signal_blocks(path: str | Path, *, column=None, fs=None, block: int = 1_000_
     CSV/TSV/TXT are read in chunks (pandas), Parquet by row groups (pyarrow), WAV and NPY
     memory-mapped, NetCDF lazily; MAT files are read whole (scipy cannot stream them). A
     time column must stay uniform across chunks, and every block free of missing values
-    (both checked block by block, as :func:`read_signal` checks a whole file). ``progress``:
-    the label of a progress bar over the samples (none without)."""
+    (both checked block by block, as [`read_signal`][recipdyn.io_signal.read_signal] checks a whole
+    file). ``progress``: the label of a progress bar over the samples (none without)."""
     path = Path(path)
     rate, name, total, raw = _raw_blocks(path, column, fs, block)
     return rate, name, total, _checked(raw, path, name, total, progress)

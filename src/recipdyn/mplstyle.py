@@ -1,7 +1,7 @@
 """Matplotlib, headless-safe, with recipdyn's colour cycle: the floor every figure uses.
 
-Kept apart from :mod:`recipdyn.plotting` so that the generic analysis layer can draw without
-importing the compressor's figures.
+Kept apart from [`recipdyn.plotting`][recipdyn.plotting] so that the generic analysis layer can draw
+without importing the compressor's figures.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F
 
 
 def _mpl():
-    """pyplot on a file backend (Agg unless a file backend is set), with :data:`PALETTE`."""
+    """pyplot on a file backend (Agg unless a file backend is set), with
+    [`PALETTE`][recipdyn.mplstyle.PALETTE]."""
     import matplotlib
 
     if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg", "cairo"):

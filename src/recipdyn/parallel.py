@@ -2,7 +2,7 @@
 
 * Workers ignore SIGINT: Ctrl-C reaches the whole foreground process group, and only the
   coordinating process decides what to keep; it then cancels pending work and terminates the
-  workers (:func:`stop_pool`).
+  workers ([`stop_pool`][recipdyn.parallel.stop_pool]).
 * Workers notice when their parent dies, even by ``kill -9``: on Linux the kernel sends them
   SIGKILL (``prctl(PR_SET_PDEATHSIG)``), and everywhere a watchdog thread exits the worker when
   its parent process id changes.
@@ -54,7 +54,8 @@ def worker_init(parent: int | None = None) -> None:
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A ``ProcessPoolExecutor`` whose workers run :func:`worker_init`."""
+    """A ``ProcessPoolExecutor`` whose workers run
+    [`worker_init`][recipdyn.parallel.worker_init]."""
     return ProcessPoolExecutor(max_workers=workers, initializer=worker_init,
                                initargs=(os.getpid(),))  # fmt: skip
 
@@ -84,8 +85,9 @@ def run_unordered(fn: Callable[[Any], Any], tasks: Iterable, workers: int,
 
     ``on_result`` runs in this process as each result arrives (any order); at most two tasks
     per worker are queued (bounded memory for huge task lists); ``pending.check()`` (from
-    :func:`recipdyn.errors.deferred_signals`) runs between results, so a signal stops the work
-    promptly. On any exception or interruption the pool is stopped (:func:`stop_pool`).
+    [`recipdyn.errors.deferred_signals`][recipdyn.errors.deferred_signals]) runs between results, so
+    a signal stops the work promptly. On any exception or interruption the pool is stopped
+    ([`stop_pool`][recipdyn.parallel.stop_pool]).
     """
     pool = process_pool(workers)
     try:

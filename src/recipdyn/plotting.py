@@ -209,7 +209,7 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
 def model_figure(ds: xr.Dataset, *, title: str | None = None):
     """Any model's record: up to three signals over time (or iteration) and a phase portrait
     of the first two (points for a map). The contact-impact compressor gets
-    :func:`contact_figure`."""
+    [`contact_figure`][recipdyn.plotting.contact_figure]."""
     names = set(ds.data_vars)
     if {"ex", "delta", "x", "v", "a"} <= names or {"ex_crosshead", "delta_crosshead"} <= names:
         return contact_figure(ds, title=title)  # the contact-impact joint, any load

@@ -1,7 +1,7 @@
 """Saying what a long phase is doing: one helper for every layer.
 
-:func:`phase` shows a spinner on a terminal while the phase runs and writes one line to
-standard error when it took longer than a second, so a log shows where the time went too.
+[`phase`][recipdyn.progress.phase] shows a spinner on a terminal while the phase runs and writes one
+line to standard error when it took longer than a second, so a log shows where the time went too.
 """
 
 from __future__ import annotations
@@ -31,5 +31,5 @@ def phase(message: str, *, say_after: float = 1.0):
 
 @contextlib.contextmanager
 def quiet(message: str, *, say_after: float = 1.0):
-    """A :func:`phase` that says nothing (library calls without progress)."""
+    """A [`phase`][recipdyn.progress.phase] that says nothing (library calls without progress)."""
     yield

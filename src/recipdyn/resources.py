@@ -32,7 +32,8 @@ def format_bytes(n: float) -> str:
 
 
 def memory_limit(max_memory: float | None = None) -> float:
-    """``max_memory`` (bytes) if given, else :data:`MEMORY_FRACTION` of the available memory."""
+    """``max_memory`` (bytes) if given, else [`MEMORY_FRACTION`][recipdyn.resources.MEMORY_FRACTION]
+    of the available memory."""
     if max_memory is not None:
         if not max_memory > 0:
             raise ParameterError(f"max_memory = {max_memory!r} bytes; allowed: > 0")
@@ -42,7 +43,8 @@ def memory_limit(max_memory: float | None = None) -> float:
 
 def check_memory(nbytes: float, what: str, how_to_reduce: str,
                  max_memory: float | None = None) -> None:  # fmt: skip
-    """Raise :class:`ParameterError` if ``nbytes`` exceeds :func:`memory_limit`."""
+    """Raise [`ParameterError`][recipdyn.errors.ParameterError] if ``nbytes`` exceeds
+    [`memory_limit`][recipdyn.resources.memory_limit]."""
     limit = memory_limit(max_memory)
     if nbytes > limit:
         origin = "--max-memory" if max_memory is not None else (

@@ -1,4 +1,4 @@
-"""High-level simulation: parameters in, a labelled :class:`xarray.Dataset` out."""
+"""High-level simulation: parameters in, a labelled `xarray.Dataset` out."""
 
 from __future__ import annotations
 
@@ -33,17 +33,19 @@ SIGN_CONVENTION = (
     "or +P (load_sign='paper', the sign of Eq. 46)."
 )
 
-#: Defaults of :func:`simulate` (also recorded in every result); see :mod:`recipdyn.defaults`.
+#: Defaults of [`simulate`][recipdyn.simulate.simulate] (also recorded in every result); see
+#: [`recipdyn.defaults`][recipdyn.defaults].
 DEFAULT_SETTINGS: dict[str, Any] = SIMULATION
 
-#: Bytes held per output sample during :func:`simulate`: ~20 float64 signals, the state and
-#: the xarray/NetCDF copies (measured: 1000 revolutions at 10 kHz peak at 1.41 GB RSS,
-#: i.e. ~450 B per sample with the interpreter).
+#: Bytes held per output sample during [`simulate`][recipdyn.simulate.simulate]: ~20 float64
+#: signals, the state and the xarray/NetCDF copies (measured: 1000 revolutions at 10 kHz peak at
+#: 1.41 GB RSS, i.e. ~450 B per sample with the interpreter).
 BYTES_PER_SAMPLE = 480
 
 
 def estimate_memory(n_samples: int) -> float:
-    """Peak memory (bytes) :func:`simulate` needs for ``n_samples`` output samples."""
+    """Peak memory (bytes) [`simulate`][recipdyn.simulate.simulate] needs for ``n_samples`` output
+    samples."""
     return 150e6 + BYTES_PER_SAMPLE * float(n_samples)
 
 
@@ -86,8 +88,9 @@ def _track_minima(model, outs, minima: dict[str, float]) -> None:
 
 
 def _check_validity(model, minima: dict[str, float], attrs: dict, values) -> None:
-    """Record (``attrs["validity"]``) and warn (:class:`ModelValidityWarning`) when an output
-    crossed the model's validity bound (where the bounds apply at ``values``)."""
+    """Record (``attrs["validity"]``) and warn
+    ([`ModelValidityWarning`][recipdyn.errors.ModelValidityWarning]) when an output crossed the
+    model's validity bound (where the bounds apply at ``values``)."""
     warning = validity_warning(model, minima) if model.validity_applies(values) else ""
     attrs["validity"] = warning or "ok"
     if warning:
@@ -108,13 +111,15 @@ def validity_warning(model, minima: dict[str, float]) -> str:
 def simulate(
     params: CompressorParams | None = None,
     *,
-    revolutions: float = DEFAULT_SETTINGS["revolutions"],
-    transient: float = DEFAULT_SETTINGS["transient"],
-    fs: float = DEFAULT_SETTINGS["fs"],
-    method: str = DEFAULT_SETTINGS["method"],
-    rtol: float = DEFAULT_SETTINGS["rtol"],
-    atol: float = DEFAULT_SETTINGS["atol"],
-    h: float | None = DEFAULT_SETTINGS["h"],
+    # the values of DEFAULT_SETTINGS (defaults.SIMULATION), written out so that the signature
+    # and the API reference show them (tests/test_docs.py checks they agree)
+    revolutions: float = 10.0,
+    transient: float = 0.0,
+    fs: float = 10_000.0,
+    method: str = "dop853",
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    h: float | None = None,
     progress: bool = False,
     max_memory: float | None = None,
     model: str | Model | None = None,
@@ -129,7 +134,8 @@ def simulate(
     Parameters
     ----------
     params : CompressorParams, optional
-        Model parameters (default: the paper's base case, :func:`~recipdyn.paper_2d12`).
+        Model parameters (default: the paper's base case,
+        [`paper_2d12`][recipdyn.model.parameters.paper_2d12]).
     revolutions : float
         Crank revolutions to record (after the transient).
     transient : float
@@ -149,11 +155,12 @@ def simulate(
         Refuse runs estimated to need more memory than this, bytes (default: half of the memory
         available at the start).
     model : str or Model, optional
-        A registered model (:func:`recipdyn.model.registry.get_model`: a name such as
-        ``"duffing"`` or a ``module:object`` path); default the paper's compressor. For other
-        models ``params`` is a mapping of their schema's parameters, ``revolutions`` and
-        ``transient`` count forcing periods (time units for an autonomous system, iterations
-        for a map) and the outputs are the model's.
+        A registered model
+        ([`recipdyn.model.registry.get_model`][recipdyn.model.registry.get_model]: a name such as
+        ``"duffing"`` or a ``module:object`` path); default the paper's compressor. For other models
+        ``params`` is a mapping of their schema's parameters, ``revolutions`` and ``transient``
+        count forcing periods (time units for an autonomous system, iterations for a map) and the
+        outputs are the model's.
     out : str or Path, optional
         Stream the record to this file (``.nc`` or ``.zarr``) block by block as it is
         computed, so memory stays flat in run length (compressor model); the returned Dataset
@@ -389,7 +396,8 @@ def _record(outs, t, T: float, keep: list[str]) -> xr.Dataset:
 
 
 def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
-    """Rebuild the :class:`CompressorParams` recorded in a result's attributes."""
+    """Rebuild the [`CompressorParams`][recipdyn.model.parameters.CompressorParams] recorded in a
+    result's attributes."""
     import dataclasses
 
     kw: dict[str, Any] = {}
@@ -422,7 +430,8 @@ def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
 
 def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, method, rtol,
                     atol, h, progress, max_memory, spec) -> xr.Dataset:  # fmt: skip
-    """:func:`simulate` for any registered model other than the compressor."""
+    """[`simulate`][recipdyn.simulate.simulate] for any registered model other than the
+    compressor."""
     values = m.parameters(dict(params or {}), **overrides)
     _check_run_settings(revolutions, transient, fs, method, rtol, atol)
     period = m.period(values)

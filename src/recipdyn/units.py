@@ -25,9 +25,9 @@ def _ureg():
 def to_si(name: str, value, unit: str | None = None) -> float:
     """Convert ``value`` (number or string such as ``"1 mm"``, ``"191 rpm"``) to SI.
 
-    ``unit`` is the SI unit expected for ``name`` (default: from :data:`PARAM_UNITS`). A bare
-    number is taken to be in that unit already (pint, ~0.4 s to import, only loads for text
-    with units).
+    ``unit`` is the SI unit expected for ``name`` (default: from
+    [`PARAM_UNITS`][recipdyn.units.PARAM_UNITS]). A bare number is taken to be in that unit already
+    (pint, ~0.4 s to import, only loads for text with units).
     """
     unit = PARAM_UNITS.get(name, SETTING_UNITS.get(name, "")) if unit is None else unit
     if isinstance(value, bool):

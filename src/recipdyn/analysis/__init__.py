@@ -1,8 +1,8 @@
 """Generic analysis: spectra, Poincaré sections, Lyapunov exponents, 0-1 test, verdicts.
 
 Nothing here knows about cranks: every function takes an
-:class:`~recipdyn.model.base.ODESystem` / :class:`~recipdyn.model.base.DiscreteMap` or a plain
-signal.
+[`ODESystem`][recipdyn.model.base.ODESystem] / [`DiscreteMap`][recipdyn.model.base.DiscreteMap] or a
+plain signal.
 """
 
 from .classify import Verdict, classify

@@ -18,12 +18,13 @@ Rules (each piece of evidence is optional; the verdict says which were used):
 
 For a measured signal (no equations) two more pieces enter:
 
-* ``determinism``: the surrogate test (:func:`~recipdyn.analysis.surrogates.surrogate_test`).
-  If it cannot reject linearly correlated noise, the verdict is never **chaotic**: it is
-  **periodic** when the spectrum or section says so, **periodic**/**quasi-periodic** by the
-  rules above when the exponents are flat and K < 0.5 (noise never gives a flat divergence
-  curve; line spectra are where the surrogate test is weakest), else **stochastic** (white
-  noise, coloured noise and a noisy periodic signal land here).
+* ``determinism``: the surrogate test
+  ([`surrogate_test`][recipdyn.analysis.surrogates.surrogate_test]). If it cannot reject linearly
+  correlated noise, the verdict is never **chaotic**: it is **periodic** when the spectrum or
+  section says so, **periodic**/**quasi-periodic** by the rules above when the exponents are flat
+  and K < 0.5 (noise never gives a flat divergence curve; line spectra are where the surrogate test
+  is weakest), else **stochastic** (white noise, coloured noise and a noisy periodic signal land
+  here).
 * ``signal_lyapunov``: estimates from the signal (Wolf, Rosenstein, Kantz); only those with a
   usable status count (refusals are listed, never read as 0). They stand in for ``lambda1``
   when no equation-based exponent is given: positive when most usable estimates exceed
@@ -157,15 +158,17 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
              speed_ratio: float | None = None) -> Verdict:  # fmt: skip
     """Verdict from any subset of: largest exponent (with error), 0-1 K, section points
     (array n x d), amplitude spectrum, a surrogate test (``determinism``: a
-    :class:`~recipdyn.analysis.surrogates.SurrogateTest` or a bool) and signal estimates
-    (``signal_lyapunov``: :class:`~recipdyn.analysis.lyapunov_signal.SignalLyapunov` list).
-    ``lyap_tol`` is in the exponent's units; ``section_rtol`` the relative distance under
+    [`SurrogateTest`][recipdyn.analysis.surrogates.SurrogateTest] or a bool) and signal estimates
+    (``signal_lyapunov``: [`SignalLyapunov`][recipdyn.analysis.lyapunov_signal.SignalLyapunov]
+    list). ``lyap_tol`` is in the exponent's units; ``section_rtol`` the relative distance under
     which section points are one (1e-6 for an integration; larger for measured signals),
     ``section_extent`` the widest group that still counts as one point and ``section_scale``
-    the scale of both (:func:`~recipdyn.analysis.poincare.count_distinct_points`).
-    ``rms_ratio`` (:func:`quarter_rms_ratio` of a signal) above ``MAX_RMS_RATIO``, or
-    ``speed_ratio`` (:func:`quarter_speed_ratio` of its crank angle) above ``MAX_SPEED_RATIO``,
-    makes the verdict undetermined: every estimator here assumes a stationary record."""
+    the scale of both ([`count_distinct_points`][recipdyn.analysis.poincare.count_distinct_points]).
+    ``rms_ratio`` ([`quarter_rms_ratio`][recipdyn.analysis.classify.quarter_rms_ratio] of a signal)
+    above ``MAX_RMS_RATIO``, or ``speed_ratio``
+    ([`quarter_speed_ratio`][recipdyn.analysis.classify.quarter_speed_ratio] of its crank angle)
+    above ``MAX_SPEED_RATIO``, makes the verdict undetermined: every estimator here assumes a
+    stationary record."""
     ev: dict[str, Any] = {}
     reasons: list[str] = []
     if rms_ratio is not None:

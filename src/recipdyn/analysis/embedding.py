@@ -170,11 +170,11 @@ class Embedding:
 def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
                      theiler: int | None = None, max_dim: int = 10,
                      e1_tol: float = 0.05, max_points: int = 10_000) -> Embedding:  # fmt: skip
-    """Delay (:func:`estimate_delay`), Theiler window (the mean period, at most N/10) and
-    dimension: the first ``d`` with ``E1(d) > 1 - 2 e1_tol`` and ``|E1(d+1) - E1(d)| <
-    e1_tol`` (Cao 1997), from the first ``max_points`` samples (Cao's statistics are averages:
-    10^4 points fix them to about 1 %, and the neighbour search in 10 dimensions grows
-    faster than N). Given values are kept."""
+    """Delay ([`estimate_delay`][recipdyn.analysis.embedding.estimate_delay]), Theiler window (the
+    mean period, at most N/10) and dimension: the first ``d`` with ``E1(d) > 1 - 2 e1_tol`` and
+    ``|E1(d+1) - E1(d)| < e1_tol`` (Cao 1997), from the first ``max_points`` samples (Cao's
+    statistics are averages: 10^4 points fix them to about 1 %, and the neighbour search in 10
+    dimensions grows faster than N). Given values are kept."""
     x = np.asarray(x, dtype=float)
     tau = estimate_delay(x) if delay is None else int(delay)
     th = int(round(mean_period(x))) if theiler is None else int(theiler)

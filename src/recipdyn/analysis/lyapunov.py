@@ -336,7 +336,7 @@ def _tangent_reset(rhs, event, reset, n: int, k: int, passive: tuple[int, ...] =
     flow of two worn pins lost all agreement with differences of the flow after four events;
     measured: tests/test_contact.py.) Rounding is then ~1e-7 of the gradient for an event
     function of size 1, truncation negligible.
-    The ``passive`` rows stay 0, as in :func:`_tangent_rhs`.
+    The ``passive`` rows stay 0, as in `_tangent_rhs`.
     """
     active = _active_rows(n, passive)
 
@@ -446,10 +446,10 @@ def lyapunov_spectrum(
         ``max_log_spread`` (see module notes).
     rtol, atol : float
         Tolerances of the (adaptive) integration of the augmented system.
-    event : :class:`~recipdyn.model.base.Event`, optional
+    event : [`Event`][recipdyn.model.base.Event], optional
         Default: the system's own acting event. A state-resetting event (an impact law): the
         state is reset at each crossing and the tangent vectors are mapped by the event's
-        saltation matrix (:func:`_tangent_reset`), so the exponents include the growth or
+        saltation matrix (`_tangent_reset`), so the exponents include the growth or
         contraction of each impact; the count is in ``settings["events"]``. Events that only
         record do not change the flow: pass none.
     """

@@ -1,12 +1,12 @@
 r"""Largest Lyapunov exponent from a measured signal: Wolf, Rosenstein, Kantz.
 
-All three embed the signal (:func:`~recipdyn.analysis.embedding.delay_embed`), search
+All three embed the signal ([`delay_embed`][recipdyn.analysis.embedding.delay_embed]), search
 neighbours with a KD-tree (memory linear in N), exclude temporal neighbours with a Theiler
 window, and guard against zero distances (duplicate points never give ``-inf``).
 Every tunable defaults to ``None`` = estimated from the data; the estimates and every
 intermediate (divergence curve, fitted region, replacements) are returned in
-:class:`SignalLyapunov` so a user can see why the estimate came out as it did, and
-:func:`recipdyn.analysis.plots.plot_divergence` draws them.
+[`SignalLyapunov`][recipdyn.analysis.lyapunov_signal.SignalLyapunov] so a user can see why the
+estimate came out as it did, and `recipdyn.analysis.plots.plot_divergence` draws them.
 
 * **Wolf et al. (1985)** -- the reference paper's method: follow one fiducial trajectory and
   one neighbour for ``evolve`` samples, accumulate ``log(d_end / d_start)``, then replace the

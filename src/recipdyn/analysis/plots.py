@@ -91,9 +91,10 @@ def plot_divergence(res, ax=None):
 
 
 def plot_vibration(rep, title: str = "", unit: str = ""):
-    """The vibration engineer's page (:func:`~recipdyn.analysis.vibration.vibration_report`):
-    order spectrum, Campbell diagram or spectrogram, envelope spectrum, cepstrum, impacts
-    over the crank angle, indicators."""
+    """The vibration engineer's page
+    ([`vibration_report`][recipdyn.analysis.vibration.vibration_report]): order spectrum, Campbell
+    diagram or spectrogram, envelope spectrum, cepstrum, impacts over the crank angle,
+    indicators."""
     plt = _mpl()
     fig, axes = plt.subplots(2, 3, figsize=(16, 8.5), constrained_layout=True)
     ax = axes[0, 0]

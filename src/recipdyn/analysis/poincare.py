@@ -1,18 +1,19 @@
-"""Poincaré sections of any :class:`~recipdyn.model.base.ODESystem`.
+"""Poincaré sections of any [`ODESystem`][recipdyn.model.base.ODESystem].
 
 Two kinds:
 
-* :func:`stroboscopic_section` -- for a periodically forced system (``system.period`` set, e.g.
-  the compressor's crank period), the state exactly once per period at a chosen phase. The
-  samples come from the integrator's 7th-order dense output at the exact instants
-  ``t_k = t0 + (k + phase / 2 pi) T``, never from the nearest stored sample.
-* :func:`hyperplane_section` -- crossings of a hyperplane ``y[i] = value`` in a chosen
-  direction, root-found on the dense output inside the integrator.
+* [`stroboscopic_section`][recipdyn.analysis.poincare.stroboscopic_section] -- for a periodically
+  forced system (``system.period`` set, e.g. the compressor's crank period), the state exactly once
+  per period at a chosen phase. The samples come from the integrator's 7th-order dense output at the
+  exact instants ``t_k = t0 + (k + phase / 2 pi) T``, never from the nearest stored sample.
+* [`hyperplane_section`][recipdyn.analysis.poincare.hyperplane_section] -- crossings of a hyperplane
+  ``y[i] = value`` in a chosen direction, root-found on the dense output inside the integrator.
 
-Both return an :class:`xarray.Dataset` over a ``section`` dimension with the state components
+Both return an `xarray.Dataset` over a ``section`` dimension with the state components
 and (optionally) the model's derived outputs at the section points, plus the settings in attrs.
 A period-1 orbit gives one distinct point, period-n n points, quasi-periodic motion a closed
-curve and chaotic motion a scattered set (see :func:`count_distinct_points`).
+curve and chaotic motion a scattered set (see
+[`count_distinct_points`][recipdyn.analysis.poincare.count_distinct_points]).
 """
 
 from __future__ import annotations
@@ -86,7 +87,8 @@ def stroboscopic_section(
     outputs : bool
         Include the model's derived outputs (crosshead x, v, a, ...) at the section points.
     **solver
-        Passed to :func:`recipdyn.integrate.integrate` (method, rtol, atol, ...).
+        Passed to [`recipdyn.integrate.integrate`][recipdyn.integrate.solve.integrate] (method,
+        rtol, atol, ...).
     """
     if system.period is None:
         raise ValueError(f"system {system.name!r} has no forcing period; use hyperplane_section")

@@ -1,5 +1,5 @@
 """One assessment of a sampled signal: embedding, exponents, 0-1 test, surrogates, spectrum and
-the verdict that combines them (:func:`~recipdyn.analysis.classify.classify`).
+the verdict that combines them ([`classify`][recipdyn.analysis.classify.classify]).
 
 This is what ``recipdyn analyze`` runs on any signal, simulated or measured: every estimate
 carries its status and diagnostics, and the verdict lists which evidence agrees.
@@ -27,7 +27,8 @@ ESTIMATORS = {"wolf": lyap_wolf, "rosenstein": lyap_rosenstein, "kantz": lyap_ka
 
 @dataclass
 class SignalAssessment:
-    """Everything :func:`assess_signal` found (``verdict`` first)."""
+    """Everything [`assess_signal`][recipdyn.analysis.signal.assess_signal] found (``verdict``
+    first)."""
 
     verdict: Verdict
     embedding: Embedding

@@ -2,7 +2,7 @@
 
 A sine of amplitude A at a bin-centred frequency shows a peak of height A whatever the window:
 the one-sided FFT magnitude is divided by the window's coherent gain (its mean). Peaks are found
-with :func:`scipy.signal.find_peaks` and labelled as harmonics of a given fundamental (the crank
+with `scipy.signal.find_peaks` and labelled as harmonics of a given fundamental (the crank
 frequency) when they fall within ``tol_bins`` bins of an integer multiple of it.
 """
 
@@ -68,7 +68,7 @@ def amplitude_spectrum(x, fs: float, window: str = "hann", detrend: bool = True)
     fs : float
         Sampling rate, Hz (> 0).
     window : str
-        Any :func:`scipy.signal.get_window` name ("hann", "hamming", "blackmanharris",
+        Any `scipy.signal.get_window` name ("hann", "hamming", "blackmanharris",
         "flattop" for accurate amplitudes between bins, "boxcar" for none).
     detrend : bool
         Remove the mean first (the DC bin is then ~0).

@@ -6,12 +6,14 @@ factor, kurtosis, band velocity RMS, the averaged spectrum) must cover all of it
 accumulators here give, for any split of the record into blocks, the result of the whole-array
 computation up to rounding:
 
-- :class:`RunningMoments`: count, mean, central moments 2-4, min and max, merged block by block
-  with the pairwise update of Chan, Golub & LeVeque (1983) and Pébay (2008, Sandia report
-  SAND2008-6212, Eq. 1.1-1.3), which stays accurate where raw power sums cancel;
-- :class:`StreamingWelch`: Welch's averaged periodogram (scipy.signal.welch, Hann window, half
-  overlap, mean removed per segment) with segments that straddle the block boundaries, so the
-  segments and their average are exactly those of ``welch`` on the whole record.
+- [`RunningMoments`][recipdyn.analysis.streaming.RunningMoments]: count, mean, central moments 2-4,
+  min and max, merged block by block with the pairwise update of Chan, Golub & LeVeque (1983) and
+  Pébay (2008, Sandia report SAND2008-6212, Eq. 1.1-1.3), which stays accurate where raw power sums
+  cancel;
+- [`StreamingWelch`][recipdyn.analysis.streaming.StreamingWelch]: Welch's averaged periodogram
+  (scipy.signal.welch, Hann window, half overlap, mean removed per segment) with segments that
+  straddle the block boundaries, so the segments and their average are exactly those of ``welch`` on
+  the whole record.
 
 Memory: one block plus one segment, whatever the record's length.
 """
@@ -66,9 +68,9 @@ class RunningMoments:
         self.n = n
 
     def indicators(self) -> dict[str, float]:
-        """The keys and definitions of :func:`recipdyn.analysis.vibration.indicators` (RMS,
-        peak and crest factor of the mean-free record, peak-to-peak, Pearson kurtosis,
-        skewness)."""
+        """The keys and definitions of
+        [`recipdyn.analysis.vibration.indicators`][recipdyn.analysis.vibration.indicators] (RMS,
+        peak and crest factor of the mean-free record, peak-to-peak, Pearson kurtosis, skewness)."""
         if self.n < 2:
             raise ValueError(f"{self.n} sample(s) fed; need at least 2")
         rms = math.sqrt(self.m2 / self.n)
@@ -135,11 +137,11 @@ class StreamingWelch:
 
 class TachoEdges:
     """Rising edges of a once-per-revolution pulse channel fed block by block: the rule of
-    :func:`recipdyn.analysis.vibration.tacho_times` (threshold halfway between the 5th and
-    95th percentiles, or the minimum and maximum for narrow pulses; an edge re-arms after a
-    fall ``hysteresis`` of the span below the threshold), with the levels taken from the first
-    block (which must hold a few revolutions) and the re-arm state carried across blocks, so
-    an edge on a block boundary counts once."""
+    [`recipdyn.analysis.vibration.tacho_times`][recipdyn.analysis.vibration.tacho_times] (threshold
+    halfway between the 5th and 95th percentiles, or the minimum and maximum for narrow pulses; an
+    edge re-arms after a fall ``hysteresis`` of the span below the threshold), with the levels taken
+    from the first block (which must hold a few revolutions) and the re-arm state carried across
+    blocks, so an edge on a block boundary counts once."""
 
     def __init__(self, fs: float, *, hysteresis: float = 0.1) -> None:
         self.fs, self.hysteresis = float(fs), float(hysteresis)

@@ -107,8 +107,9 @@ def prediction_error(x, dim: int, delay: int, horizon: int = 1, k: int = 5) -> f
 
 @dataclass
 class SurrogateTest:
-    """Result of :func:`surrogate_test`: ``nonlinear`` is True when the null hypothesis (linear
-    Gaussian process, static transform) is rejected at ``significance``."""
+    """Result of [`surrogate_test`][recipdyn.analysis.surrogates.surrogate_test]: ``nonlinear`` is
+    True when the null hypothesis (linear Gaussian process, static transform) is rejected at
+    ``significance``."""
 
     nonlinear: bool
     statistic: float

@@ -4,7 +4,8 @@ velocity RMS with evaluation zones, condition indicators and impact detection.
 
 Generic: every function takes a sampled signal and, where the crank matters, the crank angle
 (in revolutions) at each sample -- from a once-per-revolution tacho/keyphasor channel
-(:func:`tacho_times`, :func:`crank_angle`) or a constant speed.
+([`tacho_times`][recipdyn.analysis.vibration.tacho_times],
+[`crank_angle`][recipdyn.analysis.vibration.crank_angle]) or a constant speed.
 
 References
 ----------
@@ -120,7 +121,7 @@ def order_spectrum_angle(x_angle, samples_per_rev: int, window: str = "hann") ->
 
 def spectrogram(x, fs: float, *, nperseg: int | None = None, overlap: float = 0.75):
     """``(frequency_hz, time_s, amplitude)`` of a short-time Fourier transform (Hann window,
-    amplitude-scaled like :func:`~recipdyn.analysis.spectrum.amplitude_spectrum`)."""
+    amplitude-scaled like [`amplitude_spectrum`][recipdyn.analysis.spectrum.amplitude_spectrum])."""
     x = np.asarray(x, dtype=float)
     nperseg = int(nperseg or min(x.size, max(64, 2 ** int(np.log2(x.size / 16)))))
     f, t, Z = sps.stft(x - x.mean(), fs, window="hann", nperseg=nperseg,
@@ -293,7 +294,7 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
     """Everything above for one signal: indicators, band velocity RMS (and its zone with
     ``zones``), order spectrum (with a crank angle ``revs``), spectrogram or Campbell data
     (when the speed varies by more than 5 %), envelope spectrum, cepstrum and impacts. The
-    result holds the arrays for :func:`~recipdyn.analysis.plots.plot_vibration` and a
+    result holds the arrays for `plot_vibration` and a
     JSON-ready ``summary``."""
     x = np.asarray(x, dtype=float)
     rep: dict = {"fs": fs, "quantity": quantity}

@@ -9,17 +9,17 @@ For an observable phi(j), j = 1..N, and a random frequency c in (pi/5, 4 pi/5)::
 
 K = median over c of K_c: ~1 for chaotic dynamics (p, q diffuse like Brownian motion), ~0 for
 regular dynamics (p, q bounded). Apply it to a map's orbit or a flow sampled stroboscopically
-(oversampled flows give false 0s; Gottwald & Melbourne 2009): :func:`zero_one` first thins a
-signal to about one sample per decorrelation time (the delay of
-:func:`~recipdyn.analysis.embedding.estimate_delay`, one sample for maps), so the same flow
-sampled at two rates gives the same K.
+(oversampled flows give false 0s; Gottwald & Melbourne 2009):
+[`zero_one`][recipdyn.analysis.zero_one.zero_one] first thins a signal to about one sample per
+decorrelation time (the delay of [`estimate_delay`][recipdyn.analysis.embedding.estimate_delay], one
+sample for maps), so the same flow sampled at two rates gives the same K.
 
 M_c(n) for all n at once by the FFT: with z = p + i q,
 sum_j |z(j+n) - z(j)|^2 = sum_{j>=n} |z_j|^2 + sum_{j<N-n} |z_j|^2 - 2 Re sum_j conj(z_j) z(j+n),
 the last sum an autocorrelation: O(N log N) per c instead of O(N n_cut).
 
 The test cannot tell chaos from noise (white noise gives K = 1): a verdict needs a
-determinism check as well (:mod:`recipdyn.analysis.surrogates`).
+determinism check as well ([`recipdyn.analysis.surrogates`][recipdyn.analysis.surrogates]).
 
 References
 ----------
@@ -54,7 +54,8 @@ def _mean_square_displacement(z: np.ndarray, n_cut: int) -> np.ndarray:
 def zero_one_test(phi, *, n_c: int = 100, n_cut: int | None = None, seed: int = 0,
                   return_all: bool = False):  # fmt: skip
     """K statistic of the 0-1 test on ``phi`` as given (median over ``n_c`` random c; seeded).
-    No thinning: for a map's orbit or a section. For a sampled flow use :func:`zero_one`."""
+    No thinning: for a map's orbit or a section. For a sampled flow use
+    [`zero_one`][recipdyn.analysis.zero_one.zero_one]."""
     phi = np.asarray(phi, dtype=float)
     if phi.ndim != 1 or phi.size < 100:
         raise ValueError("need a 1-D series of at least 100 values")

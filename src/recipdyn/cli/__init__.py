@@ -41,8 +41,8 @@ _REPORT: contextvars.ContextVar[dict | None] = contextvars.ContextVar("report", 
 
 def with_json(func):
     """Give a command a ``--json`` option: everything it says goes to standard error and one
-    JSON object (what the command passed to :func:`report`) is printed on standard output at
-    the end, for scripts (``recipdyn simulate ... --json | jq .peak_a``)."""
+    JSON object (what the command passed to [`report`][recipdyn.cli.report]) is printed on standard
+    output at the end, for scripts (``recipdyn simulate ... --json | jq .peak_a``)."""
     sig = inspect.signature(func)
     extra = inspect.Parameter(
         "json_out", inspect.Parameter.KEYWORD_ONLY, annotation=bool,

@@ -1,4 +1,4 @@
-"""Compiled integrators for any :class:`~recipdyn.model.base.ODESystem`."""
+"""Compiled integrators for any [`ODESystem`][recipdyn.model.base.ODESystem]."""
 
 from .solve import METHODS, IntegrationError, Method, Solution, integrate, prepare, propagate
 from .tableaus import RK4, Tableau, dop853

@@ -1,7 +1,8 @@
 """Compiled integrator loops (numba): the public compiled API of the integrator.
 
-The Python front end is :func:`recipdyn.integrate.integrate`; compiled callers (the Benettin
-loop of :mod:`recipdyn.analysis.lyapunov`) call :func:`dop853_kernel` directly.
+The Python front end is [`recipdyn.integrate.integrate`][recipdyn.integrate.solve.integrate];
+compiled callers (the Benettin loop of [`recipdyn.analysis.lyapunov`][recipdyn.analysis.lyapunov])
+call [`dop853_kernel`][recipdyn.integrate.kernels.dop853_kernel] directly.
 
 Both loops call the model's compiled ``rhs(t, y, p, out)`` directly. The DOP853 loop follows
 SciPy's ``solve_ivp(method="DOP853")`` step for step (initial step selection, error norm, step
@@ -286,10 +287,10 @@ def _dop853_run(
     A, B, C, E3, E5, D, use_event, event_dir, event_action, reset, Y, ev_t, ev_y, ev_y2, stats,
     fstate, K, W, Fd, y, f,
 ):  # fmt: skip
-    """:func:`dop853_kernel`'s loop, given its work arrays, compiled without reference
-    counting (with it, the atomic counts of the array arguments at every call and view cost
-    ~0.1 us a step: the contact model's revolution at rtol 1e-10, 8.0 -> 7.5 ms for 5 536
-    steps)."""
+    """[`dop853_kernel`][recipdyn.integrate.kernels.dop853_kernel]'s loop, given its work arrays,
+    compiled without reference counting (with it, the atomic counts of the array arguments at every
+    call and view cost ~0.1 us a step: the contact model's revolution at rtol 1e-10, 8.0 -> 7.5 ms
+    for 5 536 steps)."""
     n = y0.shape[0]
     max_events = ev_t.shape[0]
     n_stages = 12
@@ -516,8 +517,8 @@ def fixed_step_kernel(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, s
 @nb.njit(cache=True, _nrt=False)
 def _fixed_step_run(rhs, t0, y0, t1, t_stop, p, h_max, t_eval, max_steps, Y, stats, fstate,
                     A, B, C, K, yt, y):  # fmt: skip
-    """:func:`fixed_step_kernel`'s loop, given its work arrays, without reference counting
-    (as :func:`_dop853_run`)."""
+    """[`fixed_step_kernel`][recipdyn.integrate.kernels.fixed_step_kernel]'s loop, given its work
+    arrays, without reference counting (as `_dop853_run`)."""
     n = y0.shape[0]
     s = B.shape[0]
     n_eval = t_eval.shape[0]

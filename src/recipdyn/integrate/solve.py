@@ -1,6 +1,6 @@
-"""Integrate any :class:`~recipdyn.model.base.ODESystem` with compiled Runge-Kutta loops.
+"""Integrate any [`ODESystem`][recipdyn.model.base.ODESystem] with compiled Runge-Kutta loops.
 
-Methods (registry :data:`METHODS`):
+Methods (registry [`METHODS`][recipdyn.integrate.solve.METHODS]):
 
 ``"dop853"``
     Dormand-Prince 8(5,3) with SciPy's error control and 7th-order dense output; outputs at
@@ -9,7 +9,7 @@ Methods (registry :data:`METHODS`):
 ``"rk4"``
     Classical fixed-step RK4 (the paper's method) with step ``h`` (at most), landing exactly on
     every output time; run from its tableau by the generic fixed-step kernel, like any explicit
-    tableau added to :data:`METHODS`.
+    tableau added to [`METHODS`][recipdyn.integrate.solve.METHODS].
 
 Long runs can be split into chunks so a progress bar can advance; a chunk ends after the first
 step that reaches its boundary (the step is not shortened), so the results are bit-identical
@@ -44,9 +44,11 @@ class Method:
     description: str
 
 
-#: The registry of methods: adaptive ones run :func:`kernels.dop853_kernel` (error control and
-#: dense output of DOP853), fixed-step ones run :func:`kernels.fixed_step_kernel` on any
-#: explicit tableau.
+#: The registry of methods: adaptive ones run
+#: [`kernels.dop853_kernel`][recipdyn.integrate.kernels.dop853_kernel] (error control and dense
+#: output of DOP853), fixed-step ones run
+#: [`kernels.fixed_step_kernel`][recipdyn.integrate.kernels.fixed_step_kernel] on any explicit
+#: tableau.
 METHODS: dict[str, Method] = {
     "dop853": Method("dop853", dop853, True, "Dormand-Prince 8(5,3), adaptive, dense output"),
     "rk4": Method("rk4", lambda: RK4, False, "classical Runge-Kutta, fixed step h"),
@@ -63,7 +65,7 @@ _MESSAGES = {
 
 @dataclass
 class Solution:
-    """Result of :func:`integrate`.
+    """Result of [`integrate`][recipdyn.integrate.solve.integrate].
 
     Attributes
     ----------
@@ -125,7 +127,8 @@ def _check_inputs(system, y0, t_span, method, rtol, atol, h):
 
 
 def check_tolerances(rtol, atol) -> None:
-    """Raise :class:`ParameterError` unless ``rtol`` and ``atol`` are in their ranges."""
+    """Raise [`ParameterError`][recipdyn.errors.ParameterError] unless ``rtol`` and ``atol`` are in
+    their ranges."""
     for name, v, (lo, hi) in (("rtol", rtol, RTOL_RANGE), ("atol", atol, ATOL_RANGE)):
         if not (is_number(v) and math.isfinite(v) and lo <= v <= hi):
             raise ParameterError(f"{name} = {v!r} out of range; allowed: [{lo:g}, {hi:g}]")
@@ -180,12 +183,13 @@ def integrate(
         (status 1); or applies ``reset`` and continues from the event.
     reset : numba function ``reset(t, y, p, out)``, optional
         The state after a ``"reset"`` event (e.g. an impact law with restitution), compiled
-        with :data:`~recipdyn.model.base.RHS_SIGNATURE`. States before and after each event are
+        with `RHS_SIGNATURE`. States before and after each event are
         in ``y_events`` and ``y_events_after``.
     chunks : int
         Split the run in this many pieces, calling ``progress(fraction)`` after each.
     raise_on_failure : bool
-        Raise :class:`IntegrationError` (with the partial solution) on failure.
+        Raise [`IntegrationError`][recipdyn.errors.IntegrationError] (with the partial solution) on
+        failure.
     sink : callable ``sink(t, y)``, optional
         Memory flat in run length: the outputs are handed to ``sink`` in blocks of about
         ``block`` samples as the integration goes (in order, each sample once) and not kept;
@@ -382,11 +386,12 @@ def _count_le(t_eval, t: float) -> int:
 
 
 def prepare(system: ODESystem, method: str = "dop853") -> None:
-    """Compile (first run on a machine) or load from the cache everything :func:`integrate`
-    needs for ``system``: the integrator loop, the model's right-hand side and its acting event.
+    """Compile (first run on a machine) or load from the cache everything
+    [`integrate`][recipdyn.integrate.solve.integrate] needs for ``system``: the integrator loop, the
+    model's right-hand side and its acting event.
 
-    Optional: :func:`integrate` does the same on its first call. The command line calls it
-    first, to say "compiling" while it takes long."""
+    Optional: [`integrate`][recipdyn.integrate.solve.integrate] does the same on its first call. The
+    command line calls it first, to say "compiling" while it takes long."""
     if method not in METHODS:
         raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
     if METHODS[method].adaptive:

@@ -4,8 +4,9 @@ The Dormand-Prince 8(5,3) coefficients (method, embedded 5th and 3rd order error
 the 7th-order dense-output extension) come from the public class attributes of SciPy's
 ``scipy.integrate.DOP853`` (``A``, ``B``, ``C``, ``E3``, ``E5``, ``D``, ``A_EXTRA``,
 ``C_EXTRA``) rather than being retyped, so our compiled integrator takes exactly SciPy's steps
-(tests compare step counts). They are assembled on first use (:func:`dop853`) and kept in the
-user's cache directory, so importing recipdyn, and later runs, do not import ``scipy.integrate``.
+(tests compare step counts). They are assembled on first use
+([`dop853`][recipdyn.integrate.tableaus.dop853]) and kept in the user's cache directory, so
+importing recipdyn, and later runs, do not import ``scipy.integrate``.
 """
 
 from __future__ import annotations

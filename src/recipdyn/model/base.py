@@ -2,8 +2,8 @@
 
 A model is *state + rule + parameters*:
 
-* an ODE ``dy/dt = f(t, y; p)`` (:class:`ODESystem`) or a map ``x_{n+1} = g(n, x_n; p)``
-  (:class:`DiscreteMap`);
+* an ODE ``dy/dt = f(t, y; p)`` ([`ODESystem`][recipdyn.model.base.ODESystem]) or a map ``x_{n+1} =
+  g(n, x_n; p)`` ([`DiscreteMap`][recipdyn.model.base.DiscreteMap]);
 * the rule is a compiled (``numba.njit``) kernel with a fixed calling convention, so the
   integrators and the tangent-space (Lyapunov) code can call it from inside their own compiled
   loops without Python overhead;
@@ -16,20 +16,21 @@ Kernel calling convention (all arrays ``float64``, C-contiguous):
 ``jac(t, y, p, out)``
     writes the Jacobian ``df/dy`` into ``out`` (shape ``(dim, dim)``, ``out[i, j] = df_i/dy_j``).
 
-Kernels are declared with :func:`compiled` and their signature (``@compiled(RHS_SIGNATURE)``):
-the integrators receive them as first-class function values (:data:`RHS_TYPE`), which keeps the
-integrators' own compiled code cacheable across processes (a dispatcher argument would
-specialise the integrator per model, which numba cannot cache). Compilation is lazy: a kernel is
-compiled (or loaded from numba's disk cache) when a run first uses it, never at import, so a run
-pays only for what it uses.
+Kernels are declared with [`compiled`][recipdyn.model.base.compiled] and their signature
+(``@compiled(RHS_SIGNATURE)``): the integrators receive them as first-class function values
+(`RHS_TYPE`), which keeps the integrators' own compiled code cacheable across processes (a
+dispatcher argument would specialise the integrator per model, which numba cannot cache).
+Compilation is lazy: a kernel is compiled (or loaded from numba's disk cache) when a run first uses
+it, never at import, so a run pays only for what it uses.
 
 For a map the same convention holds with the step index ``n`` (a float) in place of ``t`` and
 ``out`` receiving ``g``/``dg/dx``.
 
 Derived outputs (e.g. crosshead displacement from the clearance angle) are *not* part of the
-compiled rule: a model may implement :meth:`ODESystem.outputs` to turn a trajectory into named,
-unit-labelled signals. Nothing here knows about cranks; the compressor model
-(:mod:`recipdyn.model.compressor`) is one implementation, the Lorenz system in the tests another.
+compiled rule: a model may implement [`ODESystem.outputs`][recipdyn.model.base.ODESystem.outputs] to
+turn a trajectory into named, unit-labelled signals. Nothing here knows about cranks; the compressor
+model ([`recipdyn.model.compressor`][recipdyn.model.compressor]) is one implementation, the Lorenz
+system in the tests another.
 """
 
 from __future__ import annotations
@@ -71,9 +72,9 @@ def compiled(signature, *, allocates: bool = False):
     """Declare a compiled kernel: ``numba.njit(cache=True)``, compiled on first use.
 
     ``signature`` documents the calling convention; numba compiles exactly it when the kernel is
-    first passed as a function value (:data:`RHS_TYPE`, ...) to an integrator, and the machine
+    first passed as a function value (`RHS_TYPE`, ...) to an integrator, and the machine
     code is kept in numba's disk cache (``NUMBA_CACHE_DIR``, by default the user's cache
-    directory, see :mod:`recipdyn`), so later processes load it instead of compiling.
+    directory, see `recipdyn`), so later processes load it instead of compiling.
 
     A kernel that allocates no arrays (a right-hand side, an event function, a reset) is
     compiled without numba's reference counting (``_nrt=False``), together with every function
@@ -83,8 +84,8 @@ def compiled(signature, *, allocates: bool = False):
     allocates anywhere in its calls (``np.empty``, ``copy``, a slice assignment that may copy)
     says ``allocates=True``. One that does not say so still works: the compilation without
     counting fails, and the kernel is compiled with it instead, with a
-    :class:`~recipdyn.errors.KernelAllocatesWarning` (slower, never wrong: without counting
-    numba refuses every allocation, it cannot leak).
+    [`KernelAllocatesWarning`][recipdyn.errors.KernelAllocatesWarning] (slower, never wrong: without
+    counting numba refuses every allocation, it cannot leak).
     """
 
     def deco(func):
@@ -133,7 +134,7 @@ def typed(dispatcher, signature):
     """``dispatcher`` compiled for exactly ``signature`` and closed to other argument types.
 
     For compiled loops called from Python with function values as arguments (the integrators):
-    the function values are then converted to :class:`numba.types.FunctionType` instead of
+    the function values are then converted to `numba.types.FunctionType` instead of
     specialising the loop per model, so one cached loop serves every model. Compiled once per
     process, on first use.
     """
@@ -209,13 +210,14 @@ class Event:
         Prefix of the recorded variables (``NAME_time``, ``NAME_<state>``,
         ``NAME_<state>_after``).
     function : numba function
-        ``g(t, y, p) -> float`` compiled with :data:`~recipdyn.model.base.EVENT_SIGNATURE`.
+        ``g(t, y, p) -> float`` compiled with
+        [`EVENT_SIGNATURE`][recipdyn.model.base.EVENT_SIGNATURE].
     direction : int
         +1 rising, -1 falling, 0 both.
     action : {"record", "terminal", "reset"}
         Only recorded; ends the run; or ``reset(t, y, p, out)`` sets the state (impact laws).
     reset : numba function, optional
-        With ``action="reset"``, compiled with :data:`~recipdyn.model.base.RHS_SIGNATURE`.
+        With ``action="reset"``, compiled with `RHS_SIGNATURE`.
     description : str
     """
 
@@ -256,8 +258,8 @@ class ODESystem:
         Extra metadata (every input parameter) copied into result attributes.
     events : tuple of Event
         The model's events. One that acts (``reset`` or ``terminal``) is part of the dynamics:
-        :func:`recipdyn.integrate.integrate` and the Lyapunov integration apply it whenever
-        they are not given another event function.
+        [`recipdyn.integrate.integrate`][recipdyn.integrate.solve.integrate] and the Lyapunov
+        integration apply it whenever they are not given another event function.
     """
 
     rhs: Callable[..., Any]

@@ -1,11 +1,12 @@
-r"""The single-cylinder compressor with a crank-pin clearance as an :class:`ODESystem`.
+r"""The single-cylinder compressor with a crank-pin clearance as an
+[`ODESystem`][recipdyn.model.base.ODESystem].
 
 State ``y = (theta_c, theta_c')``; time ``t`` in s; crank angle ``theta1 = theta1_0 + omega t``.
 The right-hand side is ``(theta_c', theta_c'')`` with ``theta_c''`` from
 
 * ``equations="exact"``: Lagrange's equation derived without approximation
-  (:mod:`.derivation`, compiled code in :mod:`._generated`), with an exact Jacobian;
-* ``equations="paper-printed"``: Eq. (43)-(47) as printed (:mod:`.paper_printed`), whose
+  (`derivation`, compiled code in `_generated`), with an exact Jacobian;
+* ``equations="paper-printed"``: Eq. (43)-(47) as printed (`paper_printed`), whose
   Jacobian's ``d/d theta_c`` column is a central difference (the printed coefficients are a
   comparison variant only).
 
@@ -123,7 +124,7 @@ class CompressorModel(ODESystem):
 
     def initial_state(self) -> np.ndarray:
         """``(theta_c0, thetadot_c0)`` (with a motor, then ``theta1_0, omega, 0, 0``);
-        default theta_c0: :func:`equilibrium_theta_c` + offset."""
+        default theta_c0: `equilibrium_theta_c` + offset."""
         p = self.cparams
         thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
         y0 = [thc0 + p.theta_c_offset, p.thetadot_c0]
@@ -174,8 +175,9 @@ def mechanism_energy_series(p: CompressorParams, y: np.ndarray) -> np.ndarray:
 
 
 def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str, Signal]:
-    """The massless-link mechanism's signals from its kinematics ``k`` (:func:`kinematics`)
-    and the gas force ``fg`` on the crosshead, whatever load gives it."""
+    """The massless-link mechanism's signals from its kinematics ``k``
+    ([`kinematics`][recipdyn.model.kinematics.kinematics]) and the gas force ``fg`` on the
+    crosshead, whatever load gives it."""
     jf = joint_forces(p, k, thc, fg)
     return {
         "x": Signal(k.x3, "m", "crosshead displacement x3"),
@@ -218,7 +220,7 @@ def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Si
 
 def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
     """Build the ODE model for ``p`` (default: the paper's base case), assembled from the
-    components ``p`` chooses (:func:`assembly`)."""
+    components ``p`` chooses (`assembly`)."""
     p = CompressorParams() if p is None else p
     if not isinstance(p, CompressorParams):
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
@@ -251,7 +253,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
 
 
 class Compressor(Model):
-    """The paper's compressor as a registered model (schema: :data:`parameters.SCHEMA`).
+    """The paper's compressor as a registered model (schema: `parameters.SCHEMA`).
 
     ``equations`` selects the exact derivation or the paper's printed Eq. (43)-(47).
     """
@@ -314,7 +316,8 @@ class Compressor(Model):
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """With ``load = "cycle"``: the API 618 pin-load reversal and the cycle's indicated
-        power and volumetric efficiencies (:func:`recipdyn.model.cycle.cycle_summary`)."""
+        power and volumetric efficiencies
+        ([`recipdyn.model.cycle.cycle_summary`][recipdyn.model.cycle.cycle_summary])."""
         return cycle_summary(values, ds)
 
 

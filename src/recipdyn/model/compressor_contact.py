@@ -6,13 +6,13 @@ model the multibody literature uses (Flores, Ambrósio, Claro & Lankarani 2008):
 centre (the rod's big end) is ``B = A + e``, ``A = r (cos theta1, sin theta1)`` the journal
 (crank-pin) centre and ``e = (ex, ey)`` free; the rod angle follows from the guide,
 ``sin theta2 = -(d + r sin theta1 + ey) / l``, and the crosshead from ``x3 = Bx + l cos theta2``.
-The journal and bearing interact only through the joint forces of :mod:`.joints.contact`:
+The journal and bearing interact only through the joint forces of `joints.contact`:
 dry contact when the penetration ``delta = |e| - rc`` is positive (the same ``rc`` as the
 massless link's length: the radial clearance), with friction, or the oil film of the
 lubricated joint. Cartesian ``e`` keeps the equations regular at ``e = 0``.
 
 Equations of motion: Lagrange's equations for ``q = (ex, ey)`` with the crank angle prescribed,
-derived by :mod:`.derive` (no small-clearance approximation) into ``_compressor_contact.py``;
+derived by `derive` (no small-clearance approximation) into ``_compressor_contact.py``;
 the joint force on the bearing ``(Fx, Fy)``, its torque on the rod about ``B`` and the gas force
 on the crosshead enter as generalized forces ``Q_k = F . dB/dq_k + T dtheta2/dq_k +
 F_gas dx3/dq_k``, computed in the compiled right-hand side.
@@ -21,13 +21,13 @@ State: ``(ex, ey, ex', ey', v_impact, W_in, W_loss)``. The last three are auxili
 degrees of freedom; ``ODESystem.aux_states``): the approach velocity of the current impact
 (set by the contact-onset event, used by the damping laws; where the event also tracks
 separations, with both pins worn or with the valves, its sign is the joint's phase, negative in
-free flight: :func:`phased_factor`), and two work integrals for the
-energy balance, ``E + U = E0 + U0 + W_in - W_loss`` (``E`` kinetic + gravity energy of rod and
-crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic energy, ``W_in`` the work of the gas
-force and of the crank through the journal, ``W_loss`` the work lost in the joint: contact
-damping, friction and the oil film's share).
+free flight: [`phased_factor`][recipdyn.model.compressor_contact.phased_factor]), and two work
+integrals for the energy balance, ``E + U = E0 + U0 + W_in - W_loss`` (``E`` kinetic + gravity
+energy of rod and crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic energy, ``W_in`` the
+work of the gas force and of the crank through the journal, ``W_loss`` the work lost in the joint:
+contact damping, friction and the oil film's share).
 
-The Jacobian is the complex step of the right-hand side (:func:`_cs_jac`): the compiled
+The Jacobian is the complex step of the right-hand side (`_cs_jac`): the compiled
 kernels take complex states, and ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no
 difference is taken), on the branch of each switch the state is on. It replaced a central
 difference whose rounding noise (~1e-4 of the contact stiffness terms) kept Benettin's
@@ -107,7 +107,7 @@ _RIGID_MASK = np.array([[i in RIGID[j] for i in range(len(STATE_NAMES))] for j i
 
 @lru_cache(maxsize=3)
 def lagrangian(joints: str = "crank"):
-    """The derived :class:`~recipdyn.model.derive.Lagrangian` of the mechanism with clearance
+    """The derived [`Lagrangian`][recipdyn.model.derive.Lagrangian] of the mechanism with clearance
     at ``joints`` (module docstring)."""
     import sympy as sp
 
@@ -154,7 +154,7 @@ def generate() -> str:
             "clearance at the crank pin, the crosshead pin, or both.", '"""', "",
             "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
     # numpy's scalar functions instead of math's: the same machine code for real arguments,
-    # and the kernels also take complex ones (the complex-step Jacobian, :func:`_cs_jac`)
+    # and the kernels also take complex ones (the complex-step Jacobian, `_cs_jac`)
     # sin and cos of the crank angle come from the caller (computed once per call)
     bodies = []
     for j in JOINTS:
@@ -240,7 +240,7 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p):
 
 @nb.njit(cache=True, inline="always")
 def _joints(t, y, p, cfg):
-    """Both joints' forces (tuples as :func:`_pair`; a rigid joint's are 0) and (power from
+    """Both joints' forces (tuples as `_pair`; a rigid joint's are 0) and (power from
     the crank, power lost in the joints, theta2', x3', cos theta2, sin and cos theta1)."""
     _, c2, th2d, v3, s1, c1 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3], y[6], y[7])
     w = p[P_OMEGA]
@@ -257,9 +257,11 @@ def _joints(t, y, p, cfg):
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
-#: Load kind of the dynamic valves (:mod:`.compressor_contact_valves`): the gas force follows
-#: the chamber pressures of the state (gas states from :data:`G_GAS`, mass counters from
-#: :data:`G_AUX`; the cycle data, then the valve data, after ``P_TABLE``).
+#: Load kind of the dynamic valves (`compressor_contact_valves`): the gas force follows
+#: the chamber pressures of the state (gas states from
+#: [`G_GAS`][recipdyn.model.compressor_contact.G_GAS], mass counters from
+#: [`G_AUX`][recipdyn.model.compressor_contact.G_AUX]; the cycle data, then the valve data, after
+#: ``P_TABLE``).
 LOAD_STATE = 3.0
 G_GAS = len(STATE_NAMES)
 G_AUX = G_GAS + va.N_GAS
@@ -410,7 +412,7 @@ def _cs_columns(t, y, p, f, J, cfg, skip_rigid):
 
 @nb.njit(cache=True)
 def _cs_jac(t, y, p, J, cfg):
-    """The full Jacobian of :func:`_cs_columns` (exact at any state, rigid states too)."""
+    """The full Jacobian of `_cs_columns` (exact at any state, rigid states too)."""
     f = np.empty(y.shape[0])
     _cs_columns(t, y, p, f, J, cfg, False)
 
@@ -479,7 +481,7 @@ def phased_factor(y, i, k, c):
     The joint's phase is the sign of its recorded approach velocity ``y[k]``: positive in
     contact, negative in free flight (its magnitude is then the last impact's). The factor is
     ``-delta/c`` in flight and ``delta/c + PHASE_MARGIN`` in contact: positive in both, it falls
-    through 0 at an onset and at a separation, and the reset (:func:`_flip`) makes it positive
+    through 0 at an onset and at a separation, and the reset (`_flip`) makes it positive
     again. So several joints and the valves share one event function, their minimum, and no two
     crossings can cancel (as they could in a product of signed factors)."""
     d = math.sqrt(y[i] * y[i] + y[i + 1] * y[i + 1]) / c - 1.0
@@ -516,7 +518,7 @@ def contact_factor(y, p, cfg):
 @compiled(EVENT_SIGNATURE)
 def onset_both(t, y, p):
     """Falls through 0 at an onset or a separation of either joint: the smaller of their
-    phased factors (:func:`phased_factor`)."""
+    phased factors ([`phased_factor`][recipdyn.model.compressor_contact.phased_factor])."""
     return contact_factor(y, p, 2)[0]
 
 
@@ -536,8 +538,8 @@ def record_crosshead(t, y, p, out):
 
 @compiled(RHS_SIGNATURE)
 def record_both(t, y, p, out):
-    """At a zero of :func:`onset_both`: the joint whose factor it is changes phase
-    (:func:`_flip`: an onset records its approach velocity)."""
+    """At a zero of [`onset_both`][recipdyn.model.compressor_contact.onset_both]: the joint whose
+    factor it is changes phase (`_flip`: an onset records its approach velocity)."""
     for i in range(y.shape[0]):
         out[i] = y[i]
     _flip(y, contact_factor(y, p, 2)[1], p, out)
@@ -692,7 +694,7 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
 
 @nb.njit(cache=True)
 def _joint_series(cfg, t, y, p):
-    """Per sample: both joints' rows of :func:`_pair` (14), the accelerations e1'', e2''
+    """Per sample: both joints' rows of `_pair` (14), the accelerations e1'', e2''
     (4), theta2', x3', gas force."""
     n = t.shape[0]
     out = np.zeros((n, 21))
@@ -815,7 +817,8 @@ class CompressorContact(Model):
 
     def tracks_separations(self, values: Mapping[str, Any]) -> bool:
         """Whether the event also locates separations (the phase is then the sign of
-        ``v_impact``; :func:`phased_factor`): with clearance at both pins."""
+        ``v_impact``; [`phased_factor`][recipdyn.model.compressor_contact.phased_factor]): with
+        clearance at both pins."""
         return values["clearance_joints"] == "both"
 
     def period(self, values: Mapping[str, Any]) -> float:
@@ -888,11 +891,11 @@ class CompressorContact(Model):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Per clearance joint (suffix ``_crosshead`` for the crosshead pin): impacts (count,
         per revolution, approach velocities), maximum penetration (in m and as a fraction of
-        the clearance) with the half-angle of the overlap arc there (:func:`overlap_half_angle`:
-        how far the contact is from the small contact the point-contact law assumes), contact
-        fraction (free flight is the rest), peak and RMS joint force; the energy lost in the
-        joints and the energy-balance residual over the recorded interval; the peak crosshead
-        acceleration."""
+        the clearance) with the half-angle of the overlap arc there
+        ([`overlap_half_angle`][recipdyn.model.compressor_contact.overlap_half_angle]: how far the
+        contact is from the small contact the point-contact law assumes), contact fraction (free
+        flight is the rest), peak and RMS joint force; the energy lost in the joints and the
+        energy-balance residual over the recorded interval; the peak crosshead acceleration."""
         out: dict[str, float] = {}
         t = ds["time"].values
         revs = (t[-1] - t[0]) / self.period(values) if t.size > 1 else float("nan")

@@ -1,19 +1,19 @@
 r"""The contact-impact clearance joint driven by the cylinder gas with dynamic valves.
 
-:mod:`.compressor_contact` (journal free in its bearing: flight, impacts, friction, oil film)
-with the gas load of :mod:`.valves`: the chamber pressures and masses and the valve plates are
+`compressor_contact` (journal free in its bearing: flight, impacts, friction, oil film)
+with the gas load of `valves`: the chamber pressures and masses and the valve plates are
 states integrated with the eccentricities, the chamber volumes follow the crosshead of the
 joint's own state, and the gas force follows the pressures (load kind
-:data:`~.compressor_contact.LOAD_STATE` of the contact kernels). This is the pairing the
+`LOAD_STATE` of the contact kernels). This is the pairing the
 double-acting cycle needs: its rod load reverses twice a revolution, where the massless link of
 ``compressor-valves`` leaves its validity and the journal really crosses its clearance.
 
 State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
-mass counters of :mod:`.valves`.
+mass counters of `valves`.
 
 Events: the integrator locates one event function, so the contact onsets and separations and
 the valve impacts share one: the minimum of the joints' phased contact factors
-(:func:`~.compressor_contact.phased_factor`) and the valves' normalised distances to the stop
+(`phased_factor`) and the valves' normalised distances to the stop
 each moving plate moves toward. Every factor is positive between its events and falls through
 0 at one, and its reset makes it positive again (a joint changes phase, an onset recording the
 approach velocity; a plate rebounds or rests), so the minimum falls through 0 at each event and

@@ -1,8 +1,8 @@
 r"""The compressor with dynamic valves: the massless-link mechanism and the cylinder gas as states.
 
-The paper's mechanism with the crank-pin clearance as the massless link (:mod:`.compressor`,
+The paper's mechanism with the crank-pin clearance as the massless link (`compressor`,
 the exact equation of motion) driven by the compression cycle with dynamic plate valves
-(:mod:`.valves`): the chamber pressures and masses and the valve plates are states integrated
+(`valves`): the chamber pressures and masses and the valve plates are states integrated
 with the clearance angle, the chamber volumes follow the crosshead of the mechanism's own state,
 and the gas force on the crosshead follows the pressures. State::
 
@@ -14,14 +14,14 @@ The last four are auxiliary (mass counters; ``ODESystem.aux_states``). A chamber
 compress (``acting = "head"`` or ``"crank"``) keeps its states at the frame pressure.
 
 The Jacobian: the mechanism rows are exact (the generated ``d theta_c''/d(theta_c,
-theta_c')`` of :mod:`._generated` and ``d theta_c''/d p`` = the equation's exact coefficient of
+theta_c')`` of `_generated` and ``d theta_c''/d p`` = the equation's exact coefficient of
 the gas force, which enters linearly, times the piston areas); the gas rows are central
 differences of the gas right-hand side (the valve stops and the regularised nozzle are not
 everywhere smooth), with steps scaled by each state's size.
 
 Benettin's method is refused: a plate that comes to rest on a stop loses its velocity in a
 reset whose saltation matrix is singular, so the tangent dynamics of the valves has exponents
-of -infinity and the QR iteration is not defined (see :attr:`lyapunov_refusal`).
+of -infinity and the QR iteration is not defined (see `lyapunov_refusal`).
 """
 
 from __future__ import annotations
@@ -84,7 +84,8 @@ N_STATE = len(STATE_NAMES)
 
 @nb.njit(cache=True, inline="always")
 def _crosshead(th1, thc, thcd, p):
-    """Crosshead position and velocity of the massless-link mechanism (:mod:`.kinematics`)."""
+    """Crosshead position and velocity of the massless-link mechanism
+    ([`kinematics`][recipdyn.model.kinematics.kinematics])."""
     r, l, rc, w = p[P_R], p[P_L], p[P_RC], p[P_OMEGA]
     s2 = -(p[P_D] + r * math.sin(th1) + rc * math.sin(thc)) / l
     c2 = math.sqrt(1.0 - s2 * s2)
@@ -245,7 +246,7 @@ class CompressorValves(Compressor):
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """The mechanism's states at 1; the gas states at their own size
-        (:func:`~recipdyn.model.valves.gas_scale`)."""
+        ([`gas_scale`][recipdyn.model.valves.gas_scale])."""
         return va.gas_scale(values, self.initial_state(values), G0, A0, np.ones(N_STATE))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray

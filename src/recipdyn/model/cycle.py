@@ -1,7 +1,7 @@
 r"""Gas load from the compression cycle: ideal valves, polytropic compression and re-expansion.
 
 The cylinder lies beyond the outer dead centre (crank angle 0, crosshead farthest from the
-crank, as in :mod:`.load`). The crosshead position follows the crank angle with the ideal
+crank, as in `load`). The crosshead position follows the crank angle with the ideal
 kinematics of the offset slider-crank (the guide at ``y = -d``)::
 
     x(theta1) = r cos(theta1) + sqrt(l^2 - (d + r sin(theta1))^2),
@@ -33,8 +33,9 @@ or ``"crank"``). With ``n_c = n_e = n`` the cycle has the closed forms (e.g. Han
     eta_v = 1 - C ((p_d/p_s)^(1/n) - 1)
     W     = n/(n-1) p_s eta_v V_s ((p_d/p_s)^((n-1)/n) - 1)    (indicated work a cycle)
 
-which :func:`ideal_volumetric_efficiency` and :func:`ideal_indicated_work` return and the tests
-compare with the quadrature of ``p dV`` of this kernel.
+which [`ideal_volumetric_efficiency`][recipdyn.model.cycle.ideal_volumetric_efficiency] and
+[`ideal_indicated_work`][recipdyn.model.cycle.ideal_indicated_work] return and the tests compare
+with the quadrature of ``p dV`` of this kernel.
 
 Limits, stated: the volume follows the crank angle, not the clearance-joint state (the piston
 position differs by up to the clearance, ``rc / s`` ~ 0.4 % of the stroke at the paper's base
@@ -57,7 +58,8 @@ __all__ = [
     "volumetric_efficiency", "RodReversal", "rod_load_reversal", "ACTING",
 ]  # fmt: skip
 
-#: Parameter names of the compression cycle, in :func:`pack_cycle`'s keyword order.
+#: Parameter names of the compression cycle, in [`pack_cycle`][recipdyn.model.cycle.pack_cycle]'s
+#: keyword order.
 CYCLE_PARAMS = ("bore", "rod_diameter", "clearance_fraction", "suction_pressure",
                 "discharge_pressure", "n_compression", "n_expansion", "frame_pressure",
                 "acting")  # fmt: skip
@@ -120,7 +122,8 @@ def pack_cycle(r: float, l: float, d: float, *, bore: float, rod_diameter: float
                clearance_fraction: float, suction_pressure: float, discharge_pressure: float,
                n_compression: float, n_expansion: float, frame_pressure: float,
                acting: str) -> np.ndarray:  # fmt: skip
-    """The cycle's data vector for :func:`cycle_force_kernel` (layout: the ``C_*`` constants)."""
+    """The cycle's data vector for [`cycle_force_kernel`][recipdyn.model.cycle.cycle_force_kernel]
+    (layout: the ``C_*`` constants)."""
     g = cycle_geometry(r, l, d, bore, rod_diameter)
     # the chambers' pressures at the dead centres are constants (module docstring): computed
     # once here, so a call of the kernel costs one power per chamber
@@ -134,8 +137,8 @@ def pack_cycle(r: float, l: float, d: float, *, bore: float, rod_diameter: float
 
 
 def cycle_data(values) -> np.ndarray:
-    """:func:`pack_cycle` of a mapping of parameter values (the mechanism's ``r``, ``l``,
-    ``d`` and :data:`CYCLE_PARAMS`)."""
+    """[`pack_cycle`][recipdyn.model.cycle.pack_cycle] of a mapping of parameter values (the
+    mechanism's ``r``, ``l``, ``d`` and `CYCLE_PARAMS`)."""
     return pack_cycle(values["r"], values["l"], values["d"],
                       **{k: values[k] for k in CYCLE_PARAMS})  # fmt: skip
 
@@ -184,7 +187,7 @@ def cycle_force_kernel(theta1, c):
 
 
 def cycle_states(theta1, c: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`cycle_state` over an array of crank angles."""
+    """[`cycle_state`][recipdyn.model.cycle.cycle_state] over an array of crank angles."""
     th = np.atleast_1d(np.asarray(theta1, dtype=np.float64))
     out = np.array([cycle_state(float(x), c) for x in th]).reshape(*th.shape, 4)
     return dict(p_head=out[..., 0], p_crank=out[..., 1], V_head=out[..., 2],

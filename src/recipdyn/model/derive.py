@@ -15,12 +15,13 @@ Jacobian uses :math:`\partial \ddot q/\partial y_k = M^{-1}(\partial b/\partial 
 (\partial M/\partial y_k)\,\ddot q)`, with every partial derivative taken symbolically. For one
 coordinate the solve is a division; for more, ``numpy.linalg.solve`` inside the compiled kernel.
 
-:func:`kernel_source` prints both kernels (numba, the calling convention of
-:mod:`recipdyn.model.base`, common subexpressions eliminated) as Python source that is checked
-in; a test regenerates it and fails if the committed file is stale. A model whose generalized
-forces come from numerical laws (the contact joint) uses :func:`accelerations_source` instead:
-``qdd`` as a tuple, the forces passed as a tuple, the mass matrix solved by a straight-line
-``L D L^T``, so its right-hand side allocates no arrays (a quarter of its cost before).
+[`kernel_source`][recipdyn.model.derive.kernel_source] prints both kernels (numba, the calling
+convention of [`recipdyn.model.base`][recipdyn.model.base], common subexpressions eliminated) as
+Python source that is checked in; a test regenerates it and fails if the committed file is stale. A
+model whose generalized forces come from numerical laws (the contact joint) uses
+[`accelerations_source`][recipdyn.model.derive.accelerations_source] instead: ``qdd`` as a tuple,
+the forces passed as a tuple, the mass matrix solved by a straight-line ``L D L^T``, so its
+right-hand side allocates no arrays (a quarter of its cost before).
 """
 
 from __future__ import annotations

@@ -26,8 +26,9 @@ with exact partials (``n(a) = (-sin a, cos a)``)::
     p_1c = lam (theta2_1c n2 - theta2_1 theta2_c e2)
     p_cc = -r_c ec + lam (theta2_cc n2 - theta2_c^2 e2)
 
-These hand derivations are independent of the sympy code in :mod:`.derivation`; the tests
-compare the two. :func:`joint_forces` solves Newton-Euler for the rod and the crosshead.
+These hand derivations are independent of the sympy code in `derivation`; the tests
+compare the two. [`joint_forces`][recipdyn.model.kinematics.joint_forces] solves Newton-Euler for
+the rod and the crosshead.
 """
 
 from __future__ import annotations

@@ -22,11 +22,11 @@ already signed as the force on the crosshead along +x) is interpolated linearly 
 periodically; ``load_sign`` does not apply to it.
 
 A measured indicator diagram (cylinder pressure over crank angle, head end and optionally crank
-end) becomes such a table through :func:`read_pressure_table`: each pressure is interpolated
-periodically with a shape-preserving cubic (PCHIP: continuous slope, no overshoot at the valve
-events, passes through every sample), resampled every ``step_deg`` and turned into the force of
-the compression-cycle model, ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod``
-(:mod:`recipdyn.model.cycle`); an end without a column is at ``p_frame``.
+end) becomes such a table through [`read_pressure_table`][recipdyn.model.load.read_pressure_table]:
+each pressure is interpolated periodically with a shape-preserving cubic (PCHIP: continuous slope,
+no overshoot at the valve events, passes through every sample), resampled every ``step_deg`` and
+turned into the force of the compression-cycle model, ``F = -p_he A + p_ce (A - A_rod) + p_frame
+A_rod`` ([`recipdyn.model.cycle`][recipdyn.model.cycle]); an end without a column is at ``p_frame``.
 """
 
 from __future__ import annotations
@@ -70,11 +70,12 @@ _COS7, _COS23 = math.cos(7.0 * _PI / 16.0), math.cos(23.0 * _PI / 16.0)
 
 @nb.njit(cache=True)
 def mu_sincos(s1: float, c1: float) -> float:
-    """:func:`mu_kernel` from ``sin`` and ``cos`` of the crank angle (a caller that has them
-    saves the angle's reduction and a sine): ``sin(pi/2 - phi) = cos theta1``,
+    """[`mu_kernel`][recipdyn.model.load.mu_kernel] from ``sin`` and ``cos`` of the crank angle (a
+    caller that has them saves the angle's reduction and a sine): ``sin(pi/2 - phi) = cos theta1``,
     ``sin(phi + pi/16)`` by the addition theorem, the branches by the signs and ``cos`` (it
-    decreases on [0, pi], increases on [pi, 2 pi]). Equal to :func:`mu_kernel` to rounding:
-    mu is continuous at every branch point."""
+    decreases on [0, pi], increases on [pi, 2 pi]). Equal to
+    [`mu_kernel`][recipdyn.model.load.mu_kernel] to rounding: mu is continuous at every branch
+    point."""
     if s1 >= 0.0:
         return c1 if c1 >= _COS7 else _SIN16
     if c1 <= _COS23:
@@ -93,7 +94,8 @@ def gas_force_kernel(theta1: float, kind: float, amp: float, sign: float, table)
     """Force on the crosshead along +x, N (compiled; see module docstring).
 
     ``kind`` 0 = paper model, 1 = table (``table`` is ``[n, angles_rad(n), forces_N(n)]``),
-    2 = compression cycle (``table`` is :func:`recipdyn.model.cycle.pack_cycle`'s vector).
+    2 = compression cycle (``table`` is
+    [`recipdyn.model.cycle.pack_cycle`][recipdyn.model.cycle.pack_cycle]'s vector).
     """
     if kind == 0.0:
         return sign * amp * mu_kernel(theta1)

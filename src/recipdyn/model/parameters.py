@@ -1,8 +1,9 @@
 """Immutable, validated parameters of the compressor model (SI units throughout).
 
-One frozen dataclass, :class:`CompressorParams`, holds geometry, inertia, faults, operation and
-the initial condition; vary it with :func:`dataclasses.replace` (validation runs again).
-:func:`paper_2d12` is the preset for the 2D12 compressor of Xiao et al. (2017).
+One frozen dataclass, [`CompressorParams`][recipdyn.model.parameters.CompressorParams], holds
+geometry, inertia, faults, operation and the initial condition; vary it with `dataclasses.replace`
+(validation runs again). [`paper_2d12`][recipdyn.model.parameters.paper_2d12] is the preset for the
+2D12 compressor of Xiao et al. (2017).
 
 What the reference paper gives and what it does not
 ----------------------------------------------------
@@ -10,7 +11,7 @@ Table 1 of the paper (masses and moments of inertia of the 2D12 compressor) is g
 only copy we have and no other source was found. The crank radius (0.12 m) and the rod length
 (0.6 m) follow from the text ("480.6 mm at the low dead point" = l - r, and the table's "0.12");
 the centroids at mid-length are stated in Section 3. **Every other value is an assumption**,
-listed in :data:`ASSUMED` and recorded as such in every output file. They are plausible for a
+listed in `ASSUMED` and recorded as such in every output file. They are plausible for a
 mid-size process compressor, not fitted to anything.
 
 Only ``m2``, ``m3``, ``J2`` (and ``g`` with ``m2``) enter the clearance-angle dynamics: the crank
@@ -73,13 +74,13 @@ ASSUMED_CYCLE: dict[str, str] = {
 _INF = math.inf
 
 #: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
-#: (real-gas isentropes, :mod:`recipdyn.model.realgas`).
+#: (real-gas isentropes, [`recipdyn.model.realgas`][recipdyn.model.realgas]).
 GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
          "Ethane", "Propane", "CarbonDioxide", "R134a", "Ammonia")  # fmt: skip
 
 #: The compressor's parameter schema: units, static ranges, groups, assumptions. Ranges that
 #: depend on other parameters (rs <= r, ls <= l, rc < r, |d| < l - r - rc) are checked in
-#: :meth:`CompressorParams.__post_init__`.
+#: `CompressorParams.__post_init__`.
 SCHEMA = Schema((
     Param("r", "m", 0.12, "crank radius A-B (paper)", 0.0, _INF, True, True, group="mechanism"),
     Param("rs", "m", 0.06, "main bearing to crank centroid (mid-length)", 0.0, _INF,
@@ -223,7 +224,7 @@ class CompressorParams:
     theta_c0 : float or None
         Initial clearance angle, rad. ``None`` (default) = the link aligned with the force the
         rod transmits at t = 0, i.e. the static equilibrium of the link under the gas load
-        (:func:`recipdyn.model.compressor.equilibrium_theta_c`), plus ``theta_c_offset``.
+        (`recipdyn.model.compressor.equilibrium_theta_c`), plus ``theta_c_offset``.
     theta_c_offset : float
         Offset added to the default initial clearance angle, rad. The motion is very sensitive
         to it: offsets of ~0.2 rad and more excite large free oscillations of the link.
@@ -241,16 +242,16 @@ class CompressorParams:
         (with their errata), for comparison only.
     load : {"paper", "cycle"}
         ``"paper"``: the piecewise load of Eq. (1)-(2). ``"cycle"``: the gas force of the
-        compression cycle with ideal valves (:mod:`recipdyn.model.cycle`), from ``bore``,
-        ``rod_diameter``, ``clearance_fraction``, ``suction_pressure``, ``discharge_pressure``
-        (absolute, Pa), ``n_compression``, ``n_expansion``, ``acting`` and ``frame_pressure``;
-        ``load_amplitude`` and ``load_sign`` do not apply to it.
+        compression cycle with ideal valves ([`recipdyn.model.cycle`][recipdyn.model.cycle]), from
+        ``bore``, ``rod_diameter``, ``clearance_fraction``, ``suction_pressure``,
+        ``discharge_pressure`` (absolute, Pa), ``n_compression``, ``n_expansion``, ``acting`` and
+        ``frame_pressure``; ``load_amplitude`` and ``load_sign`` do not apply to it.
     drive : {"prescribed", "motor"}
         ``"prescribed"``: ``theta1 = theta1_0 + omega t``. ``"motor"``: the crank angle and
         speed are states driven by the torque law ``motor`` (``"induction"``: Kloss's curve
         with ``motor_sync_speed``, ``motor_breakdown_torque``, ``motor_breakdown_slip``;
         ``"constant"``: ``motor_torque``) on the inertia ``J_drive``; ``omega`` is then the
-        initial speed (:mod:`recipdyn.model.components.drive`).
+        initial speed (``recipdyn.model.components.drive``).
     """
 
     r: float = 0.12
@@ -387,7 +388,7 @@ def _validate_table(table) -> None:
 def paper_2d12(**overrides: Any) -> CompressorParams:
     """The 2D12 compressor of Xiao et al. (2017), base case rc = d = 1 mm, omega = 20 rad/s.
 
-    Lengths are the paper's; masses and rod inertia are assumptions (:data:`ASSUMED`). Any
+    Lengths are the paper's; masses and rod inertia are assumptions (`ASSUMED`). Any
     field can be overridden, e.g. ``paper_2d12(rc=0.5e-3, d=0.0)``.
     """
     names = {resolve_name(k): v for k, v in overrides.items()}

@@ -4,18 +4,22 @@ A *model* is a family of dynamical systems with a typed parameter schema:
 
 * ``name`` and a one-line ``description``;
 * ``state_names`` and ``state_units``;
-* ``schema``: a :class:`Schema` of :class:`Param` (name, unit, default, allowed range or
-  choices, description, whether the value is an assumption, group);
-* :meth:`Model.system`: the compiled system (:class:`~recipdyn.model.base.ODESystem` or
-  :class:`~recipdyn.model.base.DiscreteMap`) for validated parameter values — its kernels follow
-  the calling convention of :mod:`recipdyn.model.base`;
-* :meth:`Model.initial_state`, :meth:`Model.period` (the forcing period, for stroboscopic
-  sections and orders; ``None`` for autonomous systems), :meth:`Model.outputs` (named signals
-  with units, default: the state components) and :meth:`Model.check` (validity checks across
+* ``schema``: a [`Schema`][recipdyn.model.protocol.Schema] of
+  [`Param`][recipdyn.model.protocol.Param] (name, unit, default, allowed range or choices,
+  description, whether the value is an assumption, group);
+* [`Model.system`][recipdyn.model.protocol.Model.system]: the compiled system
+  ([`ODESystem`][recipdyn.model.base.ODESystem] or [`DiscreteMap`][recipdyn.model.base.DiscreteMap])
+  for validated parameter values — its kernels follow the calling convention of
+  [`recipdyn.model.base`][recipdyn.model.base];
+* [`Model.initial_state`][recipdyn.model.protocol.Model.initial_state],
+  [`Model.period`][recipdyn.model.protocol.Model.period] (the forcing period, for stroboscopic
+  sections and orders; ``None`` for autonomous systems),
+  [`Model.outputs`][recipdyn.model.protocol.Model.outputs] (named signals with units, default: the
+  state components) and [`Model.check`][recipdyn.model.protocol.Model.check] (validity checks across
   parameters).
 
-Models are found by name through :mod:`recipdyn.model.registry`. The layers above the model talk
-to a model only through this class; see ``docs/architecture.md``.
+Models are found by name through [`recipdyn.model.registry`][recipdyn.model.registry]. The layers
+above the model talk to a model only through this class; see ``docs/architecture.md``.
 """
 
 from __future__ import annotations
@@ -87,7 +91,8 @@ class Param:
         return f"{lb}{self.low:g}, {self.high:g}{rb}" + (f" {self.unit}" if self.unit else "")
 
     def check(self, value: Any) -> Any:
-        """``value`` validated (numbers as float); :class:`ParameterError` names the range."""
+        """``value`` validated (numbers as float);
+        [`ParameterError`][recipdyn.errors.ParameterError] names the range."""
         if value is None and self.optional:
             return None
         if self.choices is not None:
@@ -111,7 +116,8 @@ class Param:
 
 @dataclass(frozen=True)
 class Schema:
-    """An ordered set of :class:`Param` with validation and round trips."""
+    """An ordered set of [`Param`][recipdyn.model.protocol.Param] with validation and round
+    trips."""
 
     params: tuple[Param, ...]
     aliases: Mapping[str, str] = field(default_factory=dict)
@@ -172,7 +178,7 @@ class Schema:
         return out
 
     def from_attrs(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
-        """Values recorded by :meth:`to_attrs` (unknown keys ignored)."""
+        """Values recorded by `to_attrs` (unknown keys ignored)."""
         out: dict[str, Any] = {}
         for p in self.params:
             key = f"param_{p.name}"
@@ -195,7 +201,7 @@ class Model(ABC):
     """Base class of registered models (see the module docstring).
 
     Subclasses set ``name``, ``description``, ``state_names``, ``state_units``, ``schema`` and
-    implement :meth:`system` and :meth:`initial_state`; the rest has generic defaults.
+    implement `system` and `initial_state`; the rest has generic defaults.
     """
 
     name: str = ""
@@ -246,7 +252,7 @@ class Model(ABC):
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         """Events to locate during a simulation (at most one today: the integrator locates
         one event function). Default: none. An acting one (reset, terminal) must also be in
-        the :class:`~recipdyn.model.base.ODESystem`'s ``events``, so that every integration
+        the [`ODESystem`][recipdyn.model.base.ODESystem]'s ``events``, so that every integration
         applies it (the interface test checks this)."""
         return ()
 
@@ -268,7 +274,7 @@ class Model(ABC):
         return np.maximum(1.0, np.abs(self.initial_state(values)))
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        """Whether :attr:`validity_bounds` apply at ``values`` (e.g. not to the compressor
+        """Whether `validity_bounds` apply at ``values`` (e.g. not to the compressor
         without clearance, whose pin is an ideal two-way joint). Default: always."""
         return True
 
@@ -293,7 +299,8 @@ class Model(ABC):
         return out
 
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
-        """Validity checks across parameters; raise :class:`ParameterError`."""
+        """Validity checks across parameters; raise
+        [`ParameterError`][recipdyn.errors.ParameterError]."""
 
     @abstractmethod
     def system(self, values: Mapping[str, Any]) -> ODESystem | DiscreteMap:
@@ -317,7 +324,7 @@ class Model(ABC):
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Figures of merit of one simulated run (``ds``: the labelled result of
-        :func:`recipdyn.simulate`), written into its attributes and printed by the CLI.
+        `recipdyn.simulate`), written into its attributes and printed by the CLI.
         Default: none."""
         return {}
 

@@ -1,10 +1,11 @@
 r"""The compression cycle with a real gas (CoolProp), ideal valves.
 
 With ``load = "cycle"`` and ``gas`` a CoolProp fluid (``Air``, ``Nitrogen``, ``Methane``, ...)
-each chamber follows the ideal-valve cycle of :mod:`recipdyn.model.cycle` with the polytropes
-replaced by **isentropes of the real gas** (no heat transfer, no losses): the suction state is
-``(p_s, T_s)`` with entropy ``s_s``; the gas compressed from bottom dead centre keeps its mass
-``m = V_max rho_s`` and ``s_s`` until the discharge pressure; the clearance gas left at top dead
+each chamber follows the ideal-valve cycle of [`recipdyn.model.cycle`][recipdyn.model.cycle] with
+the polytropes replaced by **isentropes of the real gas** (no heat transfer, no losses): the suction
+state is ``(p_s, T_s)`` with entropy ``s_s``; the gas compressed from bottom dead centre keeps its
+mass ``m = V_max rho_s`` and ``s_s`` until the discharge pressure; the clearance gas left at top
+dead
 centre (``rho_d = rho(p_d, s_s)``) re-expands at ``s_s`` to the suction pressure. So::
 
     growing volume:   p = max(p_s, P(rho = V_0 rho_d / V, s_s))
@@ -15,8 +16,9 @@ with ``P(rho, s)`` from CoolProp's Helmholtz equations of state. The re-expanded
 
 CoolProp cannot be called from compiled code, so the pressures are computed once per parameter
 set on a 0.25 deg grid (cached), and the kernels interpolate the resulting force table like
-any tabulated load (:func:`recipdyn.model.load.gas_force_kernel`); the cost of a run is that of
-a table load plus the table (96 CoolProp flashes along the isentrope, ~0.2 s, once).
+any tabulated load ([`recipdyn.model.load.gas_force_kernel`][recipdyn.model.load.gas_force_kernel]);
+the cost of a run is that of a table load plus the table (96 CoolProp flashes along the isentrope,
+~0.2 s, once).
 
 Reference: Bell, Wronski, Quoilin, Lemort (2014), Pure and pseudo-pure fluid thermophysical
 property evaluation and the open-source thermophysical property library CoolProp, Ind. Eng.
@@ -185,7 +187,8 @@ T_HEADER = 11
 @functools.lru_cache(maxsize=16)
 def chamber_table(gas: str, ps: float, pd: float, Ts: float) -> np.ndarray:
     r"""Real-gas properties of a chamber on a grid of ``(ln(p/rho), ln p)``, for
-    :func:`recipdyn.model.valves.gas_rhs` (layout: the ``T_*`` constants).
+    [`recipdyn.model.valves.gas_rhs`][recipdyn.model.valves.gas_rhs] (layout: the ``T_*``
+    constants).
 
     The first law of the open, adiabatic chamber in the states ``p`` and ``m`` needs, at
     ``rho = m / V``: the specific internal energy ``u`` and the derivatives

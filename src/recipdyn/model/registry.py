@@ -5,7 +5,7 @@
 * Entry points: another package registers ``name = "pkg.module:object"`` in the group
   ``recipdyn.models`` of its ``pyproject.toml``; ``recipdyn models`` then lists it.
 * A path: ``"my_models:PENDULUM"`` (an importable module) or ``"path/to/file.py:PENDULUM"``
-  (a file of the user's own), naming a :class:`~recipdyn.model.protocol.Model` instance or
+  (a file of the user's own), naming a [`Model`][recipdyn.model.protocol.Model] instance or
   class.
 
 Modules are imported only when a model is asked for, so listing names costs nothing.
@@ -56,7 +56,8 @@ def _entry_points() -> dict[str, str]:
 
 
 def model_names() -> list[str]:
-    """Every model name that :func:`get_model` accepts (paths aside)."""
+    """Every model name that [`get_model`][recipdyn.model.registry.get_model] accepts (paths
+    aside)."""
     return sorted({*_BUILTIN, *_entry_points(), *_REGISTERED})
 
 
@@ -90,7 +91,7 @@ def _load_path(spec: str) -> object:
 
 
 def get_model(spec: str | Model | None = None) -> Model:
-    """The model named ``spec`` (default :data:`DEFAULT_MODEL`); see the module docstring."""
+    """The model named ``spec`` (default `DEFAULT_MODEL`); see the module docstring."""
     if isinstance(spec, Model):
         return spec
     spec = DEFAULT_MODEL if spec is None else str(spec).strip()

@@ -1,6 +1,6 @@
 r"""Dynamic valves: the cylinder pressure as a state, plate valves with mass, spring and stops.
 
-The compression cycle of :mod:`.cycle` with its ideal valves replaced by the lumped
+The compression cycle of `cycle` with its ideal valves replaced by the lumped
 control-volume model of Soedel (*Design and Mechanics of Compressor Valves*, Purdue 1984, ch. 2
 and 5; the same formulation as Habing, *Flow and plate motion in compressor valves*, PhD thesis,
 University of Twente 2005, ch. 2). For each working chamber (head end, crank end):
@@ -16,7 +16,7 @@ balances of the control volume give::
 chamber's own ``T`` for gas that leaves). With ``n = k`` this is the exact first law; like the
 ideal cycle, the exponent is ``n_compression`` while the chamber shrinks and ``n_expansion``
 while it grows, so that with closed valves ``p V^n`` is constant and the closed forms of
-:mod:`.cycle` are the limit of stiff, light valves (the tests check this). The suction line is
+`cycle` are the limit of stiff, light valves (the tests check this). The suction line is
 at ``(p_s, T_s)``; the discharge line at ``p_d`` and (for back-flow) at the isentropic discharge
 temperature ``T_d = T_s (p_d/p_s)^((n_c-1)/n_c)``.
 
@@ -24,7 +24,7 @@ temperature ``T_d = T_s (p_d/p_s)^((n_c-1)/n_c)``.
 real-gas properties, ``dp/dt = (dp/drho)_u (mdot - rho dV/dt)/V + (dp/du)_rho (sum mdot_i
 (h_i - u) - p dV/dt)/m`` (``h_i``: the suction gas's, the discharge line's on the suction
 isentrope, or the chamber's own ``u + p/rho`` for gas that leaves), the properties
-interpolated in :func:`recipdyn.model.realgas.chamber_table` (the equation above with ``n = k``
+interpolated in `recipdyn.model.realgas.chamber_table` (the equation above with ``n = k``
 for an ideal gas). The nozzle then takes ``Z R T = p/rho`` of the upstream gas and the suction
 gas's isentropic exponent.
 
@@ -53,7 +53,7 @@ integrator steps through the cycle at the gas's own time scales.
 A plate faster than ``V_REST`` is never stopped by the right-hand side: within a step it moves
 on through the stop (the right-hand side is smooth there) until the impact event, located on
 the step's dense output, puts it back on the stop. The event factor of a plate
-(:func:`_distance`) is continuous in the state and negative exactly where a fast plate is
+(`_distance`) is continuous in the state and negative exactly where a fast plate is
 beyond its stop, so rest (right-hand side) and impact (event) share one bound. When the
 right-hand side instead stopped every plate pressed onto its stop, a step across the stop met
 the error test only at steps below the resolution of ``t`` at tight tolerances: the runs
@@ -61,7 +61,7 @@ stopped with a step-size underflow at rtol 1e-12 (70 rad/s) and 1e-13 (20 rad/s)
 cases tried (tests/test_valves.py).
 
 **Force on the mechanism**: ``F = -p_he A + p_ce (A - A_rod) + p_frame A_rod`` as in
-:mod:`.cycle`, with the pressures of the states. The chamber volumes follow the crosshead
+`cycle`, with the pressures of the states. The chamber volumes follow the crosshead
 position of the mechanism's own state (not the ideal crank angle), so gas and mechanism are
 coupled both ways.
 
@@ -250,7 +250,7 @@ N_AUX = len(AUX_STATE_NAMES)
 
 
 def _gas_table(values) -> np.ndarray | None:
-    """The chamber property table of a real gas (:func:`recipdyn.model.realgas.chamber_table`,
+    """The chamber property table of a real gas (`recipdyn.model.realgas.chamber_table`,
     cached per parameter set), or None for the ideal gas."""
     gas = values.get("gas", "ideal")
     if gas == "ideal":
@@ -261,7 +261,7 @@ def _gas_table(values) -> np.ndarray | None:
 
 
 def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
-    """Valve data for :func:`gas_rhs` (layout: the ``V_*`` constants)."""
+    """Valve data for [`gas_rhs`][recipdyn.model.valves.gas_rhs] (layout: the ``V_*`` constants)."""
     area = float(values["valve_area_fraction"]) * cycle_data[cy.C_AHE]
     k, m = float(values["valve_stiffness"]), float(values["valve_mass"])
     nc = float(values["n_compression"])
@@ -310,7 +310,7 @@ def _psi(ratio, crit, e1, e2, coef):
 
 def flow_function(ratio: float, kappa: float) -> float:
     """``sqrt(2 k/(k-1) (pi^(2/k) - pi^((k+1)/k)))`` for ``pi = p_dn/p_u`` in ``[0, 1]``,
-    choked below the critical ratio and linear in ``1 - pi`` below :data:`EPS_LIN` (the
+    choked below the critical ratio and linear in ``1 - pi`` below `EPS_LIN` (the
     kernel's function, callable from Python)."""
     return float(_psi(float(ratio), *_nozzle_constants(float(kappa))))
 
@@ -349,8 +349,8 @@ def _plate(y, dp, v, out, i):
 
 @nb.njit(cache=True, inline="always")
 def _stop_factor(lift, u, ymax):
-    """:func:`_distance` of a plate at ``lift`` moving at ``u``: negative exactly where a plate
-    faster than :data:`V_REST` is beyond the stop it moves toward (its impact to act on)."""
+    """`_distance` of a plate at ``lift`` moving at ``u``: negative exactly where a plate
+    faster than `V_REST` is beyond the stop it moves toward (its impact to act on)."""
     if u < 0.0:
         return max(lift / ymax, (u + V_REST) / V_REST)
     if u > 0.0:
@@ -378,7 +378,7 @@ def _bilinear(tab, k, i, j, wx, wp):
 @nb.njit(cache=True, inline="always")
 def real_properties(p, rt, tab):
     """``(u - u0, (dp/drho)_u, (dp/du)_rho, T)`` of the real gas at pressure ``p`` and
-    ``p/rho = rt``, bilinear on :func:`recipdyn.model.realgas.chamber_table` (its scaled
+    ``p/rho = rt``, bilinear on `recipdyn.model.realgas.chamber_table` (its scaled
     values, held constant beyond the table's edges)."""
     fx = (math.log(rt) - tab[rg.T_LX0]) / tab[rg.T_DLX]
     fp = (math.log(p) - tab[rg.T_LP0]) / tab[rg.T_DLP]
@@ -432,7 +432,7 @@ def state_force(y, g, c):
 @nb.njit(cache=True, inline="always")
 def _volume(x, xdot, j, c):
     """Volume of chamber ``j`` (0 head end, 1 crank end) and its rate, for the crosshead at
-    ``x`` moving at ``xdot`` (:mod:`.cycle`'s chamber geometry)."""
+    ``x`` moving at ``xdot`` (`cycle`'s chamber geometry)."""
     stroke = c[cy.C_XMAX] - c[cy.C_XMIN]
     if j == 0:
         return (c[cy.C_CLEAR] * c[cy.C_AHE] * stroke + c[cy.C_AHE] * (c[cy.C_XMAX] - x),
@@ -448,9 +448,10 @@ def _volume(x, xdot, j, c):
 def gas_rhs(x, xdot, y, g, a, c, v, out):
     """Derivatives of the gas states ``y[g:g+12]`` and the mass counters ``y[a:a+4]`` for the
     crosshead at ``x`` moving at ``xdot``; returns the gas force on the crosshead along +x.
-    ``c``: the cycle data (:func:`recipdyn.model.cycle.pack_cycle`), ``v``: :func:`pack_valves`.
-    A chamber that does not compress (single-acting) keeps its states (derivatives 0) and the
-    frame pressure acts on its piston face."""
+    ``c``: the cycle data ([`recipdyn.model.cycle.pack_cycle`][recipdyn.model.cycle.pack_cycle]),
+    ``v``: [`pack_valves`][recipdyn.model.valves.pack_valves]. A chamber that does not compress
+    (single-acting) keeps its states (derivatives 0) and the frame pressure acts on its piston
+    face."""
     acting = int(v[V_NCH])
     for j in range(2):
         b = g + 6 * j
@@ -470,13 +471,13 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
 @nb.njit(cache=True)
 def _distance(y, i, ymax):
     """Event factor of plate ``i``: negative only for a plate beyond the stop it moves toward
-    and faster than :data:`V_REST` (an impact to act on); 1 at rest.
+    and faster than `V_REST` (an impact to act on); 1 at rest.
 
     Toward the seat (``u < 0``) it is ``max(lift / ymax, (u + V_REST) / V_REST)``, toward the
     guard the mirror image: continuous in the state, so it falls through 0 where a fast plate
     reaches its stop (the impact), and a slow plate, or one at rest that the dense output
     shows a rounding-size velocity toward its stop, never makes an event (the right-hand
-    side lets such a plate rest on the stop instead; :func:`_plate`). It is the distance to
+    side lets such a plate rest on the stop instead; `_plate`). It is the distance to
     the stop the plate moves *toward* (not the nearer one), so it is 1 right after a rebound
     and the event function leaves its surface at once (a crossing of another factor just
     after the rebound is not hidden); it jumps where the plate turns, between two positive
@@ -501,7 +502,7 @@ def _nearest(y, g, v):
 
 @nb.njit(cache=True)
 def valve_event(y, g, v):
-    """The smallest event factor of the plates (:func:`_distance`; falls through 0 at an
+    """The smallest event factor of the plates (`_distance`; falls through 0 at an
     impact)."""
     return _nearest(y, g, v)[1]
 
@@ -510,7 +511,7 @@ def valve_event(y, g, v):
 def valve_reset(y, g, v, out):
     """The impact of the plate whose factor is smallest (on its surface at the event): it is
     put on the stop it moves toward and rebounds with the restitution, or rests there when
-    the rebound is below :data:`V_REST`."""
+    the rebound is below `V_REST`."""
     for i in range(y.shape[0]):
         out[i] = y[i]
     best, d = _nearest(y, g, v)
@@ -576,7 +577,7 @@ def _real_temperatures(p, rt, tab):
 
 
 def gas_scale(values, y0: np.ndarray, g: int, a: int, out: np.ndarray) -> np.ndarray:
-    """Typical sizes of the gas states in ``out`` (:meth:`Model.state_scale`): pressures and
+    """Typical sizes of the gas states in ``out`` (`Model.state_scale`): pressures and
     masses at their initial values, lifts at the full lift, the mass counters at the initial
     gas mass (plate velocities keep ``out``'s)."""
     for j in range(2):

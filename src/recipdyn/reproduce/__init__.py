@@ -1,11 +1,13 @@
 """Reproduce Xiao et al. (2017): every figure and every reported number, side by side.
 
-:func:`reproduce` runs each case of the paper (:mod:`.cases`) under three variants
-(:data:`.runner.VARIANTS`: exact equations from the natural start, exact equations with an
-initial link offset, the paper's printed equations), caches the runs, regenerates the figures
-(:mod:`.figures`), tabulates every number the paper reports beside ours with the relative
-difference and a reason (:mod:`.report`), checks the claims about the model's behaviour
-(:func:`investigate`), and writes a self-contained HTML report plus Markdown/CSV tables.
+[`reproduce`][recipdyn.reproduce.reproduce] runs each case of the paper
+([`cases`][recipdyn.reproduce.cases]) under three variants
+([`runner.VARIANTS`][recipdyn.reproduce.runner.VARIANTS]: exact equations from the natural start,
+exact equations with an initial link offset, the paper's printed equations), caches the runs,
+regenerates the figures (`figures`), tabulates every number the paper reports beside ours with the
+relative difference and a reason (`report`), checks the claims about the model's behaviour
+([`investigate`][recipdyn.reproduce.investigate]), and writes a self-contained HTML report plus
+Markdown/CSV tables.
 """
 
 from __future__ import annotations

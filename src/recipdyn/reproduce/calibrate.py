@@ -1,11 +1,12 @@
 """Can any choice of the unknown inertia parameters reproduce the paper's peak accelerations?
 
 The paper's Table 1 (masses, inertia) is illegible, so its seven reported peak crosshead
-accelerations (77.68 ... 16010 m/s^2) are the only handle on them. :func:`calibrate` searches
-the unknowns within physical bounds (scipy's differential evolution, seeded) for the best match
-in the log-ratio sense, optionally together with the unknown initial clearance-angle offset,
-and reports how close the best choice gets. This is a diagnostic of whether the published
-numbers are reachable by this model at all; it never changes the package's defaults.
+accelerations (77.68 ... 16010 m/s^2) are the only handle on them.
+[`calibrate`][recipdyn.reproduce.calibrate.calibrate] searches the unknowns within physical bounds
+(scipy's differential evolution, seeded) for the best match in the log-ratio sense, optionally
+together with the unknown initial clearance-angle offset, and reports how close the best choice
+gets. This is a diagnostic of whether the published numbers are reachable by this model at all; it
+never changes the package's defaults.
 """
 
 from __future__ import annotations

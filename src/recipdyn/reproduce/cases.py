@@ -8,8 +8,9 @@ Section 3 and 4 of the paper simulate the 2D12 compressor for three one-paramete
 * crank speed omega = 10, (20,) 70, 150 rad/s at rc = d = 1 mm (Figs. 14-16); the phase
   trajectories and exponents (Figs. 22-23, 24c) use rc = 5 mm, d = 1 mm.
 
-:data:`CASES` names every parameter set once; :data:`PAPER_VALUES` lists every reported number
-with the case it belongs to, the quantity we compute for it and the paper's location.
+[`CASES`][recipdyn.reproduce.cases.CASES] names every parameter set once;
+[`PAPER_VALUES`][recipdyn.reproduce.cases.PAPER_VALUES] lists every reported number with the case it
+belongs to, the quantity we compute for it and the paper's location.
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ def case_by_id(cid: str) -> Case:
 class PaperValue:
     """One number reported in the paper.
 
-    ``quantity`` names what we compute (see :mod:`.measures`): ``peak_a`` (max |a|, m/s^2),
+    ``quantity`` names what we compute (see `measures`): ``peak_a`` (max |a|, m/s^2),
     ``dev_x``/``dev_v`` (max |x - x_ref|, |v - v_ref| against the case ``ref``; mm and m/s),
     ``min_x`` (mm), ``max_v`` (m/s), ``freq`` (a spectral peak, Hz; ``harmonic`` = the crank
     order it is, 0 = a non-harmonic component), ``lyap`` (largest Lyapunov exponent).

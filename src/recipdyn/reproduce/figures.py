@@ -95,7 +95,7 @@ def _overlay(runs, variant, num, var, label, cids, what):
     smooth, the overlay and below it each case's difference from the first (reference) case,
     which the overlay hides when the curves nearly coincide; when a case carries a fast
     oscillation (the offset start's link ringing), one row per case on shared axes, each drawn
-    by :func:`~recipdyn.plotting.plot_signal` (envelope and zoom) instead of an overplot."""
+    by [`plot_signal`][recipdyn.plotting.plot_signal] (envelope and zoom) instead of an overplot."""
     plt = _mpl()
     sets = [runs[(cid, variant)] for cid in cids]
     names = [case_by_id(cid).label for cid in cids]

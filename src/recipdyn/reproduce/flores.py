@@ -10,9 +10,9 @@ gravity; the journal starts at the bearing centre. In recipdyn this is the compr
 model with ``clearance_joints = "crosshead"``, the slider as the crosshead (``d = 0``, no gas
 load).
 
-:func:`ideal` gives the ideal joint's slider acceleration and pin force in closed form
-(Newton-Euler for the rod about the crank pin), so every run carries its ideal reference.
-The published curves were not available where this module was written: the comparison in
+[`ideal`][recipdyn.reproduce.flores.ideal] gives the ideal joint's slider acceleration and pin force
+in closed form (Newton-Euler for the rod about the crank pin), so every run carries its ideal
+reference. The published curves were not available where this module was written: the comparison in
 ``docs/flores_benchmark.md`` is with the qualitative findings the papers state, and the
 numbers are ours.
 """

@@ -240,7 +240,8 @@ def compare(overrides: dict[str, Any] | None = None, revolutions: float = 0.25,
 
 def figure(results: dict[str, dict[str, Any]]):
     """The journal's eccentricity from both codes over the window, and their distance, per
-    contact law (``results``: law -> :func:`compare`'s result)."""
+    contact law (``results``: law -> [`compare`][recipdyn.reproduce.flores_exudyn.compare]'s
+    result)."""
     from ..plotting import _mpl
 
     plt = _mpl()

@@ -1,10 +1,11 @@
 """Both joint models side by side: the paper's massless link and the contact-impact joint.
 
 The same mechanism (the paper's geometry, the assumed masses) is run with the massless virtual
-link of the paper and with the contact-impact clearance joint (:mod:`recipdyn.model.
-compressor_contact`), under the paper's load and under a light one (20 kN) where inertia can
-pull the pin off the bearing wall. The massless link is only valid while its contact force is
-positive; the contact model shows what happens where it is not: free flight and impacts.
+link of the paper and with the contact-impact clearance joint
+(`recipdyn.model.compressor_contact`), under the paper's load and under a light one (20 kN)
+where inertia can pull the pin off the bearing wall. The massless link is only valid while its
+contact force is positive; the contact model shows what happens where it is not: free flight
+and impacts.
 """
 
 from __future__ import annotations

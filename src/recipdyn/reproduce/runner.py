@@ -135,7 +135,7 @@ def run_all(
 
     ``progress(key, cached)`` is called as each run completes. A cache file that cannot be read
     back (truncated by a crash, corrupted) is recomputed, never used. On SIGINT/SIGTERM the runs
-    finished so far stay in the cache and :class:`~recipdyn.errors.Interrupted` says so.
+    finished so far stay in the cache and [`Interrupted`][recipdyn.errors.Interrupted] says so.
     """
     cache.mkdir(parents=True, exist_ok=True)
     remove_orphans(cache)  # left by a run killed outright (kill -9, power loss)

@@ -1,6 +1,6 @@
 """Run a sweep on a backend, writing each point to a Zarr store as it finishes.
 
-Backends (one code path: :func:`recipdyn.sweep.work.run_point`):
+Backends (one code path: `recipdyn.sweep.work.run_point`):
 
 ``serial``
     In this process, in grid order.
@@ -11,19 +11,19 @@ Backends (one code path: :func:`recipdyn.sweep.work.run_point`):
     workers; ``scheduler="tcp://host:8786"`` uses an existing cluster (see docs/sweeps.md).
 
 The store (``OUT/sweep.zarr``) has one small chunk per point (blocks of points along the last
-axis for grids above :data:`BLOCK_ABOVE` points), written in batches (:class:`StoreWriter`).
-A point counts as done only after its data are written, read back and match their checksum
-(``checksum``, CRC-32 of every value of the point); ``done`` is written last. On
-``resume=True`` every done point is verified again (a torn or corrupted chunk after ``kill -9``
-or a disk fault is found and its points recomputed, never counted as done), and with
-``continuation`` every point after the first missing one is recomputed from its predecessor's
-recorded final state, so a resumed sweep equals an uninterrupted one. A failing point gets its
-message in ``error`` and the sweep goes on. Only the coordinating process writes; every value
-depends only on its point, so results are bit-identical across backends.
+axis for grids above `BLOCK_ABOVE` points), written in batches
+([`StoreWriter`][recipdyn.sweep.run.StoreWriter]). A point counts as done only after its data are
+written, read back and match their checksum (``checksum``, CRC-32 of every value of the point);
+``done`` is written last. On ``resume=True`` every done point is verified again (a torn or corrupted
+chunk after ``kill -9`` or a disk fault is found and its points recomputed, never counted as done),
+and with ``continuation`` every point after the first missing one is recomputed from its
+predecessor's recorded final state, so a resumed sweep equals an uninterrupted one. A failing point
+gets its message in ``error`` and the sweep goes on. Only the coordinating process writes; every
+value depends only on its point, so results are bit-identical across backends.
 
-One sweep at a time per output folder (:class:`~recipdyn.locking.RunLock`). SIGINT/SIGTERM
+One sweep at a time per output folder (`RunLock`). SIGINT/SIGTERM
 stop the sweep after the points already finished are written; the workers are ended and the
-:class:`~recipdyn.errors.Interrupted` raised says how many points are kept.
+[`Interrupted`][recipdyn.errors.Interrupted] raised says how many points are kept.
 """
 
 from __future__ import annotations
@@ -132,10 +132,10 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
 
 _FILL = {"f8": np.nan, "i8": -1, "str": ""}
 
-#: Grids larger than this store blocks of :data:`POINT_BLOCK` points (along the last axis) per
-#: chunk instead of one point per chunk: Zarr spends ~0.5 ms on every chunk it writes or reads
-#: and a file-system block of disk, so a 10^6-point map would otherwise take 15 million files
-#: and cap the coordinator at ~60 points/s (benchmarks/bench_scaling.py).
+#: Grids larger than this store blocks of [`POINT_BLOCK`][recipdyn.sweep.run.POINT_BLOCK] points
+#: (along the last axis) per chunk instead of one point per chunk: Zarr spends ~0.5 ms on every
+#: chunk it writes or reads and a file-system block of disk, so a 10^6-point map would otherwise
+#: take 15 million files and cap the coordinator at ~60 points/s (benchmarks/bench_scaling.py).
 BLOCK_ABOVE = 4096
 POINT_BLOCK = 64
 
@@ -370,9 +370,9 @@ def run_sweep(
 ) -> Path:
     """Run ``spec``; returns the store path (``OUT/sweep.zarr``).
 
-    Raises :class:`~recipdyn.errors.ParameterError` for bad settings, an existing store
+    Raises [`ParameterError`][recipdyn.errors.ParameterError] for bad settings, an existing store
     without ``resume``/``force``, a store made by a different spec, or an output folder in use
-    by another run; :class:`~recipdyn.errors.Interrupted` on SIGINT/SIGTERM (points finished
+    by another run; [`Interrupted`][recipdyn.errors.Interrupted] on SIGINT/SIGTERM (points finished
     so far are kept).
     """
     if backend not in BACKENDS:
@@ -569,13 +569,13 @@ def _run_processes(tasks, workers, accept, pending) -> None:
 #: Dask tasks in flight per worker: enough to keep every worker busy while results travel,
 #: few enough that a 10^6-point map never sits in the scheduler's memory at once.
 DASK_IN_FLIGHT = 2
-#: Most points one Dask task carries (see :func:`dask_batch_size`).
+#: Most points one Dask task carries (see [`dask_batch_size`][recipdyn.sweep.run.dask_batch_size]).
 DASK_MAX_BATCH = 32
 
 
 def dask_batch_size(n_points: int, n_workers: int) -> int:
     """Points per Dask task: ~8 tasks a worker over the sweep (so the last wave is short), at
-    most :data:`DASK_MAX_BATCH`. The scheduler costs ~1 ms a task; a point costs 0.1-10 s, so
+    most `DASK_MAX_BATCH`. The scheduler costs ~1 ms a task; a point costs 0.1-10 s, so
     batching matters only for very many short points, where it divides that cost."""
     return max(1, min(DASK_MAX_BATCH, n_points // (8 * max(1, n_workers))))
 

@@ -3,8 +3,8 @@
 ``--param omega=10:150:281`` (start:stop:count, linear), ``--param clearance=0.1mm:5mm:50:log``
 (logarithmic), ``--param d=0,0.1mm,1mm`` (explicit list). One ``--param`` gives a 1-D sweep, two
 give the outer-product grid (fault map). Values carry units (pint) and are converted to SI;
-every grid point is validated as a :class:`~recipdyn.model.parameters.CompressorParams` before
-anything runs, so a value outside a parameter's range is reported up front.
+every grid point is validated as a [`CompressorParams`][recipdyn.model.parameters.CompressorParams]
+before anything runs, so a value outside a parameter's range is reported up front.
 """
 
 from __future__ import annotations

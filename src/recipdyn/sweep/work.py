@@ -52,7 +52,7 @@ def run_point(task: dict[str, Any]) -> dict[str, Any]:
 
 
 def run_points(tasks: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """:func:`run_point` for each task (one Dask task carries several short points)."""
+    """`run_point` for each task (one Dask task carries several short points)."""
     return [run_point(t) for t in tasks]
 
 
@@ -163,8 +163,9 @@ def _compute(task: dict[str, Any]) -> dict[str, Any]:
 
 
 def _features(a, fs: float, revs, pt) -> dict[str, float]:
-    """The sweep's ``features`` measure: :func:`recipdyn.features.signal_features` of the
-    vibration signal, as ``feat_<name>`` (the numeric ones the store declares)."""
+    """The sweep's ``features`` measure:
+    [`recipdyn.features.signal_features`][recipdyn.features.signal_features] of the vibration
+    signal, as ``feat_<name>`` (the numeric ones the store declares)."""
     from ..features import feature_units, signal_features
 
     row = signal_features(a, fs, revs=revs)

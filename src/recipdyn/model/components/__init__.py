@@ -1,9 +1,9 @@
-"""Components the compressor is assembled from (contract: :mod:`.contract`).
+"""Components the compressor is assembled from (contract: `.contract`).
 
-Families: ``drive`` (:mod:`.drive`: prescribed speed or a motor, whose torque law is the
-``motor`` family) and ``load`` (:mod:`.load`: the paper's load, a table, the ideal-valve
+Families: ``drive`` (`.drive`: prescribed speed or a motor, whose torque law is the
+``motor`` family) and ``load`` (`.load`: the paper's load, a table, the ideal-valve
 cycle). The mechanism with its crank-pin joint (the massless link, or the ideal joint at
-rc = 0) is assembled with them by :mod:`recipdyn.model.compressor`.
+rc = 0) is assembled with them by `recipdyn.model.compressor`.
 """
 
 from .contract import Assembly, Component, check_fragments, glue_module

@@ -2,16 +2,16 @@ r"""The component contract: what one piece of the compressor declares, and how p
 
 A compressor is assembled from components, one per *family*: the mechanism (with the joint at
 the crank pin), the **drive** (what turns the crank) and the **load** (the force of the gas on
-the crosshead). A component is a :class:`Component`:
+the crosshead). A component is a `Component`:
 
 * ``family`` and ``name`` (``drive`` / ``motor``): the parameter that chooses it
   (``--set drive=motor``) and the value that selects it;
-* ``params``: its schema fragment (:class:`~recipdyn.model.protocol.Param`, with units,
+* ``params``: its schema fragment (`recipdyn.model.protocol.Param`, with units,
   ranges, assumptions); a name may belong to one component only, so two components cannot
-  read each other's values by accident (:func:`check_fragments`);
+  read each other's values by accident (`check_fragments`);
 * ``states`` and ``aux_states``: the state components it adds, with units (a motor adds the
   crank angle and speed, and the work it does);
-* ``pack(values)``: its slice of the flat parameter vector ``p``. :class:`Assembly` computes
+* ``pack(values)``: its slice of the flat parameter vector ``p``. `Assembly` computes
   every slice's offset once and passes it to the component's compiled functions, so no
   component reads another's slice and none needs a kind code to tell loads apart;
 * ``kernels``: its compiled contributions, ``role -> function`` in ``module`` (a load's
@@ -20,7 +20,7 @@ the crosshead). A component is a :class:`Component`:
   offset ``o``.
 
 The glue that calls the chosen components in one right-hand side is **generated source**
-(:func:`glue_module`): the offsets and the chosen functions are written into it as literals
+(`glue_module`): the offsets and the chosen functions are written into it as literals
 and imports, so numba compiles one specialised kernel per combination, inlines the components
 and caches it on disk; a component's function cannot be called with another's offset or
 slice. The generated file is named by the hash of its source in recipdyn's cache folder
@@ -116,7 +116,7 @@ class Assembly:
     """Chosen components in the order of the parameter vector, after a fixed head.
 
     ``head`` is the number of values the mechanism packs first; each part's slice follows in
-    order, its offset computed here once (:attr:`offsets`).
+    order, its offset computed here once (`offsets`).
     """
 
     head: int

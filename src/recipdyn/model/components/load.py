@@ -1,12 +1,12 @@
 r"""Load components: the force of the gas on the crosshead along +x, ``F(theta1)``.
 
 * ``paper``: the piecewise load of the paper's Eq. (1)-(2), ``F = s P mu(theta1)``
-  (:mod:`recipdyn.model.load`), slice ``load_amplitude, s``;
+  (`recipdyn.model.load`), slice ``load_amplitude, s``;
 * ``table``: a periodic table of crank angle and force, linear between nodes (a measured
-  indicator diagram through :func:`recipdyn.model.load.read_pressure_table`, or the real-gas
+  indicator diagram through `recipdyn.model.load.read_pressure_table`, or the real-gas
   cycle tabulated once from CoolProp), slice ``n, angles (rad), forces (N)``;
 * ``cycle``: the compression cycle with ideal valves and polytropic gas
-  (:mod:`recipdyn.model.cycle`), slice :func:`recipdyn.model.cycle.cycle_data`.
+  (`recipdyn.model.cycle`), slice `recipdyn.model.cycle.cycle_data`.
 
 Each is one compiled function ``force(theta1, p, o)`` reading its slice at offset ``o``.
 """
@@ -56,7 +56,7 @@ def table_force(th1, p, o):
 
 @nb.njit(cache=True, inline="always")
 def cycle_force(th1, p, o):
-    """The ideal-valve compression cycle (slice :func:`~recipdyn.model.cycle.cycle_data`)."""
+    """The ideal-valve compression cycle (slice `recipdyn.model.cycle.cycle_data`)."""
     return cycle_force_kernel(th1, p[o:])
 
 

@@ -1,15 +1,15 @@
 r"""The slider-crank mechanism with the massless-link joint at the crank pin, as glue source.
 
 The mechanism packs the head of the parameter vector (``r, rs, l, ls, m1, m2, m3, J1, J2, g,
-rc, d``: :data:`HEAD`); the drive and the load components follow (:class:`.contract.Assembly`).
-:func:`glue_source` writes the right-hand side, its Jacobian and their combined call for one
+rc, d``: `HEAD`); the drive and the load components follow (`.contract.Assembly`).
+`glue_source` writes the right-hand side, its Jacobian and their combined call for one
 choice of drive, torque law, load and equations, calling
 
 * with the prescribed drive, the reduced equation of the clearance angle (``theta1'' = 0``):
-  the exact derivation (:mod:`recipdyn.model._generated`) or the paper's printed Eq. (43)-(47)
-  (:mod:`recipdyn.model.paper_printed`);
+  the exact derivation (`recipdyn.model._generated`) or the paper's printed Eq. (43)-(47)
+  (`recipdyn.model.paper_printed`);
 * with a motor, the free-crank equations ``M (theta1'', theta_c'') = b`` with the motor torque
-  on ``theta1`` and the inertia ``J_drive`` (:mod:`recipdyn.model._generated_drive`), plus the
+  on ``theta1`` and the inertia ``J_drive`` (`recipdyn.model._generated_drive`), plus the
   work integrals of the motor and of the gas.
 
 State: ``(theta_c, theta_c')``, then with a motor ``(theta1, omega1, W_motor, W_gas)``.

@@ -1,7 +1,7 @@
 """Joint models: force laws of clearance joints, shared by the models that use them.
 
-* :mod:`.contact` -- dry contact-impact of a journal in a bearing: normal force laws with
-  hysteresis damping (Hertz, Lankarani-Nikravesh, Hunt-Crossley, Flores, Gonthier), the
-  Hertz stiffness of a pin in a hole, Coulomb friction with Ambrósio's dynamic correction, and
+* [`contact`][recipdyn.model.joints.contact] -- dry contact-impact of a journal in a bearing: normal
+  force laws with hysteresis damping (Hertz, Lankarani-Nikravesh, Hunt-Crossley, Flores, Gonthier),
+  the Hertz stiffness of a pin in a hole, Coulomb friction with Ambrósio's dynamic correction, and
   the hydrodynamic short-bearing (Pinkus-Sternlicht / Ocvirk) oil-film forces.
 """

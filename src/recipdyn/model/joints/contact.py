@@ -8,7 +8,8 @@ start of the impact (an event at ``delta = 0``):
 .. math:: F_n = K \delta^n \left(1 + \chi\,\dot\delta / \dot\delta^-\right),\qquad n = 3/2,
 
 clamped at zero (a contact force cannot pull). The hysteresis factor ``chi`` for a nominal
-coefficient of restitution ``e`` (:func:`hysteresis_factor`):
+coefficient of restitution ``e``
+([`hysteresis_factor`][recipdyn.model.joints.contact.hysteresis_factor]):
 
 ==========================  ===================================  ===============================
 law                         chi                                  source
@@ -29,17 +30,18 @@ law                         chi                                  source
 (the formulas as collected by Machado, Moreira, Flores & Lankarani 2012, Mech. Mach. Theory 53,
 99-121). Each is derived under its own approximation, so the restitution a law *delivers*
 differs from the nominal ``e``; for this force law it has a closed form
-(:func:`delivered_restitution`): integrating :math:`m u\,du/d\delta = -K\delta^n(1 + \chi
-u/u^-)` from :math:`u^-` to :math:`-e_* u^-` between two zeros of :math:`\delta` gives
+([`delivered_restitution`][recipdyn.model.joints.contact.delivered_restitution]): integrating
+:math:`m u\,du/d\delta = -K\delta^n(1 + \chi u/u^-)` from :math:`u^-` to :math:`-e_* u^-` between
+two zeros of :math:`\delta` gives
 
 .. math:: \chi (1 + e_*) = \ln\frac{1 + \chi}{1 - \chi e_*},
 
 independent of ``K``, ``n``, the mass and the impact velocity (tests/test_contact.py checks
 the integrated impacts against it).
 
-Stiffness of a pin in a hole (:func:`hertz_stiffness`): the formula used for revolute
-clearance joints by Flores et al. (2008), *Kinematics and Dynamics of Multibody Systems with
-Imperfect Joints*, Springer, Eq. (3.9):
+Stiffness of a pin in a hole ([`hertz_stiffness`][recipdyn.model.joints.contact.hertz_stiffness]):
+the formula used for revolute clearance joints by Flores et al. (2008), *Kinematics and Dynamics of
+Multibody Systems with Imperfect Joints*, Springer, Eq. (3.9):
 :math:`K = \frac{4}{3(\sigma_j + \sigma_b)}\sqrt{R_j R_b / (R_b - R_j)}`,
 :math:`\sigma = (1 - \nu^2)/E`.
 

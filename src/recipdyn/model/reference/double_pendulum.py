@@ -1,5 +1,5 @@
 """The planar double pendulum with joint damping: the first model derived by the N-coordinate
-generator (:mod:`recipdyn.model.derive`), two coordinates, a generalized force.
+generator ([`recipdyn.model.derive`][recipdyn.model.derive]), two coordinates, a generalized force.
 
 Point masses m1, m2 on massless rods l1, l2; angles q1, q2 from the downward vertical; viscous
 damping c at both joints (generalized forces ``Q = -c (q1', q2')``). Undamped, the energy is
@@ -30,7 +30,7 @@ PARAMS = ("m1", "m2", "l1", "l2", "g", "c")
 
 @lru_cache(maxsize=1)
 def lagrangian():
-    """The derived :class:`~recipdyn.model.derive.Lagrangian`."""
+    """The derived [`Lagrangian`][recipdyn.model.derive.Lagrangian]."""
     import sympy as sp
 
     from ..derive import derive
