@@ -26,8 +26,8 @@ import numpy as np
 
 from .base import ODESystem, Signal, rhs_series
 from .components import DRIVES, MOTORS, Assembly, Component, glue_module, load_component
-from .components.mechanism import HEAD, N_HEAD, glue_source
-from .cycle import cycle_states, cycle_summary
+from .components.load import cycle_outputs, cycle_summary
+from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
 from .load import gas_force, pack_load
 from .parameters import SCHEMA, CompressorParams, ParameterError
@@ -90,30 +90,6 @@ def _kernels(equations: str, drive: str, motor: str | None, load: str,
     stem = f"compressor_{drive}_{load}_{equations}".replace("-", "_")  # fmt: skip
     mod = glue_module(src, stem if motor is None else f"{stem}_{motor}")
     return mod.rhs, mod.jac, mod.rhs_jac
-
-
-def equilibrium_theta_c(p: CompressorParams, t: float = 0.0) -> float:
-    r"""Clearance angle at which the link is aligned with the rod load at time ``t``.
-
-    The gas force on the crosshead is transmitted along the rod; the massless link is in
-    static equilibrium when it points along the rod, ``sin(theta_c - theta2) = 0``, i.e.
-    ``dx3/dtheta_c = 0``. The stable branch has the journal pushed away from the load:
-    ``theta_c = theta2 + pi`` when the force on the crosshead points toward the crank
-    (``F_x < 0``, physical sign, rod in compression) and ``theta_c = theta2`` when it points
-    away (``F_x > 0``, the paper's sign, rod in tension). theta2 depends weakly on theta_c
-    (``|d theta2/d theta_c| <= rc/(l cos theta2)``), so a fixed-point iteration converges.
-    """
-    th1 = p.theta1_0 + p.omega * t
-    F = float(gas_force(th1, p))
-    shift = math.pi if F <= 0.0 else 0.0
-    thc = shift
-    for _ in range(100):
-        s2 = -(p.d + p.r * math.sin(th1) + p.rc * math.sin(thc)) / p.l
-        new = math.asin(s2) + shift
-        if abs(new - thc) < 1e-15:
-            break
-        thc = new
-    return thc
 
 
 @dataclass(frozen=True)
@@ -197,25 +173,6 @@ def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str,
                                 "joint contact force (>0: permanent contact holds)"),
         "guide_force": Signal(jf.guide, "N", "guide normal force on the crosshead"),
     }  # fmt: skip
-
-
-def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Signal]:
-    """Cylinder pressures and volumes of the compression-cycle load (none for other loads),
-    for any joint model whose parameters include the cycle's."""
-    if values.get("load") != "cycle" or values.get("load_table") is not None:
-        return {}
-    if values.get("gas", "ideal") != "ideal":
-        from .realgas import real_gas_states
-
-        st = real_gas_states(theta1, values)
-    else:
-        st = cycle_states(theta1, pack_load(values)[1])
-    return {
-        "p_head": Signal(st["p_head"], "Pa", "head-end cylinder pressure (absolute)"),
-        "p_crank": Signal(st["p_crank"], "Pa", "crank-end cylinder pressure (absolute)"),
-        "V_head": Signal(st["V_head"], "m**3", "head-end cylinder volume"),
-        "V_crank": Signal(st["V_crank"], "m**3", "crank-end cylinder volume"),
-    }
 
 
 def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
@@ -317,7 +274,7 @@ class Compressor(Model):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """With ``load = "cycle"``: the API 618 pin-load reversal and the cycle's indicated
         power and volumetric efficiencies
-        ([`recipdyn.model.cycle.cycle_summary`][recipdyn.model.cycle.cycle_summary])."""
+        (`recipdyn.model.components.load.cycle_summary`)."""
         return cycle_summary(values, ds)
 
 

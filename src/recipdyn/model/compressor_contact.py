@@ -59,8 +59,8 @@ from .base import (
     Signal,
     compiled,
 )
-from .compressor import cycle_outputs
-from .cycle import N_CYCLE, cycle_summary
+from .components.load import cycle_outputs, cycle_summary
+from .cycle import N_CYCLE
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -783,7 +783,7 @@ class CompressorContact(Model):
         pin's the other way), at rest relative to the journals; a rigid joint's are 0."""
         ang = values["e0_angle"]
         if ang is None:
-            from .compressor import equilibrium_theta_c
+            from .components.mechanism import equilibrium_theta_c
             from .parameters import CompressorParams
 
             keys = (

@@ -321,31 +321,3 @@ def pin_reversal_summary(values, ds) -> dict[str, float | str]:
                 pin_peak_tension_N=rev.peak_tension,
                 api618_pin_reversal="pass" if rev.passed else "FAIL",
                 gas_rod_load_reversal_deg=gas.reversal_deg)  # fmt: skip
-
-
-def cycle_summary(values, ds) -> dict[str, float | str]:
-    """Figures of a run with ``load = "cycle"`` (empty otherwise): the API 618 crosshead-pin
-    reversal over the last recorded revolution, of the combined load ``m3 a - F_gas`` and of
-    the gas load alone, and the ideal cycle's indicated power and volumetric efficiencies."""
-    if values.get("load") != "cycle" or not {"theta1", "a", "gas_force"} <= set(ds.variables):
-        return {}
-    from .load import pack_load
-
-    out: dict[str, float | str] = pin_reversal_summary(values, ds)
-    grid = np.linspace(0.0, 2.0 * math.pi, 20_000, endpoint=False)
-    if values.get("gas", "ideal") != "ideal":
-        from .realgas import real_gas_states
-
-        st = real_gas_states(grid, values)
-    else:
-        st = cycle_states(grid, pack_load(values)[1])
-    acting = values.get("acting", "double")
-    work = 0.0
-    for end, on in (("head", acting in ("head", "double")), ("crank", acting != "head")):
-        if on:
-            work += indicated_work(st[f"p_{end}"], st[f"V_{end}"])
-            out[f"volumetric_efficiency_{end}"] = volumetric_efficiency(
-                st[f"p_{end}"], st[f"V_{end}"], float(values["suction_pressure"]), rtol=1e-9
-            )
-    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
-    return out

@@ -154,7 +154,7 @@ def read_load_table(path, *, area: float | None = None) -> tuple[tuple[float, fl
     the second column is a pressure and the force is ``pressure * area``. Angles are wrapped
     into [0, 360) and sorted.
     """
-    from .parameters import ParameterError
+    from ..errors import ParameterError
 
     try:
         data = np.genfromtxt(path, delimiter=",", comments="#", dtype=float)
@@ -179,7 +179,7 @@ def _unit_factor(header: str, default: str, what: str, path) -> float:
 
     import pint
 
-    from .parameters import ParameterError
+    from ..errors import ParameterError
 
     m = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
     unit = m.group(1) if m else default
@@ -217,7 +217,7 @@ def read_pressure_table(path, *, bore: float, rod_diameter: float,
     """
     from scipy.interpolate import PchipInterpolator
 
-    from .parameters import ParameterError
+    from ..errors import ParameterError
 
     try:
         with open(path, encoding="utf-8") as fh:

@@ -28,6 +28,7 @@ from ..defaults import RC_MIN
 from ..errors import ParameterError
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .protocol import Param, Schema
+from .realgas import GASES
 
 __all__ = [
     "CompressorParams",
@@ -72,11 +73,6 @@ ASSUMED_CYCLE: dict[str, str] = {
 }
 
 _INF = math.inf
-
-#: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
-#: (real-gas isentropes, [`recipdyn.model.realgas`][recipdyn.model.realgas]).
-GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
-         "Ethane", "Propane", "CarbonDioxide", "R134a", "Ammonia")  # fmt: skip
 
 #: The compressor's parameter schema: units, static ranges, groups, assumptions. Ranges that
 #: depend on other parameters (rs <= r, ls <= l, rc < r, |d| < l - r - rc) are checked in

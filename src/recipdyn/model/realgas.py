@@ -33,7 +33,11 @@ import math
 import numpy as np
 
 from .cycle import CYCLE_PARAMS, cycle_data, cycle_states, pressure_force
-from .parameters import GASES  # noqa: F401  (re-exported)
+
+#: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
+#: (real-gas isentropes).
+GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
+         "Ethane", "Propane", "CarbonDioxide", "R134a", "Ammonia")  # fmt: skip
 
 __all__ = [
     "GASES",
@@ -59,7 +63,7 @@ def _key(v) -> tuple:
 def _tables(key: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     import CoolProp
 
-    from .parameters import ParameterError
+    from ..errors import ParameterError
 
     v = dict(zip(_KEYS, key, strict=True))
     gas = v["gas"]
@@ -205,7 +209,7 @@ def chamber_table(gas: str, ps: float, pd: float, Ts: float) -> np.ndarray:
     are not gas (two-phase) take the values of the nearest valid node of their pressure."""
     import CoolProp
 
-    from .parameters import ParameterError
+    from ..errors import ParameterError
 
     st = CoolProp.AbstractState("HEOS", gas)
     try:

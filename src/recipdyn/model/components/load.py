@@ -20,11 +20,28 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..cycle import cycle_data, cycle_force_kernel
+from ..base import Signal
+from ..cycle import (
+    cycle_data,
+    cycle_force_kernel,
+    cycle_states,
+    indicated_work,
+    pin_reversal_summary,
+    volumetric_efficiency,
+)
 from ..load import mu_kernel, pack_table
 from .contract import Component
 
-__all__ = ["PAPER", "TABLE", "CYCLE", "LOADS", "load_component"]
+__all__ = [
+    "PAPER",
+    "TABLE",
+    "CYCLE",
+    "LOADS",
+    "load_component",
+    "cycle_gas_states",
+    "cycle_outputs",
+    "cycle_summary",
+]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -92,3 +109,48 @@ def load_component(values: Mapping[str, Any]) -> Component:
     if values.get("load", "paper") == "cycle" and values.get("gas", "ideal") != "ideal":
         return TABLE
     return LOADS[values.get("load", "paper")]
+
+
+def cycle_gas_states(theta1: np.ndarray, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """Chamber pressures and volumes of the cycle load at crank angles ``theta1``: the
+    polytropic cycle, or the real gas's isentropes (CoolProp) for ``gas`` other than ideal."""
+    if values.get("gas", "ideal") != "ideal":
+        from ..realgas import real_gas_states
+
+        return real_gas_states(theta1, values)
+    return cycle_states(theta1, cycle_data(values))
+
+
+def cycle_outputs(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, Signal]:
+    """Cylinder pressures and volumes of the compression-cycle load (none for other loads),
+    for any joint model whose parameters include the cycle's."""
+    if values.get("load") != "cycle" or values.get("load_table") is not None:
+        return {}
+    st = cycle_gas_states(theta1, values)
+    return {
+        "p_head": Signal(st["p_head"], "Pa", "head-end cylinder pressure (absolute)"),
+        "p_crank": Signal(st["p_crank"], "Pa", "crank-end cylinder pressure (absolute)"),
+        "V_head": Signal(st["V_head"], "m**3", "head-end cylinder volume"),
+        "V_crank": Signal(st["V_crank"], "m**3", "crank-end cylinder volume"),
+    }
+
+
+def cycle_summary(values, ds) -> dict[str, float | str]:
+    """Figures of a run with ``load = "cycle"`` (empty otherwise): the API 618 crosshead-pin
+    reversal over the last recorded revolution, of the combined load ``m3 a - F_gas`` and of
+    the gas load alone, and the ideal cycle's indicated power and volumetric efficiencies."""
+    if values.get("load") != "cycle" or not {"theta1", "a", "gas_force"} <= set(ds.variables):
+        return {}
+    out: dict[str, float | str] = pin_reversal_summary(values, ds)
+    grid = np.linspace(0.0, 2.0 * math.pi, 20_000, endpoint=False)
+    st = cycle_gas_states(grid, values)
+    acting = values.get("acting", "double")
+    work = 0.0
+    for end, on in (("head", acting in ("head", "double")), ("crank", acting != "head")):
+        if on:
+            work += indicated_work(st[f"p_{end}"], st[f"V_{end}"])
+            out[f"volumetric_efficiency_{end}"] = volumetric_efficiency(
+                st[f"p_{end}"], st[f"V_{end}"], float(values["suction_pressure"]), rtol=1e-9
+            )
+    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
+    return out
