@@ -29,7 +29,7 @@ from .components import DRIVES, MOTORS, Assembly, Component, glue_module, load_c
 from .components.load import cycle_outputs, cycle_summary
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
-from .load import gas_force, pack_load
+from .load import pack_load
 from .parameters import SCHEMA, CompressorParams, ParameterError
 from .protocol import Model
 
@@ -89,7 +89,7 @@ def _kernels(equations: str, drive: str, motor: str | None, load: str,
     )
     stem = f"compressor_{drive}_{load}_{equations}".replace("-", "_")  # fmt: skip
     mod = glue_module(src, stem if motor is None else f"{stem}_{motor}")
-    return mod.rhs, mod.jac, mod.rhs_jac
+    return mod.rhs, mod.jac, mod.rhs_jac, mod.observe
 
 
 @dataclass(frozen=True)
@@ -97,6 +97,9 @@ class CompressorModel(ODESystem):
     """The compressor as an ODE with crosshead outputs (see module docstring)."""
 
     cparams: CompressorParams = field(default_factory=CompressorParams)
+    #: ``observe(t, y, p) -> (n, 3)``: crank angle, crank speed and gas force at each sample,
+    #: from the compiled functions that were integrated (the generated glue)
+    observer: Any = None
 
     def initial_state(self) -> np.ndarray:
         """``(theta_c0, thetadot_c0)`` (with a motor, then ``theta1_0, omega, 0, 0``);
@@ -117,17 +120,20 @@ class CompressorModel(ODESystem):
         motor: crank speed and acceleration, motor torque, energies)."""
         p = self.cparams
         f = rhs_series(self.rhs, self.params, t, y)
+        obs = self.observer(np.ascontiguousarray(t, dtype=np.float64),
+                            np.ascontiguousarray(y, dtype=np.float64), self.params)  # fmt: skip
+        th1, w1, F = obs[:, 0], obs[:, 1], obs[:, 2]
         thc, thcd, thcdd = y[:, 0], y[:, 1], f[:, 1]
         if p.drive != "motor":
-            k = kinematics(p, t, thc, thcd, thcdd)
+            k = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=w1)
             return {
-                **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(k.theta1, p)),
+                **mechanism_outputs(p, k, thc, thcd, thcdd, F),
                 **cycle_outputs(vars(p), k.theta1),
             }
-        th1, w1, a1 = y[:, 2], y[:, 3], f[:, 3]
+        a1 = f[:, 3]
         k = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=w1, alpha1=a1)
         out = {
-            **mechanism_outputs(p, k, thc, thcd, thcdd, gas_force(th1, p)),
+            **mechanism_outputs(p, k, thc, thcd, thcdd, F),
             **cycle_outputs(vars(p), th1),
             "omega1": Signal(w1, "rad/s", "crank speed"),
             "alpha1": Signal(a1, "rad/s**2", "crank angular acceleration"),
@@ -183,8 +189,13 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
     vec, offsets, parts = pack_assembled(p)
     motor = parts.get("motor")
-    rhs, jac, rhs_jac = _kernels(p.equations, p.drive, None if motor is None else motor.name,
-                                 parts["load"].name, tuple(sorted(offsets.items())))  # fmt: skip
+    rhs, jac, rhs_jac, observe = _kernels(
+        p.equations,
+        p.drive,
+        None if motor is None else motor.name,
+        parts["load"].name,
+        tuple(sorted(offsets.items())),
+    )
     names, units = ("theta_c", "thetadot_c"), ("rad", "rad/s")
     extra: dict[str, Any] = {}
     if p.drive == "motor":
@@ -205,6 +216,7 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         name=f"compressor-{p.equations}",
         attrs=p.to_attrs(),
         cparams=p,
+        observer=observe,
         **extra,
     )
 

@@ -101,7 +101,7 @@ def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c, *, thet
     q1c = t2 * q1 * qc
     th2d = q1 * w + qc * thcd
     th2dd = q11 * w**2 + 2 * q1c * w * thcd + qcc * thcd**2 + qc * thcdd
-    if free:
+    if alpha1 is not None:
         th2dd = th2dd + q1 * np.asarray(alpha1, dtype=float)
 
     def point(lam):
@@ -123,7 +123,7 @@ def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c, *, thet
             a * w**2 + 2 * b * w * thcd + c * thcd**2 + e * thcdd
             for a, b, c, e in zip(p11, p1c, pcc, pc, strict=True)
         ]
-        if free:
+        if alpha1 is not None:
             acc = [x + a * np.asarray(alpha1, dtype=float) for x, a in zip(acc, p1, strict=True)]
         return pos, vel, acc
 

@@ -222,7 +222,34 @@ def jac(t, y, p, J):
 
 
 rhs_jac = None
+
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    out = np.empty((t.shape[0], 3))
+    for i in range(t.shape[0]):
+        out[i, 0] = y[i, 2]
+        out[i, 1] = y[i, 3]
+        out[i, 2] = load_force(y[i, 2], p, {LO})
+    return out
 '''
+
+
+#: The observer: what the outputs are computed from (crank angle and speed, the load's force),
+#: by the same compiled functions that were integrated, so a record cannot disagree with its
+#: own dynamics.
+_OBSERVE_PRESCRIBED = """
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    out = np.empty((t.shape[0], 3))
+    for i in range(t.shape[0]):
+        th1, w = crank(t[i], y[i], p, {DO})
+        out[i, 0] = th1
+        out[i, 1] = w
+        out[i, 2] = load_force(th1, p, {LO})
+    return out
+"""
 
 
 def glue_source(*, equations: str, drive, load, motor, offsets) -> str:
@@ -236,6 +263,7 @@ def glue_source(*, equations: str, drive, load, motor, offsets) -> str:
     if drive.name == "prescribed":
         body = _PRESCRIBED if equations == "exact" else _PRINTED
         src += body.format(drive_module=drive.module, crank_fn=drive.kernel("crank"), **fill)
+        src += _OBSERVE_PRESCRIBED.format(**fill)
     else:
         if equations != "exact":
             raise ValueError("the paper's printed equations exist for a prescribed crank only")
