@@ -337,6 +337,8 @@ class Compressor(Model):
         "the contact-impact joint (--model compressor-contact)",
     ),)  # fmt: skip
 
+    summary_verdicts = ("api618_pin_reversal",)
+
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return float(values["rc"]) > 0.0  # rc = 0: the ideal mechanism, no clearance dynamics
 
