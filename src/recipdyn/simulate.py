@@ -107,10 +107,10 @@ def validity_warning(model, minima: dict[str, float]) -> str:
 
 #: The start-up a run summary leaves out: the first revolutions (forcing periods) after the
 #: initial state, t < STARTUP_REVOLUTIONS * T. The initial state is a guess (the link aligned
-#: with the load, the journal on the wall), not a state of the steady motion, and the first
-#: impacts it causes are no part of it: the contact joint at 150 rad/s peaks at 3.5e4 m/s^2
-#: 1.4 ms after the start, 1.2e4 m/s^2 at most in every later revolution. A run recorded
-#: after ``transient`` >= 1 revolutions has no start-up left.
+#: with the load, the journal on the wall, at rest relative to the crank), not a state of the
+#: steady motion, and the first impacts it causes belong to no steady motion. One revolution
+#: is the shortest span that holds every crank angle once; a run recorded after
+#: ``transient`` >= 1 revolutions has no start-up left. Measurements: docs/reliability.md.
 STARTUP_REVOLUTIONS = 1.0
 
 
