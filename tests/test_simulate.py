@@ -230,3 +230,21 @@ def test_verdicts_are_withheld_outside_the_models_validity(tmp_path, capsys):
     before = texts(fig)
     assert any("PASS" in t or "FAIL" in t for t in before)  # a valid run keeps its verdict
     assert texts(mark_invalid(fig, good.attrs)) == before  # and no banner
+
+
+@pytest.mark.slow
+def test_issue31_valves_command_gives_no_api618_verdict(tmp_path, capsys):
+    """Issue 31's exact command: air, 20 rad/s, rc = 0.1 mm, dynamic valves. The massless
+    link is asked to pull under the reversing rod load (-272 N measured): the run printed
+    'api618_pin_reversal = pass'; now the verdict is withheld and the contact-impact model with
+    dynamic valves is named."""
+    from recipdyn.cli import main
+
+    out = tmp_path / "v.nc"
+    assert main(["simulate", "--model", "compressor-valves", "--set", "gas=Air", "--set",
+                 "omega=20", "--set", "rc=0.1mm", "-n", "2", "--transient", "2", "-o",
+                 str(out), "--no-progress"]) == 0  # fmt: skip
+    io = capsys.readouterr()
+    assert "api618_pin_reversal = invalid" in io.out and "= pass" not in io.out
+    assert "--model compressor-contact-valves" in io.out
+    assert io.err.count("warning: contact_force reaches") == 1
