@@ -170,10 +170,19 @@ def test_every_compressor_model_gives_the_same_numeric_columns(tmp_path, capsys)
     assert len(f) == 4 and np.all(np.isfinite(f[features].to_numpy(dtype=float)))
     np.testing.assert_allclose(f["speed_hz"], f["param_omega"] / (2 * np.pi), rtol=1e-12)
     assert not [c for c in f.columns if c.endswith(("_note", "_units"))]
+    # the only text columns: where a row comes from and the models' choices (categories)
+    from recipdyn.model.registry import get_model
+
+    choices = {f"param_{p.name}" for m in f["model"] for p in get_model(m).schema
+               if p.choices is not None}  # fmt: skip
+    text = {c for c in f.columns if not pd.api.types.is_numeric_dtype(f[c])}
+    assert text <= {"file", "signal", "model", *choices}, text - choices
+    assert sorted(f["model"]) == sorted(p.stem for p in runs)
     guide = pd.read_csv(tmp_path / "f.dictionary.csv", keep_default_na=False)
     assert list(guide["column"]) == list(f.columns)
     unit = dict(zip(guide["column"], guide["unit"], strict=True))
     assert unit["speed_hz"] == "Hz" and unit["order_1"] == "m/s**2" and unit["param_m3"] == "kg"
     note = dict(zip(guide["column"], guide["note"], strict=True))
     assert note["param_m3"]  # an assumed value says why
+    assert "load_model: " in note["model"]  # a text a model records is a note, not a column
     assert all(guide["description"].str.len() > 0)

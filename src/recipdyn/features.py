@@ -255,7 +255,10 @@ def _record_labels(attrs, meta: dict | None) -> dict[str, Any]:
         schema = get_model(attrs.get("model_spec", attrs.get("model_name"))).schema
     except (ParameterError, ImportError, AttributeError):
         schema = None
-    labels: dict[str, Any] = {}
+    labels: dict[str, Any] = {"model": str(attrs.get("model_name", ""))}
+    if meta is not None:
+        meta.setdefault("model", {"unit": "", "note": "", "description": "the recipdyn model "
+                                  "of the run (recipdyn models NAME)"})  # fmt: skip
     for k, v in attrs.items():
         if not k.startswith("param_") or k.endswith(("_note", "_units")):
             continue
@@ -263,6 +266,12 @@ def _record_labels(attrs, meta: dict | None) -> dict[str, Any]:
             continue
         name = k.removeprefix("param_")
         p = schema[name] if schema is not None and name in schema else None
+        if p is None and schema is not None and isinstance(v, str):
+            if meta is not None:  # a text the model records beside its parameters: a note
+                entry = meta["model"]
+                if f"{name}: {v}" not in entry["note"]:
+                    entry["note"] = "; ".join(n for n in (entry["note"], f"{name}: {v}") if n)
+            continue
         note = str(attrs.get(f"{k}_note", ""))
         if v == "default" and (p is None or p.kind == "number"):
             v = math.nan
