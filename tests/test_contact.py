@@ -499,12 +499,17 @@ def test_the_run_summary_reports_the_penetration_against_the_clearance():
     deeper (relative) than a 1 mm one (delta ~ (F/K)^(2/3) with K ~ c^(-1/2): delta / c ~
     c^(-2/3), 4.6x for c 10x smaller; measured over this half revolution 0.398 against 0.082,
     4.8x; the bound 3-6x leaves room for the dynamic part of the load)."""
+    import warnings
+
     import recipdyn
+    from recipdyn.errors import LawRangeWarning
 
     got = {}
     for rc in (1e-4, 1e-3):
-        ds = recipdyn.simulate(model="compressor-contact", params=dict(rc=rc), revolutions=0.5,
-                               fs=2000)  # fmt: skip
+        with warnings.catch_warnings():  # rc = 0.1 mm: the law's range, tested below
+            warnings.simplefilter("ignore", LawRangeWarning)
+            ds = recipdyn.simulate(model="compressor-contact", params=dict(rc=rc),
+                                   revolutions=0.5, fs=2000)  # fmt: skip
         a = ds.attrs
         assert a["max_penetration_ratio"] == pytest.approx(a["max_penetration_m"] / rc, rel=1e-12)
         assert a["contact_arc_deg"] == pytest.approx(
@@ -512,3 +517,63 @@ def test_the_run_summary_reports_the_penetration_against_the_clearance():
         )
         got[rc] = a["max_penetration_ratio"]
     assert 3.0 < got[1e-4] / got[1e-3] < 6.0
+
+
+def test_the_summary_reports_the_steady_state_and_the_startup_apart():
+    """Issue 31, item 3: a run recorded from t = 0 holds the start-up (the initial state is a
+    guess, not a state of the motion); the summary reports the steady state, t >= one
+    revolution (simulate.STARTUP_REVOLUTIONS), and the start-up's peak apart. Checked against
+    the record itself: the peak over each part, the impacts counted after the start-up
+    only. A run recorded after a transient revolution has no start-up part. The case is the
+    issue's (150 rad/s, 20 kN load): its journal is pushed 37.8 % of the clearance into the
+    bearing, which warns (LawRangeWarning)."""
+    import recipdyn
+    from recipdyn.errors import LawRangeWarning
+    from recipdyn.simulate import STARTUP_REVOLUTIONS
+
+    with pytest.warns(LawRangeWarning, match="37.8 % of the clearance"):  # issue 31's case
+        ds = recipdyn.simulate(model="compressor-contact", revolutions=2.5, fs=20000,
+                               params=dict(omega=150.0, load_amplitude=2e4))  # fmt: skip
+    a, t = ds.attrs, ds["time"].values
+    cut = STARTUP_REVOLUTIONS * 2 * math.pi / 150.0
+    acc = np.abs(ds["a"].values)
+    assert a["peak_abs_a_m_s2"] == float(acc[t >= cut].max())
+    assert a["startup_peak_abs_a_m_s2"] == float(acc[t < cut].max())
+    assert a["summary_interval"].startswith("steady state") and a["startup_revolutions"] == 1.0
+    vr = (ds["impact_ex"] * ds["impact_ex_dot"] + ds["impact_ey"] * ds["impact_ey_dot"]).values
+    onsets = (vr > 0) & (ds["impact_time"].values >= cut)
+    assert a["impacts"] == onsets.sum() and a["impacts"] < (vr > 0).sum()
+    late = recipdyn.simulate(model="compressor-contact", params=dict(omega=150.0),
+                             revolutions=1, transient=1, fs=5000)  # fmt: skip
+    assert "startup_peak_abs_a_m_s2" not in late.attrs
+    assert late.attrs["summary_interval"] == "steady state: the whole record (after the transient)"
+
+
+def test_a_point_contact_law_stretched_beyond_its_range_warns(tmp_path, capsys):
+    """Issue 31, item 3: Hertz's law needs a contact small against the radii; a run whose
+    overlap arc exceeds cc.HERTZ_ARC_LIMIT_DEG (an arc as long as the radius, 28.6 deg) warns
+    (LawRangeWarning, the record's law_range attribute, one CLI line) with the threshold and
+    its source. Under the paper's load a 0.1 mm clearance is pushed to a ~44 deg arc (warns),
+    a 1 mm one to ~22 deg (does not; measured in the test above and in docs/contact.md)."""
+    import warnings
+
+    import recipdyn
+    from recipdyn.cli import main
+    from recipdyn.errors import LawRangeWarning
+
+    assert cc.HERTZ_ARC_LIMIT_DEG == pytest.approx(28.648, abs=1e-3)
+    with pytest.warns(LawRangeWarning, match="Johnson 1985"):
+        ds = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-4),
+                               revolutions=0.5, fs=2000)  # fmt: skip
+    assert "28.6 deg" in ds.attrs["law_range"] and "crank pin" in ds.attrs["law_range"]
+    assert ds.attrs["contact_arc_deg"] > cc.HERTZ_ARC_LIMIT_DEG
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LawRangeWarning)
+        ok = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-3),
+                               revolutions=0.5, fs=2000)  # fmt: skip
+    assert ok.attrs["law_range"] == "ok" and ok.attrs["contact_arc_deg"] < cc.HERTZ_ARC_LIMIT_DEG
+    assert main(["simulate", "--model", "compressor-contact", "--set", "rc=0.1 mm", "-n", "0.5",
+                 "--fs", "2 kHz", "-o", str(tmp_path / "r.nc"), "--no-figure",
+                 "--no-progress"]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("warning: the point-contact law") == 1 and "Johnson 1985" in err

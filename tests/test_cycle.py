@@ -139,7 +139,9 @@ def test_simulated_gas_force_is_the_cycle_and_the_report_has_api618(tmp_path, ca
     w = sum(ideal_indicated_work(1e5, 4.0, 0.1, 1.3, a * g.stroke)
             for a in (g.area_head, g.area_crank))  # fmt: skip
     assert ds.attrs["indicated_power_W"] == pytest.approx(w * p.omega / (2 * math.pi), rel=1e-6)
-    assert ds.attrs["api618_pin_reversal"] in ("pass", "FAIL")
+    # the verdict, or "invalid" where the massless link left its validity (issue 31)
+    verdicts = ("pass", "FAIL") if ds.attrs["validity"] == "ok" else ("invalid",)
+    assert ds.attrs["api618_pin_reversal"] in verdicts
 
 
 @pytest.mark.parametrize("args, words", [

@@ -146,3 +146,43 @@ def test_sweep_features_measure_equals_the_run_features(tmp_path):
         row = f[np.isclose(f["rc"], rc)].iloc[0]
         for k in ("rms", "kurtosis", "crest_factor", "centroid_hz", "order_1", "order_2"):
             assert row[f"feat_{k}"] == pytest.approx(ref[k], rel=1e-9), k
+
+
+def test_every_compressor_model_gives_the_same_numeric_columns(tmp_path, capsys):
+    """Issue 31, item 4: runs of the four compressor models give a feature table fit for
+    learning: every row has its speed (from the model's period: omega / 2 pi, checked
+    against the recorded omega) and finite order amplitudes; no text note or unit column;
+    the units, descriptions and assumption notes are in the data dictionary beside the table
+    (one row per column of the table, in its order)."""
+    runs = []
+    for model in ("compressor", "compressor-contact", "compressor-valves",
+                  "compressor-contact-valves"):  # fmt: skip
+        p = tmp_path / f"{model}.nc"
+        assert main(["simulate", "--model", model, "-n", "1", "--fs", "5 kHz", "-o", str(p),
+                     "--no-figure", "--no-progress"]) == 0  # fmt: skip
+        runs.append(p)
+    out = tmp_path / "f.csv"
+    assert main(["features", *map(str, runs), "-o", str(out), "--no-progress"]) == 0
+    assert "f.dictionary.csv" in capsys.readouterr().out
+    f = pd.read_csv(out)
+    features = ["speed_hz", *[f"order_{k}" for k in range(1, 11)], "rms", "peak",
+                "velocity_rms_2_1000hz", "dominant_hz", "spectral_entropy"]  # fmt: skip
+    assert len(f) == 4 and np.all(np.isfinite(f[features].to_numpy(dtype=float)))
+    np.testing.assert_allclose(f["speed_hz"], f["param_omega"] / (2 * np.pi), rtol=1e-12)
+    assert not [c for c in f.columns if c.endswith(("_note", "_units"))]
+    # the only text columns: where a row comes from and the models' choices (categories)
+    from recipdyn.model.registry import get_model
+
+    choices = {f"param_{p.name}" for m in f["model"] for p in get_model(m).schema
+               if p.choices is not None}  # fmt: skip
+    text = {c for c in f.columns if not pd.api.types.is_numeric_dtype(f[c])}
+    assert text <= {"file", "signal", "model", *choices}, text - choices
+    assert sorted(f["model"]) == sorted(p.stem for p in runs)
+    guide = pd.read_csv(tmp_path / "f.dictionary.csv", keep_default_na=False)
+    assert list(guide["column"]) == list(f.columns)
+    unit = dict(zip(guide["column"], guide["unit"], strict=True))
+    assert unit["speed_hz"] == "Hz" and unit["order_1"] == "m/s**2" and unit["param_m3"] == "kg"
+    note = dict(zip(guide["column"], guide["note"], strict=True))
+    assert note["param_m3"]  # an assumed value says why
+    assert "load_model: " in note["model"]  # a text a model records is a note, not a column
+    assert all(guide["description"].str.len() > 0)

@@ -180,3 +180,71 @@ def test_negative_contact_force_is_flagged(tmp_path, capsys):
     sw = open_sweep(store / "sweep.zarr")
     low = sw["min_contact_force"].values
     assert low[0] < 0 < low[1] and sw["min_contact_force"].attrs["units"] == "N"
+
+
+def test_verdicts_are_withheld_outside_the_models_validity(tmp_path, capsys):
+    """Issue 31, item 2: the double-acting compression cycle reverses the rod load, so the
+    massless link (rc = 1 mm) is asked to pull (validity crossed). Every verdict computed from
+    that run is withheld: the API 618 pin-reversal verdict is 'invalid' with the reason and
+    the model to use, in the attributes, the CLI print (no 'pass'/'FAIL' line) and the
+    figures (a red title naming the model to use; the rod-load panel says the verdict is
+    withheld). The numbers stay (they are what the equations give). With rc = 0 the pin is an
+    ideal two-way joint, the bound does not apply, and the same cycle keeps its verdict."""
+    import warnings
+
+    import matplotlib.text
+
+    import recipdyn
+    from recipdyn.cli import main
+    from recipdyn.errors import ModelValidityWarning
+    from recipdyn.plotting import cycle_figure, mark_invalid, response_figure
+
+    with pytest.warns(ModelValidityWarning, match="compressor-contact"):
+        bad = recipdyn.simulate(load="cycle", revolutions=1.2, fs=5000.0)
+    a = bad.attrs
+    assert a["validity"] != "ok" and a["api618_pin_reversal"] == "invalid"
+    assert "compressor-contact" in a["api618_pin_reversal_reason"]
+    assert a["pin_reversal_deg"] > 0.0  # the numbers are kept, only the verdict is withheld
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelValidityWarning)
+        good = recipdyn.simulate(load="cycle", rc=0.0, revolutions=1.2, fs=5000.0)
+    assert good.attrs["validity"] == "ok" and good.attrs["api618_pin_reversal"] in ("pass", "FAIL")
+    assert "api618_pin_reversal_reason" not in good.attrs
+
+    out = tmp_path / "c.nc"
+    assert main(["simulate", "--set", "load=cycle", "-n", "1.2", "--fs", "5 kHz", "-o",
+                 str(out), "--no-progress"]) == 0  # fmt: skip
+    text = capsys.readouterr().out
+    assert "api618_pin_reversal = invalid" in text and "compressor-contact" in text
+    assert "= pass" not in text and "= FAIL" not in text
+    assert out.with_suffix(".png").exists() and out.with_name("c.cycle.png").exists()
+
+    def texts(fig):
+        return [t.get_text() for t in fig.findobj(matplotlib.text.Text)]
+
+    for fig in (mark_invalid(cycle_figure(bad), a), mark_invalid(response_figure(bad), a)):
+        assert any("INVALID" in t and "compressor-contact" in t for t in texts(fig))
+        assert "OUTSIDE THE MODEL'S VALIDITY" in texts(fig)
+        assert not any("PASS" in t or "FAIL" in t for t in texts(fig))
+    fig = cycle_figure(good)
+    before = texts(fig)
+    assert any("PASS" in t or "FAIL" in t for t in before)  # a valid run keeps its verdict
+    assert texts(mark_invalid(fig, good.attrs)) == before  # and no banner
+
+
+@pytest.mark.slow
+def test_issue31_valves_command_gives_no_api618_verdict(tmp_path, capsys):
+    """Issue 31's exact command: air, 20 rad/s, rc = 0.1 mm, dynamic valves. The massless
+    link is asked to pull under the reversing rod load (-272 N measured): the run printed
+    'api618_pin_reversal = pass'; now the verdict is withheld and the contact-impact model with
+    dynamic valves is named."""
+    from recipdyn.cli import main
+
+    out = tmp_path / "v.nc"
+    assert main(["simulate", "--model", "compressor-valves", "--set", "gas=Air", "--set",
+                 "omega=20", "--set", "rc=0.1mm", "-n", "2", "--transient", "2", "-o",
+                 str(out), "--no-progress"]) == 0  # fmt: skip
+    io = capsys.readouterr()
+    assert "api618_pin_reversal = invalid" in io.out and "= pass" not in io.out
+    assert "--model compressor-contact-valves" in io.out
+    assert io.err.count("warning: contact_force reaches") == 1

@@ -38,6 +38,13 @@ class ModelValidityWarning(UserWarning):
     machine there."""
 
 
+class LawRangeWarning(UserWarning):
+    """A run used a constitutive law (e.g. Hertz's point-contact law) beyond the range its
+    source states: the equations still hold as the model defines them, but the law no longer
+    describes the real contact there, so forces and accelerations are the model's, not the
+    machine's."""
+
+
 class KernelAllocatesWarning(UserWarning):
     """A compiled kernel declared without ``allocates=True`` allocates arrays, so it was
     compiled with numba's reference counting after all: correct, but slower

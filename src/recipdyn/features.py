@@ -20,7 +20,8 @@ from .defaults import MAX_MEMORY_SAMPLES
 from .model.parameters import ParameterError
 
 __all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS",
-           "feature_units"]  # fmt: skip
+           "feature_units", "record_speed_hz", "write_dictionary", "dictionary_path",
+           "COLUMN_DESCRIPTIONS"]  # fmt: skip
 
 #: Crank orders whose amplitudes are features (1..N_ORDERS).
 N_ORDERS = 10
@@ -70,6 +71,37 @@ def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
         r = lyap_rosenstein(x, 1.0 / fs)
         row["lambda1_rosenstein"], row["lambda1_status"] = r.exponent, r.status
     return row
+
+
+#: What each feature column means (its unit depends on the signal: `feature_units`).
+COLUMN_DESCRIPTIONS: dict[str, str] = {
+    "store": "sweep store the row comes from",
+    "file": "input file the row comes from",
+    "signal": "the signal the features are computed from (a run: its vibration signal)",
+    "window_start_s": "start of the window in the record",
+    "window_s": "window length",
+    "fs_hz": "sampling rate",
+    "speed_hz": "crank (forcing) speed: a run's model period, --speed or the tacho; NaN if "
+    "unknown",
+    "rms": "root mean square of the signal",
+    "peak": "largest magnitude",
+    "peak_to_peak": "largest minus smallest value",
+    "crest_factor": "peak / rms",
+    "kurtosis": "kurtosis (3 for a Gaussian signal)",
+    "skewness": "skewness",
+    "velocity_rms_2_1000hz": "ISO 20816-8 band (2-1000 Hz) RMS of the velocity integrated "
+    "from the acceleration",
+    "dominant_hz": "frequency of the largest spectral line",
+    "centroid_hz": "power-weighted mean frequency",
+    "spread_hz": "power-weighted standard deviation of the frequency",
+    "spectral_entropy": "normalised spectral entropy (0: one line, 1: white)",
+    "k01": "0-1 test for chaos, K (near 0 regular, near 1 chaotic)",
+    "k01_status": "status of the 0-1 test (ok or refused with the reason)",
+    "lambda1_rosenstein": "largest Lyapunov exponent (Rosenstein) of the signal",
+    "lambda1_status": "status of the Rosenstein estimate (ok, flat, refused)",
+    **{f"order_{k}": f"amplitude of crank order {k} (angle-domain spectrum)"
+       for k in range(1, N_ORDERS + 1)},
+}  # fmt: skip
 
 
 def feature_units(signal_unit: str, *, orders: bool = True,
@@ -122,7 +154,7 @@ def _windows(n: int, fs: float, window: str | None, rev_s: float | None):
 
 def file_features(path: str | Path, *, column=None, fs=None, window: str | None = None,
                   speed=None, tacho=None, chaos: bool = False, progress: bool = False,
-                  max_memory_samples: int = MAX_MEMORY_SAMPLES,
+                  max_memory_samples: int = MAX_MEMORY_SAMPLES, meta: dict | None = None,
                   ) -> list[dict[str, Any]]:  # fmt: skip
     """Rows for one file: a recipdyn run (its vibration signal, speed and parameters) or a
     measured signal (``column``/``fs`` as for analyze; ``speed`` or a ``tacho`` column for
@@ -130,14 +162,20 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
 
     With ``window``, a signal file is read block by block, whatever its length. Without, its
     one row needs the whole signal in memory: a file longer than ``max_memory_samples`` is
-    refused (a [`ParameterError`][recipdyn.errors.ParameterError] that says to give a window) before
-    anything is read."""
+    refused (a `ParameterError` that says to give a window) before anything is read.
+
+    Every run of a model with a forcing period (the compressor models) gets its speed
+    (`record_speed_hz`) and so the same numeric columns, orders included. ``meta``, a
+    dict, receives each column's unit, description and note (the parameters' assumption
+    notes) for the data dictionary (`write_dictionary`); the table itself holds no
+    notes or units."""
     from .analysis.vibration import crank_angle
     from .analyze import is_record
     from .io_signal import crank_revs, read_signal, record_length, speed_hz
 
     path = Path(path)
     labels: dict[str, Any] = {}
+    unit = ""
     if column is None and fs is None and is_record(path):
         from .io import read_dataset
 
@@ -145,13 +183,15 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         vib = "a" if "a" in ds else next(iter(ds.data_vars))
         t = ds[ds[vib].dims[0]].values
         x, rate = ds[vib].values.astype(float), 1.0 / float(np.median(np.diff(t)))
-        labels = {k: v for k, v in ds.attrs.items() if k.startswith("param_")
-                  and isinstance(v, (int, float, str, np.number))}  # fmt: skip
-        f_rev = float(ds.attrs.get("crank_frequency_hz", 0.0)) or None
-        name = vib
+        labels = _record_labels(ds.attrs, meta)
+        f_rev = record_speed_hz(ds.attrs)
+        name, unit = vib, str(ds[vib].attrs.get("units", ""))
     else:
         if window:  # window by window: files longer than memory are fine
-            return _streamed_rows(path, column, fs, window, speed, chaos, progress, tacho)
+            rows = _streamed_rows(path, column, fs, window, speed, chaos, progress, tacho)
+            if meta is not None:
+                _feature_meta(meta, "")
+            return rows
         n_est = record_length(path, column=column)
         if n_est is not None and n_est > max_memory_samples:
             raise ParameterError(
@@ -163,6 +203,7 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         sig = read_signal(path, column=column, fs=fs)
         x, rate, name = sig.x, sig.fs, sig.name
         f_rev = None
+        unit = sig.units
     revs = None
     if tacho is not None:
         revs = crank_revs(path, x.size, rate, tacho=tacho)
@@ -181,7 +222,109 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
                                    chaos=chaos))  # fmt: skip
         row.update(labels)
         rows.append(row)
+    if meta is not None:
+        _feature_meta(meta, unit)
     return rows
+
+
+def record_speed_hz(attrs) -> float | None:
+    """The forcing (crank) frequency of a recipdyn run from its attributes, through the model
+    protocol: ``1 / model.period(values)`` of the recorded model and parameters; None for an
+    autonomous system, a map, or a record whose model cannot be rebuilt."""
+    from .model.registry import get_model
+
+    spec = attrs.get("model_spec", attrs.get("model_name"))
+    try:
+        m = get_model(spec)
+        period = m.period(m.schema.from_attrs(attrs)) if m.kind == "ode" else None
+    except (ParameterError, ImportError, AttributeError, KeyError, TypeError, ValueError):
+        period = None
+    if not period:  # a record of an older recipdyn: its compressor said its speed
+        f = float(attrs.get("crank_frequency_hz", 0.0))
+        return f or None
+    return 1.0 / float(period)
+
+
+def _record_labels(attrs, meta: dict | None) -> dict[str, Any]:
+    """The parameter columns (``param_*``) of a run; their units and assumption notes go to
+    ``meta`` (the data dictionary), not into the table. A value the model derives (recorded
+    as ``"default"``) of a numeric parameter is NaN, so a column stays numeric."""
+    from .model.registry import get_model
+
+    try:
+        schema = get_model(attrs.get("model_spec", attrs.get("model_name"))).schema
+    except (ParameterError, ImportError, AttributeError):
+        schema = None
+    labels: dict[str, Any] = {"model": str(attrs.get("model_name", ""))}
+    if meta is not None:
+        meta.setdefault("model", {"unit": "", "note": "", "description": "the recipdyn model "
+                                  "of the run (recipdyn models NAME)"})  # fmt: skip
+    for k, v in attrs.items():
+        if not k.startswith("param_") or k.endswith(("_note", "_units")):
+            continue
+        if not isinstance(v, (int, float, str, np.number)):
+            continue
+        name = k.removeprefix("param_")
+        p = schema[name] if schema is not None and name in schema else None
+        if p is None and schema is not None and isinstance(v, str):
+            if meta is not None:  # a text the model records beside its parameters: a note
+                entry = meta["model"]
+                if f"{name}: {v}" not in entry["note"]:
+                    entry["note"] = "; ".join(n for n in (entry["note"], f"{name}: {v}") if n)
+            continue
+        note = str(attrs.get(f"{k}_note", ""))
+        if v == "default" and (p is None or p.kind == "number"):
+            v = math.nan
+            note = "; ".join(n for n in (note, "NaN: derived by the model (not set)") if n)
+        labels[k] = v
+        if meta is not None:
+            entry = meta.setdefault(k, {"unit": "", "description": "", "note": ""})
+            entry["unit"] = entry["unit"] or str(attrs.get(f"{k}_units", p.unit if p else ""))
+            entry["description"] = entry["description"] or (
+                f"model parameter: {p.description}" if p else "model parameter")  # fmt: skip
+            if note and note not in entry["note"]:
+                entry["note"] = "; ".join(n for n in (entry["note"], note) if n)
+    return labels
+
+
+def _feature_meta(meta: dict, signal_unit: str) -> None:
+    """Units and descriptions of the feature columns of a signal in ``signal_unit``."""
+    units = {"file": "", "signal": "", "window_start_s": "s", "window_s": "s", "fs_hz": "Hz",
+             "speed_hz": "Hz", **feature_units(signal_unit), "k01": "1", "k01_status": "",
+             "lambda1_rosenstein": "1/s", "lambda1_status": ""}  # fmt: skip
+    for col, unit in units.items():
+        entry = meta.setdefault(col, {"unit": unit, "description": "", "note": ""})
+        entry["description"] = entry["description"] or COLUMN_DESCRIPTIONS.get(col, "")
+        if entry["unit"] != unit and unit not in entry["unit"].split(" or "):
+            entry["unit"] = f"{entry['unit']} or {unit}"  # rows of signals in other units
+
+
+def dictionary_path(table: str | Path) -> Path:
+    """The data dictionary beside a table: ``f.csv`` -> ``f.dictionary.csv``."""
+    table = Path(table)
+    return table.with_name(table.stem + ".dictionary.csv")
+
+
+def write_dictionary(meta: dict, rows: list[dict[str, Any]], table: str | Path) -> Path:
+    """The data dictionary of a feature table, beside it (`dictionary_path`): one row per
+    column of the table, in its order: ``column, unit, description, note``."""
+    import pandas as pd
+
+    from .io import atomic_path, write_error
+
+    cols: list[str] = []
+    for r in rows:
+        cols += [k for k in r if k not in cols]
+    empty = {"unit": "", "description": "", "note": ""}
+    frame = pd.DataFrame([{"column": c, **{**empty, **meta.get(c, {})}} for c in cols],
+                         columns=["column", "unit", "description", "note"])  # fmt: skip
+    path = dictionary_path(table)
+    try:
+        with atomic_path(path) as tmp:
+            frame.to_csv(tmp, index=False)
+    except Exception as exc:
+        raise write_error(path, exc) from None
+    return path
 
 
 def _tacho_pulses(path, tacho, fs, progress) -> np.ndarray:
@@ -251,7 +394,7 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress,
     return rows
 
 
-def sweep_features(path: str | Path) -> list[dict[str, Any]]:
+def sweep_features(path: str | Path, meta: dict | None = None) -> list[dict[str, Any]]:
     """One row per computed point of a sweep store: its parameter values and every scalar
     measure (vector measures such as section points are left out); with the sweep measure
     ``features``, the vibration signal's features of each point (``feat_*``). Columns: the
@@ -262,6 +405,14 @@ def sweep_features(path: str | Path) -> list[dict[str, Any]]:
     grid = [d for d in ds["done"].dims]
     scalar = sorted(k for k, v in ds.data_vars.items()
                     if tuple(v.dims) == tuple(grid) and k != "done")  # fmt: skip
+    if meta is not None:
+        meta.setdefault("store", {"unit": "", "description": COLUMN_DESCRIPTIONS["store"],
+                                  "note": ""})  # fmt: skip
+        for k in grid + scalar:
+            a = ds[k].attrs
+            entry = {"unit": str(a.get("units", "")), "note": "",
+                     "description": str(a.get("long_name", ""))}  # fmt: skip
+            meta.setdefault(k, entry)
     frame = ds[scalar + ["done"]].to_dataframe().reset_index()
     frame = frame[frame["done"].astype(bool)].drop(columns=["done"])
     return frame[grid + scalar].to_dict("records")

@@ -20,6 +20,7 @@ __all__ = [
     "centred",
     "unit_tex",
     "is_dense",
+    "mark_invalid",
     "PALETTE",
 ]
 
@@ -431,6 +432,8 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     rev = rod_load_reversal(last["theta1"].values, pin)
     ax.set_title("c) rod load at the crosshead pin, compression > 0")
     verdict = rev.describe().replace(" (API", "\n(API").replace(", reverse", ",\nreverse")
+    if ds.attrs.get("validity", "ok") != "ok":  # no verdict from an invalid model
+        verdict = verdict.rsplit(":", 1)[0] + ":\nAPI 618 verdict WITHHELD (outside the model)"
     ax.text(0.02, 0.02, verdict, transform=ax.transAxes, fontsize=8, va="bottom",
             bbox=dict(boxstyle="round", fc="white", ec="0.6", alpha=0.9))  # fmt: skip
     ax.set_xlabel("crank angle (deg)")
@@ -457,4 +460,23 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
     fig.suptitle(title or f"Compression cycle ({kind}) and rod loads, last revolution")
     fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))  # room for the footer
     fig.text(0.01, 0.005, provenance_footer(ds), fontsize=6.5, color="0.35")
+    return fig
+
+
+def mark_invalid(fig, attrs):
+    """Say on ``fig``, where nobody can miss it, that its run left the model's validity
+    (``attrs["validity"]`` is not ``"ok"``): the reason and the model to use in red above the
+    title, and "OUTSIDE THE MODEL'S VALIDITY" across the figure. Returns ``fig`` (unchanged
+    for a valid run)."""
+    import textwrap
+
+    why = str(attrs.get("validity", "ok"))
+    if why == "ok":
+        return fig
+    old = fig.get_suptitle()
+    head = "INVALID RUN: outside the model's validity, verdicts withheld"
+    text = "\n".join([head, *textwrap.wrap(why, 150), *([old] if old else [])])
+    fig.suptitle(text, color="#B00020", fontsize=9)
+    fig.text(0.5, 0.5, "OUTSIDE THE MODEL'S VALIDITY", ha="center", va="center", rotation=20,
+             fontsize=44, color="#B00020", alpha=0.15, zorder=10)  # fmt: skip
     return fig

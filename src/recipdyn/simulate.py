@@ -14,7 +14,7 @@ import xarray as xr
 
 from . import __version__
 from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
-from .errors import Interrupted, ModelValidityWarning, is_number
+from .errors import Interrupted, LawRangeWarning, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import UniformGrid, check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
@@ -23,8 +23,8 @@ from .model.protocol import Model
 from .model.registry import get_model
 from .resources import check_memory
 
-__all__ = ["simulate", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
-           "estimate_memory"]  # fmt: skip
+__all__ = ["simulate", "summarize", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
+           "estimate_memory", "STARTUP_REVOLUTIONS"]  # fmt: skip
 
 SIGN_CONVENTION = (
     "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
@@ -106,6 +106,102 @@ def validity_warning(model, minima: dict[str, float]) -> str:
         if low is not None and math.isfinite(low) and low < bound:
             out.append(f"{name} reaches {low:.4g} {unit} (< {bound:g}): {why}; use {instead}")
     return "; ".join(out)
+
+
+#: The start-up a run summary leaves out: the first revolutions (forcing periods) after the
+#: initial state, t < STARTUP_REVOLUTIONS * T. The initial state is a guess (the link aligned
+#: with the load, the journal on the wall, at rest relative to the crank), not a state of the
+#: steady motion, and the first impacts it causes belong to no steady motion. One revolution
+#: is the shortest span that holds every crank angle once; a run recorded after
+#: ``transient`` >= 1 revolutions has no start-up left. Measurements: docs/reliability.md.
+STARTUP_REVOLUTIONS = 1.0
+
+
+def _unit_suffix(unit: str) -> str:
+    """``m/s**2`` -> ``_m_s2``: the unit as a suffix of a summary entry's name."""
+    u = unit.replace("**", "").replace("/", "_").replace("*", "_").replace(" ", "")
+    return f"_{u}" if u not in ("", "1") else ""
+
+
+def _time_slice(ds: xr.Dataset, t_lo: float) -> xr.Dataset:
+    """The samples at ``time >= t_lo`` and the events (``NAME_event`` dimensions with a
+    ``NAME_time`` variable) there."""
+    t = np.asarray(ds["time"].values, dtype=float)
+    part = ds.isel(time=np.flatnonzero(t >= t_lo))
+    for dim in [d for d in ds.dims if str(d).endswith("_event")]:
+        tv = f"{str(dim)[: -len('_event')]}_time"
+        if tv in ds:
+            part = part.isel({dim: np.flatnonzero(np.asarray(ds[tv].values) >= t_lo)})
+    return part
+
+
+def summarize(m: Model, values: Mapping[str, Any], ds: xr.Dataset,
+              validity: str = "ok") -> dict[str, Any]:  # fmt: skip
+    """The run summary of a record ``ds`` of model ``m`` (what `simulate` writes into
+    the attributes and the CLI prints): the model's `Model.run_summary` over the steady
+    state, the start-up separately, verdicts withheld outside
+    the model's validity.
+
+    * Steady state: the samples after `STARTUP_REVOLUTIONS` forcing periods from the
+      initial state (all of them for a record that starts later, for an autonomous system or a
+      map, and -- said in ``summary_interval`` -- for a record with less than one period after
+      the start-up).
+    * Start-up: ``startup_peak_abs_<signal>``, the largest magnitude of the model's vibration
+      signal over the start-up part of the record, and ``startup_revolutions``.
+    * Verdicts (`recipdyn.model.protocol.Model.summary_verdicts`): when ``validity``
+      is not ``"ok"`` (the run left the model's validity) their value is ``"invalid"`` and
+      ``<verdict>_reason`` says why and which model to use.
+    """
+    period = m.period(values) if m.kind == "ode" else None
+    vib, unit = m.vibration()
+    part, interval, startup = ds, "the whole record", None
+    if period and "time" in ds.dims and ds.sizes["time"] > 1:
+        t = np.asarray(ds["time"].values, dtype=float)
+        t_cut = STARTUP_REVOLUTIONS * float(period)
+        dt = float(t[1] - t[0])
+        if t[0] < t_cut - 0.5 * dt:  # the record holds (part of) the start-up
+            if t[-1] - t_cut >= float(period) - 1.5 * dt:  # at least a period after it
+                part = _time_slice(ds, t_cut)
+                startup = ds.isel(time=np.flatnonzero(t < t_cut))
+                interval = (f"steady state: t >= {t_cut:.6g} s (after the first "
+                            f"{STARTUP_REVOLUTIONS:g} revolution(s) of the start-up, reported "
+                            "as startup_*)")  # fmt: skip
+            else:
+                interval = (f"the whole record, start-up included: less than one revolution "
+                            f"after the first {STARTUP_REVOLUTIONS:g} (raise --revolutions or "
+                            "--transient)")  # fmt: skip
+        else:
+            interval = "steady state: the whole record (after the transient)"
+    out: dict[str, Any] = dict(m.run_summary(values, part)) if part.sizes.get(
+        "time", 0) else {}  # fmt: skip
+    if period and vib in ds:
+        out.setdefault(f"peak_abs_{vib}{_unit_suffix(unit)}",
+                       float(np.nanmax(np.abs(part[vib].values))))  # fmt: skip
+        if startup is not None and startup.sizes["time"]:
+            out[f"startup_peak_abs_{vib}{_unit_suffix(unit)}"] = float(
+                np.nanmax(np.abs(startup[vib].values)))  # fmt: skip
+            out["startup_revolutions"] = STARTUP_REVOLUTIONS
+    out["summary_interval"] = interval
+    if validity != "ok" and any(key in out for key in m.summary_verdicts):
+        withheld: dict[str, Any] = {}
+        for key, value in out.items():  # the reason right after its verdict
+            if key in m.summary_verdicts:
+                withheld[key] = "invalid"
+                withheld[f"{key}_reason"] = (f"withheld: the run left the model's validity "
+                                             f"({validity})")  # fmt: skip
+            else:
+                withheld[key] = value
+        out = withheld
+    return out
+
+
+def _check_law_range(m: Model, values, ds: xr.Dataset, attrs: dict) -> None:
+    """Record (``attrs["law_range"]``) and warn (`LawRangeWarning`) when the run used
+    a law of the model beyond its stated range (over the whole record, start-up included)."""
+    msg = m.law_range(values, ds) if ds.sizes.get("time", 0) else ""
+    attrs["law_range"] = msg or "ok"
+    if msg:
+        warnings.warn(msg, LawRangeWarning, stacklevel=3)
 
 
 def simulate(
@@ -330,7 +426,7 @@ def simulate(
     _check_validity(COMPRESSOR, minima, attrs, vars(p))
     recent = ds if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
-        attrs.update(clean_attrs(COMPRESSOR.run_summary(vars(p), recent)))
+        attrs.update(clean_attrs(summarize(COMPRESSOR, vars(p), recent, attrs["validity"])))
     if writer is not None:
         from .io import open_record
 
@@ -500,8 +596,9 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
         _check_validity(m, minima, ds.attrs, values)
     if events:
         ds = _with_events(ds, m, values, events[0], sol, t_start)
+    _check_law_range(m, values, ds, ds.attrs)
     if sol.t.size:
-        ds.attrs.update(clean_attrs(m.run_summary(values, ds)))
+        ds.attrs.update(clean_attrs(summarize(m, values, ds, ds.attrs.get("validity", "ok"))))
     if failure is not None:
         failure.dataset = ds
         raise failure

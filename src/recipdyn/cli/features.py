@@ -46,23 +46,26 @@ def features(
 ) -> None:
     """Time-domain statistics, spectral and order features, chaos indicators: one row per
     run or window, labelled with the run's parameters."""
-    from ..features import file_features, sweep_features, write_table
+    from ..features import file_features, sweep_features, write_dictionary, write_table
     from ..model.parameters import ParameterError
 
     if out.suffix.lower() not in (".csv", ".parquet"):  # before any work
         raise ParameterError(f"output {out}: use .csv or .parquet")
-    rows = []
+    rows: list[dict] = []
+    meta: dict = {}  # column -> unit, description, note: the data dictionary
     for path in inputs:
         if not path.exists():
             raise ParameterError(f"input not found: {path}")
         with phase(f"features of {path.name}"):
             if path.is_dir():
-                rows += [{"store": path.name, **r} for r in sweep_features(path)]
+                rows += [{"store": path.name, **r} for r in sweep_features(path, meta)]
             else:
                 extra = {} if max_memory_samples is None else {
                     "max_memory_samples": max_memory_samples}  # fmt: skip
                 rows += file_features(path, column=column, fs=fs, window=window, speed=speed,
                                       tacho=tacho, chaos=chaos, progress=progress,
-                                      **extra)  # fmt: skip
+                                      meta=meta, **extra)  # fmt: skip
     write_table(rows, out)
-    typer.echo(f"wrote {len(rows)} row(s) to {out}")
+    guide = write_dictionary(meta, rows, out)
+    typer.echo(f"wrote {len(rows)} row(s) to {out}; units, descriptions and notes of its "
+               f"columns in {guide}")  # fmt: skip

@@ -143,10 +143,10 @@ def simulate(
 ) -> None:
     """Simulate a model (default: the compressor); write the record (.nc, .csv or .zarr) and a
     figure."""
-    from ..errors import Interrupted, ModelValidityWarning, ParameterError
+    from ..errors import Interrupted, LawRangeWarning, ModelValidityWarning, ParameterError
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset
-    from ..simulate import DEFAULT_SETTINGS
+    from ..simulate import DEFAULT_SETTINGS, summarize
     from ..simulate import simulate as run_sim
     from ..units import to_si
 
@@ -190,6 +190,7 @@ def simulate(
     try:
         with warnings.catch_warnings():  # said once below, as a line of its own
             warnings.simplefilter("ignore", ModelValidityWarning)
+            warnings.simplefilter("ignore", LawRangeWarning)
             ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
                          model=m, **extra, **kw)  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
@@ -209,17 +210,19 @@ def simulate(
                    if k.startswith("param_") and not k.endswith(("_note", "_units"))}  # fmt: skip
     report(output=str(out), model=m.name, samples=dict(ds.sizes), parameters=params_used,
            validity=ds.attrs.get("validity", "ok"))  # fmt: skip
-    if ds.attrs.get("validity", "ok") != "ok":
-        typer.echo(f"warning: {ds.attrs['validity']}", err=True)
+    validity = ds.attrs.get("validity", "ok")
+    for key in ("validity", "law_range"):
+        if ds.attrs.get(key, "ok") != "ok":
+            typer.echo(f"warning: {ds.attrs[key]}", err=True)
     if m.name != "compressor":
         typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
-        summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds) if ds.sizes else {}
+        summary = summarize(m, m.schema.from_attrs(ds.attrs), ds, validity) if ds.sizes else {}
         _echo_summary(summary)
         report(summary=summary)
         if figure:
-            from ..plotting import _mpl, model_figure
+            from ..plotting import _mpl, mark_invalid, model_figure
 
-            fig = model_figure(ds)
+            fig = mark_invalid(model_figure(ds), ds.attrs)
             typer.echo(f"wrote {save_figure(fig, out.with_suffix('.png'), dpi=130)}")
             _mpl().close(fig)
             _cycle_png(ds, out)
@@ -233,21 +236,21 @@ def simulate(
         typer.echo("figure and summary need all outputs: not drawn (--columns)")
         return
     if figure:
-        from ..plotting import _mpl, response_figure
+        from ..plotting import _mpl, mark_invalid, response_figure
 
-        fig = response_figure(ds)
+        fig = mark_invalid(response_figure(ds), ds.attrs)
         png = save_figure(fig, out.with_suffix(".png"), dpi=130)
         _mpl().close(fig)
         typer.echo(f"wrote {png}")
         _cycle_png(ds, out)
-    a = ds["a"].values
+    summary = summarize(m, m.schema.from_attrs(ds.attrs), ds, validity)
+    peak = summary.pop("peak_abs_a_m_s2")
     typer.echo(
-        f"peak |a| = {abs(a).max():.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
+        f"peak |a| = {peak:.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
         f"{ds.x.max().item():.5f}] m, min contact force = {ds.attrs['min_contact_force_N']:.4g} N"
     )
-    summary = m.run_summary(m.schema.from_attrs(ds.attrs), ds)
     _echo_summary(summary)
-    report(peak_a=float(abs(a).max()), x_min=ds.x.min().item(), x_max=ds.x.max().item(),
+    report(peak_a=peak, x_min=ds.x.min().item(), x_max=ds.x.max().item(),
            min_contact_force=float(ds.attrs["min_contact_force_N"]), summary=summary)  # fmt: skip
 
 
@@ -257,9 +260,9 @@ def _cycle_png(ds, out: Path) -> None:
     cycle = ds.attrs.get("param_load") == "cycle" or "y_suction_head" in ds.data_vars
     if cycle and {"p_head", "V_head", "theta1", "a", "gas_force"} <= set(ds.data_vars):
         from ..io import save_figure
-        from ..plotting import _mpl, cycle_figure
+        from ..plotting import _mpl, cycle_figure, mark_invalid
 
-        fig = cycle_figure(ds.load())
+        fig = mark_invalid(cycle_figure(ds.load()), ds.attrs)
         png = save_figure(fig, out.with_name(out.stem + ".cycle.png"), dpi=110)
         _mpl().close(fig)
         typer.echo(f"wrote {png}")

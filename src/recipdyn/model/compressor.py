@@ -246,6 +246,8 @@ class Compressor(Model):
         "the contact-impact joint (--model compressor-contact)",
     ),)  # fmt: skip
 
+    summary_verdicts = ("api618_pin_reversal",)
+
     def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
         """``theta_c, thetadot_c``; a motor drive adds the crank angle and speed and the work
         integrals of the motor and the gas."""

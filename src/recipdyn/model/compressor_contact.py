@@ -643,6 +643,16 @@ def stiffness(values: Mapping[str, Any], joint: str = "crank") -> float:
                            values["nu_bearing"])  # fmt: skip
 
 
+#: The widest overlap half-angle (degrees) at which the point-contact law is taken to hold:
+#: Hertz's theory needs a contact small against the radii (Johnson 1985, Contact Mechanics,
+#: sec. 4.1) and must not be used when the contact arc is of the order of the radius
+#: (Mostofi & Gohar, summarised in Lubricants 10 (2022) 233,
+#: doi:10.3390/lubricants10100233). "Of the order" is taken here as an arc 2 phi R_j as long
+#: as the radius R_j: phi = 0.5 rad = 28.6 deg (the paper's
+#: base case, c = 1 mm, reaches 23 deg; c = 0.1 mm under the same load 45 deg).
+HERTZ_ARC_LIMIT_DEG = math.degrees(0.5)
+
+
 def overlap_half_angle(R_j: float, c: float, delta: float) -> float:
     """Half-angle (degrees) of the arc over which a journal of radius ``R_j`` overlaps its
     bearing (radius ``R_j + c``) at penetration ``delta``, seen from the bearing centre: from
@@ -736,6 +746,7 @@ class CompressorContact(Model):
     section_signals = (("ex", "m"), ("ey", "m"), ("x", "m"), ("v", "m/s"), ("a", "m/s**2"))
     vibration_signal = ("a", "m/s**2")
     section_pair = ("v", "a")
+    summary_verdicts = ("api618_pin_reversal",)
     #: The paper's load never reverses (the journal stays on the wall); at 150 rad/s with a
     #: tenth of it, inertia separates the journal and it impacts several times a revolution.
     event_example = {"omega": 150.0, "load_amplitude": 2e4}
@@ -887,6 +898,31 @@ class CompressorContact(Model):
                                             "force magnitude"),
             })  # fmt: skip
         return sig
+
+    def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
+        """The point-contact law beyond its range: at a joint whose deepest penetration gives
+        an overlap arc (`overlap_half_angle`) wider than `HERTZ_ARC_LIMIT_DEG`."""
+        out = []
+        for key, rc, rj, where in (("", "rc", "journal_radius", "crank pin"),
+                                   ("_crosshead", "rc_crosshead", "crosshead_pin_radius",
+                                    "crosshead pin")):  # fmt: skip
+            if "delta" + key not in ds:
+                continue
+            pen = float(max(np.nanmax(ds["delta" + key].values), 0.0))
+            c = float(values[rc])
+            arc = overlap_half_angle(float(values[rj]), c, pen)
+            if arc > HERTZ_ARC_LIMIT_DEG:
+                out.append(f"{where}: penetration {pen * 1e6:.4g} um = {100 * pen / c:.3g} % of "
+                           f"the clearance, contact arc +-{arc:.3g} deg")  # fmt: skip
+        if not out:
+            return ""
+        return (f"the point-contact law {values['contact_law']!r} is stretched beyond its range "
+                f"({'; '.join(out)} > {HERTZ_ARC_LIMIT_DEG:.3g} deg, an arc as long as the "
+                "radius): Hertz's theory assumes a contact small against the radii (Johnson "
+                "1985, Contact Mechanics, sec. 4.1) and does not hold when the arc is of the "
+                "order of the radius (Mostofi & Gohar, as summarised in Lubricants 10 "
+                "(2022) 233); the forces and accelerations are the model's, not a real "
+                "bearing's: set a stiffer K or a larger clearance")  # fmt: skip
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Per clearance joint (suffix ``_crosshead`` for the crosshead pin): impacts (count,

@@ -240,6 +240,12 @@ class Model(ABC):
     #: lower bound, why, what to use instead). Simulate warns and sweeps record the minimum
     #: (``min_<output>``) and mark the points that cross.
     validity_bounds: tuple[tuple[str, str, float, str, str], ...] = ()
+    #: Entries of `run_summary` that are verdicts (pass/fail against a standard, e.g.
+    #: the API 618 pin-load reversal): `recipdyn.simulate.summarize` withholds them
+    #: (value ``"invalid"``, the reason in ``<entry>_reason``) for a run that left the model's
+    #: validity, since a verdict computed from equations that no longer describe the machine
+    #: must not be acted on.
+    summary_verdicts: tuple[str, ...] = ()
     #: Outputs whose mean over a run sweeps store with the ``peak`` measure: (output name,
     #: stored name, unit), e.g. the contact-impact joint's time fraction in contact; NaN for a
     #: point whose run lacks the output.
@@ -277,6 +283,14 @@ class Model(ABC):
         """Whether `validity_bounds` apply at ``values`` (e.g. not to the compressor
         without clearance, whose pin is an ideal two-way joint). Default: always."""
         return True
+
+    def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
+        """Where a run (``ds``: its record) used a constitutive law of the model beyond the
+        range its source states (e.g. a point-contact law at a contact arc of the order of the
+        radii): the message with the threshold and its source; empty when within range (the
+        default). `recipdyn.simulate` records it (``law_range``) and warns
+        (`recipdyn.errors.LawRangeWarning`)."""
+        return ""
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         """False where the state cannot move (e.g. the compressor with rc = 0): Lyapunov
