@@ -14,6 +14,8 @@ import numpy as np
 from scipy.fft import rfft, rfftfreq
 from scipy.signal import find_peaks, get_window
 
+from .checks import as_signal, check_rate
+
 __all__ = [
     "Spectrum",
     "Peak",
@@ -78,11 +80,9 @@ def amplitude_spectrum(x, fs: float, window: str = "hann", detrend: bool = True)
     ``amplitude = 2 |X_k| / (n * mean(w))`` for ``0 < k < n/2``, half that at DC and Nyquist.
     Frequency resolution ``fs / n``: a 10-revolution record at 20 rad/s resolves 0.32 Hz.
     """
-    x = np.asarray(x, dtype=float)
-    if x.ndim != 1 or x.size < 2:
-        raise ValueError("x must be a 1-D signal with at least 2 samples")
-    if not (fs > 0 and np.isfinite(fs)):
-        raise ValueError(f"fs = {fs}; allowed: > 0")
+    # a constant signal has an exact spectrum (zero): a stalled channel's window keeps its row
+    x = as_signal(x, name="x", min_samples=2, allow_constant=True)
+    fs = check_rate(fs)
     n = x.size
     if detrend:
         x = x - x.mean()
@@ -101,16 +101,33 @@ def find_spectral_peaks(
     fundamental: float | None = None,
     tol_bins: float = 1.5,
     min_rel_height: float = 1e-3,
+    min_separation: float = 0.0,
 ) -> list[Peak]:
     """The ``n`` largest local maxima, largest first, labelled as harmonics of ``fundamental``.
 
     ``min_rel_height`` drops peaks below that fraction of the largest (numerical noise).
+    ``min_separation`` (relative): a peak within ``min_separation * f`` (and at least two
+    bins) of a larger accepted one is part of the same hump -- the comb of harmonics under a
+    structural ring excited once a revolution, or the ripples of one broad line -- and is
+    left out, so a table lists separate lines (0: every local maximum).
     """
     amp = spec.amplitude
     if amp.size < 3 or amp.max() <= 0:
         return []
-    idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
-    idx = idx[np.argsort(amp[idx])[::-1][:n]]
+    idx, _ = find_peaks(amp, height=min_rel_height * amp.max(),
+                        prominence=min_rel_height * amp.max())  # fmt: skip
+    idx = idx[np.argsort(amp[idx])[::-1]]
+    if min_separation > 0:
+        kept: list[int] = []
+        for i in idx:
+            f = spec.frequency[i]
+            gap = max(min_separation * f, 2 * spec.resolution)
+            if all(abs(spec.frequency[j] - f) > gap for j in kept):
+                kept.append(int(i))
+            if len(kept) == n:
+                break
+        idx = np.array(kept, dtype=int)
+    idx = idx[:n]
     peaks = []
     for i in idx:
         f = float(spec.frequency[i])
