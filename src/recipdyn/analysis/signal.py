@@ -74,7 +74,8 @@ class SignalAssessment:
         rows.append(("embedding", f"delay {self.embedding.delay}, dimension {self.embedding.dim}",
                      self.embedding.status))  # fmt: skip
         for k, r in self.lyapunov.items():
-            val = f"{r.exponent:.4g} /s" if r.ok else "-"
+            val = (f"{r.exponent:.4g} /s" if r.ok else f"({r.exponent:.4g} /s)"
+                   if r.status == "inconsistent" else "-")  # fmt: skip
             rows.append((f"lambda1 ({k})", val, r.status + (f": {r.reason}" if r.reason else "")))
         z = self.zero_one
         rows.append(("0-1 test K", "-" if not np.isfinite(z.K) else f"{z.K:.3f}",
