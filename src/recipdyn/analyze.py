@@ -199,7 +199,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
 
 #: Spectral peaks closer than this fraction of their frequency to a larger one belong to the
 #: same hump (a ring's comb of harmonics) and are left out of the summary's peak table.
-PEAK_SEPARATION = 0.05
+PEAK_SEPARATION = 0.1
 
 
 def _headline(verdict, vib) -> str:

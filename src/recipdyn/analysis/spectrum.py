@@ -106,28 +106,23 @@ def find_spectral_peaks(
     """The ``n`` largest local maxima, largest first, labelled as harmonics of ``fundamental``.
 
     ``min_rel_height`` drops peaks below that fraction of the largest (numerical noise).
-    ``min_separation`` (relative): a peak within ``min_separation * f`` (and at least two
-    bins) of a larger accepted one is part of the same hump -- the comb of harmonics under a
-    structural ring excited once a revolution, or the ripples of one broad line -- and is
-    left out, so a table lists separate lines (0: every local maximum).
+    ``min_separation`` (relative, e.g. 0.1): list humps, not bins. The spectrum is averaged
+    over +-``min_separation * f`` around each frequency ``f`` (a window that widens with
+    frequency, as an analyst's fractional-octave bands do); each maximum of that envelope which
+    stands out from its surroundings (prominence at least a quarter of its height) is one
+    entry, reported at the largest line of the raw spectrum between its bases. The comb of
+    harmonics under a structural ring excited once a revolution, or the ripples of one broad
+    line, is then one entry, while low harmonics (further apart than the window) stay
+    separate. 0: every local maximum of the raw spectrum.
     """
     amp = spec.amplitude
     if amp.size < 3 or amp.max() <= 0:
         return []
-    idx, _ = find_peaks(amp, height=min_rel_height * amp.max(),
-                        prominence=min_rel_height * amp.max())  # fmt: skip
-    idx = idx[np.argsort(amp[idx])[::-1]]
     if min_separation > 0:
-        kept: list[int] = []
-        for i in idx:
-            f = spec.frequency[i]
-            gap = max(min_separation * f, 2 * spec.resolution)
-            if all(abs(spec.frequency[j] - f) > gap for j in kept):
-                kept.append(int(i))
-            if len(kept) == n:
-                break
-        idx = np.array(kept, dtype=int)
-    idx = idx[:n]
+        idx = _hump_peaks(spec, min_separation, min_rel_height)
+    else:
+        idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
+    idx = idx[np.argsort(amp[idx])[::-1][:n]]
     peaks = []
     for i in idx:
         f = float(spec.frequency[i])
@@ -138,6 +133,27 @@ def find_spectral_peaks(
                 order = int(k)
         peaks.append(Peak(f, float(amp[i]), order))
     return peaks
+
+
+def _hump_peaks(spec: Spectrum, rel: float, min_rel_height: float) -> np.ndarray:
+    """Indices of the largest raw line under each prominent maximum of the spectrum averaged
+    over +-``rel * f`` (see :func:`find_spectral_peaks`)."""
+    amp = spec.amplitude
+    k = np.arange(amp.size)
+    half = np.maximum(1, np.round(rel * spec.frequency / spec.resolution)).astype(int)
+    lo, hi = np.maximum(0, k - half), np.minimum(amp.size - 1, k + half)
+    cs = np.concatenate(([0.0], np.cumsum(amp)))
+    env = (cs[hi + 1] - cs[lo]) / (hi - lo + 1)
+    cand, props = find_peaks(env, prominence=0.0)
+    keep = props["prominences"] >= 0.25 * env[cand]
+    out = []
+    for i, left, right in zip(cand[keep], props["left_bases"][keep],
+                              props["right_bases"][keep], strict=True):  # fmt: skip
+        a, b = max(left, i - half[i]), min(right, i + half[i])
+        j = a + int(np.argmax(amp[a : b + 1]))
+        if amp[j] >= min_rel_height * amp.max():
+            out.append(j)
+    return np.unique(np.array(out, dtype=int))
 
 
 def order_spectrum(spec: Spectrum, fundamental: float) -> tuple[np.ndarray, np.ndarray]:

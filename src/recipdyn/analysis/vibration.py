@@ -359,7 +359,7 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
         summ["order_lines"] = [
             {"order": round(p.frequency, 3), "amplitude": p.amplitude}
             for p in find_spectral_peaks(rep["orders"], n=8, min_rel_height=0.02,
-                                         min_separation=0.05)
+                                         min_separation=0.1)
         ]  # fmt: skip
         summ["samples_per_rev"] = spr
         if speed.max() > 1.05 * speed.min():
