@@ -30,13 +30,13 @@ def as_signal(x, *, name: str = "signal", min_samples: int = 2,
         raise ValueError(f"{name}: not a numeric array") from None
     if arr.ndim != 1:
         raise ValueError(f"{name}: array of shape {arr.shape}; allowed: a 1-D signal")
-    if arr.size < min_samples:
-        raise ValueError(f"{name}: {arr.size} sample(s); at least {min_samples} needed")
     bad = ~np.isfinite(arr)
     if bad.any():
         raise ValueError(f"{name}: {int(bad.sum())} NaN or infinite value(s), the first at "
                          f"sample {int(np.argmax(bad))}; allowed: finite values (fill or cut "
                          "them first)")  # fmt: skip
+    if arr.size < min_samples:
+        raise ValueError(f"{name}: {arr.size} sample(s); at least {min_samples} needed")
     if not allow_constant and arr.max() == arr.min():
         raise ValueError(f"{name}: constant (every sample {arr[0]:g}); a constant signal has "
                          "no dynamics to analyse")  # fmt: skip
