@@ -220,8 +220,10 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
             # record sampled too coarsely for its fastest motion. Neither is shown.
             deterministic = None
             ev["surrogate_unpredictable"] = True
-            reasons.append(f"nonlinear but unpredictable (prediction error {error:.2f} of "
-                           f"the spread, >= {MAX_PREDICTION_ERROR}): determinism not shown")  # fmt: skip
+            reasons.append(
+                f"nonlinear but unpredictable (prediction error {error:.2f} of the spread, "
+                f">= {MAX_PREDICTION_ERROR}): determinism not shown"
+            )
     all_refused = False
     conflict = withheld = False
     if signal_lyapunov:
