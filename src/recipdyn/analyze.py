@@ -82,7 +82,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
 
     with phase("analyze: spectrum and phase portraits"):
         spec = amplitude_spectrum(a, fs)
-        peaks = find_spectral_peaks(spec, n=8, fundamental=fc)
+        peaks = find_spectral_peaks(spec, n=8, fundamental=fc, min_separation=PEAK_SEPARATION)
         summary["spectrum"] = {
             "resolution_hz": spec.resolution,
             "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude, crank_order=p.order)
@@ -192,9 +192,27 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                        lyap_tol=LYAP_TOL, signal_lyapunov=list(assessment.lyapunov.values()),
                        time_scale=assessment.embedding.delay / fs)  # fmt: skip
     summary["verdict"] = verdict.to_dict()
+    summary["verdict"]["headline"] = _headline(verdict, summary.get("vibration"))
     write_text(out / "summary.json", json.dumps(_plain(summary), indent=2))
     write_text(out / "summary.md", _markdown(summary))
     return summary
+
+
+#: Spectral peaks closer than this fraction of their frequency to a larger one belong to the
+#: same hump (a ring's comb of harmonics) and are left out of the summary's peak table.
+PEAK_SEPARATION = 0.1
+
+
+def _headline(verdict, vib) -> str:
+    """The verdict in a vibration analyst's words: 'periodic, 3 impacts a revolution at 30°,
+    150°, 250°'."""
+    text = verdict.verdict
+    pattern = ((vib or {}).get("impacts") or {}).get("pattern") or []
+    if pattern and verdict.verdict in ("periodic", "quasi-periodic"):
+        n = sum(round(p["per_revolution"]) for p in pattern)
+        where = ", ".join(f"{p['angle_deg']:.0f}°" for p in pattern)
+        text += f", {n} impact{'s' if n != 1 else ''} a revolution at {where}"
+    return text
 
 
 def _divergence_figures(assessment, out, plt) -> None:
@@ -337,11 +355,20 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
         spec = Spectrum(f_w, a_w, rate / welch.nperseg, "hann", rate)
         title = (f"spectrum of {sig.name}: whole record, Welch mean of {welch.segments} "
                  f"segments")  # fmt: skip
-    peaks = find_spectral_peaks(spec, n=8)
+    revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
+    f_crank = None
+    if revs is not None:
+        from .analysis.classify import quarter_speed_ratio
+        from .defaults import MAX_SPEED_RATIO
+
+        ok = np.isfinite(revs)
+        if ok.sum() > 1 and quarter_speed_ratio(revs, rate) <= MAX_SPEED_RATIO:
+            idx = np.flatnonzero(ok)  # the mean speed: orders of a steady machine
+            f_crank = float((revs[idx[-1]] - revs[idx[0]]) * rate / (idx[-1] - idx[0]))
+    peaks = find_spectral_peaks(spec, n=8, fundamental=f_crank, min_separation=PEAK_SEPARATION)
     fig = plot_spectrum(spec, peaks, title=title)
     save_figure(fig, out / "spectrum.png", dpi=110)
     plt.close(fig)
-    revs = crank_revs(path, x.size, rate, tacho=tacho, speed=speed)
     with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
         vib = vibration_section(x, rate, out, plt, revs=revs, quantity=quantity,
                                 zones=zone_bounds, band=band,
@@ -360,7 +387,8 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
                      "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude,
                                     crank_order=p.order) for p in peaks]},
         "lyapunov_signal": {k: r.diagnostics() for k, r in a.lyapunov.items()},
-        "signal_assessment": a.to_dict(), "verdict": a.verdict.to_dict(),
+        "signal_assessment": a.to_dict(),
+        "verdict": a.verdict.to_dict() | {"headline": _headline(a.verdict, vib)},
         "evidence": [list(r) for r in a.evidence_table()], "vibration": vib,
     }  # fmt: skip
     summary = _plain(summary)
@@ -490,8 +518,8 @@ def _markdown(s: dict[str, Any]) -> str:
     unit = (s.get("units") or "signal units") if measured else "m/s^2"
     peaks = s["spectrum"]["peaks"]
     orders = not measured or any(p["crank_order"] for p in peaks)  # a speed was known
-    lines = [f"# Analysis of {s['input']}", "", f"**Verdict: {v['verdict']}** — "
-             + "; ".join(v["reasons"]), "", f"## Spectrum peaks ({what})", "",
+    lines = [f"# Analysis of {s['input']}", "", f"**Verdict: {v.get('headline', v['verdict'])}**"
+             " — " + "; ".join(v["reasons"]), "", f"## Spectrum peaks ({what})", "",
              f"| f (Hz) | amplitude ({unit}) |" + (" crank order |" if orders else ""),
              "|---|---|" + ("---|" if orders else "")]  # fmt: skip
     for p in peaks:
@@ -522,6 +550,13 @@ def _markdown(s: dict[str, Any]) -> str:
         imp = vib["impacts"]
         per = f", {imp['per_revolution']:.3g} per revolution" if imp["per_revolution"] else ""
         lines.append(f"- impacts: {imp['count']}{per}")
+        for p in imp.get("pattern") or []:
+            lines.append(f"  - at {p['angle_deg']:.0f}° of the crank, "
+                         f"{p['per_revolution']:.2f} per revolution")  # fmt: skip
+        if vib.get("order_lines"):
+            lines += ["", "## Orders (angle domain)", "", "| crank order | amplitude |",
+                      "|---|---|"]  # fmt: skip
+            lines += [f"| {o['order']:.3g} | {o['amplitude']:.4g} |" for o in vib["order_lines"]]
     if s.get("evidence"):
         lines += ["", "## Evidence", "", "| evidence | value | status |", "|---|---|---|"]
         lines += [f"| {a} | {b} | {c} |" for a, b, c in s["evidence"]]
@@ -535,7 +570,9 @@ def _markdown(s: dict[str, Any]) -> str:
             f"- Benettin (equations): {le['exponents_per_s']} ({unit}), sum {le['sum_per_s']:.3g}"
         )
     for name, r in s["lyapunov_signal"].items():
-        val = r["exponent"] if r["status"] in ("ok", "flat") else f"refused ({r['reason']})"
+        val = (r["exponent"] if r["status"] in ("ok", "flat")
+               else f"{r['exponent']:.4g}, withheld ({r['reason']})"
+               if r["status"] == "inconsistent" else f"refused ({r['reason']})")  # fmt: skip
         lines.append(f"- {name} (signal {s.get('signal', 'a')}): {val}")
     if s.get("zero_one_K") is not None:
         lines.append(f"- 0-1 test K (stroboscopic theta_c'): {s['zero_one_K']:.3f}")

@@ -10,6 +10,7 @@ __all__ = [
     "RTOL", "ATOL", "CALIBRATION_RTOL", "CALIBRATION_ATOL", "FS", "SIMULATION",
     "RK4_STEPS_PER_REVOLUTION", "SWEEP", "ANALYZE", "LYAP_TOL", "MAX_PERIODIC_POINTS", "RC_MIN",
     "MEMORY_FRACTION", "RTOL_RANGE", "ATOL_RANGE", "MAX_RMS_RATIO", "MAX_SPEED_RATIO",
+    "MIN_SIGNAL_SAMPLES",
 ]  # fmt: skip
 
 #: DOP853 tolerances for every trajectory (simulate, sections, sweeps, Benettin). At 1e-10 the
@@ -55,6 +56,10 @@ MAX_RMS_RATIO = 3.0
 #: diagram at the same 5 %). Mean speeds over quarters, not the instantaneous speed, whose
 #: ripple within a revolution is normal for a reciprocating machine.
 MAX_SPEED_RATIO = 1.05
+#: Fewest samples of a signal the neighbour-based estimators (embedding, exponents from a
+#: signal, surrogates) accept, and ``recipdyn analyze`` for a signal file: below it no
+#: divergence curve with a scaling region, nor 50 references with neighbours, can be had.
+MIN_SIGNAL_SAMPLES = 200
 #: Smallest non-zero clearance, m. The free link oscillates at ~sqrt(F / (m rc)); at 0.1 um the
 #: integrator already needs ~0.5 million steps per revolution (rc = 0 is the ideal joint).
 RC_MIN = 1e-7

@@ -66,10 +66,16 @@ def signal_features(x, fs: float, *, revs=None, quantity: str = "acceleration",
         from .analysis.lyapunov_signal import lyap_rosenstein
         from .analysis.zero_one import zero_one
 
-        z = zero_one(x)
-        row["k01"], row["k01_status"] = z.K, z.status
-        r = lyap_rosenstein(x, 1.0 / fs)
-        row["lambda1_rosenstein"], row["lambda1_status"] = r.exponent, r.status
+        try:  # a window too short or constant is refused, as the functions say
+            z = zero_one(x)
+            row["k01"], row["k01_status"] = z.K, z.status
+        except ValueError:
+            row["k01"], row["k01_status"] = math.nan, "refused"
+        try:
+            r = lyap_rosenstein(x, 1.0 / fs)
+            row["lambda1_rosenstein"], row["lambda1_status"] = r.exponent, r.status
+        except ValueError:
+            row["lambda1_rosenstein"], row["lambda1_status"] = math.nan, "refused"
     return row
 
 

@@ -54,6 +54,34 @@ def _csv_sep(suffix: str) -> str:
     return {".csv": ",", ".tsv": "\t"}.get(suffix, r"[\s,;]+")
 
 
+def _csv_options(path: Path) -> tuple[dict, bool]:
+    """``pandas.read_csv`` options for a text table, and whether its first line is data.
+
+    A first line (after ``#`` comments and blank lines) whose fields all read as numbers is
+    data, not a header: the columns are then named by position (``column 0``, ``column 1``,
+    ...), so the first sample is kept and no signal is named after a number."""
+    import re
+
+    sep = _csv_sep(path.suffix.lower())
+    first = ""
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            body = line.split("#", 1)[0].strip()
+            if body:
+                first = body
+                break
+    fields = [f for f in re.split(sep, first) if f.strip()]
+    try:
+        [float(f) for f in fields]
+        headerless = bool(fields)
+    except ValueError:
+        headerless = False
+    opts = dict(sep=sep, engine="python", comment="#")
+    if headerless:
+        opts.update(header=None, names=[f"column {i}" for i in range(len(fields))])
+    return opts, headerless
+
+
 def _fs_option(fs) -> float | None:
     if fs is None:
         return None
@@ -144,9 +172,12 @@ def read_signal(
         if suffix in (".csv", ".txt", ".tsv"):
             import pandas as pd
 
-            sep = _csv_sep(suffix)
-            frame = pd.read_csv(path, sep=sep, engine="python", comment="#", nrows=rows)
+            opts, headerless = _csv_options(path)
+            frame = pd.read_csv(path, nrows=rows, **opts)
             x, fs, name, notes = _table(frame, path, column, fs)
+            if headerless:
+                notes.insert(0, "no header line: the first line is data, the columns are "
+                             "named by position")  # fmt: skip
         elif suffix == ".parquet":
             import pandas as pd
 
@@ -274,12 +305,11 @@ def _raw_blocks(path: Path, column, fs, block: int):
     if suffix in (".csv", ".txt", ".tsv"):
         import pandas as pd
 
-        sep = _csv_sep(suffix)
+        opts, _ = _csv_options(path)
 
         def gen():
             last_t = None
-            for frame in pd.read_csv(path, sep=sep, engine="python", comment="#",
-                                     chunksize=block):  # fmt: skip
+            for frame in pd.read_csv(path, chunksize=block, **opts):
                 tcol = next((c for c in frame.columns if str(c).strip().lower() in TIME_NAMES),
                             None)  # fmt: skip
                 if tcol is not None and fs is None:

@@ -16,6 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..defaults import MIN_SIGNAL_SAMPLES
+from .checks import as_signal
+
 __all__ = ["delay_embed", "mutual_information", "autocorrelation", "estimate_delay",
            "false_nearest_neighbours", "cao", "estimate_dimension", "mean_period", "Embedding",
            "choose_embedding"]  # fmt: skip
@@ -26,7 +29,7 @@ def delay_embed(x, dim: int, delay: int) -> np.ndarray:
 
     Shape ``(N - (dim - 1) delay, dim)``.
     """
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", allow_constant=True)
     if dim < 1 or delay < 1:
         raise ValueError(f"dim = {dim}, delay = {delay}; allowed: >= 1")
     n = x.size - (dim - 1) * delay
@@ -37,7 +40,7 @@ def delay_embed(x, dim: int, delay: int) -> np.ndarray:
 
 def mutual_information(x, max_lag: int, bins: int = 32) -> np.ndarray:
     """Average mutual information I(lag) (nats) for lags 0..max_lag (histogram estimate)."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=max(2, int(max_lag) + 2))
     edges = np.histogram_bin_edges(x, bins=bins)
     idx = np.clip(np.digitize(x, edges[1:-1]), 0, bins - 1)
     out = np.empty(max_lag + 1)
@@ -52,7 +55,7 @@ def mutual_information(x, max_lag: int, bins: int = 32) -> np.ndarray:
 
 def autocorrelation(x, max_lag: int | None = None) -> np.ndarray:
     """Normalised autocorrelation for lags 0..max_lag (FFT, O(N log N))."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x")
     x = x - x.mean()
     n = x.size
     max_lag = n - 1 if max_lag is None else min(int(max_lag), n - 1)
@@ -70,7 +73,7 @@ def estimate_delay(x, max_lag: int | None = None) -> int:
     after one or two samples, while the mutual information of a chaotic map decays over
     ``log(bins) / lambda_1`` samples (its first minimum is then a lag at which the coordinates
     are already unrelated: a delay of 30 for the Ikeda map)."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=MIN_SIGNAL_SAMPLES)
     max_lag = max_lag or max(10, min(x.size // 10, 500))
     below = np.nonzero(autocorrelation(x, max_lag) < np.exp(-1))[0]
     tau_ac = int(below[0]) if below.size else max_lag
@@ -84,7 +87,7 @@ def estimate_delay(x, max_lag: int | None = None) -> int:
 def false_nearest_neighbours(x, delay: int, max_dim: int = 10, rtol: float = 15.0,
                              atol: float = 2.0, theiler: int = 0) -> np.ndarray:  # fmt: skip
     """Fraction of false nearest neighbours for dimensions 1..max_dim (Kennel et al. 1992)."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=max_dim * delay + 2)
     sd = x.std()
     out = np.empty(max_dim)
     for m in range(1, max_dim + 1):
@@ -111,7 +114,7 @@ def cao(x, delay: int, max_dim: int = 10, theiler: int = 0) -> tuple[np.ndarray,
     ``E1`` stops changing (near 1) once ``d`` is an embedding dimension; ``E2`` is 1 for every
     ``d`` for a random series and differs from 1 for some ``d`` for a deterministic one.
     Maximum norm, nearest neighbours outside a Theiler window, zero distances skipped."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=(max_dim + 1) * delay + 2)
     E = np.full(max_dim + 1, np.nan)
     Es = np.full(max_dim + 1, np.nan)
     for d in range(1, max_dim + 2):
@@ -159,12 +162,16 @@ class Embedding:
     reason: str
     e1: np.ndarray
     e2: np.ndarray
+    fnn: np.ndarray | None = None
 
     def diagnostics(self) -> dict:
-        return {"delay": self.delay, "dim": self.dim, "theiler": self.theiler,
-                "status": self.status, "reason": self.reason,
-                "cao_E1": np.round(self.e1, 4).tolist(),
-                "cao_E2": np.round(self.e2, 4).tolist()}  # fmt: skip
+        out = {"delay": self.delay, "dim": self.dim, "theiler": self.theiler,
+               "status": self.status, "reason": self.reason,
+               "cao_E1": np.round(self.e1, 4).tolist(),
+               "cao_E2": np.round(self.e2, 4).tolist()}  # fmt: skip
+        if self.fnn is not None:
+            out["false_neighbours"] = np.round(self.fnn, 4).tolist()
+        return out
 
 
 def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
@@ -175,7 +182,7 @@ def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
     ``|E1(d+1) - E1(d)| < e1_tol`` (Cao 1997), from the first ``max_points`` samples (Cao's
     statistics are averages: 10^4 points fix them to about 1 %, and the neighbour search in 10
     dimensions grows faster than N). Given values are kept."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=MIN_SIGNAL_SAMPLES)
     tau = estimate_delay(x) if delay is None else int(delay)
     th = int(round(mean_period(x))) if theiler is None else int(theiler)
     th = min(th, x.size // 10)
@@ -197,17 +204,18 @@ def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
         d = max(int(below[0]) + 1, 2)
         return Embedding(tau, d, th, "ok", f"Cao's E1 does not saturate; false nearest "
                          f"neighbours below 1 % at d = {below[0] + 1}", e1, e2)  # fmt: skip
+    # the statistics themselves are in diagnostics() (cao_E1, fnn): the reason stays one line
     return Embedding(tau, max_dim, th, "not_saturated",
                      f"neither Cao's E1 saturates nor the false-nearest-neighbour fraction "
-                     f"drops below 1 % up to d = {max_dim} (E1 = "
-                     f"{np.array2string(e1, precision=2)}, FNN = "
-                     f"{np.array2string(fnn, precision=2)}): more dimensions than this record "
-                     "supports, or noise", e1, e2)  # fmt: skip
+                     f"drops below 1 % up to d = {max_dim} (lowest "
+                     f"{100 * float(np.nanmin(fnn)):.0f} %): more dimensions than this record "
+                     "supports, or noise", e1, e2, fnn)  # fmt: skip
 
 
 def mean_period(x) -> float:
     """Mean period in samples, 1 / (power-weighted mean frequency) -- a Theiler window."""
-    x = np.asarray(x, dtype=float) - np.mean(x)
+    x = as_signal(x, name="x")
+    x = x - np.mean(x)
     p = np.abs(np.fft.rfft(x)) ** 2
     f = np.fft.rfftfreq(x.size)
     p[0] = 0.0

@@ -33,12 +33,14 @@ Kantz (1994), Phys. Lett. A 185, 77-87.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
 from scipy.stats import linregress
 
+from ..defaults import MIN_SIGNAL_SAMPLES
+from .checks import as_signal, check_rate
 from .embedding import choose_embedding, delay_embed
 
 __all__ = ["SignalLyapunov", "lyap_wolf", "lyap_rosenstein", "lyap_kantz"]
@@ -62,7 +64,12 @@ class SignalLyapunov:
     ``fit`` the (start, stop) indices used; ``params`` every setting actually used.
     ``status``: ``ok``; ``flat`` (no divergence: the exponent is 0 to the estimator's
     resolution, a regular signal); ``refused`` (``exponent`` is NaN and ``reason`` says why:
-    no embedding dimension found, no linear scaling region, too few neighbours...).
+    no embedding dimension found, no linear scaling region, too few neighbours...);
+    ``inconsistent`` (the estimator's own fit was fine, but the number contradicts other
+    evidence -- its slope changes with the embedding dimension, the other estimators
+    disagree beyond their accuracy, or the once-per-revolution section is a periodic orbit;
+    ``exponent`` keeps the number for the record, ``reason`` says what it contradicts, and
+    it is never used as an exponent: `recipdyn.analysis.signal.assess_signal`).
     """
 
     method: str
@@ -80,6 +87,10 @@ class SignalLyapunov:
         """True when the estimate can be used (``status`` ``ok`` or ``flat``)."""
         return self.status in ("ok", "flat")
 
+    def withheld(self, reason: str) -> SignalLyapunov:
+        """This estimate with status ``inconsistent`` and ``reason`` (the number is kept)."""
+        return replace(self, status="inconsistent", reason=reason)
+
     def diagnostics(self) -> dict:
         """Everything a reader needs to judge the estimate (JSON-ready)."""
         out = {"method": self.method, "status": self.status, "reason": self.reason,
@@ -92,13 +103,9 @@ class SignalLyapunov:
 
 
 def _prepare(x, dim, delay, theiler, dt):
-    x = np.asarray(x, dtype=float)
-    if x.ndim != 1 or x.size < 50:
-        raise ValueError("need a 1-D signal of at least 50 samples")
-    if not np.all(np.isfinite(x)):
-        raise ValueError("signal contains NaN or inf")
-    if np.ptp(x) == 0:
-        raise ValueError("signal is constant")
+    x = as_signal(x, name="x", min_samples=MIN_SIGNAL_SAMPLES)
+    if dt is not None:
+        dt = check_rate(dt, "dt")
     emb = choose_embedding(x, delay=delay, dim=dim, theiler=theiler)
     dim = max(emb.dim, 2)
     X = delay_embed(x, dim, emb.delay)

@@ -165,6 +165,8 @@ def count_distinct_points(points, rtol: float = 1e-6, scale=None,
     from scipy.spatial import cKDTree
 
     pts = np.atleast_2d(np.asarray(points, dtype=float))
+    if not np.all(np.isfinite(pts)):
+        raise ValueError("points: NaN or infinite coordinates; allowed: finite values")
     n = pts.shape[0]
     if n == 0:
         return 0

@@ -14,6 +14,8 @@ import numpy as np
 from scipy.fft import rfft, rfftfreq
 from scipy.signal import find_peaks, get_window
 
+from .checks import as_signal, check_rate
+
 __all__ = [
     "Spectrum",
     "Peak",
@@ -78,11 +80,9 @@ def amplitude_spectrum(x, fs: float, window: str = "hann", detrend: bool = True)
     ``amplitude = 2 |X_k| / (n * mean(w))`` for ``0 < k < n/2``, half that at DC and Nyquist.
     Frequency resolution ``fs / n``: a 10-revolution record at 20 rad/s resolves 0.32 Hz.
     """
-    x = np.asarray(x, dtype=float)
-    if x.ndim != 1 or x.size < 2:
-        raise ValueError("x must be a 1-D signal with at least 2 samples")
-    if not (fs > 0 and np.isfinite(fs)):
-        raise ValueError(f"fs = {fs}; allowed: > 0")
+    # a constant signal has an exact spectrum (zero): a stalled channel's window keeps its row
+    x = as_signal(x, name="x", min_samples=2, allow_constant=True)
+    fs = check_rate(fs)
     n = x.size
     if detrend:
         x = x - x.mean()
@@ -101,15 +101,27 @@ def find_spectral_peaks(
     fundamental: float | None = None,
     tol_bins: float = 1.5,
     min_rel_height: float = 1e-3,
+    min_separation: float = 0.0,
 ) -> list[Peak]:
     """The ``n`` largest local maxima, largest first, labelled as harmonics of ``fundamental``.
 
     ``min_rel_height`` drops peaks below that fraction of the largest (numerical noise).
+    ``min_separation`` (relative, e.g. 0.1): list humps, not bins. The spectrum is averaged
+    over +-``min_separation * f`` around each frequency ``f`` (a window that widens with
+    frequency, as an analyst's fractional-octave bands do); each maximum of that envelope which
+    stands out from its surroundings (prominence at least a quarter of its height) is one
+    entry, reported at the largest line of the raw spectrum between its bases. The comb of
+    harmonics under a structural ring excited once a revolution, or the ripples of one broad
+    line, is then one entry, while low harmonics (further apart than the window) stay
+    separate. 0: every local maximum of the raw spectrum.
     """
     amp = spec.amplitude
     if amp.size < 3 or amp.max() <= 0:
         return []
-    idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
+    if min_separation > 0:
+        idx = _hump_peaks(spec, min_separation, min_rel_height)
+    else:
+        idx, _ = find_peaks(amp, height=min_rel_height * amp.max())
     idx = idx[np.argsort(amp[idx])[::-1][:n]]
     peaks = []
     for i in idx:
@@ -121,6 +133,27 @@ def find_spectral_peaks(
                 order = int(k)
         peaks.append(Peak(f, float(amp[i]), order))
     return peaks
+
+
+def _hump_peaks(spec: Spectrum, rel: float, min_rel_height: float) -> np.ndarray:
+    """Indices of the largest raw line under each prominent maximum of the spectrum averaged
+    over +-``rel * f`` (see `find_spectral_peaks`)."""
+    amp = spec.amplitude
+    k = np.arange(amp.size)
+    half = np.maximum(1, np.round(rel * spec.frequency / spec.resolution)).astype(int)
+    lo, hi = np.maximum(0, k - half), np.minimum(amp.size - 1, k + half)
+    cs = np.concatenate(([0.0], np.cumsum(amp)))
+    env = (cs[hi + 1] - cs[lo]) / (hi - lo + 1)
+    cand, props = find_peaks(env, prominence=0.0)
+    keep = props["prominences"] >= 0.25 * env[cand]
+    out = []
+    for i, left, right in zip(cand[keep], props["left_bases"][keep],
+                              props["right_bases"][keep], strict=True):  # fmt: skip
+        a, b = max(left, i - half[i]), min(right, i + half[i])
+        j = a + int(np.argmax(amp[a : b + 1]))
+        if amp[j] >= min_rel_height * amp.max():
+            out.append(j)
+    return np.unique(np.array(out, dtype=int))
 
 
 def order_spectrum(spec: Spectrum, fundamental: float) -> tuple[np.ndarray, np.ndarray]:

@@ -36,6 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..defaults import MIN_SIGNAL_SAMPLES
+from .checks import as_signal
 from .embedding import delay_embed
 
 __all__ = ["iaaft", "match_ends", "prediction_error", "SurrogateTest", "surrogate_test"]
@@ -49,7 +51,7 @@ def iaaft(x, n_surrogates: int = 19, *, seed: int = 0, max_iter: int = 200,
     of ``x``: the iteration stops when fewer than ``rank_tol`` of the ranks change in a round
     (the spectrum then matches to better than 1e-3 relative; it stalls there, Schreiber & Schmitz
     1996), or after ``max_iter`` rounds."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=4)
     rng = np.random.default_rng(seed)
     amp = np.abs(np.fft.rfft(x))
     ordered = np.sort(x)
@@ -72,7 +74,7 @@ def match_ends(x, max_cut: float = 0.1) -> tuple[int, int]:
     """``(start, stop)`` of the sub-record, cutting at most ``max_cut`` of the length at each
     end, whose first and last samples agree best in value and in slope (both relative to the
     signal's spread)."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=4, allow_constant=True)
     n = x.size
     m = max(2, int(max_cut * n))
     sd = np.std(x) or 1.0
@@ -91,7 +93,7 @@ def prediction_error(x, dim: int, delay: int, horizon: int = 1, k: int = 5) -> f
     is predicted ``horizon`` samples ahead as the mean of what followed its ``k`` nearest
     neighbours (delay embedding) in the first half. RMS error / standard deviation of ``x``:
     about 1.4 for white noise, far below 1 for low-dimensional determinism."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=4)
     X = delay_embed(x, dim, delay)
     target = np.arange(X.shape[0]) + (dim - 1) * delay + horizon  # index into x
     usable = target < x.size
@@ -148,9 +150,7 @@ def surrogate_test(x, *, dim: int, delay: int, horizon: int | None = None,
     (significance ``1 / (n_surrogates + 1)``) and at least ``min_z`` standard deviations of
     the surrogates' errors below their mean: a bare rank test rejects for one noise record
     in twenty, and a verdict of chaos should not rest on that."""
-    x = np.asarray(x, dtype=float)[:max_samples]
-    if x.size < 200:
-        raise ValueError(f"surrogate test: {x.size} samples; at least 200 needed")
+    x = as_signal(x, name="x", min_samples=MIN_SIGNAL_SAMPLES)[:max_samples]
     a, b = match_ends(x)
     x = x[a:b]
     dim = int(min(max(dim, 2), 8))

@@ -26,12 +26,14 @@ import numpy as np
 from scipy import signal as sps
 from scipy.stats import kurtosis, skew
 
-from .spectrum import Spectrum, amplitude_spectrum
+from .checks import as_signal
+from .spectrum import Spectrum, amplitude_spectrum, find_spectral_peaks
 
 __all__ = ["tacho_times", "crank_angle", "angle_resample", "order_spectrum_angle",
            "spectrogram", "campbell", "envelope_spectrum", "cepstrum", "band_rms",
            "velocity_rms", "zone", "indicators", "Impact", "detect_impacts",
-           "ISO20816_8_BAND_HZ", "vibration_report", "resonance_band"]  # fmt: skip
+           "ISO20816_8_BAND_HZ", "vibration_report", "resonance_band",
+           "impact_pattern"]  # fmt: skip
 
 #: Frequency band of the ISO 20816-8:2018 velocity evaluation, Hz.
 ISO20816_8_BAND_HZ = (2.0, 1000.0)
@@ -46,7 +48,7 @@ def tacho_times(tacho, fs: float, *, threshold: float | None = None,
     revolution (a keyphasor notch: the percentiles then both lie on the baseline); an edge
     re-arms only after the signal falls ``hysteresis`` (a fraction of that span) below it, so
     noise on a slow edge does not count twice."""
-    v = np.asarray(tacho, dtype=float)
+    v = as_signal(tacho, name="tacho", min_samples=3, allow_constant=True)
     lo, hi = np.percentile(v, [5, 95])
     if hi <= lo:
         lo, hi = float(np.min(v)), float(np.max(v))
@@ -122,7 +124,7 @@ def order_spectrum_angle(x_angle, samples_per_rev: int, window: str = "hann") ->
 def spectrogram(x, fs: float, *, nperseg: int | None = None, overlap: float = 0.75):
     """``(frequency_hz, time_s, amplitude)`` of a short-time Fourier transform (Hann window,
     amplitude-scaled like [`amplitude_spectrum`][recipdyn.analysis.spectrum.amplitude_spectrum])."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=8, allow_constant=True)
     nperseg = int(nperseg or min(x.size, max(64, 2 ** int(np.log2(x.size / 16)))))
     f, t, Z = sps.stft(x - x.mean(), fs, window="hann", nperseg=nperseg,
                        noverlap=int(overlap * nperseg), boundary=None, padded=False,
@@ -161,7 +163,7 @@ def envelope_spectrum(x, fs: float, band: tuple[float, float] | None = None,
     """Spectrum of the Hilbert envelope of ``x`` band-passed to ``band`` (Hz; default the
     upper half of the spectrum, fs/4 to 0.45 fs, where impact-excited resonances live).
     Returns ``(spectrum, envelope)``: repeated impacts show as lines at their rate."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=16, allow_constant=True)
     lo, hi = band if band is not None else (fs / 4, 0.45 * fs)
     if not 0 < lo < hi < fs / 2:
         raise ValueError(f"band = ({lo:g}, {hi:g}) Hz; allowed: 0 < low < high < fs/2 = "
@@ -175,7 +177,7 @@ def cepstrum(x, fs: float, window: str = "hann") -> tuple[np.ndarray, np.ndarray
     """Real cepstrum ``(quefrency_s, c)``: the inverse FFT of the log amplitude spectrum.
     Families of harmonics or sidebands spaced by ``df`` show as a peak at ``1/df``; an echo
     delayed by ``tau`` as a peak at ``tau``."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=4)
     w = sps.get_window(window, x.size)
     mag = np.abs(np.fft.rfft((x - x.mean()) * w))
     c = np.fft.irfft(np.log(mag + 1e-12 * mag.max()), n=x.size)
@@ -188,7 +190,7 @@ def band_rms(x, fs: float, band: tuple[float, float], *, integrate: int = 0) -> 
     """RMS of ``x`` restricted to ``band`` (Hz), after integrating ``integrate`` times in the
     frequency domain (1: acceleration to velocity, 2: to displacement). Parseval over the
     one-sided FFT; bins outside the band are dropped (an ideal filter)."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", allow_constant=True)
     n = x.size
     X = np.fft.rfft(x - x.mean())
     f = np.fft.rfftfreq(n, 1.0 / fs)
@@ -217,7 +219,7 @@ def zone(value: float, boundaries) -> str:
 def indicators(x) -> dict[str, float]:
     """RMS, peak, peak-to-peak, crest factor (peak / RMS), kurtosis (Pearson: 3 for Gaussian
     noise, 1.5 for a sine, large for impacts) and skewness of the mean-free signal."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=1, allow_constant=True)
     y = x - x.mean()
     rms = float(np.sqrt(np.mean(y**2)))
     peak = float(np.max(np.abs(y)))
@@ -288,6 +290,42 @@ def detect_impacts(x, fs: float, *, revs=None, band: tuple[float, float] | None 
     return out
 
 
+def impact_pattern(hits, revolutions: float, *, tol_deg: float = 10.0,
+                   min_share: float = 0.5) -> list[dict]:  # fmt: skip
+    """Crank angles at which impacts recur: ``[{"angle_deg", "per_revolution"}]``, by angle.
+
+    The impacts' onset angles (``hits``: `Impact` with a crank angle) are grouped on
+    the circle: neighbours closer than ``tol_deg`` are one group (a group may not wrap
+    through 360 deg twice). A group counts when it holds impacts in at least ``min_share`` of
+    the ``revolutions`` covered: an impact that happens at that angle every revolution has
+    ``per_revolution`` ~1. Its angle is the circular mean of its members."""
+    ang = np.array([h.angle_deg for h in hits if np.isfinite(h.angle_deg)], dtype=float)
+    if ang.size == 0 or not revolutions > 0:
+        return []
+    ang = np.sort(ang % 360.0)
+    gaps = np.diff(np.r_[ang, ang[0] + 360.0])
+    if np.all(gaps <= tol_deg):  # impacts at every angle: no pattern
+        return []
+    start = int(np.argmax(gaps)) + 1  # begin after the widest gap: no group spans it
+    ang = np.roll(ang, -start)
+    groups, cur = [], [ang[0]]
+    for a, b in zip(ang[:-1], ang[1:], strict=True):
+        if (b - a) % 360.0 <= tol_deg:
+            cur.append(b)
+        else:
+            groups.append(cur)
+            cur = [b]
+    groups.append(cur)
+    out = []
+    for g in groups:
+        share = len(g) / revolutions
+        if share >= min_share:
+            rad = np.deg2rad(g)
+            mean = np.rad2deg(np.arctan2(np.sin(rad).mean(), np.cos(rad).mean())) % 360.0
+            out.append({"angle_deg": round(float(mean), 1), "per_revolution": round(share, 3)})
+    return sorted(out, key=lambda d: d["angle_deg"])
+
+
 def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration", zones=None,
                      band: tuple[float, float] | None = None, samples_per_rev: int = 256,
                      impact_threshold: float = 8.0) -> dict:  # fmt: skip
@@ -296,7 +334,7 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
     (when the speed varies by more than 5 %), envelope spectrum, cepstrum and impacts. The
     result holds the arrays for `plot_vibration` and a
     JSON-ready ``summary``."""
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x", min_samples=16)
     rep: dict = {"fs": fs, "quantity": quantity}
     summ: dict = {"indicators": indicators(x)}
     if quantity in ("acceleration", "velocity") and fs > 2 * ISO20816_8_BAND_HZ[1]:
@@ -319,6 +357,11 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
         _, xa = angle_resample(x, revs, spr)
         rep["orders"] = order_spectrum_angle(xa, spr)
         summ["order_resolution"] = rep["orders"].resolution
+        summ["order_lines"] = [
+            {"order": round(p.frequency, 3), "amplitude": p.amplitude}
+            for p in find_spectral_peaks(rep["orders"], n=8, min_rel_height=0.02,
+                                         min_separation=0.1)
+        ]  # fmt: skip
         summ["samples_per_rev"] = spr
         if speed.max() > 1.05 * speed.min():
             rep["campbell"] = campbell(x, fs, np.where(ok, revs, np.interp(
@@ -340,5 +383,7 @@ def vibration_report(x, fs: float, *, revs=None, quantity: str = "acceleration",
         "angles_deg": [round(h.angle_deg, 2) for h in hits[:200]] if revs is not None else None,
         "times_s": [round(h.start, 6) for h in hits[:200]],
     }  # fmt: skip
+    if revs is not None and n_rev:
+        summ["impacts"]["pattern"] = impact_pattern(hits, n_rev)
     rep["summary"] = summ
     return rep

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .checks import as_signal
+
 __all__ = ["zero_one_test", "zero_one", "ZeroOne"]
 
 #: Fewest samples the test is run on after thinning (Gottwald & Melbourne use 10^3 to 10^4).
@@ -56,11 +58,7 @@ def zero_one_test(phi, *, n_c: int = 100, n_cut: int | None = None, seed: int = 
     """K statistic of the 0-1 test on ``phi`` as given (median over ``n_c`` random c; seeded).
     No thinning: for a map's orbit or a section. For a sampled flow use
     [`zero_one`][recipdyn.analysis.zero_one.zero_one]."""
-    phi = np.asarray(phi, dtype=float)
-    if phi.ndim != 1 or phi.size < 100:
-        raise ValueError("need a 1-D series of at least 100 values")
-    if not np.all(np.isfinite(phi)):
-        raise ValueError("series contains NaN or inf")
+    phi = as_signal(phi, name="phi", min_samples=100)
     N = phi.size
     n_cut = n_cut or N // 10
     rng = np.random.default_rng(seed)
@@ -100,9 +98,9 @@ def zero_one(x, *, stride: int | None = None, max_samples: int = 20_000, n_c: in
     values. Refused (K NaN) when fewer than ``MIN_SAMPLES`` values remain."""
     from .embedding import estimate_delay
 
-    x = np.asarray(x, dtype=float)
+    x = as_signal(x, name="x")
     if stride is None:
-        stride = estimate_delay(x[:50_000]) if x.size >= 100 else 1
+        stride = estimate_delay(x[:50_000]) if x.size >= MIN_SAMPLES else 1
     stride = max(1, int(stride))
     y = x[::stride][:max_samples]
     if y.size < MIN_SAMPLES:

@@ -83,6 +83,9 @@ def analyze(
             typer.echo(f"note: {note}")
         for name, value, status in s["evidence"]:
             typer.echo(f"  {name:<20} {value:<28} {status}")
-    typer.echo(f"verdict: {s['verdict']['verdict']} ({'; '.join(s['verdict']['reasons'])})")
+    typer.echo(
+        f"verdict: {s['verdict'].get('headline', s['verdict']['verdict'])} "
+        f"({'; '.join(s['verdict']['reasons'])})"
+    )
     typer.echo(f"wrote {out}/summary.md, summary.json and figures")
     report(**s, output=str(out))
