@@ -259,16 +259,27 @@ def _texts(fig) -> list:
     return out
 
 
+def _within(bb, box) -> bool:
+    """Bounding box ``bb`` lies wholly inside ``box``."""
+    return box.x0 <= bb.x0 and bb.x1 <= box.x1 and box.y0 <= bb.y0 and bb.y1 <= box.y1
+
+
 def layout_defects(fig, tol: float = 0.5) -> list[str]:
     """Draw ``fig`` (its layout engine runs) and list its layout defects: two texts whose boxes
-    intersect, a text or an axes outside the figure, a text running into another axes (a
-    panel or a colour bar; an inset's texts may lie on its parent), a note or annotation
-    crossing its own axes' frame (half in, half out; a label wholly in the margin is fine).
+    intersect, a layout engine that gave up (axes collapsed), a text or an axes outside the
+    figure, a text running into another axes (a panel or a colour bar; an inset's texts may
+    lie on its parent), a note or annotation crossing its own axes' frame (half in, half
+    out; a label wholly in the margin is fine).
     ``tol`` pixels at each box's edge are forgiven (glyph boxes include antialiasing
     margins)."""
+    import warnings
+
     from matplotlib.text import Text
 
-    fig.canvas.draw()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fig.canvas.draw()
+    bad = [f"layout engine: {w.message}" for w in caught if "layout" in str(w.message)]
     r = fig.canvas.get_renderer()
     fb = fig.bbox.padded(tol)
     items = []
@@ -276,23 +287,17 @@ def layout_defects(fig, tol: float = 0.5) -> list[str]:
         bb = Text.get_window_extent(t, r)  # the text alone, not an annotation's arrow
         if bb.width > 0 and bb.height > 0:
             items.append((name, ax, bb.padded(-tol)))
-    bad = [
-        f"outside the figure: {n}"
-        for n, _, bb in items
-        if not (fb.x0 <= bb.x0 and bb.x1 <= fb.x1 and fb.y0 <= bb.y0 and bb.y1 <= fb.y1)
-    ]
+    bad += [f"outside the figure: {n}" for n, _, bb in items if not _within(bb, fb)]
     for ax in _all_axes(fig):
         bb = ax.get_window_extent(r).padded(-tol)
-        if ax.get_visible() and not (fb.x0 <= bb.x0 and bb.x1 <= fb.x1 and fb.y0 <= bb.y0
-                                     and bb.y1 <= fb.y1):  # fmt: skip
+        if ax.get_visible() and not _within(bb, fb):
             bad.append(f"axes outside the figure: {ax.title.get_text() or ax.get_label()!r}")
     boxes = [(ax, ax.get_window_extent(r)) for ax in _all_axes(fig) if ax.get_visible()]
     parent = {child: ax for ax in _all_axes(fig) for child in ax.child_axes}
     for name, ax, bb in items:
         family = {ax, parent.get(ax), *getattr(ax, "child_axes", ())}
         for other, box in boxes:
-            inside = (box.x0 <= bb.x0 + tol and bb.x1 <= box.x1 + tol and box.y0 <= bb.y0 + tol
-                      and bb.y1 <= box.y1 + tol)  # fmt: skip
+            inside = _within(bb, box.padded(tol))
             if other is ax and " text " in name and not inside and bb.overlaps(box):
                 bad.append(f"crosses its axes' frame: {name}")  # half in, half out
             elif other not in family and bb.overlaps(box):

@@ -156,7 +156,8 @@ def campbell_figure(ds: xr.Dataset, out: Path, plt=None) -> Path:
         # the labels beside the right edge (clear of the last point's markers), thinned so
         # that none covers the next (orders of a few hertz under a kHz line are a pixel apart)
         gap = _label_gap(fig, ax, fontsize=7)
-        for k in thin_labels([k * fc[-1] for k in orders], gap):
+        ends = [k * fc[-1] for k in orders if k * fc[-1] <= ax.get_ylim()[1]]  # in view
+        for k in thin_labels(ends, gap):
             ax.annotate(f"{k + 1}\u00d7", (1.0, (k + 1) * fc[-1]), xycoords=("axes fraction",
                         "data"), fontsize=7, color="0.4", xytext=(3, 0),
                         textcoords="offset points", va="center", annotation_clip=False)  # fmt: skip
