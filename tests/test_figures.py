@@ -516,3 +516,97 @@ def test_reproduction_figures_have_no_layout_defects(tmp_path):
             plt.close(fig)
     assert len(found) > 70
     assert not any(found.values()), _report(found)
+
+
+def test_compare_spectra_on_a_log_frequency_axis(short_records, ringing_run, tmp_path,
+                                                 monkeypatch):  # fmt: skip
+    """The spectra panel of ``compare``: a log frequency axis whose range holds both the
+    3.18 Hz crank line (at 20 rad/s) and the ~2.3 kHz link line, with crank orders on top."""
+    import recipdyn.compare as compare
+
+    a, b = tmp_path / "natural.nc", tmp_path / "ringing.nc"
+    short_records["compressor"].to_netcdf(a)
+    ringing_run.to_netcdf(b)
+    figs = []
+    monkeypatch.setattr(compare, "save_figure", lambda fig, path, **kw: figs.append(fig))
+    monkeypatch.setattr(_mpl(), "close", lambda fig: None)
+    compare.compare_runs([a, b], tmp_path / "cmp")
+    ax = figs[0].axes[1]
+    try:
+        assert ax.get_xscale() == "log"
+        lo, hi = ax.get_xlim()
+        fc = 20.0 / (2 * np.pi)
+        assert lo <= fc / 2 and hi >= 2000.0
+        assert any(c.get_xlabel() == "crank order" for c in ax.child_axes)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(figs[0])
+
+
+def test_contact_figure_is_scaled_to_the_steady_part(short_records):
+    """The contact record starts with the journal's fall onto the bearing (|a| ~4000 m/s^2
+    against ~60 after it): the acceleration panel is scaled to the second revolution and the
+    start-up is marked as off scale."""
+    from recipdyn.plotting import contact_figure
+
+    ds = short_records["compressor-contact"]
+    t, a = ds["time"].values, ds["a"].values
+    steady = t >= t[0] + 2 * np.pi / ds.attrs["param_omega"]
+    assert np.abs(a[~steady]).max() > 10 * np.abs(a[steady]).max()  # the premise
+    fig = contact_figure(ds)
+    try:
+        lo, hi = fig.axes[0].get_ylim()
+        span = a[steady].max() - a[steady].min()
+        assert lo == pytest.approx(a[steady].min() - 0.05 * span)
+        assert hi == pytest.approx(a[steady].max() + 0.05 * span)
+        labels = fig.axes[0].get_legend_handles_labels()[1]
+        assert any(lab.startswith("start-up (1st revolution): off scale") for lab in labels)
+    finally:
+        _mpl().close(fig)
+
+
+def test_dense_phase_portrait_is_a_density_and_a_cycle_stays_a_line():
+    """analyze's phase portrait: 2000 turns of a quasi-periodic orbit are drawn as their
+    occupation density (fractions summing to 1), ten turns of a cycle as a line."""
+    from recipdyn.analysis.plots import plot_phase
+
+    plt = _mpl()
+    t = np.linspace(0, 1.0, 60_000)
+    x = np.sin(2 * np.pi * 2000 * t) + 0.5 * np.sin(2 * np.pi * 2000 * np.sqrt(2) * t)
+    y = np.cos(2 * np.pi * 2000 * t) + 0.5 * np.cos(2 * np.pi * 2000 * np.sqrt(2) * t)
+    fig = plot_phase(x, y, "x", "y", title="torus")
+    try:
+        ax = fig.axes[0]
+        (mesh,) = ax.collections
+        h = np.ma.filled(mesh.get_array(), np.nan).astype(float)
+        assert np.nansum(h) == pytest.approx(1.0, rel=1e-12)
+        assert "occupation density" in ax.get_title()
+    finally:
+        plt.close(fig)
+    fig = plot_phase(x[:300], y[:300], "x", "y")
+    try:
+        assert len(fig.axes[0].get_lines()) == 1 and not fig.axes[0].collections
+    finally:
+        plt.close(fig)
+
+
+def test_lyapunov_plots_give_the_time_unit():
+    """The averaging time of Benettin's history and the divergence time carry units."""
+    from types import SimpleNamespace
+
+    from recipdyn.analysis.plots import plot_divergence, plot_lyapunov_history
+
+    plt = _mpl()
+    res = SimpleNamespace(times=np.arange(1.0, 5.0), history=np.ones((4, 2)),
+                          exponents=np.array([1.0, -1.0]), sum=0.0)  # fmt: skip
+    for unit, expect in (("1/s", "(s)"), ("per iteration", "(iterations)")):
+        fig = plot_lyapunov_history(res, unit=unit)
+        assert fig.axes[0].get_xlabel() == f"averaging time {expect}"
+        plt.close(fig)
+    div = SimpleNamespace(params={"dt": 1e-4, "dim": 3, "delay": 2}, steps=np.arange(10),
+                          curve=np.linspace(0, 1, 10), fit=(1, 5), exponent=10.0, ok=True,
+                          method="rosenstein", reason="")  # fmt: skip
+    fig = plot_divergence(div)
+    assert fig.axes[0].get_xlabel() == "divergence time (s)"
+    plt.close(fig)
