@@ -372,7 +372,8 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
     ax.set_xlabel(xlab)
     ax.set_ylabel(ylab)
     after = " after the start-up" if t_up is not None else ""
-    ax.set_title(f"stroboscopic section ({ts.size} revolutions{after})", fontsize=9)
+    revs = f"{ts.size} revolution{'' if ts.size == 1 else 's'}"
+    ax.set_title(f"stroboscopic section ({revs}{after})", fontsize=9)
     ax.grid(alpha=0.3)
     ax = fig.add_subplot(grid[0, 2])
     for key in keys:
