@@ -131,3 +131,31 @@ def test_analyze_says_what_it_is_doing(tmp_path):
     for what in ("spectrum", "vibration page", "exponents from the signal", "Poincaré section",
                  "Benettin"):  # fmt: skip
         assert any(what in m for m in seen), (what, seen)
+
+
+def test_benettin_exponents_printed_to_their_uncertainty():
+    """summary.md prints each exponent to the digit its uncertainty (the larger of the limit's
+    error and the second half's spread) supports, at most 4 significant digits, not 17."""
+    from recipdyn.analyze import _with_uncertainty
+
+    le = {"exponents_per_s": [0.62134567891234567, -0.0041234, -25.3712345678],
+          "lambda1_limit_error": 0.0031, "spread_second_half": 0.001}  # fmt: skip
+    assert _with_uncertainty(le) == "0.621, -0.004, -25.37 (\u00b1 0.003)"
+    tight = {"exponents_per_s": [5.123456789, -300.123456], "lambda1_limit_error": 1e-12}
+    assert _with_uncertainty(tight) == "5.123, -300.1 (\u00b1 1e-12)"  # 4 digits at most
+    assert _with_uncertainty({"exponents_per_s": [0.6213456789]}) == "0.6213"
+
+
+def test_signal_verdict_names_its_threshold():
+    """The reason for a positive signal exponent says what the number it exceeds is."""
+    from types import SimpleNamespace
+
+    from recipdyn.analysis.classify import _signal_exponent
+
+    est = [SimpleNamespace(exponent=x, ok=True, stderr=0.1, method=m, status="ok", reason="")
+           for x, m in ((292.9, "wolf"), (300.0, "rosenstein"), (280.0, "kantz"))]  # fmt: skip
+    reasons: list[str] = []
+    lam, _, _ = _signal_exponent(est, 1e-4, 0.01, {}, reasons)
+    assert lam == 292.9
+    assert "median 292.9 > 100, the smallest exponent counted as positive: 0.01 per " \
+        "embedding delay of 0.0001" in reasons[0]  # fmt: skip

@@ -428,6 +428,24 @@ def is_record(path: str | Path) -> bool:
         return True  # let analyze_run report what is wrong with it
 
 
+def _with_uncertainty(le: dict) -> str:
+    """The Benettin exponents to the digits their uncertainty supports: the larger of the
+    limit's error and the spread over the second half, its first digit the last one printed
+    (at most 4 significant digits each), followed by that uncertainty: ``0.621, -0.004,
+    -25.37 (+- 0.003)``."""
+    vals = np.asarray(le["exponents_per_s"], dtype=float)
+    errs = [le.get("lambda1_limit_error"), le.get("spread_second_half")]
+    u = max((float(e) for e in errs if e is not None and np.isfinite(e)), default=0.0)
+    if not (u > 0 and vals.size and np.isfinite(vals).all()):
+        return ", ".join(f"{v:.4g}" for v in vals)
+    decimals = int(max(0, -np.floor(np.log10(u))))
+
+    def fmt(v: float) -> str:  # no more than 4 significant digits
+        return f"{v:.{min(decimals, int(max(0, 3 - np.floor(np.log10(abs(v) or 1.0)))))}f}"
+
+    return ", ".join(fmt(v) for v in vals) + f" (\u00b1 {u:.1g})"
+
+
 def _spread(res) -> float:
     """Uncertainty of lambda1: the spread of its running estimate over the second half."""
     tail = res.history[len(res.history) // 2 :, 0]
@@ -504,7 +522,7 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
         "spread_second_half": _spread(res), "revolutions": lyap_revolutions,
     }  # fmt: skip
-    fig = plot_lyapunov_history(res)
+    fig = plot_lyapunov_history(res, unit=unit)  # per s or per iteration
     save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
     plt.close(fig)
     summary["zero_one_K"] = k01
@@ -566,9 +584,8 @@ def _markdown(s: dict[str, Any]) -> str:
         lines.append(f"- Benettin (equations): refused — {le['refused']}")
     elif le:
         unit = le.get("units", "1/s")
-        lines.append(
-            f"- Benettin (equations): {le['exponents_per_s']} ({unit}), sum {le['sum_per_s']:.3g}"
-        )
+        lines.append(f"- Benettin (equations): {_with_uncertainty(le)} ({unit}), "
+                     f"sum {le['sum_per_s']:.3g}")  # fmt: skip
     for name, r in s["lyapunov_signal"].items():
         val = (r["exponent"] if r["status"] in ("ok", "flat")
                else f"{r['exponent']:.4g}, withheld ({r['reason']})"

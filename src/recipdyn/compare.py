@@ -150,15 +150,19 @@ def compare_runs(paths: list[str | Path], out: str | Path, *, signal: str | None
 def _figure(runs, labels, signal, path: Path) -> None:
     plt = _mpl()
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), constrained_layout=True)
-    top = 0.0
+    top, bottom = 0.0, np.inf
     for ds, label, color in zip(runs, labels, PALETTE * 4, strict=False):
         t = ds["time"].values
         plot_signal(axes[0], t - t[0], ds[signal].values, color=color, label=label, zoom=False)
         fs = 1.0 / float(np.median(np.diff(t)))
         spec = amplitude_spectrum(ds[signal].values, fs)
-        axes[1].semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.8,
-                         color=color, label=label)  # fmt: skip
-        top = max(top, display_band(spec, forcing_frequency(ds.attrs)))
+        # a log frequency axis: the crank's few hertz and a link's kilohertz both readable
+        axes[1].loglog(spec.frequency[1:], np.maximum(spec.amplitude[1:], 1e-300), lw=0.8,
+                       color=color, label=label)  # fmt: skip
+        fc = forcing_frequency(ds.attrs)
+        top = max(top, display_band(spec, fc))
+        bottom = min(bottom, spec.frequency[1] if spec.frequency.size > 1 else 1.0,
+                     fc / 2 if fc else np.inf)  # fmt: skip
         sec = _section(ds, signal)
         if sec is not None:
             axes[2].plot(sec[0], sec[1], "o", ms=3, color=color, label=label)
@@ -168,10 +172,16 @@ def _figure(runs, labels, signal, path: Path) -> None:
     axes[0].set_xlabel("time from the start of each record (s)")
     axes[0].set_ylabel(axis_label(signal, ref))
     axes[0].set_title("signal")
-    axes[1].set_xlim(0, top)
+    axes[1].set_xlim(bottom, top)
     amp_max = max(float(np.nanmax(np.abs(ds[signal].values))) for ds in runs)
     axes[1].set_ylim(amp_max * 1e-7, amp_max * 2)
-    axes[1].set_xlabel("frequency (Hz)")
+    axes[1].set_xlabel("frequency (Hz), log scale")
+    fcs = {forcing_frequency(ds.attrs) for ds in runs}
+    if len(fcs) == 1 and (fc := fcs.pop()):  # one crank speed: its orders on the top axis
+        orders = axes[1].secondary_xaxis("top", functions=(lambda f: f / fc,
+                                                           lambda o: o * fc))  # fmt: skip
+        orders.set_xlabel("crank order", fontsize=8)
+        orders.tick_params(labelsize=7)
     axes[1].set_ylabel(f"amplitude of {axis_label(signal, ref)}, log scale")
     axes[1].set_title("amplitude spectra (Hann window)")
     axes[2].set_title("section: once per revolution" if runs[0].attrs.get("crank_frequency_hz")

@@ -12,6 +12,7 @@ import xarray as xr
 __all__ = [
     "response_figure",
     "provenance_footer",
+    "add_footer",
     "model_figure",
     "axis_label",
     "contact_figure",
@@ -24,27 +25,7 @@ __all__ = [
     "PALETTE",
 ]
 
-from .mplstyle import PALETTE, _mpl  # noqa: F401  (the style lives on the floor)
-
-
-def _columns(ax) -> int:
-    """Width of the axes in pixels at the figure's dpi (before layout: an estimate)."""
-    fig = ax.get_figure()
-    return max(100, int(ax.get_position().width * fig.get_figwidth() * fig.dpi))
-
-
-def is_dense(y, columns: int, per_column: float = 1 / 3) -> bool:
-    """True when ``y`` has more than ``per_column * columns`` clear oscillations (prominence
-    above 1 % of its range): drawn as a line it fills the axes as a solid block."""
-    from scipy.signal import find_peaks
-
-    y = np.asarray(y, dtype=float)
-    span = float(np.ptp(y)) if y.size else 0.0
-    if y.size < 3 * columns or not span > 0:
-        return False
-    peaks, _ = find_peaks(y, prominence=0.01 * span)
-    return peaks.size > per_column * columns
-
+from .mplstyle import PALETTE, _columns, _mpl, dense_orbit, is_dense, orbit_density  # noqa: F401
 
 _PREFIX = ((1e-9, "n"), (1e-6, "\u00b5"), (1e-3, "m"), (1.0, ""))
 
@@ -80,20 +61,11 @@ def centred(values, name: str, unit: str) -> tuple[np.ndarray, str]:
 
 def plot_orbit(ax, x, y, *, color=None, lw: float = 0.5):
     """A phase portrait. A dense orbit (more turns than twice the axes' pixel columns) is
-    drawn as its occupation density (a 2-D histogram of the samples, i.e. the time spent per
-    cell, on a log colour scale): a line would fill the axes as one block."""
-    x = np.asarray(x, dtype=float)
-    y = np.asarray(y, dtype=float)
-    cols = _columns(ax)
-    if not (is_dense(x, cols, 2.0) or is_dense(y, cols, 2.0)):  # a 2-D line takes more
+    drawn as its occupation density (`recipdyn.mplstyle.orbit_density`: the time spent
+    per cell, on a log colour scale): a line would fill the axes as one block."""
+    if not dense_orbit(ax, x, y):
         return ax.plot(x, y, lw=lw, color=color)
-    from matplotlib.colors import LogNorm
-
-    ok = np.isfinite(x) & np.isfinite(y)
-    h, xe, ye = np.histogram2d(x[ok], y[ok], bins=(cols // 5, cols // 6))
-    h = np.where(h > 0, h / h.sum(), np.nan)
-    return ax.pcolormesh(xe, ye, h.T, cmap="Blues", norm=LogNorm(vmin=np.nanmax(h) * 1e-3),
-                         shading="flat", rasterized=True)  # fmt: skip
+    return orbit_density(ax, x, y)
 
 
 def plot_signal(ax, t, y, *, color=None, label=None, lw: float = 0.7, zoom: bool = True):
@@ -120,10 +92,14 @@ def plot_signal(ax, t, y, *, color=None, label=None, lw: float = 0.7, zoom: bool
         period = float(np.median(np.diff(t[peaks]))) if peaks.size > 1 else (t[-1] - t[0]) / 50
         i = int(np.argmax(np.abs(y - np.median(y))))
         sel = (t >= t[i] - 3 * period) & (t <= t[i] + 3 * period)
-        ins = ax.inset_axes([0.66, 0.64, 0.32, 0.33])
+        ins = ax.inset_axes([0.66, 0.6, 0.32, 0.32])  # its title inside the axes
         ins.plot(t[sel], y[sel], lw=0.8, color=color)
         ins.set_title(f"zoom: t = {t[i]:.4g} s", fontsize=6.5, pad=2)
         ins.tick_params(labelsize=6)
+        from matplotlib.ticker import MaxNLocator
+
+        ins.xaxis.set_major_locator(MaxNLocator(3))  # a small inset: few labels that fit
+        ins.yaxis.set_major_locator(MaxNLocator(4))
         ins.patch.set_alpha(0.92)
         ins.grid(alpha=0.3)
     return art
@@ -155,6 +131,35 @@ def provenance_footer(ds: xr.Dataset) -> str:
     )
 
 
+#: Font size of the provenance footer (points).
+FOOTER_SIZE = 6.5
+
+
+def add_footer(fig, text: str):
+    """Put the provenance line ``text`` under the panels as the figure's ``supxlabel``: the
+    layout engine (constrained or compressed) reserves its room, so it never covers an axis
+    label; left-aligned, wrapped to the figure's width (a character of the footer's font is
+    taken as 0.6 of its size, wider than DejaVu Sans' mean)."""
+    import textwrap
+
+    width = max(40, int(fig.get_figwidth() * 72 / (0.6 * FOOTER_SIZE)))
+    return fig.supxlabel(textwrap.fill(text, width), x=0.01, ha="left", fontsize=FOOTER_SIZE,
+                         color="0.35")  # fmt: skip
+
+
+def _annotate_line(ax, f, amp, text: str) -> None:
+    """Label the spectral line at ``(f, amp)`` with ``text`` inside the axes: the note sits in
+    the top band kept free of data (see the y limits of `response_figure`), on the side
+    away from the line, with an arrow down to it."""
+    lo, hi = ax.get_xlim()
+    frac = (f - lo) / (hi - lo) if hi > lo else 0.5
+    right = frac < 0.5  # the line on the left: the note on the right, and the other way round
+    ax.annotate(text, (f, amp), xytext=(0.98 if right else 0.02, 0.97),
+                textcoords="axes fraction", ha="right" if right else "left", va="top",
+                fontsize=7.5, bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.7", alpha=0.9),
+                arrowprops=dict(arrowstyle="->", lw=0.6, color="0.2"))  # fmt: skip
+
+
 def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | None = None):
     """Crosshead x, v, a over time and the amplitude spectrum of a (the paper's Fig. 4 layout).
 
@@ -179,7 +184,7 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
                 va="center", transform=ax.transAxes)  # fmt: skip
         ax.set_axis_off()
         fig.suptitle(title or "Crosshead response")
-        fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+        add_footer(fig, provenance_footer(ds))
         return fig
     from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 
@@ -190,20 +195,20 @@ def response_figure(ds: xr.Dataset, *, title: str | None = None, fmax: float | N
     spec = amplitude_spectrum(ds["a"].values, fs, window="hann")
     f_top = fmax if fmax is not None else display_band(spec, fc)
     ax.semilogy(spec.frequency, np.maximum(spec.amplitude, 1e-300), lw=0.7)
-    top = float(spec.amplitude.max()) if spec.amplitude.size else 1.0
-    ax.set_ylim(max(top, 1e-300) * 1e-6, max(top, 1e-300) * 3)  # 120 dB below the largest line
+    top = max(float(spec.amplitude.max()) if spec.amplitude.size else 1.0, 1e-300)
+    # 120 dB below the largest line; the 1.5 decades above it are kept free for the note
+    ax.set_ylim(top * 1e-6, top * 30)
+    ax.set_xlim(0, f_top)
     f_link = nonharmonic_peak(spec.frequency, spec.amplitude, fc, min_rel_height=1e-4)
     if np.isfinite(f_link) and f_link <= f_top:
         amp = float(np.interp(f_link, spec.frequency, spec.amplitude))
-        ax.annotate(f"{f_link:.4g} Hz = {f_link / fc:.1f} crank orders\n(not a crank harmonic)",
-                    (f_link, amp), xytext=(-10, 12), textcoords="offset points", ha="right",
-                    fontsize=8, arrowprops=dict(arrowstyle="->", lw=0.6))  # fmt: skip
+        _annotate_line(ax, f_link, amp, f"{f_link:.4g} Hz = {f_link / fc:.1f} crank orders\n"
+                                        "(not a crank harmonic)")  # fmt: skip
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("d) amplitude of a (m/s$^2$), log scale")
-    ax.set_xlim(0, f_top)
     ax.grid(alpha=0.3)
     fig.suptitle(title or "Crosshead response")
-    fig.text(0.01, 0.002, provenance_footer(ds), fontsize=6.5, color="0.35")
+    add_footer(fig, provenance_footer(ds))
     return fig
 
 
@@ -268,27 +273,85 @@ def _impacts(ds: xr.Dataset, key: str) -> np.ndarray:
     return np.flatnonzero(onset)
 
 
+def _startup_end(ds: xr.Dataset) -> float | None:
+    """End of the start-up that the contact figure shows apart: the first crank revolution of
+    a record that begins with the run (no revolution discarded as transient) and holds at
+    least one more. The journal is released at rest in the clearance, so its first fall onto
+    the bearing is an impact far harder than the steady ones; scaled to it, the steady motion
+    would be a flat line. ``None`` when there is no such start-up in the record."""
+    if float(ds.attrs.get("transient_revolutions", 0.0)) > 0:
+        return None
+    t = ds["time"].values
+    period = 2 * np.pi / float(ds.attrs["param_omega"])
+    if t.size < 2 or t[-1] - t[0] < 1.5 * period:
+        return None
+    return float(t[0] + period)
+
+
+def _steady_ylim(ax, y, steady, margin: float = 0.05) -> bool:
+    """Scale ``ax``'s y axis to ``y[steady]`` (with a margin); True when the other samples (the
+    start-up) reach outside it, i.e. are partly off scale."""
+    ys = y[steady & np.isfinite(y)]
+    if ys.size == 0:
+        return False
+    lo, hi = float(ys.min()), float(ys.max())
+    pad = margin * ((hi - lo) or abs(hi) or 1.0)
+    ax.set_ylim(lo - pad, hi + pad)
+    rest = y[~steady & np.isfinite(y)]
+    return bool(rest.size and (rest.min() < lo - pad or rest.max() > hi + pad))
+
+
+def _emptiest_direction(angle) -> float:
+    """Centre (deg) of the 30-degree sector holding the fewest of ``angle`` (rad): where a
+    polar plot's radial labels cover the least data."""
+    counts, edges = np.histogram(np.mod(angle, 2 * np.pi), bins=12, range=(0, 2 * np.pi))
+    k = int(np.argmin(counts))
+    return float(np.degrees(edges[k] + np.pi / 12))
+
+
 def contact_figure(ds: xr.Dataset, *, title: str | None = None):
     """The contact-impact joint's record, per clearance joint: crosshead acceleration and
     joint force over crank angle with the impacts marked, the journal's orbit inside the
     clearance circle, the joint force in polar form over the crank angle, and the impact map
-    (states at impacts) beside the stroboscopic section (once a revolution)."""
+    (states at impacts) beside the stroboscopic section (once a revolution).
+
+    A record that begins with the run shows its first revolution (the start-up: the journal's
+    first fall onto the bearing) in grey and apart: every panel is scaled to the steady part
+    after it, and a start-up reaching outside that scale is said so in the legend."""
+    from matplotlib.ticker import MaxNLocator
+
     plt = _mpl()
     joints = ds.attrs.get("param_clearance_joints", "crank")
     keys = {"crank": [""], "crosshead": ["_crosshead"], "both": ["", "_crosshead"]}[joints]
     deg = np.degrees(np.mod(ds["theta1"].values, 2 * np.pi))
     t = ds["time"].values
-    fig = plt.figure(figsize=(13, 4.0 * (1 + len(keys))), constrained_layout=True)
+    t_up = _startup_end(ds)
+    steady = t >= t_up if t_up is not None else np.ones(t.size, dtype=bool)
+    grey = "0.65"
+    omega, th0 = float(ds.attrs["param_omega"]), float(ds.attrs["param_theta1_0"])
+    fig = plt.figure(figsize=(13, 4.0 * (1 + len(keys))), layout="constrained")
     grid = fig.add_gridspec(1 + len(keys), 3)
+    colors = {"": "C3", "_crosshead": "C2"}
+
+    def startup_note(ax, y) -> str:
+        """The start-up's legend entry; its extreme when it reaches outside the steady scale."""
+        off = _steady_ylim(ax, y, steady)
+        peak = float(np.nanmax(np.abs(y[~steady]))) if (~steady).any() else 0.0
+        return "start-up (1st revolution)" + (f": off scale, |peak| {peak:.3g}" if off else "")
+
     # row 0: the vibration signal with impacts, the stroboscopic section, impact map
     ax = fig.add_subplot(grid[0, 0])
-    ax.plot(t, ds["a"].values, lw=0.5, color="C0")
-    colors = {"": "C3", "_crosshead": "C2"}
+    a = ds["a"].values
+    ax.plot(t[steady], a[steady], lw=0.5, color="C0")
+    if t_up is not None:
+        up = t <= t_up
+        ax.plot(t[up], a[up], lw=0.5, color=grey)
+        ax.axvspan(t[0], t_up, color="0.92", zorder=0, label=startup_note(ax, a))
     for key in keys:
         i = _impacts(ds, key)
         if i.size:
             ti = ds["impact_time"].values[i]
-            ax.plot(ti, np.interp(ti, t, ds["a"].values), "v", ms=3, color=colors[key],
+            ax.plot(ti, np.interp(ti, t, a), "v", ms=3, color=colors[key],
                     label=f"impacts, {'crank' if key == '' else 'crosshead'} pin")  # fmt: skip
     ax.set_xlabel("time (s)")
     ax.set_ylabel(axis_label("crosshead acceleration", ds["a"]))
@@ -296,32 +359,38 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="upper right")
     ax = fig.add_subplot(grid[0, 1])
-    T = 2 * np.pi / ds.attrs["param_omega"]
     from .analysis.poincare import strobe_times
 
-    ts = strobe_times(t[0], t[-1], T)
+    ts = strobe_times(t[0], t[-1], 2 * np.pi / omega)
+    if t_up is not None:
+        ts = ts[ts >= t_up - 1e-9 * (t[1] - t[0])]  # the steady part's revolutions
+    vu, au = ds["v"].attrs.get("units", "m/s"), ds["a"].attrs.get("units", "m/s**2")
+    sv, xlab = centred(np.interp(ts, t, ds["v"].values), "crosshead velocity", vu)
+    sa, ylab = centred(np.interp(ts, t, a), "crosshead acceleration", au)
     if ts.size:
-        ax.plot(np.interp(ts, t, ds["v"].values), np.interp(ts, t, ds["a"].values), "o",
-                ms=3, color="C0")  # fmt: skip
-    ax.set_xlabel(axis_label("crosshead velocity", ds["v"]))
-    ax.set_ylabel(axis_label("crosshead acceleration", ds["a"]))
-    ax.set_title(f"stroboscopic section ({ts.size} revolutions)", fontsize=9)
+        ax.plot(sv, sa, "o", ms=3, color="C0")
+    ax.xaxis.set_major_locator(MaxNLocator(5))
+    ax.set_xlabel(xlab)
+    ax.set_ylabel(ylab)
+    after = " after the start-up" if t_up is not None else ""
+    revs = f"{ts.size} revolution{'' if ts.size == 1 else 's'}"
+    ax.set_title(f"stroboscopic section ({revs}{after})", fontsize=9)
     ax.grid(alpha=0.3)
     ax = fig.add_subplot(grid[0, 2])
     for key in keys:
         i = _impacts(ds, key)
         if i.size:
-            th = np.degrees(np.mod(ds.attrs["param_omega"] * ds["impact_time"].values[i]
-                                   + ds.attrs["param_theta1_0"], 2 * np.pi))  # fmt: skip
-            ax.plot(
-                th,
-                ds[f"impact_v_impact{key}_after"].values[i],
-                ".",
-                ms=4,
-                color=colors[key],
-                label="crank pin" if key == "" else "crosshead pin",
-            )
+            ti = ds["impact_time"].values[i]
+            th = np.degrees(np.mod(omega * ti + th0, 2 * np.pi))
+            v_after = ds[f"impact_v_impact{key}_after"].values[i]
+            late = ti >= t_up if t_up is not None else np.ones(ti.size, dtype=bool)
+            ax.plot(th[late], v_after[late], ".", ms=4, color=colors[key],
+                    label="crank pin" if key == "" else "crosshead pin")  # fmt: skip
+            if (~late).any():
+                ax.plot(th[~late], v_after[~late], "o", ms=4, mfc="none", color=grey,
+                        label=f"{'crank' if key == '' else 'crosshead'} pin, start-up")  # fmt: skip
     ax.set_xlim(0, 360)
+    ax.set_xticks(range(0, 361, 60))
     ax.set_xlabel("crank angle at impact (deg)")
     ax.set_ylabel("approach velocity (m/s)")
     ax.set_title("impact map (state at each impact)", fontsize=9)
@@ -332,26 +401,33 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
         where = "crank pin" if key == "" else "crosshead pin"
         rc = ds.attrs["param_rc" + key]
         ax = fig.add_subplot(grid[row, 0])
-        ax.plot(deg, ds["joint_force" + key].values, ".", ms=1, color="C0")
+        force = ds["joint_force" + key].values / 1e3
+        if t_up is not None:
+            ax.plot(deg[~steady], force[~steady], ".", ms=1, color=grey,
+                    label=startup_note(ax, force))  # fmt: skip
+        ax.plot(deg[steady], force[steady], ".", ms=1, color="C0")
         i = _impacts(ds, key)
         if i.size:
             ti = ds["impact_time"].values[i]
-            thi = np.degrees(np.mod(ds.attrs["param_omega"] * ti + ds.attrs["param_theta1_0"],
-                                    2 * np.pi))  # fmt: skip
-            ax.plot(thi, np.interp(ti, t, ds["joint_force" + key].values), "v", ms=3,
-                    color=colors[key], label="impacts")  # fmt: skip
-            ax.legend(fontsize=7, loc="upper right")
+            thi = np.degrees(np.mod(omega * ti + th0, 2 * np.pi))
+            ax.plot(thi, np.interp(ti, t, force), "v", ms=3, color=colors[key], label="impacts")
+        if ax.get_legend_handles_labels()[0]:
+            for handle in ax.legend(fontsize=7, loc="upper right").legend_handles:
+                handle.set_markersize(4)  # the 1-point dots, readable in the legend
         ax.set_xlim(0, 360)
+        ax.set_xticks(range(0, 361, 60))
         ax.set_xlabel("crank angle (deg)")
-        ax.set_ylabel(f"{where} joint force (N)")
+        ax.set_ylabel(f"{where} joint force (kN)")
         ax.grid(alpha=0.3)
         ax = fig.add_subplot(grid[row, 1])
         ring = np.linspace(0, 2 * np.pi, 361)
         ax.plot(np.cos(ring), np.sin(ring), color="0.4", lw=1)
         ex, ey = ds["ex" + key].values / rc, ds["ey" + key].values / rc
-        ax.plot(ex, ey, lw=0.5, color="C0")
+        if t_up is not None:
+            ax.plot(ex[~steady], ey[~steady], lw=0.5, color=grey, label="start-up")
+        ax.plot(ex[steady], ey[steady], lw=0.5, color="C0")
         ax.set_aspect("equal")
-        lim = max(1.1, float(np.nanmax(np.hypot(ex, ey))) * 1.05)
+        lim = max(1.1, float(np.nanmax(np.hypot(ex[steady], ey[steady]))) * 1.05)
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_xlabel("e_x / c")
@@ -359,17 +435,27 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
         ax.set_title(f"{where}: journal orbit in the clearance circle (c = {1e3 * rc:g} mm)",
                      fontsize=9)  # fmt: skip
         ax.grid(alpha=0.3)
+        if t_up is not None:
+            ax.legend(fontsize=7, loc="upper right")
         ax = fig.add_subplot(grid[row, 2], projection="polar")
-        fx, fy = ds["joint_force_x" + key].values, ds["joint_force_y" + key].values
-        ax.plot(np.arctan2(fy, fx), np.hypot(fx, fy), ".", ms=1, color="C0")
-        ax.set_title(f"{where}: joint force on the rod, polar (N)", fontsize=9)
+        fx, fy = ds["joint_force_x" + key].values / 1e3, ds["joint_force_y" + key].values / 1e3
+        ang, mag = np.arctan2(fy, fx), np.hypot(fx, fy)
+        if t_up is not None:
+            ax.plot(ang[~steady], mag[~steady], ".", ms=1, color=grey)
+        ax.plot(ang[steady], mag[steady], ".", ms=1, color="C0")
+        top = float(np.nanmax(mag[steady])) if np.isfinite(mag[steady]).any() else 1.0
+        ax.set_rmax(1.08 * top if top > 0 else 1.0)
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.set_rlabel_position(_emptiest_direction(ang[steady]))  # over the fewest points
+        ax.tick_params(labelsize=7)
+        ax.set_title(f"{where}: joint force on the rod, polar (kN)", fontsize=9, pad=12)
     footer = (
         f"compressor-contact, clearance at {joints}, law {ds.attrs.get('param_contact_law')}"
         f" e={ds.attrs.get('param_restitution')}, friction {ds.attrs.get('param_friction')}"
         f", omega={ds.attrs['param_omega']:g} rad/s | {ds.attrs.get('solver_method')} "
         f"rtol={ds.attrs.get('solver_rtol')} | recipdyn {ds.attrs.get('recipdyn_version')}"
     )
-    fig.text(0.01, 0.002, footer, fontsize=6.5, color="0.35")
+    add_footer(fig, footer)
     fig.suptitle(title or "Contact-impact clearance joint")
     return fig
 
@@ -458,8 +544,7 @@ def cycle_figure(ds: xr.Dataset, *, title: str | None = None):
         ax.grid(alpha=0.3)
     kind = "dynamic valves" if valves else "ideal valves"
     fig.suptitle(title or f"Compression cycle ({kind}) and rod loads, last revolution")
-    fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))  # room for the footer
-    fig.text(0.01, 0.005, provenance_footer(ds), fontsize=6.5, color="0.35")
+    add_footer(fig, provenance_footer(ds))
     return fig
 
 

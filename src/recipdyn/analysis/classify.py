@@ -171,7 +171,8 @@ def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     if len(pos) * 2 > len(usable):  # a majority positive
         lam = float(np.median([e.exponent for e in pos]))
         reasons.append(f"{len(pos)} of {len(usable)} signal estimates positive "
-                       f"(median {lam:.4g} > {lim:.3g})")  # fmt: skip
+                       f"(median {lam:.4g} > {lim:.3g}, the smallest exponent counted as "
+                       f"positive: {tol:g} per embedding delay of {time_scale:.3g})")  # fmt: skip
         return lam, 0.0, False
     if pos and len(pos) * 2 == len(usable):  # a tie
         reasons.append(f"signal estimates disagree: {len(pos)} of {len(usable)} positive")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mplstyle import _mpl
+from ..mplstyle import _mpl, dense_orbit, orbit_density
 
 __all__ = [
     "plot_spectrum",
@@ -21,11 +21,21 @@ def plot_spectrum(spec, peaks=(), ax=None, fmax=None, title=None):
     if ax is None:
         _, ax = plt.subplots(figsize=(8, 4), constrained_layout=True)
     ax.plot(spec.frequency, spec.amplitude, lw=0.7)
-    for p in peaks:
+    ax.set_xlim(0, fmax or spec.frequency[-1])
+    ax.set_ylim(0, 1.12 * max(float(np.max(spec.amplitude, initial=0.0)), 1e-300))
+    # strongest first; a label that would cover one already placed is left out (a cluster of
+    # lines a few bins apart gets the label of its strongest)
+    placed: list[tuple[float, float]] = []
+    lo, hi = ax.get_xlim()
+    top = ax.get_ylim()[1]
+    for p in sorted(peaks, key=lambda p: -p.amplitude):
+        u, v = (p.frequency - lo) / (hi - lo), p.amplitude / top
+        if not 0 <= u <= 1 or any(abs(u - a) < 0.07 and abs(v - b) < 0.06 for a, b in placed):
+            continue
+        placed.append((u, v))
         label = f"{p.order}x" if p.order else f"{p.frequency:.4g} Hz"
         ax.annotate(label, (p.frequency, p.amplitude), fontsize=7, xytext=(2, 2),
-                    textcoords="offset points")  # fmt: skip
-    ax.set_xlim(0, fmax or spec.frequency[-1])
+                    textcoords="offset points", ha="right" if u > 0.93 else "left")  # fmt: skip
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("amplitude")
     ax.set_title(title or f"spectrum ({spec.window} window, resolution {spec.resolution:.3g} Hz)")
@@ -34,10 +44,22 @@ def plot_spectrum(spec, peaks=(), ax=None, fmax=None, title=None):
 
 
 def plot_phase(x, y, xlabel="x", ylabel="y", ax=None, title=None, points=False):
+    """A phase portrait of ``(x, y)``: a line, or points (``points``: a section). An orbit
+    that turns more than twice per pixel column (a chaotic or quasi-periodic orbit over many
+    periods, which a line draws as a solid blob) is drawn as its occupation density, the
+    fraction of the time spent in each cell on a log colour scale
+    (`recipdyn.mplstyle.orbit_density`): it shows where the motion dwells and the
+    attractor's structure; its Poincaré section is the complementary view."""
     plt = _mpl()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 5), constrained_layout=True)
-    ax.plot(x, y, "." if points else "-", ms=2, lw=0.4)
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if not points and dense_orbit(ax, x, y):
+        mesh = orbit_density(ax, x, y)
+        ax.figure.colorbar(mesh, ax=ax, label="fraction of time per cell", pad=0.01)
+        title = f"{title}: occupation density" if title else "occupation density"
+    else:
+        ax.plot(x, y, "." if points else "-", ms=2, lw=0.4)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     if title:
@@ -46,15 +68,23 @@ def plot_phase(x, y, xlabel="x", ylabel="y", ax=None, title=None, points=False):
     return ax.figure
 
 
+def _time_unit(unit: str) -> str:
+    """The time unit of an exponent's unit: ``1/s`` or ``per s`` -> ``s``; ``per iteration``
+    or ``1/iteration`` -> ``iterations``."""
+    u = unit.removeprefix("1/").removeprefix("per ").strip() or "s"
+    return "iterations" if u in ("iteration", "iterations") else u
+
+
 def plot_lyapunov_history(res, ax=None, unit="1/s"):
-    """Running Benettin estimates against averaging time."""
+    """Running Benettin estimates against averaging time; ``unit`` is the exponents' unit
+    (``1/s``; ``per iteration`` for a map), the averaging time's unit follows from it."""
     plt = _mpl()
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
     for i in range(res.history.shape[1]):
         ax.plot(res.times, res.history[:, i], label=f"lambda_{i + 1} = {res.exponents[i]:.4g}")
     ax.axhline(0, color="k", lw=0.6)
-    ax.set_xlabel("averaging time")
+    ax.set_xlabel(f"averaging time ({_time_unit(unit)})")
     ax.set_ylabel(f"exponent ({unit})")
     ax.set_title(f"Benettin convergence (sum = {res.sum:.3g})")
     ax.legend(fontsize=7)
@@ -62,8 +92,10 @@ def plot_lyapunov_history(res, ax=None, unit="1/s"):
     return ax.figure
 
 
-def plot_divergence(res, ax=None):
-    """Divergence curve (Rosenstein/Kantz) with the fitted region, or Wolf's running estimate."""
+def plot_divergence(res, ax=None, time_unit: str = "s"):
+    """Divergence curve (Rosenstein/Kantz) with the fitted region, or Wolf's running estimate,
+    against time in ``time_unit``, the unit of the sampling step ``dt`` the estimate was given
+    (``"samples"`` when it was given none)."""
     plt = _mpl()
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
@@ -75,8 +107,9 @@ def plot_divergence(res, ax=None):
         ax.axvspan(t[lo], t[hi], color="C1", alpha=0.2, label="fitted region")
         ax.plot(t[lo : hi + 1], res.curve[lo] + res.exponent * (t[lo : hi + 1] - t[lo]), "C1--",
                 label=f"slope {res.exponent:.4g}")  # fmt: skip
-    ax.set_xlabel("time")
-    ax.set_ylabel("running estimate" if res.method == "wolf" else "<ln divergence>")
+    ax.set_xlabel(f"{'time' if res.method == 'wolf' else 'divergence time'} ({time_unit})")
+    per = "sample" if time_unit == "samples" else time_unit
+    ax.set_ylabel(f"running estimate (1/{per})" if res.method == "wolf" else "<ln divergence>")
     what = f"lambda_1 = {res.exponent:.4g}" if res.ok else "refused"
     ax.set_title(f"{res.method}: {what}  (dim {res.params.get('dim')}, "
                  f"delay {res.params.get('delay')})")  # fmt: skip

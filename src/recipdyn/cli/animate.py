@@ -26,8 +26,9 @@ def animate(
     frames_per_revolution: int = typer.Option(48, "--frames-per-revolution"),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
 ) -> None:
-    """Animate the crank, the (magnified) clearance link, the rod and the crosshead, with the
-    crosshead acceleration and a cursor below."""
+    """Animate the crank, the (magnified) clearance link, the rod and the crosshead.
+
+    Below the mechanism: the crosshead acceleration, with a cursor at the frame's time."""
     from ..animate import animate_run
     from ..io import read_dataset
 

@@ -25,8 +25,10 @@ def compare(
     ),
     labels: str = typer.Option(None, "--labels", help="Comma list of names for the runs."),
 ) -> None:
-    """Overlay signals, spectra and sections of runs; tabulate the inputs that differ and the
-    differences of the main measures (peak, RMS, dominant line, own line, contact force)."""
+    """Compare runs: their signals, spectra and sections overlaid, and the inputs that differ.
+
+    A table gives the differences of the main measures (peak, RMS, dominant line, own line,
+    contact force) from the first run."""
     from ..compare import MEASURES, compare_runs
     from ..errors import ParameterError
 

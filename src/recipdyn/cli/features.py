@@ -44,8 +44,9 @@ def features(
         "whole file in memory; with --window any length is read block by block). Default 2^24.",
     ),
 ) -> None:
-    """Time-domain statistics, spectral and order features, chaos indicators: one row per
-    run or window, labelled with the run's parameters."""
+    """Tabulate features: time-domain statistics, spectral and order features, chaos indicators.
+
+    One row per run or window, labelled with the run's parameters."""
     from ..features import file_features, sweep_features, write_dictionary, write_table
     from ..model.parameters import ParameterError
 

@@ -14,8 +14,9 @@ WIDE = 150
 def models(
     name: str = typer.Argument(None, help="A model name or module:object; omit to list all."),
 ) -> None:
-    """List the registered models, or print one model's parameters (default, unit, range,
-    description, assumed or not)."""
+    """List the registered models, or print one model's parameters.
+
+    For each parameter: its default, unit, range, description, and whether it is assumed."""
     from rich.console import Console
     from rich.markup import escape
     from rich.table import Column, Table

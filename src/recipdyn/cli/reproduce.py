@@ -41,8 +41,10 @@ def calibrate(
     jobs: int = typer.Option(1, "--jobs", "-j", help="Parallel workers (-1: all cores)."),
     out: Path = typer.Option(Path("out/calibration"), "--out", "-o"),
 ) -> None:
-    """Fit the unknown inertia parameters (within physical bounds) to the paper's peak
-    accelerations and report how close any choice gets. Defaults are never changed."""
+    """Fit the unknown inertia parameters to the paper's peak accelerations.
+
+    The fit stays within physical bounds and reports how close any choice gets. The defaults
+    are never changed."""
     from ..model.parameters import ParameterError
     from ..reproduce.calibrate import calibrate as fit
     from ..reproduce.calibrate import write_calibration

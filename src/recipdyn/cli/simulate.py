@@ -141,8 +141,9 @@ def simulate(
         "and stop; 'simulate -c FILE' runs it. A recorded run (.nc) is a config too.",
     ),
 ) -> None:
-    """Simulate a model (default: the compressor); write the record (.nc, .csv or .zarr) and a
-    figure."""
+    """Simulate a model (default: the compressor); write the record and a figure.
+
+    The record's format follows the extension of --out: .nc, .csv, .mat or .zarr."""
     from ..errors import Interrupted, LawRangeWarning, ModelValidityWarning, ParameterError
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset

@@ -11,7 +11,7 @@ import xarray as xr
 from ..io import save_figure
 from ..plotting import _mpl, axis_label, unit_tex
 
-__all__ = ["sweep_figures", "campbell_figure", "cell_edges", "wrap_around_mean"]
+__all__ = ["sweep_figures", "campbell_figure", "cell_edges", "wrap_around_mean", "thin_labels"]
 
 _LABELS = {"rc": ("clearance rc", 1e3, "mm"), "d": ("subsidence d", 1e3, "mm"),
            "omega": ("crank speed omega", 1.0, "rad/s")}  # fmt: skip
@@ -103,6 +103,25 @@ def _run_signals(ds) -> list[tuple[str, str]]:
     return out
 
 
+def thin_labels(positions, gap: float) -> list[int]:
+    """Indices of the ascending ``positions`` to label so that labelled neighbours are at least
+    ``gap`` apart: the first is kept, then each next one that clears the last kept."""
+    kept: list[int] = []
+    for i, y in enumerate(positions):
+        if not kept or y - positions[kept[-1]] >= gap:
+            kept.append(i)
+    return kept
+
+
+def _label_gap(fig, ax, fontsize: float) -> float:
+    """The data distance along ``ax``'s y axis that one line of text of ``fontsize`` points
+    takes, with 20 % spacing; the axes' height is taken as 85 % of its position before the
+    layout engine runs (the colour bar and labels take room from it)."""
+    lo, hi = ax.get_ylim()
+    height_pt = 0.85 * ax.get_position().height * fig.get_figheight() * 72
+    return 1.2 * fontsize * (hi - lo) / max(height_pt, 1.0)
+
+
 #: Orders of the forcing frequency drawn in the Campbell diagram (1x ... this).
 MAX_ORDER_LINES = 10
 
@@ -130,11 +149,18 @@ def campbell_figure(ds: xr.Dataset, out: Path, plt=None) -> Path:
     fc = ds.forcing_hz.values[done] if "forcing_hz" in ds else np.full(done.sum(), np.nan)
     if np.isfinite(fc).any() and ok.any():
         top = np.nanmax(f[ok])
-        for k in range(1, min(MAX_ORDER_LINES, int(np.ceil(top / np.nanmin(fc)))) + 1):
-            ax.plot(x[done], k * fc, "--", color="0.55", lw=0.7, zorder=1)
-            ax.annotate(f"{k}\u00d7", (x[done][-1], k * fc[-1]), fontsize=7, color="0.4",
-                        xytext=(2, 0), textcoords="offset points", va="center")  # fmt: skip
         ax.set_ylim(0, 1.05 * top)
+        orders = range(1, min(MAX_ORDER_LINES, int(np.ceil(top / np.nanmin(fc)))) + 1)
+        for k in orders:
+            ax.plot(x[done], k * fc, "--", color="0.55", lw=0.7, zorder=1)
+        # the labels beside the right edge (clear of the last point's markers), thinned so
+        # that none covers the next (orders of a few hertz under a kHz line are a pixel apart)
+        gap = _label_gap(fig, ax, fontsize=7)
+        ends = [k * fc[-1] for k in orders if k * fc[-1] <= ax.get_ylim()[1]]  # in view
+        for k in thin_labels(ends, gap):
+            ax.annotate(f"{k + 1}\u00d7", (1.0, (k + 1) * fc[-1]), xycoords=("axes fraction",
+                        "data"), fontsize=7, color="0.4", xytext=(3, 0),
+                        textcoords="offset points", va="center", annotation_clip=False)  # fmt: skip
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"frequency ({unit_tex(ds.peak_freq.attrs.get('units', 'Hz'))})")
     ax.set_title(f"Campbell diagram ({f.shape[1]} strongest lines per point"

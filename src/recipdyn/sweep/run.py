@@ -32,6 +32,7 @@ import os
 import shutil
 import sys
 import time
+import warnings
 import zlib
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
@@ -339,13 +340,29 @@ def open_sweep(path: str | Path) -> xr.Dataset:
     if not path.is_dir():
         raise ParameterError(f"{path}: is a file; expected {expected}")
     try:
-        ds = xr.open_zarr(str(path), consolidated=False)
+        with warnings.catch_warnings():  # a store of an older version has no consolidated
+            warnings.filterwarnings(
+                "ignore", "Failed to open Zarr store with consolidated", RuntimeWarning
+            )  # metadata: read it array by array
+            ds = xr.open_zarr(str(path))
     except Exception as exc:
         raise ParameterError(f"{path}: cannot be read as Zarr ({type(exc).__name__}); "
                              f"expected {expected}") from None  # fmt: skip
     if "spec_json" not in ds.attrs or "done" not in ds:
         raise ParameterError(f"{path}: not a recipdyn sweep store; expected {expected}")
     return ds
+
+
+def consolidate(store: str | Path) -> None:
+    """Write the store's consolidated metadata (every array's metadata in the group's own
+    file), so that ``xr.open_zarr`` opens it in one read and without a warning. Done when the
+    store is created and when a run ends; the chunks are not part of it, so points written in
+    between are read as usual, and a resumed run reads each array's own metadata."""
+    import zarr
+
+    with warnings.catch_warnings():  # zarr: consolidated metadata is not in the v3 spec yet
+        warnings.simplefilter("ignore")
+        zarr.consolidate_metadata(str(store))
 
 
 def _tasks(spec: SweepSpec, todo: Iterable) -> Iterable[dict[str, Any]]:
@@ -446,8 +463,8 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
         raise ParameterError(f"{store} exists: use --resume to continue it or --force to redo it")
     rejected = 0
     if store.exists() and resume:
-        try:
-            g = zarr.open_group(str(store), mode="a")
+        try:  # each array's own metadata, not the consolidated copy
+            g = zarr.open_group(str(store), mode="a", use_consolidated=False)
             digest = g.attrs.get("spec_digest")
         except Exception as exc:
             raise ParameterError(f"{store} cannot be opened as a sweep store ({exc}); "
@@ -469,7 +486,8 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
         if store.exists():
             shutil.rmtree(store)
         _create_store(store, spec)
-        g = zarr.open_group(str(store), mode="a")
+        consolidate(store)
+        g = zarr.open_group(str(store), mode="a", use_consolidated=False)
         done = np.zeros(spec.shape, dtype=bool)
     grid = list(spec.grid())
     y0 = None
@@ -538,6 +556,7 @@ def _run_locked(spec, out, backend, workers, dask_local, scheduler, resume, forc
         if bar is not None:
             bar.close()
     g.attrs["last_run_seconds"] = time.perf_counter() - t0
+    consolidate(store)
     if progress:
         print(f"sweep: {n_total - n_skip} computed ({failed} failed), {n_skip} reused, "
               f"{time.perf_counter() - t0:.1f} s -> {store}")  # fmt: skip
