@@ -96,10 +96,6 @@ class Field:
         return value
 
 
-def _number(x: float) -> str:
-    return f"{x:.12g}"
-
-
 def _factor(unit: str, si_unit: str) -> float:
     """SI value of one display ``unit`` (1.0 when they are the same)."""
     if unit == si_unit:
@@ -125,19 +121,22 @@ def _display_unit(p: Param) -> str:
 
 
 def format_value(value: Any, field: Field) -> str:
-    """``value`` (SI) as field text: in the display unit when six digits write it exactly,
-    else in SI when they do, else with twelve digits in the display unit."""
+    """``value`` (SI) as field text that reads back to it exactly: six digits in the display
+    unit when they are exact (``"1 mm"``), else six digits in SI (``"20 rad/s"``), else the
+    shortest exact text in the display unit, else in SI (``"2.6666666666666665"``)."""
     if value is None:
         return ""
     if isinstance(value, str):
         return value
     value = float(value)
-    for unit in dict.fromkeys((field.unit, field.si_unit)):
-        f = _factor(unit, field.si_unit)
-        short = f"{value / f:.6g}"
-        if float(short) * f == value or abs(float(short) * f - value) <= 1e-14 * abs(value):
-            return f"{short} {unit}".strip()
-    return f"{_number(value / _factor(field.unit, field.si_unit))} {field.unit}".strip()
+    units = list(dict.fromkeys((field.unit, field.si_unit)))
+    for digits in ("{:.6g}", "{!r}"):
+        for unit in units:
+            f = _factor(unit, field.si_unit)
+            text = digits.format(value / f)
+            if float(text) * f == value:
+                return f"{text} {unit}".strip()
+    return f"{value!r} {field.si_unit}".strip()
 
 
 def _run_fields() -> list[Field]:

@@ -87,8 +87,12 @@ class PageResult:
 def _empty() -> Any:
     import plotly.graph_objects as go
 
-    return go.Figure().update_layout(xaxis_visible=False, yaxis_visible=False,
-                                     margin=dict(l=10, r=10, t=10, b=10))  # fmt: skip
+    return go.Figure().update_layout(
+        xaxis_visible=False,
+        yaxis_visible=False,
+        plot_bgcolor="white",
+        margin=dict(l=10, r=10, t=10, b=10),
+    )
 
 
 def run_page(model: str, texts: dict[str, Any]) -> PageResult:
@@ -175,7 +179,8 @@ def build_app(store: str | Path | None = None):
                              style={"display": "grid", "gridTemplateColumns": "1fr 1fr"}),
                     html.Div(id="images"),
                 ])),
-                dcc.Graph(id="sweep", style={"height": "480px"}),
+                dcc.Graph(id="sweep", style={"height": "480px"}, figure=_empty().update_layout(
+                    title="sweep browser: open a sweep folder to see its map")),
             ], style={"flex": "1", "minWidth": "0"}),
         ], style={"display": "flex", "gap": "1em"}),
     ], style={"fontFamily": "sans-serif"})  # fmt: skip
