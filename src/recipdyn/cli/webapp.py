@@ -17,9 +17,10 @@ def app_command(
         "127.0.0.1", "--host", help="Address to listen on (default: this machine only)."
     ),
 ) -> None:
-    """Explore the compressor in the browser: every parameter as a widget with its unit and
-    range, live simulation (signal, spectrum, phase portrait, Poincaré section, clearance
-    link), and a sweep browser (fault map or bifurcation diagram; click a point to run it)."""
+    """Explore every registered model in the browser: its parameters in engineering units
+    (mm, bar, rpm) with their ranges, the figures 'recipdyn simulate' draws, a shareable
+    address and config, and a sweep browser (fault map or bifurcation diagram; click a point
+    to run it)."""
     from ..app import build_app
     from ..errors import ParameterError
 
