@@ -423,6 +423,8 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         assert page_.wait(f"{_POINTS} === 0") and page_.js(
             "document.querySelectorAll('#images img').length") == 0  # fmt: skip
         assert "not run" in page_.js(_STATUS)
+        frame = 'document.getElementById(\'{"key":"rc","type":"field"}\').parentElement'
+        assert page_.js(f"getComputedStyle({frame}).borderColor") == "rgb(176, 0, 32)"  # red
         # 6. click the fault map's (rc = 2 mm, d = 2 mm) cell: that point of the
         # compressor's sweep opens in the panel and runs
         page_.wait("(() => { const g = document.querySelector('#sweep .js-plotly-plot');"

@@ -23,6 +23,7 @@ __all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "G
 #: The interactive views, in the order :func:`recipdyn.app.figures.views` returns them.
 GRAPHS = ("signal", "spectrum", "phase", "section")
 _RED = "#B00020"
+_INPUT = {"width": "12em"}
 
 
 def _field_row(f: Field, text: Any) -> Any:
@@ -36,7 +37,7 @@ def _field_row(f: Field, text: Any) -> Any:
     else:
         widget = dcc.Input(id={"type": "field", "key": f.key}, type="text", value=text,
                            placeholder="derived" if f.optional else f.default_text,
-                           debounce=False, style={"width": "12em"})  # fmt: skip
+                           debounce=False, style=_INPUT)  # fmt: skip
     unit = f.unit.replace("**2", "²").replace("**1.5", "^1.5")
     return html.Div([
         html.Div([
@@ -157,19 +158,22 @@ def build_app(store: str | Path | None = None):
                 html.Div("Type values with units ('0.5 mm', '300 rpm', '3 bar'); a bare number "
                          "is read in the unit beside the field. Hover a name for its meaning.",
                          style={"fontSize": "12px", "color": "#444", "marginBottom": "6px"}),
-                html.Div(id="panel"),
-                html.Div(id="form-error", style={"color": _RED}),
                 html.Button("Simulate", id="run", n_clicks=0, style=button),
                 html.Button("Download config", id="dl", n_clicks=0, style=button,
                             title="a TOML file that 'recipdyn simulate -c FILE' runs"),
+                html.Div(id="form-error", style={"color": _RED}),
                 html.Div(id="dl-msg", style={"color": _RED, "fontSize": "12px"}),
-                html.H4("Sweep browser"),
-                dcc.Input(id="store", type="text", value=str(store) if store else "",
-                          placeholder="folder of a sweep", style={"width": "20em"}),
-                html.Button("Open", id="open", n_clicks=0),
-                dcc.Dropdown(id="sweep-var", options=[], value=None),
-            ], style={"width": "31em", "flex": "none", "fontSize": "13px",
-                      "maxHeight": "calc(100vh - 60px)", "overflowY": "auto"}),
+                html.Div([
+                    html.Div(id="panel"),
+                    html.H4("Sweep browser"),
+                    dcc.Input(id="store", type="text", value=str(store) if store else "",
+                              placeholder="folder of a sweep", style={"width": "20em"}),
+                    html.Button("Open", id="open", n_clicks=0),
+                    dcc.Dropdown(id="sweep-var", options=[], value=None),
+                ], id="panel-scroll", style={"maxHeight": "calc(100vh - 230px)",
+                                             "overflowY": "auto", "marginTop": "6px",
+                                             "borderTop": "1px solid #ccc"}),
+            ], style={"width": "31em", "flex": "none", "fontSize": "13px"}),
             html.Div([
                 html.Div(id="status", style={"fontFamily": "monospace", "margin": "4px",
                                              "whiteSpace": "pre-wrap"}),
@@ -221,7 +225,8 @@ def build_app(store: str | Path | None = None):
         + [Output("images", "children"), Output("status", "children"),
            Output({"type": "ferr", "key": ALL}, "children"),
            Output("form-error", "children", allow_duplicate=True),
-           Output("nav", "search", allow_duplicate=True), Output("shown", "data")],
+           Output("nav", "search", allow_duplicate=True), Output("shown", "data"),
+           Output({"type": "field", "key": ALL}, "style")],
         Input("run", "n_clicks"), Input("go", "data"),
         Input({"type": "field", "key": ALL}, "n_submit"),
         State("model", "value"), State("url", "search"), *fields_state,
@@ -237,7 +242,10 @@ def build_app(store: str | Path | None = None):
         status = html.Div([html.Div(line) for line in res.status],
                           style={"color": _RED} if res.query is None else {})  # fmt: skip
         nav = res.query if res.query is not None and res.query != search else no_update
-        return [*res.figures, imgs, status, errs, res.general, nav, res.query]
+        marks = [_INPUT | ({"borderColor": _RED, "outline": f"1px solid {_RED}"}
+                           if o["id"]["key"] in res.errors else {})
+                 for o in ctx.outputs_list[10]]  # fmt: skip
+        return [*res.figures, imgs, status, errs, res.general, nav, res.query, marks]
 
     @app.callback(
         Output("download", "data"), Output("dl-msg", "children"),
