@@ -103,12 +103,12 @@ def views(ds, model) -> list[Any]:
         elif period:
             ts = strobe_times(t[0], t[-1], period)
             sx, sy = np.interp(ts, t, xa), np.interp(ts, t, xb)
-            what = f"once per period ({ts.size} points)"
+            what = f"{ts.size} points, one per period"
         else:
             sx = sy = np.empty(0)
             what = "none: an autonomous system has no forcing period"
         sec.add_trace(go.Scatter(x=sx, y=sy, mode="markers", marker=dict(size=5)))
-        sec.update_layout(title=f"stroboscopic section, {what}", xaxis_title=_label(ds, a),
+        sec.update_layout(title=f"section ({what})", xaxis_title=_label(ds, a),
                           yaxis_title=_label(ds, b))  # fmt: skip
     for fig in (sig, spc, ph, sec):
         fig.update_layout(margin=dict(l=60, r=20, t=50, b=50), showlegend=False)

@@ -178,7 +178,7 @@ def build_app(store: str | Path | None = None):
                 html.Div(id="status", style={"fontFamily": "monospace", "margin": "4px",
                                              "whiteSpace": "pre-wrap"}),
                 dcc.Loading(html.Div([
-                    html.Div([dcc.Graph(id=f"g-{g}", figure=_empty(),
+                    html.Div([dcc.Graph(id=f"g-{g}", figure=_empty(), config={"displaylogo": False},
                                         style={"height": "330px"}) for g in GRAPHS],
                              style={"display": "grid", "gridTemplateColumns": "1fr 1fr"}),
                     html.Div(id="images"),
