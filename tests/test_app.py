@@ -214,6 +214,9 @@ def test_address_round_trip():
     name, back, err = from_query("?clearance=2+mm&nope=1")
     assert back == {"rc": "2 mm"} and "nope" in err
     assert from_query("?model=nosuch")[2].startswith("address: unknown model")
+    # a link never imports code: module:object paths are refused (the CLI accepts them)
+    name, back, err = from_query("?model=os:path&rc=1+mm")
+    assert (name, back) == ("compressor", {}) and "unknown model 'os:path'" in err
 
 
 def test_downloaded_config_runs_on_the_command_line(tmp_path):

@@ -22,7 +22,7 @@ from urllib.parse import parse_qsl, urlencode
 from ..defaults import ATOL_RANGE, RTOL_RANGE, SIMULATION
 from ..errors import ParameterError
 from ..model.protocol import Param
-from ..model.registry import DEFAULT_MODEL, get_model
+from ..model.registry import DEFAULT_MODEL, get_model, model_names
 from ..units import to_si
 
 __all__ = ["Field", "fields", "read_form", "format_value", "to_query", "from_query",
@@ -277,13 +277,15 @@ def to_query(model: Any, texts: dict[str, Any]) -> str:
 
 def from_query(search: str | None) -> tuple[str, dict[str, str], str]:
     """``(model name, field texts, error)`` from an address query; parameter aliases are
-    accepted and unknown names reported in ``error`` (the known ones are still read)."""
+    accepted and unknown names reported in ``error`` (the known ones are still read). Only
+    registered model names are accepted, never a ``module:object`` path (opening a link must
+    not import a file)."""
     pairs = parse_qsl((search or "").lstrip("?"), keep_blank_values=True)
     spec = dict(pairs).get("model") or DEFAULT_MODEL
-    try:
-        m = get_model(spec)
-    except ParameterError as exc:
-        return DEFAULT_MODEL, {}, f"address: {exc}"
+    if spec not in model_names():  # never a module:object path: a link must not import code
+        return DEFAULT_MODEL, {}, (f"address: unknown model {spec!r}; known: "
+                                   f"{', '.join(model_names())}")  # fmt: skip
+    m = get_model(spec)
     keys = {f.key for f in fields(m)}
     texts, unknown = {}, []
     for k, v in pairs:

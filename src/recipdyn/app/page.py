@@ -156,7 +156,8 @@ def build_app(store: str | Path | None = None):
                 html.Div(id="model-help", style={"fontSize": "12px", "color": "#444",
                                                  "margin": "4px 0"}),
                 html.Div("Type values with units ('0.5 mm', '300 rpm', '3 bar'); a bare number "
-                         "is read in the unit beside the field. Hover a name for its meaning.",
+                         "is read in the unit beside the field. Hover a name for its meaning. "
+                         "A model's first run on a machine compiles it (a minute or two).",
                          style={"fontSize": "12px", "color": "#444", "marginBottom": "6px"}),
                 html.Button("Simulate", id="run", n_clicks=0, style=button),
                 html.Button("Download config", id="dl", n_clicks=0, style=button,
