@@ -232,8 +232,8 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
         if m.name == DEFAULT_MODEL:
             from ..config import build_params
 
-            form.params = build_params({k: "default" if k == "theta_c0" and v is None else v
-                                        for k, v in values.items()})  # fmt: skip
+            # the compressor's own parameter class and its checks across parameters
+            form.params = build_params(values)
         else:
             form.params = m.parameters(values)
     except (ParameterError, TypeError, ValueError) as exc:

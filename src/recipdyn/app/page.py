@@ -101,6 +101,9 @@ def run_page(model: str, texts: dict[str, Any]) -> PageResult:
     message is given to its field (or to ``general``)."""
     from ..integrate import IntegrationError
 
+    if model not in model_names():  # the page offers registered models only
+        return PageResult([_empty() for _ in GRAPHS], [], [f"not run: unknown model {model!r}"],
+                          general=f"unknown model {model!r}")  # fmt: skip
     form = read_form(model, texts)
     blank = PageResult([_empty() for _ in GRAPHS], [], [], dict(form.errors), form.general)
     if not form.ok:
@@ -254,6 +257,8 @@ def build_app(store: str | Path | None = None):
         prevent_initial_call=True,
     )  # fmt: skip
     def _download(_n, name, *state):
+        if name not in model_names():
+            raise PreventUpdate
         form = read_form(name, form_texts(*state))
         if not form.ok:
             bad = "; ".join([*form.errors.values(), form.general][: len(form.errors) or 1])
