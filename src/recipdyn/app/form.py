@@ -232,8 +232,9 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
         if m.name == DEFAULT_MODEL:
             from ..config import build_params
 
-            # the compressor's own parameter class and its checks across parameters
-            form.params = build_params(values)
+            # the compressor's own parameter class and its checks across parameters; an
+            # empty optional field (None) is its default: derived by the model
+            form.params = build_params({k: v for k, v in values.items() if v is not None})
         else:
             form.params = m.parameters(values)
     except (ParameterError, TypeError, ValueError) as exc:
