@@ -186,7 +186,7 @@ def test_the_contact_model_draws_simulates_figure():
     assert "rc = 0.5 mm" in res.status[0]
     assert any(line.startswith("contact_fraction = ") for line in res.status)
     assert len(res.images) == 1
-    ds = simulate_form(read_form("compressor-contact", {"rc": "0.5 mm", **SHORT}))
+    ds, _ = simulate_form(read_form("compressor-contact", {"rc": "0.5 mm", **SHORT}))
     assert "ex" in ds and _png_size(images(ds)[0][1]) == _sizes(ds, [contact_figure])
     assert _png_size(res.images[0][1]) == _sizes(ds, [contact_figure])
 
@@ -199,8 +199,33 @@ def test_the_compression_cycle_adds_its_figure():
     texts = {"load": "cycle", **SHORT}
     res = run_page("compressor", texts)
     assert [t.split(" ")[0] for t, _ in res.images] == ["figure", "compression"]
-    ds = simulate_form(read_form("compressor", texts))
+    ds, notes = simulate_form(read_form("compressor", texts))
     assert [_png_size(u) for _, u in res.images] == _sizes(ds, [response_figure, cycle_figure])
+    # this run leaves the massless link's validity (the contact force turns negative): said
+    # once, from the record, not again as a warning
+    assert notes == [] and ds.attrs["validity"] != "ok"
+    assert [line.startswith("outside the model: contact_force") for line in res.status].count(
+        True
+    ) == 1
+
+
+def test_a_runs_warnings_are_shown_on_the_page(monkeypatch):
+    """Whatever a run warns (a contact law stretched beyond its range, ...) reaches the
+    status, once per message, instead of the server's console."""
+    import sys
+    import warnings
+
+    mod = sys.modules["recipdyn.simulate"]
+    real = mod.simulate
+
+    def warned(*a, **kw):
+        for _ in range(3):
+            warnings.warn("the law is stretched", UserWarning, stacklevel=2)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(mod, "simulate", warned)
+    res = run_page("compressor", SHORT)
+    assert res.status.count("warning: the law is stretched") == 1
 
 
 def test_address_round_trip():

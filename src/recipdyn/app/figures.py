@@ -27,18 +27,24 @@ _MPL_LOCK = threading.Lock()
 
 
 def simulate_form(form: Form):
-    """Simulate a valid :class:`~recipdyn.app.form.Form` (the validity warning is kept in the
-    record's ``validity`` attribute and shown in the status)."""
+    """Simulate a valid :class:`~recipdyn.app.form.Form`; returns ``(record, warnings)``:
+    the messages of the warnings the run raised (a law stretched beyond its range, ...),
+    each once, to be shown on the page rather than on the server's console. The validity
+    warning is left out: the record's ``validity`` attribute carries it (see
+    :func:`status_lines`)."""
     from ..simulate import simulate
 
     s = form.settings
     kw = dict(revolutions=s["revolutions"], transient=s["transient"], fs=s["fs"],
               method=s["method"], rtol=s["rtol"], atol=s["atol"])  # fmt: skip
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ModelValidityWarning)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         if form.model.name == DEFAULT_MODEL:
-            return simulate(form.params, **kw)
-        return simulate(form.params, model=form.model, **kw)
+            ds = simulate(form.params, **kw)
+        else:
+            ds = simulate(form.params, model=form.model, **kw)
+    notes = [str(w.message) for w in caught if not issubclass(w.category, ModelValidityWarning)]
+    return ds, list(dict.fromkeys(notes))
 
 
 def period_of(ds) -> float | None:

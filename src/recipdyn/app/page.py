@@ -112,13 +112,14 @@ def run_page(model: str, texts: dict[str, Any]) -> PageResult:
                         else f"not run: {form.general}"]  # fmt: skip
         return blank
     try:
-        ds = simulate_form(form)
+        ds, notes = simulate_form(form)
     except (ParameterError, IntegrationError) as exc:
         blank.general = str(exc)
         blank.status = [f"not run: {exc}"]
         return blank
     m = form.model
-    return PageResult(views(ds, m), images(ds), status_lines(ds, m), query=to_query(m, texts))
+    status = status_lines(ds, m) + [f"warning: {n}" for n in notes]
+    return PageResult(views(ds, m), images(ds), status, query=to_query(m, texts))
 
 
 def click_query(store: str, click: dict, texts: dict[str, Any]) -> str:
