@@ -1,10 +1,16 @@
-"""recipdyn app: the callbacks as functions, and the page in a real headless Chromium
-(load it, change a parameter and see the plots update, click a fault-map cell and see that
-point simulated), driven through the Chrome DevTools Protocol."""
+"""recipdyn app: the form (every model's schema, units, ranges, errors per field), the page's
+functions behind each callback (run, address, config, sweep click), and the page in a real
+headless Chromium driven through the Chrome DevTools Protocol (choose the contact model,
+change a value with units, see its figures; a bad value shows its error and clears them;
+click a fault-map cell; download the config and run it with the CLI)."""
 
+import base64
+import dataclasses
 import json
+import math
 import shutil
 import socket
+import struct
 import subprocess
 import threading
 import time
@@ -13,11 +19,31 @@ import urllib.request
 import numpy as np
 import pytest
 
-from recipdyn.app import WIDGETS, build_app, point_from_click, run_figures, sweep_figure
+from recipdyn.app import (
+    GRAPHS,
+    build_app,
+    click_query,
+    config_text,
+    fields,
+    from_query,
+    log_ticks,
+    panel_for,
+    point_from_click,
+    read_form,
+    run_page,
+    sweep_figure,
+    to_query,
+)
+from recipdyn.defaults import SIMULATION
 from recipdyn.errors import ParameterError
 from recipdyn.model.parameters import CompressorParams
+from recipdyn.model.registry import get_model, model_names
+from recipdyn.plotting import contact_figure, cycle_figure, response_figure
 from recipdyn.sweep.run import run_sweep
 from recipdyn.sweep.spec import SweepSpec, parse_axis
+
+#: Short runs: the app's own default is the CLI's (10 revolutions at 10 kHz).
+SHORT = {"run.revolutions": "1", "run.fs": "2 kHz"}
 
 
 @pytest.fixture(scope="module")
@@ -29,38 +55,250 @@ def store(tmp_path_factory):
     return out
 
 
-def test_every_numeric_parameter_has_a_widget_with_its_range():
-    names = {p.name for p in WIDGETS}
-    assert {"rc", "d", "omega", "m2", "m3", "J2", "theta_c_offset"} <= names
-    assert all(p.unit is not None and p.low <= p.default <= p.high for p in WIDGETS)
+def _png_size(uri: str) -> tuple[int, int]:
+    """Width and height of a PNG data URI (from its IHDR chunk)."""
+    data = base64.b64decode(uri.split(",", 1)[1])
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", data[16:24])
 
 
-def test_run_figures_are_the_simulation():
-    figs, status = run_figures(dict(rc=1e-3, d=1e-3, omega=20.0), 2.0, 2000.0)
-    sig, spec, _, sec, _ = figs
-    a = np.asarray(sig.data[0].y)
-    assert np.abs(a).max() == pytest.approx(57.66, rel=0.01)  # the base case's peak
-    T = 2 * np.pi / 20.0
-    t_end = np.asarray(sig.data[0].x)[-1]  # the last sample, just before 2T
-    assert len(sec.data[0].x) == int(np.floor(t_end / T + 1e-9)) + 1 == 2
+# --- the form -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", model_names())
+def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
+    """Every registered model gets a field for each schema parameter a field can hold, and
+    its default texts ("1 mm", "20 rad/s", "207 GPa") read back to the defaults to the bit."""
+    m = get_model(name)
+    flds = fields(m)
+    keys = {f.key for f in flds}
+    tables = {p.name for p in m.schema if p.choices is None and not p.optional
+              and not isinstance(p.default, (int, float))}  # fmt: skip
+    assert keys >= set(m.schema.names) - tables
+    assert {"run.revolutions", "run.fs", "run.method"} <= keys
+    form = read_form(m, {f.key: f.default_text if f.choices is None else f.default
+                         for f in flds})  # fmt: skip
+    assert form.ok, form.errors
+    defaults = CompressorParams() if name == "compressor" else m.parameters()
+    assert form.params == defaults  # exact: no unit conversion rounds a default
+    assert panel_for(name, {})  # the Dash components build
+
+
+def test_fields_read_the_units_engineers_type():
+    by = {f.key: f for f in fields("compressor")}
+    assert by["rc"].unit == "mm" and by["suction_pressure"].unit == "bar"
+    assert by["omega"].unit == "rpm" and by["theta_c_offset"].unit == "deg"
+    assert by["rc"].parse("0.5 mm") == pytest.approx(0.5e-3, rel=1e-15)
+    assert by["rc"].parse("0.5") == pytest.approx(0.5e-3, rel=1e-15)  # a bare number: mm
+    assert by["rc"].parse("500 um") == pytest.approx(0.5e-3, rel=1e-15)
+    assert by["omega"].parse("300 rpm") == pytest.approx(10 * math.pi, rel=1e-15)
+    assert by["omega"].parse("20 rad/s") == 20.0
+    assert by["suction_pressure"].parse("2 bar") == pytest.approx(2e5, rel=1e-15)
+    assert by["theta_c_offset"].parse("90 deg") == pytest.approx(math.pi / 2, rel=1e-15)
+    assert by["run.fs"].parse("5 kHz") == 5000.0
+    # written back in the display unit when six digits are exact, else in SI
+    assert by["rc"].default_text == "1 mm" and by["omega"].default_text == "20 rad/s"
+    assert by["suction_pressure"].range_text() == "(0, 10000] bar"
+
+
+def test_run_settings_are_the_command_lines():
+    """The app's defaults come from recipdyn.defaults, like `recipdyn simulate`'s."""
+    s = read_form("compressor", {}).settings
+    assert s == {k: v for k, v in SIMULATION.items() if k != "h"}
+    assert s["fs"] == 10_000.0
+    assert {f.key: f.default_text for f in fields("duffing")}["run.fs"] == "10 kHz"
+
+
+@pytest.mark.parametrize(
+    ("texts", "key", "match"),
+    [
+        ({"rc": "-0.001"}, "rc", r"rc = -0.001 mm is out of range; allowed: \[0, inf\] mm"),
+        ({"rc": "3 bar"}, "rc", "cannot be converted to m"),
+        ({"d": "abc"}, "d", "unknown unit"),
+        ({"omega": ""}, "omega", "empty"),
+        ({"run.fs": "-1 kHz"}, "run.fs", "fs = -1 kHz is out of range"),
+        ({"run.revolutions": "1e6"}, "run.revolutions", "more than the app draws"),
+        # a check across parameters goes to the field it names
+        ({"suction_pressure": "5 bar"}, "discharge_pressure", "suction_pressure"),
+        ({"m2": "0", "m3": "0", "J2": "0"}, "m2", "at least one must be > 0"),
+    ],
+)
+def test_a_bad_value_is_told_at_its_field(texts, key, match):
+    form = read_form("compressor", texts)
+    assert list(form.errors) == [key]
+    assert __import__("re").search(match, form.errors[key]), form.errors[key]
+
+
+def test_every_bad_field_gets_its_message_at_once():
+    form = read_form("compressor-contact", {"rc": "-1 mm", "restitution": "2", "bore": "x"})
+    assert set(form.errors) == {"rc", "restitution", "bore"}
+    assert "allowed: (0, 1]" in form.errors["restitution"]
+
+
+# --- the page's functions -----------------------------------------------------------------
+
+
+def test_a_bad_value_clears_the_figures():
+    res = run_page("compressor", {"rc": "-0.001", **SHORT})
+    assert res.query is None and res.images == []
+    assert all(len(f.data) == 0 for f in res.figures) and len(res.figures) == len(GRAPHS)
+    assert res.errors["rc"].startswith("rc = -0.001 mm")
+    assert "1 field(s) to correct (rc)" in res.status[0]
+
+
+def test_the_views_are_the_simulated_record():
+    """The signal view is the record's acceleration sample for sample, and the section has
+    one point per revolution; the base case's peak is the known 57.66 m/s^2."""
+    from recipdyn import simulate
+
+    res = run_page("compressor", {"run.revolutions": "2", "run.fs": "2 kHz"})
+    ds = simulate(CompressorParams(), revolutions=2, fs=2000.0)
+    sig, spec, _, sec = res.figures
+    assert np.array_equal(np.asarray(sig.data[0].y), ds["a"].values)
+    assert np.abs(ds["a"].values).max() == pytest.approx(57.66, rel=0.01)
+    assert len(sec.data[0].x) == 2  # strobe times 0 and T in [0, 2T)
     assert spec.layout.yaxis.type == "log"
-    assert "rc = 1 mm" in status
-    with pytest.raises(ParameterError, match="rc"):
-        run_figures(dict(rc=-1.0), 1.0, 2000.0)
-    with pytest.raises(ParameterError, match="revolutions"):
-        run_figures({}, 0.0, 2000.0)
+    assert res.query == "?model=compressor&run.revolutions=2&run.fs=2+kHz"
+    assert [t for t, _ in res.images] == ["figure of recipdyn simulate"]
+    assert _png_size(res.images[0][1]) == _sizes(ds, [response_figure])
+
+
+def _sizes(ds, makers, dpi=80):
+    """Pixel sizes of the figures ``makers`` draw for ``ds`` (what the app's images are)."""
+    from recipdyn.plotting import _mpl
+
+    out = []
+    for make in makers:
+        fig = make(ds)
+        out.append(tuple(int(round(v * dpi)) for v in fig.get_size_inches()))
+        _mpl().close(fig)
+    return out[0] if len(out) == 1 else out
+
+
+def test_the_contact_model_draws_simulates_figure():
+    """The contact joint's run: its summary in the status, and its image is the figure
+    `recipdyn simulate` draws (contact_figure: journal orbit, joint forces, impact map). The
+    first compilation of the contact model takes about a minute."""
+    from recipdyn.app import images, simulate_form
+
+    res = run_page("compressor-contact", {"rc": "0.5 mm", **SHORT})
+    assert res.query is not None, res.status
+    assert "rc = 0.5 mm" in res.status[0]
+    assert any(line.startswith("contact_fraction = ") for line in res.status)
+    assert len(res.images) == 1
+    ds, _ = simulate_form(read_form("compressor-contact", {"rc": "0.5 mm", **SHORT}))
+    assert "ex" in ds and _png_size(images(ds)[0][1]) == _sizes(ds, [contact_figure])
+    assert _png_size(res.images[0][1]) == _sizes(ds, [contact_figure])
+
+
+def test_the_compression_cycle_adds_its_figure():
+    """With load = cycle the app also shows the cycle figure (p-V, pressures, rod load),
+    as `recipdyn simulate` writes it beside the record."""
+    from recipdyn.app import simulate_form
+
+    texts = {"load": "cycle", **SHORT}
+    res = run_page("compressor", texts)
+    assert [t.split(" ")[0] for t, _ in res.images] == ["figure", "compression"]
+    ds, notes = simulate_form(read_form("compressor", texts))
+    assert [_png_size(u) for _, u in res.images] == _sizes(ds, [response_figure, cycle_figure])
+    # this run leaves the massless link's validity (the contact force turns negative): said
+    # once, from the record, not again as a warning
+    assert notes == [] and ds.attrs["validity"] != "ok"
+    assert [line.startswith("outside the model: contact_force") for line in res.status].count(
+        True
+    ) == 1
+
+
+def test_a_runs_warnings_are_shown_on_the_page(monkeypatch):
+    """Whatever a run warns (a contact law stretched beyond its range, ...) reaches the
+    status, once per message, instead of the server's console."""
+    import sys
+    import warnings
+
+    mod = sys.modules["recipdyn.simulate"]
+    real = mod.simulate
+
+    def warned(*a, **kw):
+        for _ in range(3):
+            warnings.warn("the law is stretched", UserWarning, stacklevel=2)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(mod, "simulate", warned)
+    res = run_page("compressor", SHORT)
+    assert res.status.count("warning: the law is stretched") == 1
+
+
+def test_address_round_trip():
+    texts = {"rc": "0.5 mm", "omega": "300 rpm", "d": "1 mm", "run.revolutions": "2"}
+    q = to_query("compressor", texts)
+    assert q == "?model=compressor&rc=0.5+mm&omega=300+rpm&run.revolutions=2"  # d: default
+    name, back, err = from_query(q)
+    assert (name, err) == ("compressor", "")
+    assert back == {"rc": "0.5 mm", "omega": "300 rpm", "run.revolutions": "2"}
+    # aliases are read, unknown names reported, the rest kept
+    name, back, err = from_query("?clearance=2+mm&nope=1")
+    assert back == {"rc": "2 mm"} and "nope" in err
+    assert from_query("?model=nosuch")[2].startswith("address: unknown model")
+    # a link never imports code: module:object paths are refused (the CLI accepts them)
+    name, back, err = from_query("?model=os:path&rc=1+mm")
+    assert (name, back) == ("compressor", {}) and "unknown model 'os:path'" in err
+
+
+def test_downloaded_config_runs_on_the_command_line(tmp_path):
+    """The config the app writes is what `recipdyn simulate -c FILE` runs: the same model,
+    parameters (from mm and rpm) and settings in the record."""
+    import xarray as xr
+
+    from recipdyn.cli import main
+
+    form = read_form("compressor", {"rc": "0.5 mm", "omega": "300 rpm", **SHORT})
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(config_text(form), encoding="utf-8")
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["param_rc"] == form.params.rc == 0.5e-3
+        assert ds.attrs["param_omega"] == pytest.approx(10 * math.pi, rel=1e-15)
+        assert ds.attrs["sampling_rate_hz"] == 2000.0 and ds.attrs["revolutions"] == 1.0
+
+
+# --- the sweep browser --------------------------------------------------------------------
+
+
+def test_log_ticks():
+    assert log_ticks(0.2, 2.0) == pytest.approx([0.2, 0.5, 1.0, 2.0])
+    assert log_ticks(1e-4, 1.0) == pytest.approx([1e-4, 1e-3, 1e-2, 0.1, 1.0])
+    assert log_ticks(3.0, 4.0) == [3.0, 4.0]  # no 1-2-5 value inside: the ends
 
 
 def test_sweep_figure_and_click(store):
     fig, options, shown = sweep_figure(store)
     assert shown == "peak_a" and "peak_a" in options
-    assert fig.layout.yaxis.type == "log"  # rc was swept on a log grid
-    values = point_from_click(store, {"points": [{"x": 2.1e-3, "y": 0.62e-3}]})
+    x = fig.layout.xaxis  # d, linear, in mm
+    y = fig.layout.yaxis  # rc, swept on a log grid, in mm with readable 1-2-5 labels
+    assert x.title.text == "d (mm)" and x.type is None
+    assert np.allclose(fig.data[0].x, [0, 2]) and np.allclose(fig.data[0].y, [0.2, 0.632, 2],
+                                                              rtol=1e-3)  # fmt: skip
+    assert y.type == "log" and y.title.text == "rc (mm)"
+    assert list(y.ticktext) == ["0.2", "0.5", "1", "2"]
+    name, values = point_from_click(store, {"points": [{"x": 2.1, "y": 0.62}]})
+    assert name == "compressor"
     assert values["d"] == pytest.approx(2e-3)
-    assert values["rc"] == pytest.approx(np.sqrt(0.2e-3 * 2e-3), rel=1e-12)  # the log grid's middle
-    assert CompressorParams(**values).rc == values["rc"]
+    assert values["rc"] == pytest.approx(np.sqrt(0.2e-3 * 2e-3), rel=1e-12)  # the log middle
+    q = click_query(store, {"points": [{"x": 2.1, "y": 0.62}]}, {"run.revolutions": "1"})
+    form = read_form(*from_query(q)[:2])
+    assert form.params.rc == values["rc"]  # the text is exact
+    assert form.settings["revolutions"] == 1.0
     with pytest.raises(ParameterError, match="not found"):
         sweep_figure(store / "nope")
+
+
+def test_the_app_builds_with_every_callback(store):
+    app = build_app(store)
+    outputs = " ".join(app.callback_map)
+    for part in ("panel.children", "g-signal.figure", "download.data", "sweep.figure",
+                 "nav.search"):  # fmt: skip
+        assert part in outputs
 
 
 # --- a real browser -----------------------------------------------------------------------
@@ -73,12 +311,12 @@ def _free_port() -> int:
 
 
 class _Page:
-    """A minimal Chrome DevTools Protocol client: evaluate JavaScript in one page."""
+    """A minimal Chrome DevTools Protocol client: evaluate JavaScript, type, click."""
 
     def __init__(self, ws_url):
         import websocket
 
-        self.ws = websocket.create_connection(ws_url, timeout=60)
+        self.ws = websocket.create_connection(ws_url, timeout=120)
         self.n = 0
 
     def call(self, method, **params):
@@ -94,7 +332,7 @@ class _Page:
                         awaitPromise=True)  # fmt: skip
         return res.get("result", {}).get("value")
 
-    def wait(self, expr, timeout=90.0):
+    def wait(self, expr, timeout=120.0):
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             value = self.js(expr)
@@ -102,25 +340,60 @@ class _Page:
                 return value
             time.sleep(0.3)
         raise AssertionError(
-            f"timed out waiting for {expr}: {self.js('document.body.innerText')[:500]}"
+            f"timed out waiting for {expr}: {self.js('document.body.innerText')[:800]}"
         )
+
+    def click(self, element_js):
+        """A real mouse click (pointer events) at the centre of an element."""
+        x, y = self.js(f"(() => {{ const e = {element_js}; e.scrollIntoView({{block: 'center'}});"
+                       " const b = e.getBoundingClientRect();"
+                       " return [b.x + b.width / 2, b.y + b.height / 2]; })()")  # fmt: skip
+        for kind in ("mouseMoved", "mousePressed", "mouseReleased"):
+            self.call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left",
+                      clickCount=1)  # fmt: skip
+
+    def type_into(self, field_key, text, enter=False):
+        """Select a field's text and type ``text`` (real key events)."""
+        el = f'document.getElementById(\'{{"key":"{field_key}","type":"field"}}\')'
+        self.js(f"(() => {{ const el = {el}; el.scrollIntoView(); el.focus(); el.select(); }})()")
+        self.call("Input.insertText", text=text)
+        if enter:
+            for kind, text in (("keyDown", "\r"), ("keyUp", "")):  # keyDown + text: keypress
+                self.call("Input.dispatchKeyEvent", type=kind, key="Enter", code="Enter",
+                          text=text, windowsVirtualKeyCode=13, nativeVirtualKeyCode=13)  # fmt: skip
+        return self.js(f"{el}.value")
+
+
+_STATUS = "(document.getElementById('status') || {innerText: ''}).innerText"
+_POINTS = ("(() => { const g = document.querySelector('#g-signal .js-plotly-plot');"
+           " return g && g._fullData ? g._fullData.length && g._fullData[0].y.length : -1; })()")  # fmt: skip  # noqa: E501
+_IMAGE = ("(() => { const i = document.querySelector('#images img');"
+          " return i && i.complete && i.naturalWidth; })()")  # fmt: skip
 
 
 @pytest.mark.browser
-def test_app_in_headless_chromium(store, tmp_path):
+def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
     if exe is None:
         pytest.skip("chromium is not installed (CI installs it in .ci/run)")
     from werkzeug.serving import make_server
 
+    import recipdyn.app.page as page
+
+    runs = []  # every simulation the page asks for (no loops, no double runs)
+    real = page.run_page
+    monkeypatch.setattr(page, "run_page", lambda m, t: runs.append(m) or real(m, t))
+    # compile (or load) the two models first, so the page waits for runs, not compilers
+    assert run_page("compressor-contact", SHORT).query is not None
     port = _free_port()
     server = make_server("127.0.0.1", port, build_app(store).server, threaded=True)
     threading.Thread(target=server.serve_forever, daemon=True).start()
-    profile = tmp_path / "profile"
+    profile, downloads = tmp_path / "profile", tmp_path / "downloads"
     proc = subprocess.Popen(
         [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         f"--user-data-dir={profile}", "--remote-debugging-port=0", "about:blank"],
+         f"--user-data-dir={profile}", "--remote-debugging-port=0", "--window-size=1400,1000",
+         "about:blank"],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )  # fmt: skip
     try:
@@ -131,51 +404,73 @@ def test_app_in_headless_chromium(store, tmp_path):
             time.sleep(0.1)
         cdp_port = int((profile / "DevToolsActivePort").read_text().split()[0])
         targets = json.load(urllib.request.urlopen(f"http://127.0.0.1:{cdp_port}/json/list"))
-        page = _Page(next(t for t in targets if t["type"] == "page")["webSocketDebuggerUrl"])
-        page.call("Page.navigate", url=f"http://127.0.0.1:{port}/")
-        # the page loads and the first simulation (the base case) is drawn
-        first = page.wait("(document.getElementById('status')||{}).innerText")
-        assert "omega = 20 rad/s" in first
-        n_points = page.wait(
-            "(() => { const g = document.querySelector('#g-signal "
-            ".js-plotly-plot'); return g && g._fullData && g._fullData.length"
-            " && g._fullData[0].y.length; })()"
-        )  # decoded by plotly.js
-        assert n_points > 1000
-        # change a parameter by typing into its field (real key events) and pressing Enter
-        page.js(
-            "(() => { const el = document.getElementById('p-omega'); el.focus(); el.select(); })()"
-        )
-        page.call("Input.insertText", text="40")
-        for kind in ("keyDown", "keyUp"):
-            page.call("Input.dispatchKeyEvent", type=kind, key="Enter", code="Enter",
-                      windowsVirtualKeyCode=13, nativeVirtualKeyCode=13)  # fmt: skip
-        assert page.js("document.getElementById('p-omega').value") == "40"
-        page.js("document.getElementById('run').click()")
-        status = page.wait(
-            "(() => { const s = document.getElementById('status').innerText;"
-            " return s.includes('omega = 40') && s; })()"
-        )
-        assert "omega = 40 rad/s" in status
-        # the fault map is drawn; click its (rc = 2 mm, d = 2 mm) cell
-        page.wait(
-            "(() => { const g = document.querySelector('#sweep .js-plotly-plot');"
-            " return g && g._fullData && g._fullData.length"
-            " && g._fullData[0].type === 'heatmap'; })()"
-        )
-        page.js("""(() => { const g = document.querySelector('#sweep .js-plotly-plot');
-            g.emit('plotly_click', {points: [{x: 0.002, y: 0.002, curveNumber: 0,
+        page_ = _Page(next(t for t in targets if t["type"] == "page")["webSocketDebuggerUrl"])
+        page_.call("Browser.setDownloadBehavior", behavior="allow",
+                   downloadPath=str(downloads))  # fmt: skip
+        # 1. the address opens the compressor with short run settings and runs it once
+        page_.call("Page.navigate", url=f"http://127.0.0.1:{port}/?run.revolutions=1"
+                   "&run.fs=2+kHz")  # fmt: skip
+        assert "compressor: 629 samples" in page_.wait(f"{_STATUS}.includes('compressor:') "
+                                                        f"&& {_STATUS}")  # fmt: skip
+        assert page_.wait(f"{_POINTS} > 100 && {_POINTS}") == 629  # decoded by plotly.js
+        assert page_.wait(_IMAGE) > 500  # simulate's figure, decoded
+        assert runs == ["compressor"]
+        # 2. choose the contact model with the mouse: its panel, its run, its figure
+        page_.click("document.getElementById('model')")
+        page_.click("[...document.querySelectorAll('[role=option]')]"
+                    ".find(e => e.innerText.trim() === 'compressor-contact')")  # fmt: skip
+        page_.wait(f"{_STATUS}.includes('compressor-contact:')")
+        assert page_.js("location.search") == (
+            "?model=compressor-contact&run.revolutions=1&run.fs=2+kHz"
+        )  # the settings are kept
+        assert page_.wait(_IMAGE) > 500  # the contact figure (journal orbit, forces)
+        assert page_.js("document.body.innerText.includes('rc_crosshead')")
+        # 3. a value with units, typed and entered: the figures follow it
+        src = page_.js("document.querySelector('#images img').src")
+        assert page_.type_into("rc", "0.5 mm", enter=True) == "0.5 mm"
+        assert "rc = 0.5 mm" in page_.wait(f"{_STATUS}.includes('rc = 0.5 mm') && {_STATUS}")
+        page_.wait(f"document.querySelector('#images img').src !== {json.dumps(src)}")
+        assert page_.js("location.search").endswith("&rc=0.5+mm&run.revolutions=1&run.fs=2+kHz")
+        assert runs == ["compressor", "compressor-contact", "compressor-contact"]
+        # 4. the config it downloads runs on the command line (checked in
+        # test_downloaded_config_runs_on_the_command_line); here: it arrives, with rc
+        page_.click("document.getElementById('dl')")
+        toml = downloads / "recipdyn-compressor-contact.toml"
+        for _ in range(100):
+            if toml.exists() and toml.stat().st_size:
+                break
+            time.sleep(0.2)
+        assert 'model = "compressor-contact"' in toml.read_text()
+        assert "\nrc = 0.0005  #" in toml.read_text()
+        # 5. a bad value: its message beside the field, the figures cleared
+        page_.type_into("rc", "-0.001")
+        page_.click("document.getElementById('run')")
+        err = page_.wait("document.getElementById('{\"key\":\"rc\",\"type\":\"ferr\"}')"
+                         ".innerText")  # fmt: skip
+        assert err == "rc = -0.001 mm is out of range; allowed: (0, inf] mm"
+        assert page_.wait(f"{_POINTS} === 0") and page_.js(
+            "document.querySelectorAll('#images img').length") == 0  # fmt: skip
+        assert "not run" in page_.js(_STATUS)
+        frame = 'document.getElementById(\'{"key":"rc","type":"field"}\').parentElement'
+        assert page_.js(f"getComputedStyle({frame}).borderColor") == "rgb(176, 0, 32)"  # red
+        # 6. click the fault map's (rc = 2 mm, d = 2 mm) cell: that point of the
+        # compressor's sweep opens in the panel and runs
+        page_.wait("(() => { const g = document.querySelector('#sweep .js-plotly-plot');"
+                   " return g && g._fullData && g._fullData.length"
+                   " && g._fullData[0].type === 'heatmap'; })()")  # fmt: skip
+        page_.js("""(() => { const g = document.querySelector('#sweep .js-plotly-plot');
+            g.emit('plotly_click', {points: [{x: 2, y: 2, curveNumber: 0,
                                               pointNumber: [2, 1]}]}); })()""")
-        status = page.wait(
-            "(() => { const s = document.getElementById('status').innerText;"
-            " return s.includes('rc = 2 mm') && s; })()"
-        )
-        assert "d = 2 mm" in status
-        assert page.js("document.getElementById('p-rc').value") in (
-            "0.002",
-            "0.0020000000000000005",
-        )
+        status = page_.wait(f"{_STATUS}.includes('compressor: ') && {_STATUS}")
+        assert "rc = 2 mm, d = 2 mm" in status
+        assert page_.js("document.getElementById('{\"key\":\"rc\",\"type\":\"field\"}')"
+                        ".value") == "2 mm"  # fmt: skip
+        assert runs[-1] == "compressor" and len(runs) == 5
+        # 7. the address reopens the same run in a fresh page
+        search = page_.js("location.search")
+        assert "rc=2+mm" in search and "d=2+mm" in search
     finally:
         proc.terminate()
         proc.wait(timeout=30)
         server.shutdown()
+    assert dataclasses.is_dataclass(read_form(*from_query(search)[:2]).params)

@@ -17,11 +17,11 @@ def app_command(
         "127.0.0.1", "--host", help="Address to listen on (default: this machine only)."
     ),
 ) -> None:
-    """Explore the compressor in the browser: live simulation and a sweep browser.
+    """Explore every registered model in the browser, with live simulation and a sweep browser.
 
-    Every parameter is a widget with its unit and range; the simulation shows the signal,
-    spectrum, phase portrait, Poincaré section and clearance link; the sweep browser a fault
-    map or bifurcation diagram (click a point to run it)."""
+    Its parameters in engineering units (mm, bar, rpm) with their ranges, the figures
+    'recipdyn simulate' draws, a shareable address and config, and a sweep browser (fault map
+    or bifurcation diagram; click a point to run it)."""
     from ..app import build_app
     from ..errors import ParameterError
 

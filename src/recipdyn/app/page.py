@@ -1,0 +1,297 @@
+"""The page: layout and callbacks. Each callback is a thin wrapper around a plain function
+of this module (``panel_for``, ``run_page``, ...), which the tests call without a browser.
+
+State lives in the address: ``?model=compressor-contact&rc=0.5+mm&run.revolutions=2`` opens
+that model with those fields and runs it. Choosing a model, clicking a sweep point or a run
+that succeeds writes the address (one history entry each), so the browser's back button and a
+copied link give the same page.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+from ..model.registry import DEFAULT_MODEL, get_model, model_names
+from .figures import images, simulate_form, status_lines, views
+from .form import RUN, Field, config_text, fields, format_value, from_query, read_form, to_query
+
+__all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "GRAPHS"]
+
+#: The interactive views, in the order :func:`recipdyn.app.figures.views` returns them.
+GRAPHS = ("signal", "spectrum", "phase", "section")
+_RED = "#B00020"
+_INPUT = {"width": "12em"}
+
+
+def _field_row(f: Field, text: Any) -> Any:
+    from dash import dcc, html
+
+    tip = f.description + (f" [assumed: {f.assumed}]" if f.assumed else "")
+    if f.choices is not None:
+        widget = dcc.Dropdown(id={"type": "choice", "key": f.key}, options=list(f.choices),
+                              value=text if text in f.choices else f.default, clearable=False,
+                              style={"width": "13em"})  # fmt: skip
+    else:
+        widget = dcc.Input(id={"type": "field", "key": f.key}, type="text", value=text,
+                           placeholder="derived" if f.optional else f.default_text,
+                           debounce=False, style=_INPUT)  # fmt: skip
+    unit = f.unit.replace("**2", "²").replace("**1.5", "^1.5")
+    return html.Div([
+        html.Div([
+            html.Label(f.name, title=tip, style={"width": "10.5em", "display": "inline-block",
+                                                  "fontWeight": "bold" if f.assumed == "" else
+                                                  "normal"}),
+            html.Div(widget, style={"display": "inline-block", "verticalAlign": "middle"}),
+            html.Span(f" {unit}" if unit and f.choices is None else "",
+                      style={"marginLeft": "0.3em"}),
+            html.Span(" assumed", title=f.assumed, style={"color": "#D55E00"})
+            if f.assumed else None,
+        ]),
+        html.Div(f"allowed {f.range_text()}" + ("; empty: derived" if f.optional else ""),
+                 style={"color": "#666", "fontSize": "11px", "marginLeft": "10.5em"}),
+        html.Div(id={"type": "ferr", "key": f.key},
+                 style={"color": _RED, "fontSize": "12px", "marginLeft": "10.5em"}),
+    ], style={"marginBottom": "4px"})  # fmt: skip
+
+
+def panel_for(model: str, texts: dict[str, str]) -> list[Any]:
+    """The parameter panel of ``model``: one group per schema group (the run settings last),
+    each field holding ``texts[key]`` or its default."""
+    from dash import html
+
+    groups: dict[str, list[Any]] = {}
+    for f in fields(model):
+        text = texts.get(f.key, f.default if f.choices is not None else f.default_text)
+        groups.setdefault("run" if f.key.startswith(RUN) else f.group, []).append(
+            _field_row(f, text)
+        )
+    return [html.Details([html.Summary(g, style={"fontWeight": "bold", "cursor": "pointer"}),
+                          *rows], open=True, style={"marginBottom": "6px"})
+            for g, rows in groups.items()]  # fmt: skip
+
+
+@dataclass
+class PageResult:
+    """What a Simulate press puts on the page."""
+
+    figures: list[Any]
+    images: list[tuple[str, str]]
+    status: list[str]
+    errors: dict[str, str] = field(default_factory=dict)
+    general: str = ""
+    query: str | None = None  #: the address of the run (None: the run failed)
+
+
+def _empty() -> Any:
+    import plotly.graph_objects as go
+
+    return go.Figure().update_layout(
+        xaxis_visible=False,
+        yaxis_visible=False,
+        plot_bgcolor="white",
+        margin=dict(l=10, r=10, t=10, b=10),
+    )
+
+
+def run_page(model: str, texts: dict[str, Any]) -> PageResult:
+    """Read the form, simulate and draw; with any error the figures are cleared and each
+    message is given to its field (or to ``general``)."""
+    from ..integrate import IntegrationError
+
+    if model not in model_names():  # the page offers registered models only
+        return PageResult([_empty() for _ in GRAPHS], [], [f"not run: unknown model {model!r}"],
+                          general=f"unknown model {model!r}")  # fmt: skip
+    form = read_form(model, texts)
+    blank = PageResult([_empty() for _ in GRAPHS], [], [], dict(form.errors), form.general)
+    if not form.ok:
+        n = len(form.errors)
+        blank.status = [f"not run: {n} field(s) to correct ({', '.join(form.errors)})" if n
+                        else f"not run: {form.general}"]  # fmt: skip
+        return blank
+    try:
+        ds, notes = simulate_form(form)
+    except (ParameterError, IntegrationError) as exc:
+        blank.general = str(exc)
+        blank.status = [f"not run: {exc}"]
+        return blank
+    m = form.model
+    status = status_lines(ds, m) + [f"warning: {n}" for n in notes]
+    return PageResult(views(ds, m), images(ds), status, query=to_query(m, texts))
+
+
+def click_query(store: str, click: dict, texts: dict[str, Any]) -> str:
+    """The address of the sweep point under ``click``: the store's model and base case with
+    the clicked values, and the run settings of the form."""
+    from .sweeps import point_from_click
+
+    name, values = point_from_click(store, click)
+    by_key = {f.key: f for f in fields(name)}
+    out = {k: format_value(v, by_key[k]) for k, v in values.items() if k in by_key}
+    out.update({k: v for k, v in texts.items() if k.startswith(RUN)})
+    return to_query(name, out)
+
+
+def _texts(ids: list[dict], values: list[Any]) -> dict[str, Any]:
+    return {i["key"]: v for i, v in zip(ids, values, strict=True)}
+
+
+def build_app(store: str | Path | None = None):
+    """The Dash application (``app.run(port=...)`` serves it)."""
+    from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
+    from dash.exceptions import PreventUpdate
+
+    app = Dash(__name__, title="recipdyn")
+    options = [{"label": f"{n}" + (" (default)" if n == DEFAULT_MODEL else ""), "value": n}
+               for n in model_names()]  # fmt: skip
+    button = {"marginRight": "0.5em", "marginTop": "0.5em"}
+    app.layout = html.Div([
+        dcc.Location(id="url", refresh=False),
+        dcc.Location(id="nav", refresh="callback-nav"),
+        dcc.Store(id="shown"), dcc.Store(id="go", data=0), dcc.Download(id="download"),
+        html.H2("recipdyn: reciprocating compressor dynamics", style={"margin": "4px 0"}),
+        html.Div([
+            html.Div([
+                html.Label("model ", htmlFor="model", style={"fontWeight": "bold"}),
+                dcc.Dropdown(id="model", options=options, value=DEFAULT_MODEL,
+                             clearable=False),
+                html.Div(id="model-help", style={"fontSize": "12px", "color": "#444",
+                                                 "margin": "4px 0"}),
+                html.Div("Type values with units ('0.5 mm', '300 rpm', '3 bar'); a bare number "
+                         "is read in the unit beside the field. Hover a name for its meaning. "
+                         "A model's first run on a machine compiles it (a minute or two).",
+                         style={"fontSize": "12px", "color": "#444", "marginBottom": "6px"}),
+                html.Button("Simulate", id="run", n_clicks=0, style=button),
+                html.Button("Download config", id="dl", n_clicks=0, style=button,
+                            title="a TOML file that 'recipdyn simulate -c FILE' runs"),
+                html.Div(id="form-error", style={"color": _RED}),
+                html.Div(id="dl-msg", style={"color": _RED, "fontSize": "12px"}),
+                html.Div([
+                    html.Div(id="panel"),
+                    html.H4("Sweep browser"),
+                    dcc.Input(id="store", type="text", value=str(store) if store else "",
+                              placeholder="folder of a sweep", style={"width": "20em"}),
+                    html.Button("Open", id="open", n_clicks=0),
+                    dcc.Dropdown(id="sweep-var", options=[], value=None),
+                ], id="panel-scroll", style={"maxHeight": "calc(100vh - 230px)",
+                                             "overflowY": "auto", "marginTop": "6px",
+                                             "borderTop": "1px solid #ccc"}),
+            ], style={"width": "31em", "flex": "none", "fontSize": "13px"}),
+            html.Div([
+                html.Div(id="status", style={"fontFamily": "monospace", "margin": "4px",
+                                             "whiteSpace": "pre-wrap"}),
+                dcc.Loading(html.Div([
+                    html.Div([dcc.Graph(id=f"g-{g}", figure=_empty(), config={"displaylogo": False},
+                                        style={"height": "330px"}) for g in GRAPHS],
+                             style={"display": "grid", "gridTemplateColumns": "1fr 1fr"}),
+                    html.Div(id="images"),
+                ])),
+                dcc.Graph(id="sweep", style={"height": "480px"}, figure=_empty().update_layout(
+                    title="sweep browser: open a sweep folder to see its map")),
+            ], style={"flex": "1", "minWidth": "0"}),
+        ], style={"display": "flex", "gap": "1em"}),
+    ], style={"fontFamily": "sans-serif"})  # fmt: skip
+
+    fields_state = [State({"type": "field", "key": ALL}, "value"),
+                    State({"type": "field", "key": ALL}, "id"),
+                    State({"type": "choice", "key": ALL}, "value"),
+                    State({"type": "choice", "key": ALL}, "id")]  # fmt: skip
+
+    def form_texts(fv, fi, cv, ci) -> dict[str, Any]:
+        return {**_texts(fi, fv), **_texts(ci, cv)}
+
+    @app.callback(
+        Output("model", "value"), Output("panel", "children"), Output("model-help", "children"),
+        Output("form-error", "children"), Output("go", "data"),
+        Input("url", "search"), State("shown", "data"), State("go", "data"),
+    )  # fmt: skip
+    def _panel(search, shown, go):
+        name, texts, err = from_query(search)
+        if shown is not None and to_query(name, texts) == shown:
+            raise PreventUpdate  # the run on the page is this address's run
+        return (name, panel_for(name, texts), get_model(name).description, err,
+                (go or 0) + 1)  # fmt: skip
+
+    @app.callback(
+        Output("nav", "search", allow_duplicate=True),
+        Input("model", "value"), State("url", "search"), *fields_state,
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _choose(name, search, *state):
+        if name == from_query(search)[0]:
+            raise PreventUpdate
+        run = {k: v for k, v in form_texts(*state).items() if k.startswith(RUN)}
+        return to_query(name, run)
+
+    @app.callback(
+        [Output(f"g-{g}", "figure") for g in GRAPHS]
+        + [Output("images", "children"), Output("status", "children"),
+           Output({"type": "ferr", "key": ALL}, "children"),
+           Output("form-error", "children", allow_duplicate=True),
+           Output("nav", "search", allow_duplicate=True), Output("shown", "data"),
+           Output({"type": "field", "key": ALL}, "style")],
+        Input("run", "n_clicks"), Input("go", "data"),
+        Input({"type": "field", "key": ALL}, "n_submit"),
+        State("model", "value"), State("url", "search"), *fields_state,
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _simulate(_n, _go, _submit, name, search, *state):
+        texts = form_texts(*state)
+        res = run_page(name, texts)
+        errs = [res.errors.get(o["id"]["key"], "") for o in ctx.outputs_list[6]]
+        imgs = [html.Figure([html.Img(src=src, alt=title, style={"maxWidth": "100%"}),
+                             html.Figcaption(title, style={"fontSize": "12px"})])
+                for title, src in res.images]  # fmt: skip
+        status = html.Div([html.Div(line) for line in res.status],
+                          style={"color": _RED} if res.query is None else {})  # fmt: skip
+        nav = res.query if res.query is not None and res.query != search else no_update
+        marks = [_INPUT | ({"borderColor": _RED, "outline": f"1px solid {_RED}"}
+                           if o["id"]["key"] in res.errors else {})
+                 for o in ctx.outputs_list[10]]  # fmt: skip
+        return [*res.figures, imgs, status, errs, res.general, nav, res.query, marks]
+
+    @app.callback(
+        Output("download", "data"), Output("dl-msg", "children"),
+        Input("dl", "n_clicks"), State("model", "value"), *fields_state,
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _download(_n, name, *state):
+        if name not in model_names():
+            raise PreventUpdate
+        form = read_form(name, form_texts(*state))
+        if not form.ok:
+            bad = "; ".join([*form.errors.values(), form.general][: len(form.errors) or 1])
+            return no_update, f"no config written: {bad}"
+        return dcc.send_string(config_text(form), f"recipdyn-{form.model.name}.toml"), ""
+
+    @app.callback(
+        Output("sweep", "figure"), Output("sweep-var", "options"), Output("sweep-var", "value"),
+        Input("open", "n_clicks"), Input("sweep-var", "value"), State("store", "value"),
+        prevent_initial_call=not bool(store),
+    )  # fmt: skip
+    def _open_sweep(_n, variable, store_path):
+        from .sweeps import sweep_figure
+
+        if not store_path:
+            return no_update, no_update, no_update
+        try:
+            fig, opts, shown = sweep_figure(store_path, variable)
+        except ParameterError as exc:
+            return _empty().update_layout(title=f"error: {exc}"), [], None
+        return fig, opts, shown
+
+    @app.callback(
+        Output("nav", "search", allow_duplicate=True),
+        Output("form-error", "children", allow_duplicate=True),
+        Input("sweep", "clickData"), State("store", "value"), *fields_state,
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _click(click, store_path, *state):
+        try:
+            return click_query(store_path, click, form_texts(*state)), ""
+        except ParameterError as exc:
+            return no_update, str(exc)
+
+    return app
