@@ -4,7 +4,7 @@ Choose a model (the compressor with its massless clearance link, the contact-imp
 the valves, the reference systems): its parameter panel is built from the model's schema,
 grouped as the schema groups them, each field in the unit engineers type (mm, bar, rpm, deg;
 any quantity pint reads is accepted) with its allowed range, and the run settings with the
-command line's defaults (:mod:`recipdyn.defaults`). "Simulate" runs the model and shows
+command line's defaults (`recipdyn.defaults`). "Simulate" runs the model and shows
 
 * four interactive views of the record: the model's vibration signal, its amplitude spectrum,
   a phase portrait and the stroboscopic section;

@@ -27,11 +27,11 @@ _MPL_LOCK = threading.Lock()
 
 
 def simulate_form(form: Form):
-    """Simulate a valid :class:`~recipdyn.app.form.Form`; returns ``(record, warnings)``:
+    """Simulate a valid `recipdyn.app.form.Form`; returns ``(record, warnings)``:
     the messages of the warnings the run raised (a law stretched beyond its range, ...),
     each once, to be shown on the page rather than on the server's console. The validity
     warning is left out: the record's ``validity`` attribute carries it (see
-    :func:`status_lines`)."""
+    `status_lines`)."""
     from ..simulate import simulate
 
     s = form.settings

@@ -2,12 +2,12 @@
 the units engineers type, with one error per field.
 
 A field holds text: a quantity with its unit (``"0.5 mm"``, ``"300 rpm"``, ``"3 bar"``), read
-by pint through :func:`recipdyn.units.to_si`, or a bare number, read in the field's display
+by pint through `recipdyn.units.to_si`, or a bare number, read in the field's display
 unit (shown beside it). Values are written back in the display unit when that writes them
 exactly to six digits (``0.001 m`` -> ``"1 mm"``), else in SI (``20 rad/s`` stays
 ``"20 rad/s"`` rather than an inexact ``"190.986 rpm"``), so the defaults of the form are the
-model's defaults to the bit. The same texts make the page's address (:func:`to_query`) and the
-run's config file (:func:`config_text`, read back by ``recipdyn simulate -c``).
+model's defaults to the bit. The same texts make the page's address (`to_query`) and the
+run's config file (`config_text`, read back by ``recipdyn simulate -c``).
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ class Field:
         return f"{lb}{ends[0]}, {ends[1]}{rb}" + (f" {self.unit}" if self.unit else "")
 
     def parse(self, text: Any) -> Any:
-        """The value of ``text`` in SI, checked against the range (:class:`ParameterError`
+        """The value of ``text`` in SI, checked against the range (`ParameterError`
         naming the field, the value and the range otherwise)."""
         if self.choices is not None:
             value = str(text)
@@ -212,7 +212,7 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
 
     Each field is parsed and range-checked on its own, so every bad field gets its message;
     then the model's checks across parameters run (an error there goes to the field it names)
-    and the run's length is bounded by :data:`MAX_SAMPLES`.
+    and the run's length is bounded by `MAX_SAMPLES`.
     """
     m = get_model(model)
     form = Form(m)

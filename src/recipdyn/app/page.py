@@ -20,7 +20,7 @@ from .form import RUN, Field, config_text, fields, format_value, from_query, rea
 
 __all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "GRAPHS"]
 
-#: The interactive views, in the order :func:`recipdyn.app.figures.views` returns them.
+#: The interactive views, in the order `recipdyn.app.figures.views` returns them.
 GRAPHS = ("signal", "spectrum", "phase", "section")
 _RED = "#B00020"
 _INPUT = {"width": "12em"}
