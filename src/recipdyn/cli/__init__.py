@@ -21,6 +21,7 @@ import inspect
 import json
 import os
 import sys
+from pathlib import Path
 
 import typer
 
@@ -76,6 +77,39 @@ def report(**items) -> None:
     collected = _REPORT.get()
     if collected is not None:
         collected.update(items)
+
+
+def _first_missing(path: Path) -> Path | None:
+    """The outermost folder of ``path`` (itself included) that does not exist yet."""
+    path = Path(path).absolute()
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists():
+            return missing
+        missing = folder
+    return missing  # pragma: no cover - the root exists
+
+
+@contextlib.contextmanager
+def refused_leaves_nothing(*paths: Path):
+    """A command refused inside this block (a :class:`ParameterError`, exit status 2) leaves
+    no folder behind: the folders on the way to ``paths`` that it created are removed again,
+    provided they hold no file (a finished or partial result is never removed).
+
+    Commands validate everything they can before they touch the file system; this covers the
+    refusals that can only come later (a run too large for its disk, a column name known once
+    the model is built)."""
+    created = {m for m in (_first_missing(p) for p in paths if p is not None) if m is not None}
+    try:
+        yield
+    except ParameterError:
+        import shutil
+
+        for folder in created:
+            kept = [f for f in folder.rglob("*") if f.is_file() and f.name != ".recipdyn.lock"]
+            if folder.is_dir() and not kept:
+                shutil.rmtree(folder, ignore_errors=True)
+        raise
 
 
 def _version(value: bool) -> None:
