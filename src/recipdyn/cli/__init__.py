@@ -141,6 +141,7 @@ def _register() -> None:
     from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
     from . import sweep as _sweep  # noqa: F401
+    from . import warmup as _warmup  # noqa: F401
     from . import webapp as _webapp  # noqa: F401
 
 

@@ -136,9 +136,41 @@ STREAM_AUTO = 1e6
 FIGURE_SAMPLES = 500_000
 
 
+#: First-run compile time per model (dop853; seconds, measured with an empty numba cache on
+#: a 2-core machine, NUMBA_CACHE_DIR=$(mktemp -d) recipdyn warmup MODEL): said before
+#: compiling. Other models: "a few seconds to a minute".
+COMPILE_SECONDS = {"compressor": 20, "compressor-contact": 80, "compressor-valves": 40,
+                   "compressor-contact-valves": 90}  # fmt: skip
+
+
+def _cache_cold(dispatchers) -> bool:
+    """Whether one of these numba dispatchers has no machine code in the on-disk cache yet
+    (its index file is missing), i.e. whether preparing them will compile. numba's cache
+    layout is not public API: if it changes this answers False (nothing said in advance)."""
+    import os
+
+    for fn in dispatchers:
+        cache = getattr(fn, "_cache", None)
+        try:
+            index = cache._cache_file._index_path
+        except AttributeError:  # not a cached dispatcher (NUMBA_DISABLE_JIT, a plain function)
+            continue
+        if not os.path.exists(index):
+            return True
+    return False
+
+
+def compile_note(name: str) -> str:
+    """The line said before a model's kernels are compiled."""
+    secs = COMPILE_SECONDS.get(name)
+    took = f"~{secs} s" if secs else "a few seconds to a minute"
+    return f"compiling the {name} model's kernels (first run only, {took}; 'recipdyn warmup' " \
+        "does it ahead)..."  # fmt: skip
+
+
 def _prepare(m, params, method: str) -> None:
     """Load the compiled code a run needs (compile it on the first run), saying so."""
-    from ..integrate import prepare
+    from ..integrate import kernels, prepare
 
     if m.kind == "map":  # iterated, not integrated: nothing to prepare
         return
@@ -148,7 +180,12 @@ def _prepare(m, params, method: str) -> None:
         system = compressor_model(params)
     else:
         system = m.system(params)
-    with phase("loading compiled kernels (compiling them on a machine's first run, ~10 s)"):
+    own = system.acting_event
+    loop = kernels.dop853_kernel if method == "dop853" else kernels.fixed_step_kernel
+    if _cache_cold((loop, system.rhs, getattr(own, "function", None),
+                    getattr(own, "reset", None))):  # fmt: skip
+        typer.echo(compile_note(m.name), err=True)
+    with phase("loading compiled kernels"):
         prepare(system, method)
 
 
@@ -245,8 +282,36 @@ def simulate(
         raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
     if m is None:  # the default model's run (other models' runs are checked by the library)
         _check_resources(out, n_samples, stream, float32, extra.get("columns"), limit)
+    note = subsidence_note(params)
+    if note:
+        typer.echo(f"warning: {note}", err=True)
     with refused_leaves_nothing(out):
         _run(m, params, kw, out, stream, extra, limit, figure, progress)
+
+
+#: A crosshead subsidence beyond this fraction of the crank radius is warned about.
+SUBSIDENCE_FRACTION = 0.1
+
+
+def subsidence_note(params) -> str | None:
+    """Why a subsidence ``d`` is implausible for a worn crosshead, or None.
+
+    Subsidence is wear of the crosshead shoes and guide: tenths of a millimetre to a few
+    millimetres (Xiao et al. 2017 go to 5 mm = 0.04 r on the 2D12's r = 120 mm). Beyond
+    :data:`SUBSIDENCE_FRACTION` of the crank radius the mechanism is an offset (desaxe)
+    slider-crank by design, not a worn one: the equations still hold (to |d| < l - r - rc,
+    where the rod can no longer reach the crosshead), so the run is warned, not refused.
+    """
+    get = params.get if isinstance(params, dict) else lambda k: getattr(params, k, None)
+    d, r, l, rc = get("d"), get("r"), get("l"), get("rc")
+    if d is None or not r or abs(d) <= SUBSIDENCE_FRACTION * r:
+        return None
+    reach = f" (the equations hold to |d| < l - r - rc = {1e3 * (l - r - rc):.0f} mm)" \
+        if l is not None and rc is not None else ""  # fmt: skip
+    return (f"d = {1e3 * d:g} mm is {abs(d) / r:.2g} crank radii: a crosshead subsidence (worn "
+            f"shoes or guide) is at most a few mm (the paper's largest: 5 mm = 0.04 r); above "
+            f"{SUBSIDENCE_FRACTION:g} r = {1e3 * SUBSIDENCE_FRACTION * r:g} mm this is an offset "
+            f"slider-crank, not a worn machine{reach}")  # fmt: skip
 
 
 def _dump_config(m, params, kw: dict, dump_config: Path) -> None:
