@@ -197,9 +197,14 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except Exception as exc:
         for click_exc, usage in _click_exception_types():
+            if isinstance(exc, usage):  # one line, like every other refusal
+                ctx = getattr(exc, "ctx", None)
+                where = ctx.command_path if ctx is not None else "recipdyn"
+                _err(f"error: {exc.format_message()} (see '{where} --help')")
+                return 2
             if isinstance(exc, click_exc):
                 exc.show()
-                return 2 if isinstance(exc, usage) else (exc.exit_code or 1)
+                return exc.exit_code or 1
         if debug or os.environ.get("RECIPDYN_DEBUG"):
             raise
         _err(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)")
