@@ -218,3 +218,68 @@ def test_light_lists_match_the_library():
 
     assert tuple(METHODS) == METHOD_NAMES
     assert tuple(MEASURES) == _MEASURES
+
+
+def test_close_matches_suggest_the_misspelt_name_only():
+    """The hint names the parameter meant, not every name that shares a suffix."""
+    from recipdyn.model.parameters import SCHEMA
+    from recipdyn.model.protocol import close_matches
+
+    names = {*SCHEMA.names, *SCHEMA.aliases}
+    assert close_matches("discharge_presure", names) == ["discharge_pressure"]
+    assert close_matches("RC", names) == ["rc"]
+    assert close_matches("subsidance", names) == ["subsidence"]
+    assert close_matches("contact_law", names) == []
+
+
+def test_models_table_shows_cross_field_bounds(capsys):
+    """rc's allowed range is [0, r), not [0, inf]: the bound that depends on another parameter
+    is shown, for the compressor and for the contact model's own subsidence limit."""
+    from recipdyn.model.parameters import SCHEMA
+
+    assert SCHEMA["rc"].range_text() == "[0, r) m"
+    assert SCHEMA["d"].range_text() == "(-(l - r - rc), l - r - rc) m"
+    assert main(["models", "compressor"]) == 0
+    assert "[0, r) m" in capsys.readouterr().out
+    assert main(["models", "compressor-contact"]) == 0
+    assert "l - r - 1.5 (rc + rc_crosshead)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("d_mm, warned", [(5.0, False), (12.0, False), (13.0, True),
+                                          (300.0, True), (-300.0, True)])  # fmt: skip
+def test_implausible_subsidence_is_warned_with_the_reason(capsys, d_mm, warned):
+    """A subsidence beyond 0.1 r (12 mm for the 2D12; the paper goes to 5 mm) is warned about,
+    with the bound and why; the paper's values are not."""
+    code = main(["simulate", "--d", f"{d_mm} mm", "--dump-config", "-"])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert ("warning:" in err) == warned
+    if warned:
+        assert "0.1 r = 12 mm" in err and "offset slider-crank" in err
+
+
+def test_compile_note_names_the_model_and_the_time():
+    """The line said before compiling names the model, that it happens once, and how long it
+    takes; a plain function (no numba cache) never counts as cold."""
+    from recipdyn.cli.simulate import COMPILE_SECONDS, _cache_cold, compile_note
+
+    note = compile_note("compressor-contact")
+    assert "compressor-contact" in note and "first run only" in note
+    assert f"~{COMPILE_SECONDS['compressor-contact']} s" in note
+    assert "a few seconds to a minute" in compile_note("my-model")
+    assert _cache_cold((None, len, lambda x: x)) is False
+
+
+@pytest.mark.slow
+def test_first_run_says_it_compiles_before_compiling(tmp_path):
+    """With an empty numba cache, simulate says it is compiling before it starts (the line
+    comes first on standard error); with the cache filled it says nothing of the kind."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path),
+           "NUMBA_CACHE_DIR": str(tmp_path / "cache")}  # fmt: skip
+    cmd = [sys.executable, "-m", "recipdyn", "simulate", "--model", "duffing", "-n", "1",
+           "--no-figure", "--no-progress", "-o", str(tmp_path / "d.nc")]  # fmt: skip
+    first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=1200)
+    assert first.returncode == 0, first.stderr
+    assert first.stderr.startswith("compiling the duffing model's kernels (first run only")
+    again = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0 and "compiling" not in again.stderr

@@ -264,6 +264,9 @@ def simulate(
     limit = max_memory_bytes(max_memory)
     if limit is not None and not limit > 0:
         raise ParameterError(f"max_memory = {max_memory!r}; allowed: > 0")
+    note = subsidence_note(params)
+    if note:
+        typer.echo(f"warning: {note}", err=True)
     if dump_config is not None:
         return _dump_config(m, params, kw, dump_config)
     if out.suffix.lower() not in DATASET_FORMATS:
@@ -282,9 +285,6 @@ def simulate(
         raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
     if m is None:  # the default model's run (other models' runs are checked by the library)
         _check_resources(out, n_samples, stream, float32, extra.get("columns"), limit)
-    note = subsidence_note(params)
-    if note:
-        typer.echo(f"warning: {note}", err=True)
     with refused_leaves_nothing(out):
         _run(m, params, kw, out, stream, extra, limit, figure, progress)
 
@@ -299,15 +299,20 @@ def subsidence_note(params) -> str | None:
     Subsidence is wear of the crosshead shoes and guide: tenths of a millimetre to a few
     millimetres (Xiao et al. 2017 go to 5 mm = 0.04 r on the 2D12's r = 120 mm). Beyond
     :data:`SUBSIDENCE_FRACTION` of the crank radius the mechanism is an offset (desaxe)
-    slider-crank by design, not a worn one: the equations still hold (to |d| < l - r - rc,
-    where the rod can no longer reach the crosshead), so the run is warned, not refused.
+    slider-crank by design, not a worn one: the equations still hold (for the compressor to
+    |d| < l - r - rc, where the rod can no longer reach the crosshead), so the run is warned,
+    not refused.
     """
     get = params.get if isinstance(params, dict) else lambda k: getattr(params, k, None)
     d, r, l, rc = get("d"), get("r"), get("l"), get("rc")
     if d is None or not r or abs(d) <= SUBSIDENCE_FRACTION * r:
         return None
-    reach = f" (the equations hold to |d| < l - r - rc = {1e3 * (l - r - rc):.0f} mm)" \
-        if l is not None and rc is not None else ""  # fmt: skip
+    reach = (
+        ""
+        if isinstance(params, dict)
+        # (the contact models' own reach differs)
+        else (f" (the equations hold to |d| < l - r - rc = {1e3 * (l - r - rc):.0f} mm)")
+    )
     return (f"d = {1e3 * d:g} mm is {abs(d) / r:.2g} crank radii: a crosshead subsidence (worn "
             f"shoes or guide) is at most a few mm (the paper's largest: 5 mm = 0.04 r); above "
             f"{SUBSIDENCE_FRACTION:g} r = {1e3 * SUBSIDENCE_FRACTION * r:g} mm this is an offset "
