@@ -136,11 +136,12 @@ STREAM_AUTO = 1e6
 FIGURE_SAMPLES = 500_000
 
 
-#: First-run compile time per model (dop853; seconds, measured with an empty numba cache on
-#: a 2-core machine, NUMBA_CACHE_DIR=$(mktemp -d) recipdyn warmup MODEL): said before
-#: compiling. Other models: "a few seconds to a minute".
+#: First-run compile time per model on an idle 2-core machine (dop853, empty numba cache, the
+#: integrator loop included), said before compiling: 18 s and 80 s measured for the compressor
+#: and the contact joint; the valve models scaled from runs side by side on shared cores (62,
+#: 135, 248 and 568 s for the four). Other models: "a few seconds to a minute".
 COMPILE_SECONDS = {"compressor": 20, "compressor-contact": 80, "compressor-valves": 40,
-                   "compressor-contact-valves": 90}  # fmt: skip
+                   "compressor-contact-valves": 170}  # fmt: skip
 
 
 def _cache_cold(dispatchers) -> bool:
