@@ -691,8 +691,8 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     return {"mechanical": kin + pot, "elastic": elastic}
 
 
-@nb.njit(cache=True, inline="always")
-def _series(cfg, t, y, p):
+@nb.njit(cache=True)
+def _joint_series(cfg, t, y, p):
     """Per sample: both joints' rows of :func:`_pair` (14), the accelerations e1'', e2''
     (4), theta2', x3', gas force."""
     n = t.shape[0]
@@ -711,29 +711,6 @@ def _series(cfg, t, y, p):
         th1 = p[P_TH10] + p[P_OMEGA] * t[i]
         out[i, 20] = _gas(t[i], yi, p, math.sin(th1), math.cos(th1))
     return out
-
-
-# One compiled series per joint configuration, as for the right-hand sides: with ``cfg`` a
-# constant the other configurations' branches (their generated accelerations, ~20 s of
-# compiling each) are pruned, so a run compiles only the configuration it uses.
-@nb.njit(cache=True)
-def _series_crank(t, y, p):
-    return _series(0, t, y, p)
-
-
-@nb.njit(cache=True)
-def _series_crosshead(t, y, p):
-    return _series(1, t, y, p)
-
-
-@nb.njit(cache=True)
-def _series_both(t, y, p):
-    return _series(2, t, y, p)
-
-
-def _joint_series(cfg, t, y, p):
-    """:func:`_series` for the joint configuration ``cfg`` (0 crank, 1 crosshead, 2 both)."""
-    return (_series_crank, _series_crosshead, _series_both)[cfg](t, y, p)
 
 
 class CompressorContact(Model):
