@@ -136,12 +136,12 @@ STREAM_AUTO = 1e6
 FIGURE_SAMPLES = 500_000
 
 
-#: First-run compile time per model on an idle 2-core machine (dop853, empty numba cache, the
-#: integrator loop included), said before compiling: 18 s and 80 s measured for the compressor
-#: and the contact joint; the valve models scaled from runs side by side on shared cores (62,
-#: 135, 248 and 568 s for the four). Other models: "a few seconds to a minute".
-COMPILE_SECONDS = {"compressor": 20, "compressor-contact": 80, "compressor-valves": 40,
-                   "compressor-contact-valves": 170}  # fmt: skip
+#: First-run compile time per model, said before compiling: the CPU time of `recipdyn warmup
+#: MODEL` with an empty numba cache (the integrator loop, shared by every model, included) on a
+#: 2-core machine, which is its duration when the machine is idle: 21, 41, 64 and 69 s. Other
+#: models: "a few seconds to a minute".
+COMPILE_SECONDS = {"compressor": 20, "compressor-valves": 40, "compressor-contact": 65,
+                   "compressor-contact-valves": 70}  # fmt: skip
 
 
 def _cache_cold(dispatchers) -> bool:
