@@ -20,19 +20,19 @@ commented config of any run, and ``recipdyn simulate -c RUN.nc`` reruns a record
 from __future__ import annotations
 
 import dataclasses
-import tomllib
+import functools
 from pathlib import Path
-from typing import Any, Literal
-
-import numpy as np
-from pydantic import BaseModel, ConfigDict, ValidationError
+from typing import TYPE_CHECKING, Any, Literal
 
 from .defaults import SIMULATION
 from .model.parameters import SCHEMA, CompressorParams, ParameterError, resolve_name
 from .units import to_si
 
+if TYPE_CHECKING:
+    from pydantic import BaseModel as RunConfig  # (the class _config_classes builds)
+
 __all__ = [
-    "SimulationConfig",
+    "SimulationConfig",  # noqa: F822  (built by _config_classes, given by __getattr__)
     "RunConfig",
     "read_config",
     "build_params",
@@ -45,33 +45,48 @@ __all__ = [
 _STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
 
 
-class SimulationConfig(BaseModel):
-    """Settings of `recipdyn.simulate` (quantities allowed where units apply)."""
+@functools.cache
+def _config_classes() -> tuple[type, type]:
+    """(SimulationConfig, RunConfig), built on first use: pydantic is imported only when a
+    config file is read or written, not to validate command-line options."""
+    from pydantic import BaseModel, ConfigDict
 
-    model_config = ConfigDict(extra="forbid")
-    revolutions: float | str = SIMULATION["revolutions"]
-    transient: float | str = SIMULATION["transient"]
-    fs: float | str = SIMULATION["fs"]
-    method: Literal["dop853", "rk4"] = SIMULATION["method"]
-    rtol: float = SIMULATION["rtol"]
-    atol: float = SIMULATION["atol"]
-    h: float | str | None = SIMULATION["h"]
+    class SimulationConfig(BaseModel):
+        """Settings of `recipdyn.simulate` (quantities allowed where units apply)."""
 
-    def resolved(self) -> dict[str, Any]:
-        out = self.model_dump()
-        for k in ("revolutions", "transient", "fs", "h"):
-            if out[k] is not None:
-                out[k] = to_si(k, out[k])
-        return out
+        model_config = ConfigDict(extra="forbid")
+        revolutions: float | str = SIMULATION["revolutions"]
+        transient: float | str = SIMULATION["transient"]
+        fs: float | str = SIMULATION["fs"]
+        method: Literal["dop853", "rk4"] = SIMULATION["method"]
+        rtol: float = SIMULATION["rtol"]
+        atol: float = SIMULATION["atol"]
+        h: float | str | None = SIMULATION["h"]
+
+        def resolved(self) -> dict[str, Any]:
+            out = self.model_dump()
+            for k in ("revolutions", "transient", "fs", "h"):
+                if out[k] is not None:
+                    out[k] = to_si(k, out[k])
+            return out
+
+    class RunConfig(BaseModel):
+        """A whole config file: an optional ``model`` name and ``[params]``, ``[simulation]``."""
+
+        model_config = ConfigDict(extra="forbid")
+        model: str | None = None
+        params: dict[str, Any] = {}
+        simulation: SimulationConfig = SimulationConfig()
+
+    for cls in (SimulationConfig, RunConfig):
+        cls.__module__ = __name__
+    return SimulationConfig, RunConfig
 
 
-class RunConfig(BaseModel):
-    """A whole config file: an optional ``model`` name and ``[params]``, ``[simulation]``."""
-
-    model_config = ConfigDict(extra="forbid")
-    model: str | None = None
-    params: dict[str, Any] = {}
-    simulation: SimulationConfig = SimulationConfig()
+def __getattr__(name: str):
+    if name in ("SimulationConfig", "RunConfig"):
+        return _config_classes()[name == "RunConfig"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def build_params(values: dict[str, Any], base: CompressorParams | None = None) -> CompressorParams:
@@ -115,6 +130,10 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
 def read_config(path: str | Path) -> RunConfig:
     """Read and validate a TOML config file (clear errors, exit status 2 at the CLI); a run
     written by ``recipdyn simulate`` (``.nc``) gives the config that made it."""
+    import tomllib
+
+    from pydantic import ValidationError
+
     path = Path(path)
     if path.suffix.lower() == ".nc":
         return config_from_record(path)
@@ -132,7 +151,7 @@ def read_config(path: str | Path) -> RunConfig:
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"config {path}: malformed TOML ({exc})") from None
     try:
-        return RunConfig.model_validate(raw)
+        return _config_classes()[1].model_validate(raw)
     except ValidationError as exc:
         first = exc.errors()[0]
         loc = ".".join(str(x) for x in first["loc"])
@@ -171,11 +190,7 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
             group = p.group
             lines.append(f"# -- {group}")
         v = values.get(p.name, p.default)
-        rng = (
-            f"one of {', '.join(p.choices)}"
-            if p.choices
-            else f"{'(' if p.low_open else '['}{p.low:g}, {p.high:g}{')' if p.high_open else ']'}"
-        )
+        rng = f"one of {', '.join(p.choices)}" if p.choices else p.range_text(unit=False)
         note = f"; note: {p.assumed}" if p.assumed else ""
         comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
         if v is None:
@@ -200,6 +215,9 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
 
 def config_from_record(path: str | Path) -> RunConfig:
     """The config a recorded run was made with (its ``param_*`` and solver attributes)."""
+    import numpy as np
+    from pydantic import ValidationError
+
     from .io import read_dataset
     from .model.registry import get_model
 
@@ -236,6 +254,7 @@ def config_from_record(path: str | Path) -> RunConfig:
             v = attrs[key]
             sim[name] = v.item() if isinstance(v, np.generic) else v
     try:
-        return RunConfig(model=m.name, params=params, simulation=SimulationConfig(**sim))
+        simulation_config, run_config = _config_classes()
+        return run_config(model=m.name, params=params, simulation=simulation_config(**sim))
     except ValidationError as exc:
         raise ParameterError(f"config {path}: recorded settings not valid ({exc})") from None

@@ -21,6 +21,7 @@ import inspect
 import json
 import os
 import sys
+from pathlib import Path
 
 import typer
 
@@ -78,6 +79,39 @@ def report(**items) -> None:
         collected.update(items)
 
 
+def _first_missing(path: Path) -> Path | None:
+    """The outermost folder of ``path`` (itself included) that does not exist yet."""
+    path = Path(path).absolute()
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists():
+            return missing
+        missing = folder
+    return missing  # pragma: no cover - the root exists
+
+
+@contextlib.contextmanager
+def refused_leaves_nothing(*paths: Path):
+    """A command refused inside this block (a `ParameterError`, exit status 2) leaves
+    no folder behind: the folders on the way to ``paths`` that it created are removed again,
+    provided they hold no file (a finished or partial result is never removed).
+
+    Commands validate everything they can before they touch the file system; this covers the
+    refusals that can only come later (a run too large for its disk, a column name known once
+    the model is built)."""
+    created = {m for m in (_first_missing(p) for p in paths if p is not None) if m is not None}
+    try:
+        yield
+    except ParameterError:
+        import shutil
+
+        for folder in created:
+            kept = [f for f in folder.rglob("*") if f.is_file() and f.name != ".recipdyn.lock"]
+            if folder.is_dir() and not kept:
+                shutil.rmtree(folder, ignore_errors=True)
+        raise
+
+
 def _version(value: bool) -> None:
     if value:
         from .. import __version__
@@ -107,6 +141,7 @@ def _register() -> None:
     from . import reproduce as _reproduce  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
     from . import sweep as _sweep  # noqa: F401
+    from . import warmup as _warmup  # noqa: F401
     from . import webapp as _webapp  # noqa: F401
 
 
@@ -162,9 +197,14 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except Exception as exc:
         for click_exc, usage in _click_exception_types():
+            if isinstance(exc, usage):  # one line, like every other refusal
+                ctx = getattr(exc, "ctx", None)
+                where = ctx.command_path if ctx is not None else "recipdyn"
+                _err(f"error: {exc.format_message()} (see '{where} --help')")
+                return 2
             if isinstance(exc, click_exc):
                 exc.show()
-                return 2 if isinstance(exc, usage) else (exc.exit_code or 1)
+                return exc.exit_code or 1
         if debug or os.environ.get("RECIPDYN_DEBUG"):
             raise
         _err(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)")

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from ..defaults import ANALYZE
-from . import app, phase, report, with_json
+from . import app, phase, refused_leaves_nothing, report, with_json
 
 
 @app.command()
@@ -58,34 +58,52 @@ def analyze(
     ),
 ) -> None:
     """Spectrum, phase portraits, Poincaré section, Lyapunov exponents, 0-1 test, verdict."""
-    from ..analyze import analyze_run, analyze_signal, is_record
-    from ..model.parameters import ParameterError
+    from ..errors import ParameterError
 
+    # the options are checked before the analysis (numba, SciPy, matplotlib) is loaded
     if not run.exists():
         raise ParameterError(f"run file not found: {run}")
-    if section_points < 1 or lyap_revolutions <= 0:
+    if section_points < 1 or not lyap_revolutions > 0:
         raise ParameterError("section_points must be >= 1 and lyap_revolutions > 0")
+    if quantity not in ("acceleration", "velocity", "other"):
+        raise ParameterError(f"quantity: {quantity!r}; allowed: acceleration, velocity, "
+                             "other")  # fmt: skip
+    if tacho is not None and speed is not None:
+        raise ParameterError("tacho and speed: give one of them")
+    if max_memory_samples is not None and max_memory_samples < 1:
+        raise ParameterError(f"max_memory_samples = {max_memory_samples}; allowed: >= 1")
+    check_rates(fs=fs, speed=speed)
+    from ..analyze import analyze_run, analyze_signal, is_record
+
     out = out or run.with_name(run.stem + "_analysis")
-    if column is None and fs is None and is_record(run):
-        s = analyze_run(run, out, section_points=section_points,
-                        lyap_revolutions=lyap_revolutions, phase=phase)  # fmt: skip
-    else:
-        if quantity not in ("acceleration", "velocity", "other"):
-            raise ParameterError(f"quantity: {quantity!r}; allowed: acceleration, velocity, "
-                                 "other")  # fmt: skip
-        if tacho is not None and speed is not None:
-            raise ParameterError("tacho and speed: give one of them")
-        extra = {} if max_memory_samples is None else {"max_memory_samples": max_memory_samples}
-        s = analyze_signal(run, out, column=column, fs=fs, tacho=tacho, speed=speed,
-                           quantity=quantity, zones=zones, phase=phase,
-                           progress=sys.stderr.isatty(), **extra)  # fmt: skip
-        for note in s["notes"]:
-            typer.echo(f"note: {note}")
-        for name, value, status in s["evidence"]:
-            typer.echo(f"  {name:<20} {value:<28} {status}")
+    with refused_leaves_nothing(out):
+        if column is None and fs is None and is_record(run):
+            s = analyze_run(run, out, section_points=section_points,
+                            lyap_revolutions=lyap_revolutions, phase=phase)  # fmt: skip
+        else:
+            extra = {} if max_memory_samples is None else {
+                "max_memory_samples": max_memory_samples}  # fmt: skip
+            s = analyze_signal(run, out, column=column, fs=fs, tacho=tacho, speed=speed,
+                               quantity=quantity, zones=zones, phase=phase,
+                               progress=sys.stderr.isatty(), **extra)  # fmt: skip
+            for note in s["notes"]:
+                typer.echo(f"note: {note}")
+            for name, value, status in s["evidence"]:
+                typer.echo(f"  {name:<20} {value:<28} {status}")
     typer.echo(
         f"verdict: {s['verdict'].get('headline', s['verdict']['verdict'])} "
         f"({'; '.join(s['verdict']['reasons'])})"
     )
     typer.echo(f"wrote {out}/summary.md, summary.json and figures")
     report(**s, output=str(out))
+
+
+def check_rates(*, fs: str | None = None, speed: str | None = None) -> None:
+    """Refuse a sampling rate or crank speed that is not a positive quantity (units via
+    pint), before anything heavy is loaded; the readers convert them again."""
+    from ..errors import ParameterError
+    from ..units import to_si
+
+    for name, text, unit in (("fs", fs, "Hz"), ("speed", speed, "rad/s")):
+        if text is not None and not to_si(name, text, unit=unit) > 0:
+            raise ParameterError(f"{name} = {text!r}; allowed: > 0")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, phase, report, with_json
+from . import app, phase, refused_leaves_nothing, report, with_json
 
 
 @app.command()
@@ -29,13 +29,19 @@ def compare(
 
     A table gives the differences of the main measures (peak, RMS, dominant line, own line,
     contact force) from the first run."""
-    from ..compare import MEASURES, compare_runs
     from ..errors import ParameterError
 
     names = [s.strip() for s in labels.split(",")] if labels else None
     if names is not None and len(names) != len(runs):
         raise ParameterError(f"labels: {len(names)} given for {len(runs)} runs")
-    with phase(f"compare: reading and measuring {len(runs)} runs"):
+    if len(runs) < 2:
+        raise ParameterError(f"runs: {len(runs)} given; compare needs at least 2")
+    for path in runs:  # before the analysis is loaded
+        if not path.is_file():
+            raise ParameterError(f"input {path}: file not found")
+    from ..compare import MEASURES, compare_runs
+
+    with phase(f"compare: reading and measuring {len(runs)} runs"), refused_leaves_nothing(out):
         s = compare_runs(runs, out, signal=signal, labels=names)
     for k, vals in s["differing_inputs"].items():
         typer.echo(f"  {k:<24} " + "  ".join(str(v) for v in vals))

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, phase
+from . import app, phase, refused_leaves_nothing
 
 
 @app.command()
@@ -47,16 +47,24 @@ def features(
     """Tabulate features: time-domain statistics, spectral and order features, chaos indicators.
 
     One row per run or window, labelled with the run's parameters."""
-    from ..features import file_features, sweep_features, write_dictionary, write_table
-    from ..model.parameters import ParameterError
+    from ..errors import ParameterError
+    from .analyze import check_rates
 
     if out.suffix.lower() not in (".csv", ".parquet"):  # before any work
         raise ParameterError(f"output {out}: use .csv or .parquet")
-    rows: list[dict] = []
-    meta: dict = {}  # column -> unit, description, note: the data dictionary
     for path in inputs:
         if not path.exists():
             raise ParameterError(f"input not found: {path}")
+    if max_memory_samples is not None and max_memory_samples < 1:
+        raise ParameterError(f"max_memory_samples = {max_memory_samples}; allowed: >= 1")
+    if tacho is not None and speed is not None:
+        raise ParameterError("tacho and speed: give one of them")
+    check_rates(fs=fs, speed=speed)
+    from ..features import file_features, sweep_features, write_dictionary, write_table
+
+    rows: list[dict] = []
+    meta: dict = {}  # column -> unit, description, note: the data dictionary
+    for path in inputs:
         with phase(f"features of {path.name}"):
             if path.is_dir():
                 rows += [{"store": path.name, **r} for r in sweep_features(path, meta)]
@@ -66,7 +74,8 @@ def features(
                 rows += file_features(path, column=column, fs=fs, window=window, speed=speed,
                                       tacho=tacho, chaos=chaos, progress=progress,
                                       meta=meta, **extra)  # fmt: skip
-    write_table(rows, out)
-    guide = write_dictionary(meta, rows, out)
+    with refused_leaves_nothing(out):
+        write_table(rows, out)
+        guide = write_dictionary(meta, rows, out)
     typer.echo(f"wrote {len(rows)} row(s) to {out}; units, descriptions and notes of its "
                f"columns in {guide}")  # fmt: skip

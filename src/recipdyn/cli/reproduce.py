@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app
+from . import app, refused_leaves_nothing
 
 
 @app.command()
@@ -18,12 +18,14 @@ def reproduce(
     progress: bool = typer.Option(True, "--progress/--no-progress"),
 ) -> None:
     """Rerun Xiao et al. (2017): figures, comparison table, HTML report (OUT/report.html)."""
-    from ..model.parameters import ParameterError
-    from ..reproduce import reproduce as run
+    from ..errors import ParameterError
 
     if jobs is not None and jobs < 1:
         raise ParameterError(f"jobs = {jobs}; allowed: >= 1")
-    path = run(out, quick=quick, force=force, jobs=jobs, progress=progress)
+    from ..reproduce import reproduce as run
+
+    with refused_leaves_nothing(out):
+        path = run(out, quick=quick, force=force, jobs=jobs, progress=progress)
     typer.echo(f"wrote {path}, {out / 'comparison.md'}, {out / 'comparison.csv'}, "
                f"{out / 'figures'}/")  # fmt: skip
 
@@ -45,15 +47,16 @@ def calibrate(
 
     The fit stays within physical bounds and reports how close any choice gets. The defaults
     are never changed."""
-    from ..model.parameters import ParameterError
-    from ..reproduce.calibrate import calibrate as fit
-    from ..reproduce.calibrate import write_calibration
+    from ..errors import ParameterError
 
     names = tuple(n.strip() for n in free.split(",") if n.strip())
     if maxiter < 1 or popsize < 1:
         raise ParameterError("maxiter and popsize must be >= 1")
     if jobs == 0 or jobs < -1:
         raise ParameterError(f"jobs = {jobs}; allowed: -1 (all cores) or >= 1")
+    from ..reproduce.calibrate import calibrate as fit
+    from ..reproduce.calibrate import write_calibration
+
     results = [fit(names, maxiter=maxiter, popsize=popsize, workers=jobs)]
     if with_offset and "theta_c_offset" not in names:
         results.append(fit((*names, "theta_c_offset"), maxiter=maxiter, popsize=popsize,

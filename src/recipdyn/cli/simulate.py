@@ -7,40 +7,105 @@ from pathlib import Path
 
 import typer
 
-from . import app, phase, report, with_json
+from ..defaults import SIMULATION
+from ..io import DATASET_FORMATS
+from . import app, phase, refused_leaves_nothing, report, with_json
 
 _SET_HELP = "Set any parameter: NAME=VALUE with units, e.g. --set m3='40 kg' (repeatable)."
 _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (default: half " \
     "of the available memory)."  # fmt: skip
 
 
-def _collect_model(model, rc, d, omega, sets, config):
+def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     """(model, parameters, simulation settings) from the options and an optional config.
 
     For the compressor the parameters are a CompressorParams (``--rc/--d/--omega`` allowed),
-    for any other model a dict of its schema's values.
+    for any other model a dict of its schema's values. The default model's parameters are
+    validated without loading its compiled code; with ``load=False`` its model is returned as
+    ``None`` (``get_model()`` loads it), so that bad input is answered before heavy imports.
+    Another model's schema lives beside its kernels: naming one loads them.
     """
     from ..config import build_params, model_values, read_config
     from ..errors import ParameterError
-    from ..model.registry import get_model
+    from ..model.protocol import UnknownParameterError
+    from ..model.registry import DEFAULT_MODEL, get_model
     from ..units import parse_assignment
 
     cfg = read_config(config) if config is not None else None
-    m = get_model(model or (cfg.model if cfg is not None else None))
+    spec = model or (cfg.model if cfg is not None else None)
+    m = None if spec in (None, DEFAULT_MODEL) else get_model(spec)
+    name = DEFAULT_MODEL if m is None else m.name
     settings = cfg.simulation.resolved() if cfg is not None else {}
     values = dict(cfg.params) if cfg is not None else {}
     options = {n: v for n, v in (("rc", rc), ("d", d), ("omega", omega)) if v is not None}
-    if options and m.name != "compressor":
+    if options and name != DEFAULT_MODEL:
         raise ParameterError(f"{', '.join('--' + n for n in options)}: compressor options; for "
-                             f"model {m.name!r} use --set NAME=VALUE (see 'recipdyn models "
-                             f"{m.name}')")  # fmt: skip
+                             f"model {name!r} use --set NAME=VALUE (see 'recipdyn models "
+                             f"{name}')")  # fmt: skip
     values.update(options)  # the config, then the options, then --set (last wins)
     for item in sets or []:
         k, v = parse_assignment(item)
         values[k] = v
-    if m.name == "compressor":
-        return m, build_params(values), settings
-    return m, model_values(m, values), settings
+    try:
+        params = build_params(values) if m is None else model_values(m, values)
+    except UnknownParameterError as exc:
+        raise _unknown_parameter(exc, name) from None
+    if m is None and load:
+        m = get_model(DEFAULT_MODEL)
+    return m, params, settings
+
+
+def _unknown_parameter(exc, model_name: str):
+    """The error for a parameter ``model_name`` does not have: the close names if it looks
+    misspelt, else the other models that have it, else where to look."""
+    from ..errors import ParameterError
+    from ..model.registry import models_with_parameter
+
+    if exc.suggestions:
+        return ParameterError(f"{exc} (model {model_name!r})")
+    others = [n for n in models_with_parameter(exc.name) if n != model_name]
+    if others:
+        return ParameterError(
+            f"{exc.name!r} is not a parameter of model {model_name!r}; it belongs to "
+            f"{', '.join(repr(n) for n in others)}: add --model {others[0]} (its "
+            f"parameters: recipdyn models {others[0]})"
+        )
+    return ParameterError(f"unknown parameter {exc.name!r} of model {model_name!r}; its "
+                          f"parameters: recipdyn models {model_name}")  # fmt: skip
+
+
+#: The integration methods (``recipdyn.integrate.METHODS``, whose module loads numba; a test
+#: keeps the two the same).
+METHOD_NAMES = ("dop853", "rk4")
+
+
+def check_settings(kw: dict, period: float | None) -> None:
+    """Refuse run settings out of range before anything is loaded or written (the library
+    checks them again; these are its ranges)."""
+    import math
+
+    from ..defaults import ATOL_RANGE, RTOL_RANGE
+    from ..errors import ParameterError, is_number
+
+    for name in ("revolutions", "fs"):
+        v = kw[name]
+        if not (is_number(v) and math.isfinite(v) and v > 0):
+            raise ParameterError(f"{name} = {v!r} out of range; allowed: > 0")
+    v = kw["transient"]
+    if not (is_number(v) and math.isfinite(v) and v >= 0):
+        raise ParameterError(f"transient = {v!r} out of range; allowed: >= 0")
+    if kw["method"] not in METHOD_NAMES:
+        raise ParameterError(f"method = {kw['method']!r}; allowed: {', '.join(METHOD_NAMES)}")
+    for name, (lo, hi) in (("rtol", RTOL_RANGE), ("atol", ATOL_RANGE)):
+        v = kw[name]
+        if not (is_number(v) and math.isfinite(v) and lo <= v <= hi):
+            raise ParameterError(f"{name} = {v!r} out of range; allowed: [{lo:g}, {hi:g}]")
+    h = kw.get("h")
+    if h is not None:
+        top = period if period else math.inf
+        if not (is_number(h) and math.isfinite(h) and 0 < h <= top):
+            where = f"{top:g}] (one revolution)" if period else "inf)"
+            raise ParameterError(f"h = {h!r} s out of range; allowed: (0, {where}")
 
 
 def max_memory_bytes(text: str | None) -> float | None:
@@ -71,9 +136,42 @@ STREAM_AUTO = 1e6
 FIGURE_SAMPLES = 500_000
 
 
+#: First-run compile time per model, said before compiling: the CPU time of `recipdyn warmup
+#: MODEL` with an empty numba cache (the integrator loop, shared by every model, included) on a
+#: 2-core machine, which is its duration when the machine is idle: 21, 41, 64 and 69 s. Other
+#: models: "a few seconds to a minute".
+COMPILE_SECONDS = {"compressor": 20, "compressor-valves": 40, "compressor-contact": 65,
+                   "compressor-contact-valves": 70}  # fmt: skip
+
+
+def _cache_cold(dispatchers) -> bool:
+    """Whether one of these numba dispatchers has no machine code in the on-disk cache yet
+    (its index file is missing), i.e. whether preparing them will compile. numba's cache
+    layout is not public API: if it changes this answers False (nothing said in advance)."""
+    import os
+
+    for fn in dispatchers:
+        cache = getattr(fn, "_cache", None)
+        try:
+            index = cache._cache_file._index_path
+        except AttributeError:  # not a cached dispatcher (NUMBA_DISABLE_JIT, a plain function)
+            continue
+        if not os.path.exists(index):
+            return True
+    return False
+
+
+def compile_note(name: str) -> str:
+    """The line said before a model's kernels are compiled."""
+    secs = COMPILE_SECONDS.get(name)
+    took = f"~{secs} s" if secs else "a few seconds to a minute"
+    return f"compiling the {name} model's kernels (first run only, {took}; 'recipdyn warmup' " \
+        "does it ahead)..."  # fmt: skip
+
+
 def _prepare(m, params, method: str) -> None:
     """Load the compiled code a run needs (compile it on the first run), saying so."""
-    from ..integrate import prepare
+    from ..integrate import kernels, prepare
 
     if m.kind == "map":  # iterated, not integrated: nothing to prepare
         return
@@ -83,7 +181,12 @@ def _prepare(m, params, method: str) -> None:
         system = compressor_model(params)
     else:
         system = m.system(params)
-    with phase("loading compiled kernels (compiling them on a machine's first run, ~10 s)"):
+    own = system.acting_event
+    loop = kernels.dop853_kernel if method == "dop853" else kernels.fixed_step_kernel
+    if _cache_cold((loop, system.rhs, getattr(own, "function", None),
+                    getattr(own, "reset", None))):  # fmt: skip
+        typer.echo(compile_note(m.name), err=True)
+    with phase("loading compiled kernels"):
         prepare(system, method)
 
 
@@ -144,17 +247,12 @@ def simulate(
     """Simulate a model (default: the compressor); write the record and a figure.
 
     The record's format follows the extension of --out: .nc, .csv, .mat or .zarr."""
-    from ..errors import Interrupted, LawRangeWarning, ModelValidityWarning, ParameterError
-    from ..integrate import IntegrationError
-    from ..io import check_output, save_figure, write_dataset
-    from ..simulate import DEFAULT_SETTINGS, summarize
-    from ..simulate import simulate as run_sim
+    from ..errors import ParameterError
     from ..units import to_si
 
-    if dump_config is None:
-        out = check_output(out)  # before any work: a bad path is reported at once
-    m, params, settings = _collect_model(model, rc, d, omega, sets, config)
-    kw = {**DEFAULT_SETTINGS, **settings}
+    # everything is validated before anything heavy is imported or any file written
+    m, params, settings = _collect_model(model, rc, d, omega, sets, config, load=False)
+    kw = {**SIMULATION, **settings}
     for name, val in (("revolutions", revolutions), ("transient", transient), ("fs", fs),
                       ("h", h)):  # fmt: skip
         if val is not None:
@@ -162,23 +260,22 @@ def simulate(
     for name, val in (("method", method), ("rtol", rtol), ("atol", atol)):
         if val is not None:
             kw[name] = val
+    # the forcing period bounds the RK4 step (the compressor's is known without its kernels)
+    period = params.crank_period if m is None else m.period(params) if m.kind != "map" else None
+    check_settings(kw, period)
+    limit = max_memory_bytes(max_memory)
+    if limit is not None and not limit > 0:
+        raise ParameterError(f"max_memory = {max_memory!r}; allowed: > 0")
+    note = subsidence_note(params)
+    if note:
+        typer.echo(f"warning: {note}", err=True)
     if dump_config is not None:
-        import dataclasses
-
-        from ..config import dump_config as dump
-        from ..io import write_text
-
-        values = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else params
-        text = dump(m, values, kw)
-        if str(dump_config) == "-":
-            typer.echo(text, nl=False)
-        else:
-            write_text(dump_config, text)
-            typer.echo(f"wrote {dump_config} (run it with: recipdyn simulate -c {dump_config})")
-        return
-    _prepare(m, params, kw["method"])
-    n_samples = kw["revolutions"] * params.crank_period * kw["fs"] if m.name == "compressor" \
-        else 0.0  # fmt: skip
+        return _dump_config(m, params, kw, dump_config)
+    if out.suffix.lower() not in DATASET_FORMATS:
+        allowed = ", ".join(f"{k} ({v})" for k, v in DATASET_FORMATS.items())
+        raise ParameterError(f"output {out}: unknown extension {out.suffix or '(none)'!r}; "
+                             f"allowed: {allowed}")  # fmt: skip
+    n_samples = kw["revolutions"] * period * kw["fs"] if m is None else 0.0
     if stream is None:
         stream = n_samples > STREAM_AUTO and out.suffix.lower() in (".nc", ".zarr")
     extra = {}
@@ -188,12 +285,92 @@ def simulate(
         extra.update(out=out, float32=float32, compress=compress)
     elif float32 or compress:
         raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
+    if m is None:  # the default model's run (other models' runs are checked by the library)
+        _check_resources(out, n_samples, stream, float32, extra.get("columns"), limit)
+    with refused_leaves_nothing(out):
+        _run(m, params, kw, out, stream, extra, limit, figure, progress)
+
+
+#: A crosshead subsidence beyond this fraction of the crank radius is warned about.
+SUBSIDENCE_FRACTION = 0.1
+
+
+def subsidence_note(params) -> str | None:
+    """Why a subsidence ``d`` is implausible for a worn crosshead, or None.
+
+    Subsidence is wear of the crosshead shoes and guide: tenths of a millimetre to a few
+    millimetres (Xiao et al. 2017 go to 5 mm = 0.04 r on the 2D12's r = 120 mm). Beyond
+    `SUBSIDENCE_FRACTION` of the crank radius the mechanism is an offset (desaxe)
+    slider-crank by design, not a worn one: the equations still hold (for the compressor to
+    |d| < l - r - rc, where the rod can no longer reach the crosshead), so the run is warned,
+    not refused.
+    """
+    get = params.get if isinstance(params, dict) else lambda k: getattr(params, k, None)
+    d, r, l, rc = get("d"), get("r"), get("l"), get("rc")
+    if d is None or not r or abs(d) <= SUBSIDENCE_FRACTION * r:
+        return None
+    reach = (
+        ""
+        if isinstance(params, dict)
+        # (the contact models' own reach differs)
+        else (f" (the equations hold to |d| < l - r - rc = {1e3 * (l - r - rc):.0f} mm)")
+    )
+    return (f"d = {1e3 * d:g} mm is {abs(d) / r:.2g} crank radii: a crosshead subsidence (worn "
+            f"shoes or guide) is at most a few mm (the paper's largest: 5 mm = 0.04 r); above "
+            f"{SUBSIDENCE_FRACTION:g} r = {1e3 * SUBSIDENCE_FRACTION * r:g} mm this is an offset "
+            f"slider-crank, not a worn machine{reach}")  # fmt: skip
+
+
+def _dump_config(m, params, kw: dict, dump_config: Path) -> None:
+    """``--dump-config``: the run's full TOML config, to a file or ('-') standard output."""
+    import dataclasses
+
+    from ..config import dump_config as dump
+    from ..io import write_text
+    from ..model.registry import get_model
+
+    values = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else params
+    text = dump(m or get_model(), values, kw)
+    if str(dump_config) == "-":
+        typer.echo(text, nl=False)
+    else:
+        write_text(dump_config, text)
+        typer.echo(f"wrote {dump_config} (run it with: recipdyn simulate -c {dump_config})")
+
+
+def _check_resources(out: Path, n_samples: float, stream: bool, float32: bool, columns,
+                     limit: float | None) -> None:  # fmt: skip
+    """Refuse a run that cannot fit in memory or on its disk, before its kernels are loaded
+    (the library checks again with the exact number of outputs; this uses a lower bound)."""
+    from ..resources import check_memory
+    from ..simulate import STREAM_BLOCK, _check_disk, estimate_memory
+
+    held = min(n_samples, 2 * STREAM_BLOCK) if stream else n_samples
+    check_memory(estimate_memory(held), f"simulate ({n_samples:.3g} samples)",
+                 "reduce --revolutions or --fs", limit)  # fmt: skip
+    if stream:
+        _check_disk(out, n_samples, (len(columns) if columns else 1) + 2, float32)
+
+
+def _run(m, params, kw: dict, out: Path, stream: bool, extra: dict, max_memory, figure: bool,
+         progress: bool) -> None:  # fmt: skip
+    """Load the model and its compiled code, integrate, write the record, figure and summary."""
+    from ..errors import Interrupted, LawRangeWarning, ModelValidityWarning
+    from ..integrate import IntegrationError
+    from ..io import check_output, save_figure, write_dataset
+    from ..model.registry import get_model
+    from ..simulate import simulate as run_sim
+    from ..simulate import summarize
+
+    out = check_output(out)
+    m = m or get_model()
+    _prepare(m, params, kw["method"])
     try:
         with warnings.catch_warnings():  # said once below, as a line of its own
             warnings.simplefilter("ignore", ModelValidityWarning)
             warnings.simplefilter("ignore", LawRangeWarning)
-            ds = run_sim(params, progress=progress, max_memory=max_memory_bytes(max_memory),
-                         model=m, **extra, **kw)  # fmt: skip
+            ds = run_sim(params, progress=progress, max_memory=max_memory, model=m, **extra,
+                         **kw)  # fmt: skip
     except (IntegrationError, Interrupted) as exc:
         kept = keep_partial(exc, out)
         if kept is not None:

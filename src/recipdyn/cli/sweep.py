@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from ..defaults import SWEEP as DEFAULTS
-from . import app
+from . import app, refused_leaves_nothing
 
 
 @app.command()
@@ -53,32 +53,48 @@ def sweep(
     ),
 ) -> None:
     """Sweep one or two parameters; write OUT/sweep.zarr and the figures."""
-    from ..model.parameters import ParameterError
-    from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
+    from ..errors import ParameterError
     from ..units import to_si
     from .simulate import _collect_model, max_memory_bytes
 
-    m, base, _ = _collect_model(model, None, None, None, sets, config)
-    if dask_local is not None or scheduler is not None:
-        backend = "dask"
+    # the options are checked before the sweep machinery (numba, xarray, zarr) is loaded
     if workers is not None and workers < 1:
         raise ParameterError(f"workers = {workers}; allowed: >= 1")
     if dask_local is not None and dask_local < 1:
         raise ParameterError(f"dask_local = {dask_local}; allowed: >= 1")
     if points < 1:
         raise ParameterError(f"points = {points}; allowed: >= 1")
+    if backend not in ("serial", "processes", "dask"):
+        raise ParameterError(f"backend = {backend!r}; allowed: serial, processes, dask")
+    if not 1 <= len(params) <= 2:
+        raise ParameterError(f"a sweep needs 1 or 2 --param axes, got {len(params)}")
+    measures = tuple(x.strip() for x in measure.split(",") if x.strip())
+    bad = [x for x in measures if x not in _MEASURES]
+    if bad or not measures:
+        raise ParameterError(f"--measure {bad or '(none)'}; allowed: {', '.join(_MEASURES)}")
     settings = dict(revolutions=revolutions, transient=transient, points=points,
                     lyap_revolutions=lyap_revolutions, fs=to_si("fs", fs), rtol=rtol,
                     atol=atol)  # fmt: skip
-    spec = SweepSpec(axes=tuple(parse_axis(p, m) for p in params),
-                     measures=tuple(x.strip() for x in measure.split(",") if x.strip()),
+    limit = max_memory_bytes(max_memory)
+    m, base, _ = _collect_model(model, None, None, None, sets, config)
+    if dask_local is not None or scheduler is not None:
+        backend = "dask"
+    from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
+
+    spec = SweepSpec(axes=tuple(parse_axis(p, m) for p in params), measures=measures,
                      base=base, settings=settings, continuation=continuation,
                      model=model or m.name)  # fmt: skip
     run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,
-                  max_memory=max_memory_bytes(max_memory))  # fmt: skip
-    store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)
+                  max_memory=limit)  # fmt: skip
+    with refused_leaves_nothing(out):
+        store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)
     for p in sweep_figures(open_sweep(store).load(), out):
         typer.echo(f"wrote {p}")
+
+
+#: The sweep's measures (``recipdyn.sweep.spec.MEASURES``, whose module loads numba; a test
+#: keeps the two the same).
+_MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict", "features")
 
 
 @app.command()

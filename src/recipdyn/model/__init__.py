@@ -1,13 +1,35 @@
-"""Physical model: parameters, gas load, kinematics, equations of motion."""
+"""Physical model: parameters, gas load, kinematics, equations of motion.
 
-from .base import DiscreteMap, ODESystem, Signal
-from .compressor import CompressorModel, compressor_model, equilibrium_theta_c
-from .kinematics import ideal_slider_crank, joint_forces, kinematics
-from .load import gas_force, mu_paper, read_load_table
-from .parameters import ASSUMED, CompressorParams, ParameterError, paper_2d12
+The names below are imported on first use (PEP 562): ``recipdyn.model.parameters`` and the
+model registry load without numba, so that the command line validates input before it loads
+any compiled code.
+"""
 
-__all__ = [
-    "ODESystem", "DiscreteMap", "Signal", "CompressorModel", "compressor_model",
-    "equilibrium_theta_c", "ideal_slider_crank", "joint_forces", "kinematics", "gas_force",
-    "mu_paper", "read_load_table", "ASSUMED", "CompressorParams", "ParameterError", "paper_2d12",
-]  # fmt: skip
+from __future__ import annotations
+
+import importlib
+
+_LAZY = {
+    "ODESystem": "base", "DiscreteMap": "base", "Signal": "base",
+    "CompressorModel": "compressor", "compressor_model": "compressor",
+    "equilibrium_theta_c": "compressor",
+    "ideal_slider_crank": "kinematics", "joint_forces": "kinematics", "kinematics": "kinematics",
+    "gas_force": "load", "mu_paper": "load", "read_load_table": "load",
+    "ASSUMED": "parameters", "CompressorParams": "parameters", "ParameterError": "parameters",
+    "paper_2d12": "parameters",
+}  # fmt: skip
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        if name != "kinematics":  # the submodule of the same name keeps its attribute
+            globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

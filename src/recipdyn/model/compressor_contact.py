@@ -575,7 +575,8 @@ SCHEMA = Schema((
     Param("rc_crosshead", "m", 1e-4, "radial clearance of the crosshead-pin joint "
           "(clearance_joints = crosshead or both)", 0.0, 0.05, low_open=True,
           assumed="assumed: a worn crosshead bush", group="joint"),
-    _link("d"),
+    _link("d", low_ref="-(l - r - 1.5 (rc + rc_crosshead))",
+          high_ref="l - r - 1.5 (rc + rc_crosshead)"),
     Param("joint", "", "dry", "'dry' contact-impact or 'lubricated' (oil film + dry contact "
           "beyond eps_dry)", choices=("dry", "lubricated"), group="joint"),
     Param("contact_law", "", "lankarani-nikravesh", "normal force law (hysteresis damping)",

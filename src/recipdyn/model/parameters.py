@@ -21,7 +21,7 @@ turns at a prescribed uniform speed, so ``m1``, ``J1`` and ``rs`` affect only th
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
 from ..defaults import RC_MIN
@@ -80,11 +80,11 @@ _INF = math.inf
 SCHEMA = Schema((
     Param("r", "m", 0.12, "crank radius A-B (paper)", 0.0, _INF, True, True, group="mechanism"),
     Param("rs", "m", 0.06, "main bearing to crank centroid (mid-length)", 0.0, _INF,
-          group="mechanism"),
+          high_ref="r", group="mechanism"),
     Param("l", "m", 0.6, "connecting-rod length (paper)", 0.0, _INF, True, True,
           group="mechanism"),
     Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (mid-length)", 0.0, _INF,
-          group="mechanism"),
+          high_ref="l", group="mechanism"),
     Param("m1", "kg", 15.0, "crank mass", 0.0, _INF, high_open=True, assumed=ASSUMED["m1"],
           group="mechanism"),
     Param("m2", "kg", 20.0, "connecting-rod mass", 0.0, _INF, high_open=True,
@@ -98,9 +98,9 @@ SCHEMA = Schema((
     Param("g", "m/s**2", 9.81, "gravitational acceleration (along -y)", 0.0, 100.0,
           group="mechanism"),
     Param("rc", "m", 1.0e-3, "radial clearance of the crank-pin joint (massless link length); "
-          "0 = ideal joint", 0.0, _INF, group="joint"),
+          "0 = ideal joint", 0.0, _INF, high_open=True, high_ref="r", group="joint"),
     Param("d", "m", 1.0e-3, "crosshead subsidence (crosshead runs at y = -d)", -_INF, _INF,
-          group="joint"),
+          True, True, low_ref="-(l - r - rc)", high_ref="l - r - rc", group="joint"),
     Param("omega", "rad/s", 20.0, "crank speed", 0.0, 1.0e4, low_open=True, group="operation"),
     Param("theta1_0", "rad", 0.0, "crank angle at t = 0 (0 = outer dead centre)", -1e6, 1e6,
           group="operation"),
@@ -121,7 +121,7 @@ SCHEMA = Schema((
     Param("bore", "m", 0.5, "cylinder bore (load = cycle)", 0.0, 10.0, low_open=True,
           assumed=ASSUMED_CYCLE["bore"], group="cycle"),
     Param("rod_diameter", "m", 0.1, "piston-rod diameter (load = cycle; < bore)", 0.0, 10.0,
-          assumed=ASSUMED_CYCLE["rod_diameter"], group="cycle"),
+          high_open=True, high_ref="bore", assumed=ASSUMED_CYCLE["rod_diameter"], group="cycle"),
     Param("clearance_fraction", "", 0.1, "clearance volume / swept volume of each chamber "
           "(load = cycle)", 0.0, 10.0, low_open=True, assumed=ASSUMED_CYCLE["clearance_fraction"],
           group="cycle"),
@@ -164,12 +164,9 @@ PARAM_ALIASES: dict[str, str] = dict(SCHEMA.aliases)
 
 
 def resolve_name(name: str) -> str:
-    """Map an alias (``clearance``) to the field name (``rc``); raise on unknown names."""
-    name = PARAM_ALIASES.get(name, name)
-    if name not in {f.name for f in fields(CompressorParams)}:
-        known = sorted({f.name for f in fields(CompressorParams)} | set(PARAM_ALIASES))
-        raise ParameterError(f"unknown parameter {name!r}; known: {', '.join(known)}")
-    return name
+    """Map an alias (``clearance``) to the field name (``rc``); raise on unknown names (with
+    the closest names, `recipdyn.model.protocol.UnknownParameterError`)."""
+    return name if name == "load_table" else SCHEMA.resolve(name)  # (a table: no schema row)
 
 
 def _check(name: str, value: float, lo: float, hi: float, lo_open=False, hi_open=False):

@@ -28,14 +28,55 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ParameterError, is_number
-from .base import DiscreteMap, Event, ODESystem, Signal
+if TYPE_CHECKING:
+    from .base import DiscreteMap, Event, ODESystem, Signal
 
-__all__ = ["Param", "Schema", "Model", "Event"]
+from ..errors import ParameterError, is_number
+
+__all__ = ["Param", "Schema", "Model", "Event", "UnknownParameterError", "close_matches"]
+
+
+def __getattr__(name: str):
+    # ``Event`` lives in .base, which loads numba: imported when first asked for, so that
+    # schemas (and the command line's validation) load without compiled code
+    if name == "Event":
+        from .base import Event
+
+        return Event
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def close_matches(word: str, candidates) -> list[str]:
+    """The candidates ``word`` may be a misspelling of, closest first: difflib's similarity
+    ratio (without case) at least 0.6 and within 0.1 of the best one's (so that
+    ``discharge_presure`` suggests ``discharge_pressure`` alone, not every ``*_pressure``)."""
+    from difflib import SequenceMatcher
+
+    scored = []
+    for c in set(candidates):
+        m = SequenceMatcher(None, word.lower(), c.lower())
+        if m.real_quick_ratio() >= 0.6 and m.quick_ratio() >= 0.6 and m.ratio() >= 0.6:
+            scored.append((m.ratio(), c))
+    if not scored:
+        return []
+    best = max(r for r, _ in scored)
+    return [c for r, c in sorted(scored, key=lambda rc: (-rc[0], rc[1])) if r >= best - 0.1][:3]
+
+
+class UnknownParameterError(ParameterError):
+    """A parameter name no schema entry or alias matches; ``suggestions`` are the closest
+    known names (possibly none)."""
+
+    def __init__(self, name: str, known) -> None:
+        self.name = name
+        self.suggestions = close_matches(name, known)
+        hint = (f"did you mean {' or '.join(repr(s) for s in self.suggestions)}?"
+                if self.suggestions else f"known: {', '.join(sorted(known))}")  # fmt: skip
+        super().__init__(f"unknown parameter {name!r}; {hint}")
 
 
 @dataclass(frozen=True)
@@ -64,6 +105,10 @@ class Param:
         ``initial``, ``operation``).
     optional : bool
         ``None`` is allowed (meaning "derived by the model", e.g. an initial angle).
+    low_ref, high_ref : str
+        A bound that depends on other parameters, as text (``"r"``, ``"l - r - rc"``): shown
+        in place of ``low``/``high`` by `range_text`; the model's cross-field check
+        (`Model.check`) enforces it.
     """
 
     name: str
@@ -78,17 +123,22 @@ class Param:
     assumed: str = ""
     group: str = "model"
     optional: bool = False
+    low_ref: str = ""
+    high_ref: str = ""
 
     @property
     def kind(self) -> str:
         return "choice" if self.choices is not None else "number"
 
-    def range_text(self) -> str:
+    def range_text(self, unit: bool = True) -> str:
+        """The allowed values as text: ``'a', 'b'``, or an interval such as ``[0, r) m``."""
         if self.choices is not None:
             return ", ".join(repr(c) for c in self.choices)
         lb = "(" if self.low_open else "["
         rb = ")" if self.high_open else "]"
-        return f"{lb}{self.low:g}, {self.high:g}{rb}" + (f" {self.unit}" if self.unit else "")
+        low = self.low_ref or f"{self.low:g}"
+        high = self.high_ref or f"{self.high:g}"
+        return f"{lb}{low}, {high}{rb}" + (f" {self.unit}" if self.unit and unit else "")
 
     def check(self, value: Any) -> Any:
         """``value`` validated (numbers as float);
@@ -145,11 +195,11 @@ class Schema:
         return tuple(p.name for p in self.params)
 
     def resolve(self, name: str) -> str:
-        """The parameter's name for ``name`` or an alias; raise on unknown names."""
+        """The parameter's name for ``name`` or an alias; raise
+        `UnknownParameterError` (with the closest names) on unknown names."""
         name = self.aliases.get(name, name)
         if name not in self:
-            known = sorted({*self.names, *self.aliases})
-            raise ParameterError(f"unknown parameter {name!r}; known: {', '.join(known)}")
+            raise UnknownParameterError(name, {*self.names, *self.aliases})
         return name
 
     def defaults(self) -> dict[str, Any]:
@@ -332,6 +382,8 @@ class Model(ABC):
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         """Named signals over a trajectory (default: the state components)."""
+        from .base import Signal
+
         return {n: Signal(np.asarray(y[:, i]), u, n)
                 for i, (n, u) in enumerate(zip(self.state_names, self.state_units,
                                                strict=True))}  # fmt: skip

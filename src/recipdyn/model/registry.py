@@ -20,9 +20,10 @@ import sys
 from pathlib import Path
 
 from ..errors import ParameterError
-from .protocol import Model
+from .protocol import Model, close_matches
 
-__all__ = ["get_model", "model_names", "register", "DEFAULT_MODEL", "ENTRY_POINT_GROUP"]
+__all__ = ["get_model", "model_names", "register", "models_with_parameter", "DEFAULT_MODEL",
+           "ENTRY_POINT_GROUP"]  # fmt: skip
 
 DEFAULT_MODEL = "compressor"
 ENTRY_POINT_GROUP = "recipdyn.models"
@@ -101,8 +102,13 @@ def get_model(spec: str | Model | None = None) -> Model:
     if target is None:
         target = _entry_points().get(spec)
     if target is None and ":" not in spec:
-        raise ParameterError(f"unknown model {spec!r}; known: {', '.join(model_names())} "
-                             "(or module:object)")  # fmt: skip
+        close = close_matches(spec, model_names())
+        hint = (
+            f"did you mean {' or '.join(repr(c) for c in close)}? (every model: recipdyn models)"
+            if close
+            else f"known: {', '.join(model_names())} (or module:object)"
+        )
+        raise ParameterError(f"unknown model {spec!r}; {hint}")
     obj = _load_path(target or spec)
     if isinstance(obj, type) and issubclass(obj, Model):
         obj = obj()
@@ -110,3 +116,18 @@ def get_model(spec: str | Model | None = None) -> Model:
         raise ParameterError(f"model {spec!r} is a {type(obj).__name__}, not a recipdyn Model "
                              "(subclass recipdyn.model.protocol.Model)")  # fmt: skip
     return obj
+
+
+def models_with_parameter(name: str) -> list[str]:
+    """The registered models (built-in, entry points, registered) whose schema has a parameter
+    or alias ``name``: where to point a user who set a parameter on the wrong model. Loads
+    every model (their schemas live beside their kernels: ~1 s), so it is for error paths."""
+    found = []
+    for model_name in model_names():
+        try:
+            schema = get_model(model_name).schema
+        except Exception:  # a broken plug-in must not hide the answer for the others
+            continue
+        if name in schema or name in schema.aliases:
+            found.append(model_name)
+    return found
