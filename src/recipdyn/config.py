@@ -89,6 +89,11 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+def _optional(name: str) -> bool:
+    """Whether the compressor's parameter ``name`` may be None (derived by the model)."""
+    return name in SCHEMA and SCHEMA[name].optional
+
+
 def build_params(values: dict[str, Any], base: CompressorParams | None = None) -> CompressorParams:
     """CompressorParams from ``{name_or_alias: number | quantity string}``, validated."""
     kw: dict[str, Any] = {}
@@ -110,8 +115,8 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
                 kw[name] = tuple(sorted((a % 360.0, f) for a, f in rows))
             else:
                 kw[name] = read_load_table(v)
-        elif name == "theta_c0" and (v is None or str(v).lower() in ("default", "none")):
-            kw[name] = None
+        elif _optional(name) and (v is None or str(v).lower() in ("default", "none")):
+            kw[name] = None  # derived by the model (theta_c0, motor_torque)
         else:
             kw[name] = to_si(name, v)
     params = dataclasses.replace(base or CompressorParams(), **kw)
