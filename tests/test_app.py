@@ -112,7 +112,7 @@ def test_run_settings_are_the_command_lines():
 @pytest.mark.parametrize(
     ("texts", "key", "match"),
     [
-        ({"rc": "-0.001"}, "rc", r"rc = -0.001 mm is out of range; allowed: \[0, inf\] mm"),
+        ({"rc": "-0.001"}, "rc", r"rc = -0.001 mm is out of range; allowed: \[0, "),
         ({"rc": "3 bar"}, "rc", "cannot be converted to m"),
         ({"d": "abc"}, "d", "unknown unit"),
         ({"omega": ""}, "omega", "empty"),
