@@ -175,3 +175,40 @@ def test_jsonable_gives_strict_json():
            "p": Path("x") / "y", "ok": 1.5}  # fmt: skip
     text = json.dumps(jsonable(obj), allow_nan=False)
     assert json.loads(text) == {"a": None, "b": [0, 1, 2], "1": [2, None], "p": "x/y", "ok": 1.5}
+
+
+def test_crank_options_apply_to_every_model_that_has_them(tmp_path, capsys):
+    """--rc/--d/--omega set the parameters of whichever model has them (the contact joint's
+    rc, the valve model's omega), and name the model that has no such parameter."""
+    import tomllib
+
+    cfg = tmp_path / "c.toml"
+    assert main(["simulate", "--model", "compressor-valves", "--rc", "0.5 mm", "--omega",
+                 "300 rpm", "--dump-config", str(cfg)]) == 0  # fmt: skip
+    params = tomllib.loads(cfg.read_text())["params"]
+    assert params["rc"] == pytest.approx(0.5e-3) and params["omega"] == pytest.approx(
+        10 * 3.14159265, rel=1e-6
+    )
+    assert main(["simulate", "--model", "duffing", "--rc", "1 mm", "-o",
+                 str(tmp_path / "x.nc")]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "--rc" in err and "'duffing' has no such parameter" in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_a_plug_in_models_record_is_analysed_from_anywhere(tmp_path, monkeypatch):
+    """A record stores the spec its model was loaded from (an absolute file path for a user's
+    file), so analyze finds the model again from another folder."""
+    from pathlib import Path
+
+    example = Path(__file__).parents[1] / "examples" / "pendulum.py"
+    run = tmp_path / "runs" / "p.nc"
+    run.parent.mkdir()
+    monkeypatch.chdir(example.parent)
+    assert main(["simulate", "--model", "pendulum.py:PENDULUM", "-n", "20", "--fs", "20 Hz",
+                 "-o", str(run), "--no-figure", "--no-progress"]) == 0  # fmt: skip
+    spec = xr.open_dataset(run).attrs["model_spec"]
+    assert spec == f"{example.resolve()}:PENDULUM"
+    monkeypatch.chdir(tmp_path)
+    assert main(["analyze", str(run), "-o", str(tmp_path / "an"), "--section-points", "20",
+                 "--lyap-revolutions", "20"]) == 0  # fmt: skip

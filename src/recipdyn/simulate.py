@@ -20,7 +20,7 @@ from .integrate.solve import UniformGrid, check_tolerances
 from .model.compressor import COMPRESSOR, compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .model.protocol import Model
-from .model.registry import get_model
+from .model.registry import get_model, model_spec
 from .resources import check_memory
 
 __all__ = ["simulate", "summarize", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
@@ -300,7 +300,7 @@ def simulate(
         return _simulate_model(
             get_model(model), params, overrides, revolutions=revolutions, transient=transient,
             fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
-            max_memory=max_memory, spec=model if isinstance(model, str) else get_model(model).name,
+            max_memory=max_memory, spec=model_spec(get_model(model)),
         )  # fmt: skip
     if params is None and model is not None and not isinstance(model, str):
         params = model.parameters()  # a Model object's own defaults (a preset of components)

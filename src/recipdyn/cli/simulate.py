@@ -19,10 +19,11 @@ _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (d
 def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     """(model, parameters, simulation settings) from the options and an optional config.
 
-    For the compressor the parameters are a CompressorParams (``--rc/--d/--omega`` allowed),
-    for any other model a dict of its schema's values. The default model's parameters are
-    validated without loading its compiled code; with ``load=False`` its model is returned as
-    ``None`` (``get_model()`` loads it), so that bad input is answered before heavy imports.
+    For the compressor the parameters are a CompressorParams, for any other model a dict of
+    its schema's values; ``--rc/--d/--omega`` apply to every model whose schema has them. The
+    default model's parameters are validated without loading its compiled code; with
+    ``load=False`` its model is returned as ``None`` (``get_model()`` loads it), so that bad
+    input is answered before heavy imports.
     Another model's schema lives beside its kernels: naming one loads them.
     """
     from ..config import build_params, model_values, read_config
@@ -38,10 +39,10 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     settings = cfg.simulation.resolved() if cfg is not None else {}
     values = dict(cfg.params) if cfg is not None else {}
     options = {n: v for n, v in (("rc", rc), ("d", d), ("omega", omega)) if v is not None}
-    if options and name != DEFAULT_MODEL:
-        raise ParameterError(f"{', '.join('--' + n for n in options)}: compressor options; for "
-                             f"model {name!r} use --set NAME=VALUE (see 'recipdyn models "
-                             f"{name}')")  # fmt: skip
+    lacking = [n for n in options if m is not None and n not in m.schema]
+    if lacking:  # the crank options belong to every model whose schema has them
+        raise ParameterError(f"{', '.join('--' + n for n in lacking)}: model {name!r} has no "
+                             f"such parameter (see 'recipdyn models {name}')")  # fmt: skip
     values.update(options)  # the config, then the options, then --set (last wins)
     for item in sets or []:
         k, v = parse_assignment(item)

@@ -22,8 +22,8 @@ from pathlib import Path
 from ..errors import ParameterError
 from .protocol import Model, close_matches
 
-__all__ = ["get_model", "model_names", "register", "models_with_parameter", "DEFAULT_MODEL",
-           "ENTRY_POINT_GROUP"]  # fmt: skip
+__all__ = ["get_model", "model_names", "register", "models_with_parameter", "model_spec",
+           "DEFAULT_MODEL", "ENTRY_POINT_GROUP"]  # fmt: skip
 
 DEFAULT_MODEL = "compressor"
 ENTRY_POINT_GROUP = "recipdyn.models"
@@ -115,7 +115,17 @@ def get_model(spec: str | Model | None = None) -> Model:
     if not isinstance(obj, Model):
         raise ParameterError(f"model {spec!r} is a {type(obj).__name__}, not a recipdyn Model "
                              "(subclass recipdyn.model.protocol.Model)")  # fmt: skip
+    if target is None:  # a user's module or file: the spec finds it again (records, workers)
+        where, _, name = spec.rpartition(":")
+        obj.spec = f"{Path(where).resolve()}:{name}" if where.endswith(".py") else spec
     return obj
+
+
+def model_spec(model: Model) -> str:
+    """The string that `get_model` finds ``model`` by again: its name when registered or
+    built in, else the ``module:object`` or absolute ``file.py:object`` it was loaded from
+    (what a record stores, so that a plug-in model's record can be analysed)."""
+    return getattr(model, "spec", None) or model.name
 
 
 def models_with_parameter(name: str) -> list[str]:
