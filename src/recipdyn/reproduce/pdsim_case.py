@@ -107,7 +107,6 @@ def params(restitution: float = 0.0) -> dict[str, Any]:
     )  # fmt: skip
 
 
-
 def reference() -> dict[str, np.ndarray]:
     """PDSim's converged cycle: ``theta_deg`` (0 at TDC), ``V`` (m^3), ``p`` (Pa), ``T`` (K),
     the lifts ``y_suction``, ``y_discharge`` clipped to the seat and stop as PDSim uses them
@@ -278,7 +277,7 @@ def figure(ds: Any, ref: dict[str, np.ndarray] | None = None, path: str | Path |
     ax2.set_xlabel("crank angle after TDC (deg)")
     ax2.set_ylabel("valve lift (mm)")
     ax2.set_xlim(0, 360)
-    ax2.legend(loc="upper center", ncol=2, fontsize=8)
+    ax2.legend(loc="center", bbox_to_anchor=(0.68, 0.5), fontsize=8)
     fig.tight_layout()
     if path is not None:
         fig.savefig(path, dpi=90)
@@ -296,7 +295,7 @@ def _fmt(v: Any) -> str:
 
 def run(out: str | Path | None = None, *, transient: float = 4.0, revolutions: float = 1.0,
         restitution: float = 0.0, rtol: float = 1e-8, atol: float = 1e-10,
-        ) -> dict[str, Any]:  # fmt: skip
+        **overrides: Any) -> dict[str, Any]:  # fmt: skip
     """Run the PDSim case with ``compressor-valves`` and compare it with PDSim's cycle.
 
     Parameters
@@ -311,6 +310,9 @@ def run(out: str | Path | None = None, *, transient: float = 4.0, revolutions: f
         The plates' coefficient of restitution; 0 is PDSim's plastic stop.
     rtol, atol : float
         Integrator tolerances.
+    **overrides
+        Parameters replaced in the case (sensitivity studies; the case itself is PDSim's
+        mapping, `params`).
 
     Returns
     -------
@@ -325,7 +327,7 @@ def run(out: str | Path | None = None, *, transient: float = 4.0, revolutions: f
     """
     from ..simulate import simulate
 
-    p = params(restitution)
+    p = params(restitution) | overrides
     ds = simulate(model="compressor-valves", revolutions=revolutions, transient=transient,
                   fs=377.0 / (2.0 * math.pi) * 3600.0, rtol=rtol, atol=atol, **p)  # fmt: skip
     rows = compare(ds)
@@ -342,3 +344,10 @@ def run(out: str | Path | None = None, *, transient: float = 4.0, revolutions: f
         (d / "pdsim_comparison.md").write_text("\n".join(lines) + "\n")
         figure(ds, path=d / "pdsim_comparison.png")
     return {"rows": rows, "dataset": ds, "params": p}
+
+
+if __name__ == "__main__":  # python -m recipdyn.reproduce.pdsim_case OUT_DIR
+    import sys
+
+    res = run(sys.argv[1] if len(sys.argv) > 1 else "pdsim_case")
+    print(Path(sys.argv[1] if len(sys.argv) > 1 else "pdsim_case") / "pdsim_comparison.md")
