@@ -51,23 +51,20 @@ def test_events_read_on_pdsim_cycle_are_those_of_the_reference_readme():
     assert d["on_stop_deg"] == pytest.approx(348.7 - 304.2, abs=0.6)
 
 
-def test_pdsim_indicated_power_and_leakage_estimate():
-    """PDSim's p-V work over its own trace, and its piston leakage estimated with its nozzle
-    on the trace: the leak plus the delivered mass is the mass the cylinder gains between the
-    suction valve's opening and closing (from the trace's p, T and V with CoolProp), to the
-    leakage into the cylinder while it is below the shell's pressure (< 2 % of the
-    displacement)."""
-    import CoolProp.CoolProp as CP
-
+def test_pdsim_leakage_estimate_closes_pdsims_mass_balance():
+    """The leak estimated with PDSim's nozzle on its cycle, added to its delivery, is the mass
+    through its suction valve; the same mass follows from the trace alone (the cylinder's gain
+    while the valve is open, less the leak in then). The shell's state is not in the trace:
+    with its pressure 0.97-1.01 p_s the net leak spans 0.150-0.189 of the displacement, so the
+    two routes must agree within that spread, 0.04 (measured 0.027)."""
     ref = pc.reference()
-    leak = pc.pdsim_leakage(ref) / (pc.SUCTION_RHO * math.pi * 0.02**3 / 4)
-    assert 0.10 < leak < 0.20
-    m = CP.PropsSI("D", "P", ref["p"], "T", ref["T"], "R410A") * ref["V"]
-    s = pc.valve_events(ref["theta_deg"], ref["y_suction"], 0.0)
-    gained = (np.interp(s["close_deg"], ref["theta_deg"], m)
-              - np.interp(s["open_deg"], ref["theta_deg"], m))  # fmt: skip
-    gained /= pc.SUCTION_RHO * math.pi * 0.02**3 / 4
-    assert gained == pytest.approx(pc.PDSIM_REPORTED["volumetric_efficiency"] + leak, abs=0.02)
+    vd = pc.SUCTION_RHO * math.pi * 0.02**3 / 4
+    leak = pc.pdsim_leakage(ref) / vd
+    ps = pc._suction_pressure()
+    spread = (pc.pdsim_leakage(ref, 0.97 * ps) - pc.pdsim_leakage(ref, 1.01 * ps)) / vd
+    assert 0.03 < spread < 0.05
+    via_trace = pc._pdsim_intake(ref) / vd
+    assert via_trace == pytest.approx(pc.PDSIM_REPORTED["volumetric_efficiency"] + leak, abs=0.04)
 
 
 @pytest.fixture(scope="module")
@@ -106,15 +103,16 @@ def test_the_case_runs_and_its_mass_balance_closes(case):
 
 def test_volumetric_efficiency_differs_by_pdsims_piston_leakage(case):
     """recipdyn has no piston leakage; PDSim loses the net leak (estimated on its cycle) from
-    the mass it takes in. The mass through the suction valves must agree within 5 % of the
-    displacement: the residual gas left at TDC differs by PDSim's leak during discharge and
-    re-expansion and its heat transfer (measured on the traces: 0.035), and the suction
-    valve's closing (12 deg apart) moves < 1 % of the displacement near BDC."""
+    the mass it takes in. So recipdyn's volumetric efficiency exceeds PDSim's by that leak,
+    and the masses through the suction valves agree, within the leak estimate's spread over
+    the unknown shell pressure (0.04, previous test) and the 0.7 % of trapped mass the two
+    cycles differ by at the suction valve's closing (0.008): 0.05 of the displacement."""
     pd_eta, ours = case["volumetric_efficiency"]
     leak = case["leakage_fraction"][0]
     assert ours > pd_eta  # no leak in recipdyn
     assert abs((ours - pd_eta) - leak) < 0.05
-    assert abs(case["intake_efficiency"][1] - case["intake_efficiency"][0]) < 0.05
+    for key in ("intake_efficiency", "intake_trace"):
+        assert abs(case[key][1] - case[key][0]) < 0.05, key
     rate = 377.0 / (2 * math.pi)
     assert case["mass_flow_g_s"][1] == pytest.approx(
         1e3 * ours * pc.SUCTION_RHO * math.pi * 0.02**3 / 4 * rate, rel=2e-4)  # fmt: skip

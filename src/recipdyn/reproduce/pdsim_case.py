@@ -148,19 +148,22 @@ def valve_events(theta_deg: np.ndarray, lift: np.ndarray, start: float) -> dict[
             "on_stop_deg": on_stop, "openings": int(starts)}  # fmt: skip
 
 
-def pdsim_leakage(ref: dict[str, np.ndarray] | None = None) -> float:
+def pdsim_leakage(
+    ref: dict[str, np.ndarray] | None = None, shell_pressure: float | None = None
+) -> float:
     """Net mass (kg) leaving PDSim's cylinder past the piston per revolution, estimated on the
     stored cycle.
 
     PDSim's path (``Recip.PistonLeakage``): an isentropic nozzle of area ``delta_gap pi D``
     between the cylinder and the shell. The cylinder's state is the trace's; the shell (not
-    in the trace) is taken at the suction state: its gas returns to the suction through a
-    10 mm nozzle, so its pressure is within the suction's pressure drop of it. Flow function of
+    in the trace) is taken at the suction state, or at ``shell_pressure`` and the suction
+    density: its gas returns to the suction through a 10 mm nozzle, so its pressure is within
+    the suction's pressure drop of it. Flow function of
     the upstream gas's isentropic exponent ``cp/cv`` (CoolProp), ``p/rho`` from CoolProp."""
     import CoolProp.CoolProp as CP
 
     ref = reference() if ref is None else ref
-    ps = _suction_pressure()
+    ps = _suction_pressure() if shell_pressure is None else float(shell_pressure)
     area = DELTA_GAP * math.pi * 0.02
     p, T = ref["p"], ref["T"]
     rho = CP.PropsSI("D", "P", p, "T", T, "R410A")
@@ -179,6 +182,21 @@ def pdsim_leakage(ref: dict[str, np.ndarray] | None = None) -> float:
     mdot = np.where(out, 1.0, -1.0) * area * np.sqrt(pu * rho_u) * psi
     t = np.radians(ref["theta_deg"]) / 377.0
     return float(np.sum(0.5 * (mdot[1:] + mdot[:-1]) * np.diff(t)))
+
+
+def _pdsim_intake(ref: dict[str, np.ndarray]) -> float:
+    """The mass (kg) through PDSim's suction valve in a cycle, from its trace: the cylinder's
+    mass (CoolProp density at the trace's p and T, times V) gained between the valve's
+    opening and closing, less what leaks in past the piston then (`pdsim_leakage` on that
+    interval)."""
+    import CoolProp.CoolProp as CP
+
+    ev = valve_events(ref["theta_deg"], ref["y_suction"], 0.0)
+    m = CP.PropsSI("D", "P", ref["p"], "T", ref["T"], "R410A") * ref["V"]
+    th = ref["theta_deg"]
+    gained = np.interp(ev["close_deg"], th, m) - np.interp(ev["open_deg"], th, m)
+    sel = (th >= ev["open_deg"]) & (th <= ev["close_deg"])
+    return float(gained + pdsim_leakage({k: v[sel] for k, v in ref.items()}))
 
 
 def _indicated_power(p: np.ndarray, V: np.ndarray, omega: float) -> float:
@@ -230,9 +248,13 @@ def compare(ds: Any, ref: dict[str, np.ndarray] | None = None) -> list[dict[str,
          "recipdyn": ours_out / (SUCTION_RHO * vdisp)},
         {"quantity": "piston leakage, net, per rev / (rho_s V_disp) (estimated on PDSim's cycle)",
          "key": "leakage_fraction", "pdsim": leak / (SUCTION_RHO * vdisp), "recipdyn": 0.0},
-        {"quantity": "mass through the suction valve / (rho_s V_disp)",
+        {"quantity": "mass through the suction valve / (rho_s V_disp): PDSim's delivered + leak",
          "key": "intake_efficiency",
          "pdsim": PDSIM_REPORTED["volumetric_efficiency"] + leak / (SUCTION_RHO * vdisp),
+         "recipdyn": ours_in / (SUCTION_RHO * vdisp)},
+        {"quantity": "mass through the suction valve / (rho_s V_disp): PDSim's cylinder gain "
+                     "while it is open, less the leak in",
+         "key": "intake_trace", "pdsim": _pdsim_intake(ref) / (SUCTION_RHO * vdisp),
          "recipdyn": ours_in / (SUCTION_RHO * vdisp)},
         {"quantity": "indicated power, p-V work x f (W)", "key": "indicated_power_W",
          "pdsim": _indicated_power(ref["p"], ref["V"], omega),
