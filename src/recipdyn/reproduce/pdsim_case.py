@@ -235,10 +235,9 @@ def compare(ds: Any, ref: dict[str, np.ndarray] | None = None) -> list[dict[str,
                            ("openings", "separate openings")):  # fmt: skip
             rows.append({"quantity": f"{kind} valve {label}", "key": f"{kind}_{key}",
                          "pdsim": a[key], "recipdyn": b[key]})  # fmt: skip
-    # PDSim's mass through the suction valve per revolution from its trace: the cylinder mass
-    # gained between the suction valve's opening and closing plus the leakage into the
-    # cylinder then is not separable; the delivered mass (solver) plus the net leakage is
-    # the mass that came through the suction valve
+    # PDSim's mass through the suction valve, by two routes: its delivered mass (solver) plus
+    # the net leak, and its trace alone (`_pdsim_intake`); they differ by the leak estimate's
+    # error (the shell's state is not in the trace)
     pd_mdot = PDSIM_REPORTED["mass_flow_g_s"]
     rows += [
         {"quantity": "mass flow delivered (g/s)", "key": "mass_flow_g_s", "pdsim": pd_mdot,
