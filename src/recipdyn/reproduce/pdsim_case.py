@@ -1,7 +1,7 @@
 r"""The dynamic-valve model against PDSim's reciprocating compressor with reed valves.
 
-PDSim (Bell, Ziviani, Lee et al., *PDSim: A general quasi-steady modeling approach for
-positive displacement compressors and expanders*, Int. J. Refrig. 2019,
+PDSim (Bell, Ziviani et al., *PDSim: A general quasi-steady modeling approach for
+positive displacement compressors and expanders*, Int. J. Refrig.,
 doi:10.1016/j.ijrefrig.2019.09.002; MIT-licensed code at github.com/ibell/pdsim) ships a
 reciprocating-compressor example (``examples/recip_compressor.py``): R410A, 60 Hz, a 20 mm
 bore and stroke, reed valves modelled as one-degree-of-freedom masses. One converged cycle of
