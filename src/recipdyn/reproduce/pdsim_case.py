@@ -10,7 +10,7 @@ provenance in its README). [`run`][recipdyn.reproduce.pdsim_case.run] integrates
 with ``compressor-valves`` and puts both side by side.
 
 The reed becomes a plate valve with PDSim's own equivalent stiffness and mass (the formulas of
-the example, a cantilever loaded at ``a`` from its root, Roark's tip-deflection formula, and a
+the example, a cantilever loaded at ``a`` from its root, stiffness from its tip deflection, and a
 third of the reed's mass)::
 
     I = d h^3 / 12,  k = 6 E I / (a^2 (3 l - a)) = 309.8 N/m,  m = rho l d h / 3 = 51.5 mg
