@@ -37,7 +37,7 @@ from .cycle import CYCLE_PARAMS, cycle_data, cycle_states, pressure_force
 #: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
 #: (real-gas isentropes).
 GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
-         "Ethane", "Propane", "CarbonDioxide", "R134a", "Ammonia")  # fmt: skip
+         "Ethane", "Propane", "CarbonDioxide", "R134a", "R410A", "Ammonia")  # fmt: skip
 
 __all__ = [
     "GASES",
