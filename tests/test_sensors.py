@@ -217,3 +217,66 @@ def test_a_resonance_above_the_nyquist_frequency_is_refused():
     ds = _record(5000.0, 100, a=lambda t: t)
     with pytest.raises(ParameterError, match=r"^resonance = 4000 Hz .*Nyquist frequency 2500"):
         record(ds, accelerometer=Accelerometer())
+
+
+@pytest.fixture(scope="module")
+def sensed(tmp_path_factory):
+    """A short compressor run (5 revolutions at 4 kHz) and its sensed copy, by the CLI."""
+    from recipdyn.cli import main
+
+    d = tmp_path_factory.mktemp("sense")
+    run, out = d / "run.nc", d / "sensed.nc"
+    assert main(["simulate", "-n", "5", "--fs", "4kHz", "-o", str(run), "--no-figure",
+                 "--no-progress"]) == 0  # fmt: skip
+    assert main(["sense", str(run), "-o", str(out), "--resonance", "1.5kHz", "--snr", "30dB",
+                 "--seed", "2"]) == 0  # fmt: skip
+    return run, out
+
+
+def test_sense_records_channels_with_units_and_settings(sensed):
+    run, out = sensed
+    ds = xr.open_dataset(out)
+    assert ds.attrs["sensor_channels"] == "accel_guide,tacho"  # the paper's load: no chambers
+    assert ds["accel_guide"].attrs["units"] == "m/s**2"
+    assert ds.attrs["sensor_accel_guide_resonance_hz"] == 1500.0
+    assert ds.attrs["sensor_accel_guide_snr_db"] == 30.0 and ds.attrs["sensor_seed"] == 2
+    assert ds.attrs["sensor_tacho_pulses"] == 5  # revolutions 0..4 start in the record
+    assert set(xr.open_dataset(run).data_vars) < set(ds.data_vars)  # the run is kept whole
+
+
+def test_analyze_reads_a_sensed_record_and_takes_its_orders_from_the_tacho(sensed, tmp_path):
+    """`analyze -c accel_guide --tacho tacho`: the crank speed comes from the tacho's pulses,
+    so the spectrum's peak labelled order 1 sits at the run's crank frequency (within the
+    spectrum's resolution) and order 1 is the order spectrum's strongest line."""
+    import json
+
+    from recipdyn.cli import main
+
+    _, out = sensed
+    folder = tmp_path / "an"
+    assert main(["analyze", str(out), "-c", "accel_guide", "--tacho", "tacho", "-o",
+                 str(folder)]) == 0  # fmt: skip
+    s = json.loads((folder / "summary.json").read_text())
+    f_crank = 20.0 / (2 * np.pi)
+    first = [p for p in s["spectrum"]["peaks"] if p["crank_order"] == 1]
+    assert first and abs(first[0]["frequency_hz"] - f_crank) <= s["spectrum"]["resolution_hz"]
+    lines = s["vibration"]["order_lines"]
+    assert lines[0]["order"] == pytest.approx(1.0, abs=s["vibration"]["order_resolution"] / 2)
+    assert s["units"] == "m/s**2"
+
+
+@pytest.mark.parametrize("args, name", [
+    (["--snr", "loud"], "snr"), (["--damping", "0"], "damping"), (["--bits", "1"], "bits"),
+    (["--resonance", "3kHz"], "resonance"), (["--source", "theta1"], "accelerometer source"),
+    (["--no-accel", "--no-pressure", "--no-tacho"], "sensors"),
+])  # fmt: skip
+def test_sense_refuses_bad_values_in_one_line_and_writes_nothing(sensed, tmp_path, capsys,
+                                                                 args, name):  # fmt: skip
+    from recipdyn.cli import main
+
+    run, _ = sensed
+    out = tmp_path / "new" / "x.nc"
+    assert main(["sense", str(run), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: {name}") and "\n" not in err, err
+    assert not out.parent.exists()

@@ -80,7 +80,8 @@ class Accelerometer:
         Signal-to-noise ratio of the added white Gaussian noise, dB, defined on the RMS of
         the band-limited signal (None: no noise).
     full_scale : float
-        ADC range +/- full_scale, m/s**2 (default 50 g).
+        ADC range +/- full_scale, m/s**2 (default 500 g: a 10 mV/g sensor into a +-5 V
+        input).
     bits : int or None
         ADC resolution (None: no quantisation and no clipping).
     """
@@ -95,7 +96,7 @@ class Accelerometer:
     lowpass_hz: float | None = None
     lowpass_order: int = 4
     snr_db: float | None = 40.0
-    full_scale: float = 50 * G0
+    full_scale: float = 500 * G0
     bits: int | None = 16
 
     def __post_init__(self):
@@ -265,8 +266,10 @@ def _condition(x, fs, s, lo, hi, rng, *, resonance=None):
     if s.snr_db is not None:
         sigma = float(np.sqrt(np.mean(y**2))) * 10.0 ** (-s.snr_db / 20.0)
         y = y + sigma * rng.standard_normal(y.size)
+    span = (float(np.min(y)), float(np.max(y)))  # what reaches the ADC
     y, clipped = adc(y, lo, hi, s.bits)
-    return y, {"lowpass_hz": lowpass, "noise_std": sigma, "clipped_samples": clipped}
+    return y, {"lowpass_hz": lowpass, "noise_std": sigma, "clipped_samples": clipped,
+               "adc_input_min": span[0], "adc_input_max": span[1]}  # fmt: skip
 
 
 def _attr(v):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, report, with_json
+from . import app, refused_leaves_nothing, report, with_json
 
 _NONE = ("none", "off")
 
@@ -127,21 +127,26 @@ def sense(
         full_scale=_quantity("pressure_full_scale", pressure_full_scale, "Pa", p0.full_scale),
         bits=_bits("pressure_bits", pressure_bits, p0.bits),
     )  # fmt: skip
-    check_output(out)
-    from ..io import read_dataset, write_dataset
-    from ..sensors import record
+    with refused_leaves_nothing(out):  # a refusal found in the record leaves no folder
+        check_output(out)
+        from ..io import read_dataset, write_dataset
+        from ..sensors import record
 
-    ds = read_dataset(run)
-    has_p = any(n in ds.data_vars for n in pres.sources)
-    res = record(ds, accelerometer=acc, pressure=pres if pressure and has_p else None,
-                 tacho=Tacho() if tacho and "theta1" in ds.data_vars else None,
-                 seed=seed)  # fmt: skip
-    write_dataset(res, out)
+        ds = read_dataset(run)
+        has_p = any(n in ds.data_vars for n in pres.sources)
+        res = record(ds, accelerometer=acc, pressure=pres if pressure and has_p else None,
+                     tacho=Tacho() if tacho and "theta1" in ds.data_vars else None,
+                     seed=seed)  # fmt: skip
+        write_dataset(res, out)
     chans = res.attrs["sensor_channels"]
     typer.echo(f"wrote {out}: channels {chans} ({res.sizes['time']} samples at "
                f"{res.attrs['sensor_fs_hz']:g} Hz, seed {seed})")  # fmt: skip
     for ch in chans.split(","):
         clipped = res[ch].attrs.get("sensor_clipped_samples", 0)
         if clipped:
-            typer.echo(f"warning: {ch}: {clipped} sample(s) clipped at the ADC's full scale")
+            a = res[ch].attrs
+            typer.echo(f"warning: {ch}: {clipped} sample(s) clipped at the ADC's range "
+                       f"{a['sensor_adc_range']} (its input spans {a['sensor_adc_input_min']:.4g}"
+                       f"..{a['sensor_adc_input_max']:.4g}); a larger full scale records "
+                       "them")  # fmt: skip
     report(output=str(out), channels=chans.split(","), seed=seed)
