@@ -280,3 +280,27 @@ def test_sense_refuses_bad_values_in_one_line_and_writes_nothing(sensed, tmp_pat
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {name}") and "\n" not in err, err
     assert not out.parent.exists()
+
+
+@pytest.mark.parametrize("args", [["--damping", "2"], ["--snr", "x"], ["--bits", "40"],
+                                  ["--resonance", "-1"]])  # fmt: skip
+def test_sense_refuses_a_bad_value_before_heavy_imports(tmp_path, args):
+    """Option values are checked before xarray, SciPy or the record are loaded (a fresh
+    interpreter reports what it imported)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "run.nc").write_bytes(b"not read")
+    heavy = ("xarray", "scipy.signal", "numba", "matplotlib", "pandas")
+    probe = ("import sys, json\nfrom recipdyn.cli import main\n"
+             f"code = main({['sense', 'run.nc', '-o', 'o/x.nc', *args]!r})\n"
+             f"print(json.dumps([code, [m for m in {heavy!r} if m in sys.modules]]))\n"
+             )  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    code, loaded = json.loads(done.stdout.strip().splitlines()[-1])
+    assert code == 2 and loaded == [], (done.stderr, loaded)
+    assert not (tmp_path / "o").exists()

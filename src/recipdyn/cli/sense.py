@@ -17,6 +17,10 @@ def _quantity(name: str, text: str | None, unit: str, default):
         return default
     if text.strip().lower() in _NONE:
         return None
+    try:  # a bare number is in SI already (and needs no unit registry)
+        return float(text)
+    except ValueError:
+        pass
     from ..units import to_si
 
     return to_si(name, text, unit=unit)
