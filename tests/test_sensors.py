@@ -17,6 +17,7 @@ from recipdyn.sensors import (
     PressureTransducer,
     Tacho,
     adc,
+    flank_error,
     record,
     resonance_filter,
     snr_db,
@@ -65,6 +66,23 @@ def test_resonance_matches_the_second_order_closed_form(fn, zeta, fs):
     fw = fn * np.tan(np.pi * f / fs) / np.tan(np.pi * fn / fs)
     closed = fn**2 / (fn**2 - fw**2 + 2j * zeta * fn * fw)
     np.testing.assert_allclose(h, closed, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("fn, want", [(4000.0, 0.20), (1000.0, 0.016), (500.0, 0.0041)])
+def test_the_recorded_flank_error_is_the_filters_own_error(fn, want):
+    """The error the record states (`sensor_resonance_flank_error`, from the warp's closed
+    form) equals the largest magnitude error of the filter's own response (freqz on a dense
+    grid) against the continuous closed form below f_n/2: it is the discretisation error.
+    Both are evaluated on grids of ~2000 points: they agree to the grid's resolution (1e-3
+    relative)."""
+    fs, zeta = 10e3, 0.05
+    b, a = resonance_filter(fn, zeta, fs)
+    f = np.linspace(fn / 4000, fn / 2, 2000)
+    _, h = freqz(b, a, worN=f, fs=fs)
+    closed = fn**2 / np.abs(fn**2 - f**2 + 2j * zeta * fn * f)
+    measured = float(np.max(np.abs(np.abs(h) / closed - 1)))
+    assert flank_error(fn, zeta, fs) == pytest.approx(measured, rel=1e-3)
+    assert measured == pytest.approx(want, rel=0.05)
 
 
 def test_a_sine_at_the_resonance_is_recorded_with_gain_one_over_two_zeta():

@@ -26,7 +26,7 @@ import numpy as np
 from .errors import ParameterError
 
 __all__ = ["Accelerometer", "PressureTransducer", "Tacho", "record", "adc", "snr_db",
-           "resonance_filter", "band_filters", "G0"]  # fmt: skip
+           "resonance_filter", "flank_error", "band_filters", "G0"]  # fmt: skip
 
 #: Standard gravity, m/s^2 (ISO 80000-3).
 G0 = 9.80665
@@ -208,6 +208,22 @@ def resonance_filter(fn: float, zeta: float, fs: float):
     return bilinear([wp**2], [1.0, 2 * zeta * wp, wp**2], fs=fs)
 
 
+def flank_error(fn: float, zeta: float, fs: float, points: int = 2001) -> float:
+    """Largest relative error of the discrete resonance's magnitude against the closed form
+    over ``0 < f <= f_n / 2`` (the band below the resonance), from the warping of
+    [`resonance_filter`][recipdyn.sensors.resonance_filter]: ``|H(j f_w)| / |H(j f)| - 1``.
+
+    About 2e-1 at f_n = 0.4 fs, 1.6e-2 at 0.1 fs, 4e-3 at 0.05 fs (damping 0.05): sample at
+    ten times the resonance or more for a flank right to 2 %."""
+    f = np.linspace(fn / 2 / points, fn / 2, points)
+    fw = fn * np.tan(np.pi * f / fs) / math.tan(np.pi * fn / fs)
+
+    def mag(x):
+        return fn**2 / np.abs(fn**2 - x**2 + 2j * zeta * fn * x)
+
+    return float(np.max(np.abs(mag(fw) / mag(f) - 1)))
+
+
 def band_filters(highpass_hz, highpass_order, lowpass_hz, lowpass_order, fs):
     """Second-order sections of the Butterworth high-pass and low-pass (either may be None),
     designed by ``scipy.signal.butter`` (bilinear, prewarped at the corner: the digital
@@ -362,6 +378,8 @@ def record(ds, *, accelerometer: Accelerometer | None = Accelerometer(),
         y, extra = _condition(src, fs, s, -s.full_scale, s.full_scale, _rng(seed, s.name),
                               resonance=res)  # fmt: skip
         settings = {k: v for k, v in asdict(s).items() if k != "name"}
+        if res is not None:
+            settings["resonance_flank_error"] = flank_error(*res, fs)
         put(
             s.name,
             y,

@@ -145,6 +145,12 @@ def sense(
     chans = res.attrs["sensor_channels"]
     typer.echo(f"wrote {out}: channels {chans} ({res.sizes['time']} samples at "
                f"{res.attrs['sensor_fs_hz']:g} Hz, seed {seed})")  # fmt: skip
+    err = res[acc.name].attrs.get("sensor_resonance_flank_error", 0.0) if acc else 0.0
+    if err > 0.01:
+        typer.echo(f"note: {acc.name}: the resonance at {acc.resonance_hz:g} Hz lies at "
+                   f"{acc.resonance_hz / res.attrs['sensor_fs_hz']:.2g} fs: below f_n/2 the "
+                   f"recorded magnitude is off the closed form by up to {err:.1%} (frequency "
+                   "warping); simulate at >= 10 f_n for 2 %")  # fmt: skip
     for ch in chans.split(","):
         clipped = res[ch].attrs.get("sensor_clipped_samples", 0)
         if clipped:
