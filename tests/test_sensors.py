@@ -327,3 +327,18 @@ def test_sense_refuses_a_bad_value_before_heavy_imports(tmp_path, args):
     code, loaded = json.loads(done.stdout.strip().splitlines()[-1])
     assert code == 2 and loaded == [], (done.stderr, loaded)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_sensed_record_writes_as_mat_with_every_setting(sensed, tmp_path):
+    """MAT files keep the settings too: their struct fields take names up to 63 characters
+    (``sensor_accel_guide_resonance_flank_error`` has 40; MAT's default limit is 31)."""
+    from scipy.io import loadmat
+
+    from recipdyn.cli import main
+
+    run, _ = sensed
+    out = tmp_path / "s.mat"
+    assert main(["sense", str(run), "-o", str(out), "--resonance", "1.5kHz"]) == 0
+    mat = loadmat(out, squeeze_me=True)
+    assert mat["attrs"]["sensor_accel_guide_resonance_flank_error"].item() > 0
+    assert mat["units"]["accel_guide"].item() == "m/s**2" and mat["tacho"].size > 0
