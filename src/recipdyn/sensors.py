@@ -299,6 +299,11 @@ def _attr(v):
 
 def _pressure_range(x) -> float:
     top = 1.25 * float(np.max(x))
+    if not top > 0:
+        raise ParameterError(
+            "pressure_full_scale: the recorded pressure is never positive; "
+            "allowed: give the range (e.g. --pressure-full-scale '10 bar')"
+        )
     e = 10.0 ** math.floor(math.log10(top))
     return next(m * e for m in (1, 2, 5, 10) if m * e >= top)
 
@@ -355,6 +360,9 @@ def record(ds, *, accelerometer: Accelerometer | None = Accelerometer(),
     'm/s**2'
     """
     _check("seed", seed, 0, 2**63 - 1, integer=True)
+    if accelerometer is None and pressure is None and tacho is None:
+        raise ParameterError("sensors: none given; allowed: an accelerometer, pressure "
+                             "transducers, a tacho, or several")  # fmt: skip
     fs = _sampling(ds)
     out = ds.copy()
     channels = []
