@@ -18,7 +18,7 @@ LAYERS = [
     {"units", "config"},  # read the model's parameter schema
     {"integrate"},
     {"analysis"},
-    {"simulate", "io_signal"},
+    {"simulate", "io_signal", "sensors"},  # sensors read records
     {"plotting", "analyze", "compare", "animate"},
     {"sweep", "features"},  # features reads sweep stores
     {"reproduce", "app"},

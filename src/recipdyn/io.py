@@ -208,7 +208,7 @@ def _write_mat(ds, path: Path) -> None:
     data["attrs"] = {_mat_name(k): (v if isinstance(v, (int, float, np.number)) else str(v))
                      for k, v in ds.attrs.items()}  # fmt: skip
     with open(path, "wb") as fh:
-        savemat(fh, data, do_compression=True, oned_as="column")
+        savemat(fh, data, do_compression=True, oned_as="column", long_field_names=True)
 
 
 def jsonable(obj):

@@ -1,4 +1,4 @@
-"""Command-line interface: ``recipdyn simulate | analyze | sweep | plot | reproduce | ...``.
+"""Command-line interface: ``recipdyn simulate | sense | analyze | sweep | plot | reproduce | ...``.
 
 Each command parses its options, calls one library function and writes files. The exit
 statuses are the contract of ``docs/reliability.md``:
@@ -139,6 +139,7 @@ def _register() -> None:
     from . import features as _features  # noqa: F401
     from . import models as _models  # noqa: F401
     from . import reproduce as _reproduce  # noqa: F401
+    from . import sense as _sense  # noqa: F401
     from . import simulate as _simulate  # noqa: F401
     from . import sweep as _sweep  # noqa: F401
     from . import warmup as _warmup  # noqa: F401
