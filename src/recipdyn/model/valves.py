@@ -65,9 +65,18 @@ cases tried (tests/test_valves.py).
 position of the mechanism's own state (not the ideal crank angle), so gas and mechanism are
 coupled both ways.
 
+**Faults** (docs/faults.md; `FAULT_PARAMS`, each per valve of `VALVES`; the defaults are
+the healthy valves and leave every result unchanged to the bit): a leak area in parallel with
+the plate (the effective area ``C_d (A_v min(max(y,0)/y_max, 1) + A_leak)``, same nozzle
+equation, both directions); a spring factor scaling ``k_v`` and ``F_0`` (0: broken; the
+damping keeps its healthy value); an adhesion force ``F_a`` holding a plate resting on its seat
+until ``A_F dp - F_0 > F_a`` (oil stiction); a piston-ring leak area between the two chambers
+(to the frame, at ``p_frame`` and ``T_s``, for a single-acting cylinder), through the same
+nozzle from the chamber at the higher pressure, its gas's enthalpy carried along.
+
 Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: the line
-pressures are constant), no leakage past the piston rings or the valves, no heat transfer other
-than through the polytropic exponent, one lumped plate per valve group, ideal gas.
+pressures are constant), no heat transfer other than through the polytropic exponent, one
+lumped plate per valve group.
 """
 
 from __future__ import annotations
@@ -89,7 +98,7 @@ __all__ = [
     "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
     "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
     "real_properties",
-    "gas_outputs", "gas_scale",
+    "gas_outputs", "gas_scale", "FAULT_PARAMS", "VALVES",
 ]  # fmt: skip
 
 #: Rebound velocity (m/s) below which a plate comes to rest on its stop (no Zeno sequence of
