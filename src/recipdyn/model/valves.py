@@ -242,7 +242,6 @@ SCHEMA_PARAMS = (
 #: The four valves, in the order of the fault data (index ``2 j + kind``: chamber ``j``, 0 head
 #: end, 1 crank end; kind 0 suction, 1 discharge).
 VALVES = tuple((kind, end) for end in ("head", "crank") for kind in ("suction", "discharge"))
-_HEALTHY = "0 (1 for a spring factor) is the healthy valve; docs/faults.md"
 #: Faults of the valves and the piston rings (docs/faults.md), each a parameter of the valve
 #: load; the defaults are the healthy machine.
 FAULT_PARAMS = (
