@@ -65,9 +65,18 @@ cases tried (tests/test_valves.py).
 position of the mechanism's own state (not the ideal crank angle), so gas and mechanism are
 coupled both ways.
 
+**Faults** (docs/faults.md; `FAULT_PARAMS`, each per valve of `VALVES`; the defaults are
+the healthy valves and leave every result unchanged to the bit): a leak area in parallel with
+the plate (the effective area ``C_d (A_v min(max(y,0)/y_max, 1) + A_leak)``, same nozzle
+equation, both directions); a spring factor scaling ``k_v`` and ``F_0`` (0: broken; the
+damping keeps its healthy value); an adhesion force ``F_a`` holding a plate resting on its seat
+until ``A_F dp - F_0 > F_a`` (oil stiction); a piston-ring leak area between the two chambers
+(to the frame, at ``p_frame`` and ``T_s``, for a single-acting cylinder), through the same
+nozzle from the chamber at the higher pressure, its gas's enthalpy carried along.
+
 Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: the line
-pressures are constant), no leakage past the piston rings or the valves, no heat transfer other
-than through the polytropic exponent, one lumped plate per valve group, ideal gas.
+pressures are constant), no heat transfer other than through the polytropic exponent, one
+lumped plate per valve group.
 """
 
 from __future__ import annotations
@@ -89,7 +98,7 @@ __all__ = [
     "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
     "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
     "real_properties",
-    "gas_outputs", "gas_scale",
+    "gas_outputs", "gas_scale", "FAULT_PARAMS", "VALVES",
 ]  # fmt: skip
 
 #: Rebound velocity (m/s) below which a plate comes to rest on its stop (no Zeno sequence of
@@ -230,10 +239,36 @@ SCHEMA_PARAMS = (
     ),
 )
 
-# Layout of the valve data (after the cycle data).
+#: The four valves, in the order of the fault data (index ``2 j + kind``: chamber ``j``, 0 head
+#: end, 1 crank end; kind 0 suction, 1 discharge).
+VALVES = tuple((kind, end) for end in ("head", "crank") for kind in ("suction", "discharge"))
+#: Faults of the valves and the piston rings (docs/faults.md), each a parameter of the valve
+#: load; the defaults are the healthy machine.
+FAULT_PARAMS = (
+    *(Param(f"leak_area_{kind}_{end}", "m**2", 0.0,
+            f"{end}-end {kind} valve leak: flow area in parallel with the plate (same nozzle "
+            "equation and discharge coefficient), e.g. a broken plate or a worn seat",
+            0.0, 0.1, group="faults") for kind, end in VALVES),
+    *(Param(f"spring_factor_{kind}_{end}", "", 1.0,
+            f"{end}-end {kind} valve spring: stiffness and preload times this factor (1 "
+            "healthy, 0 broken)", 0.0, 1.0, group="faults") for kind, end in VALVES),
+    *(Param(f"adhesion_force_{kind}_{end}", "N", 0.0,
+            f"{end}-end {kind} valve sticking: oil-film adhesion holding the plate on its "
+            "seat until the net opening force exceeds it", 0.0, 1e6, group="faults")
+      for kind, end in VALVES),
+    Param("ring_leak_area", "m**2", 0.0,
+          "piston-ring leak: flow area between the head-end and crank-end chambers (to the "
+          "frame for a single-acting cylinder), same nozzle equation and discharge coefficient",
+          0.0, 0.1, group="faults"),
+)  # fmt: skip
+SCHEMA_PARAMS = (*SCHEMA_PARAMS, *FAULT_PARAMS)
+
+# Layout of the valve data (after the cycle data); the fault data hold four values each, one
+# per valve in the order of `VALVES`.
 (V_AREA, V_LIFT, V_MASS, V_K, V_F0, V_C, V_AF, V_CD, V_E, V_R, V_KAPPA, V_TS, V_TD,
  V_NCH, V_CRIT, V_E1, V_E2, V_COEF) = range(18)  # fmt: skip
-N_VALVE = 18
+V_LEAK, V_SPRING, V_STICK, V_RING, V_PFRAME = 18, 22, 26, 30, 31
+N_VALVE = 32
 
 #: Gas states of one chamber: pressure, mass, suction-plate lift and velocity, discharge-plate
 #: lift and velocity.
@@ -282,13 +317,20 @@ def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
     out[V_TS] = t_s
     out[V_TD] = t_s * ratio ** ((nc - 1.0) / nc)
     out[V_NCH] = cycle_data[cy.C_ACTING]
+    cd = float(values["discharge_coefficient"])
+    for q, (kind, end) in enumerate(VALVES):
+        out[V_LEAK + q] = cd * float(values.get(f"leak_area_{kind}_{end}", 0.0))
+        out[V_SPRING + q] = values.get(f"spring_factor_{kind}_{end}", 1.0)
+        out[V_STICK + q] = values.get(f"adhesion_force_{kind}_{end}", 0.0)
+    out[V_RING] = cd * float(values.get("ring_leak_area", 0.0))
+    out[V_PFRAME] = cycle_data[cy.C_PFRAME]
     tab = _gas_table(values)
     if tab is None:
-        out[V_CRIT:] = _nozzle_constants(float(values["isentropic_exponent"]))
+        out[V_CRIT:V_LEAK] = _nozzle_constants(float(values["isentropic_exponent"]))
         return out
     # a real gas: the chamber property table follows, and the nozzle takes the isentropic
     # exponent of the suction gas
-    out[V_CRIT:] = _nozzle_constants(float(tab[rg.T_KAPPA]))
+    out[V_CRIT:V_LEAK] = _nozzle_constants(float(tab[rg.T_KAPPA]))
     return np.concatenate([out, tab])
 
 
@@ -330,15 +372,18 @@ def _mdot(p_line, rt_line, p, rt, area, v):
 
 
 @nb.njit(cache=True, inline="always")
-def _plate(y, dp, v, out, i):
-    """Plate equation of a valve at ``y[i], y[i+1]`` opened by ``dp``; rests on its stops."""
+def _plate(y, dp, v, out, i, q):
+    """Plate equation of valve ``q`` (`VALVES`) at ``y[i], y[i+1]`` opened by ``dp``; rests
+    on its stops. Its spring is scaled by its factor, and an adhesion force holds it on the
+    seat until the net opening force exceeds it (docs/faults.md)."""
     lift, u_ = y[i], y[i + 1]
-    force = v[V_AF] * dp - v[V_F0] - v[V_K] * lift - v[V_C] * u_
+    sf = v[V_SPRING + q]
+    force = v[V_AF] * dp - sf * v[V_F0] - sf * v[V_K] * lift - v[V_C] * u_
     ymax = v[V_LIFT]
     # A plate pressed onto a stop rests there when it is slower than V_REST (a fast one
     # moves on through the stop until its impact event acts, so that a step that crosses the
     # stop sees a smooth right-hand side; _distance makes the event at the same bound)
-    if (lift <= 0.0 and -V_REST < u_ <= 0.0 and force <= 0.0) or (
+    if (lift <= 0.0 and -V_REST < u_ <= 0.0 and force <= v[V_STICK + q]) or (
             lift >= ymax and 0.0 <= u_ < V_REST and force >= 0.0):  # fmt: skip
         out[i] = 0.0
         out[i + 1] = 0.0
@@ -393,33 +438,80 @@ def real_properties(p, rt, tab):
 
 
 @nb.njit(cache=True, inline="always")
-def _chamber(V, dV, y, b, c, v, out):
-    """Derivatives of one chamber's six states at ``y[b:b+6]``; returns (mdot_s, mdot_d)."""
+def _chamber(V, dV, y, b, q, c, v, mr, hr, out):
+    """Derivatives of one chamber's six states at ``y[b:b+6]`` (its suction valve ``q``, its
+    discharge valve ``q + 1``); ``mr``: the ring leak into it, with the enthalpy (real gas) or
+    ``R T`` (ideal gas) of its upstream gas ``hr``. Returns (mdot_s, mdot_d)."""
     p, m = y[b], y[b + 1]
     ps, pd = c[cy.C_PS], c[cy.C_PD]
+    # a leak is an area in parallel with the plate (0 when healthy: the sum is exact)
+    a_s = _area(y[b + 2], y[b + 3], v) + v[V_LEAK + q]
+    a_d = _area(y[b + 4], y[b + 5], v) + v[V_LEAK + q + 1]
     if v.shape[0] > N_VALVE:  # a real gas: the first law with the tabulated properties
         tab = v[N_VALVE:]
         rt = p * V / m
-        ms = _mdot(ps, tab[rg.T_RTS], p, rt, _area(y[b + 2], y[b + 3], v), v)
-        md = _mdot(pd, tab[rg.T_RTD], p, rt, _area(y[b + 4], y[b + 5], v), v)
+        ms = _mdot(ps, tab[rg.T_RTS], p, rt, a_s, v)
+        md = _mdot(pd, tab[rg.T_RTD], p, rt, a_d, v)
         u, dp_drho, dp_du, _t = real_properties(p, rt, tab)
         hs = tab[rg.T_HS] if ms > 0.0 else u + rt
         hd = tab[rg.T_HD] if md > 0.0 else u + rt
-        out[b] = (dp_drho * (ms + md - m / V * dV) / V
-                  + dp_du / m * (ms * (hs - u) + md * (hd - u) - p * dV))  # fmt: skip
+        q_in = ms * (hs - u) + md * (hd - u)
+        if mr != 0.0:
+            q_in += mr * ((hr if mr > 0.0 else u + rt) - u)
+        out[b] = (dp_drho * (ms + md + mr - m / V * dV) / V
+                  + dp_du / m * (q_in - p * dV))  # fmt: skip
     else:
         R = v[V_R]
         T = p * V / (m * R)
-        ms = _mdot(ps, R * v[V_TS], p, R * T, _area(y[b + 2], y[b + 3], v), v)
-        md = _mdot(pd, R * v[V_TD], p, R * T, _area(y[b + 4], y[b + 5], v), v)
+        ms = _mdot(ps, R * v[V_TS], p, R * T, a_s, v)
+        md = _mdot(pd, R * v[V_TD], p, R * T, a_d, v)
         n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
         ts = v[V_TS] if ms > 0.0 else T
         td = v[V_TD] if md > 0.0 else T
-        out[b] = n / V * (R * (ts * ms + td * md) - p * dV)
-    out[b + 1] = ms + md
-    _plate(y, ps - p, v, out, b + 2)
-    _plate(y, p - pd, v, out, b + 4)
+        h_in = ts * ms + td * md
+        if mr != 0.0:
+            h_in += mr * (hr / R if mr > 0.0 else T)
+        out[b] = n / V * (R * h_in - p * dV)
+    out[b + 1] = ms + md + mr
+    _plate(y, ps - p, v, out, b + 2, q)
+    _plate(y, p - pd, v, out, b + 4, q + 1)
     return ms, md
+
+
+@nb.njit(cache=True, inline="always")
+def _gas_rt(p, m, V, v):
+    """``p / rho`` and the specific enthalpy (real gas) or ``R T`` (ideal gas) of a chamber's
+    gas, for the ring leak that leaves it."""
+    rt = p * V / m
+    if v.shape[0] > N_VALVE:
+        return rt, real_properties(p, rt, v[N_VALVE:])[0] + rt
+    return rt, rt
+
+
+@nb.njit(cache=True, inline="always")
+def _ring(x, xdot, y, g, c, v):
+    """Ring leak into the head-end chamber (kg/s, < 0: out of it) and into the crank-end
+    chamber, each with the ``h`` or ``R T`` of its upstream gas: the nozzle equation between
+    the two chambers of a double-acting cylinder, or between the working chamber and the frame
+    (at the frame pressure and the suction temperature) for a single-acting one."""
+    area = v[V_RING]
+    acting = int(v[V_NCH])
+    if v.shape[0] > N_VALVE:
+        tab = v[N_VALVE:]
+        rt_f, h_f = tab[rg.T_RTS], tab[rg.T_HS]
+    else:
+        rt_f = h_f = v[V_R] * v[V_TS]
+    if acting == 3:
+        rt0, h0 = _gas_rt(y[g], y[g + 1], _volume(x, xdot, 0, c)[0], v)
+        rt1, h1 = _gas_rt(y[g + 6], y[g + 7], _volume(x, xdot, 1, c)[0], v)
+        m0 = _mdot(y[g + 6], rt1, y[g], rt0, area, v)
+        return m0, h1, -m0, h0
+    pf = v[V_PFRAME]
+    if acting == 1:
+        rt0, h0 = _gas_rt(y[g], y[g + 1], _volume(x, xdot, 0, c)[0], v)
+        return _mdot(pf, rt_f, y[g], rt0, area, v), h_f, 0.0, 0.0
+    rt1, h1 = _gas_rt(y[g + 6], y[g + 7], _volume(x, xdot, 1, c)[0], v)
+    return 0.0, 0.0, _mdot(pf, rt_f, y[g + 6], rt1, area, v), h_f
 
 
 @nb.njit(cache=True, inline="always")
@@ -453,6 +545,9 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
     (single-acting) keeps its states (derivatives 0) and the frame pressure acts on its piston
     face."""
     acting = int(v[V_NCH])
+    m0 = h0 = m1 = h1 = 0.0
+    if v[V_RING] > 0.0:
+        m0, h0, m1, h1 = _ring(x, xdot, y, g, c, v)
     for j in range(2):
         b = g + 6 * j
         if not acting & (1 << j):
@@ -462,7 +557,8 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
             out[a + 2 * j + 1] = 0.0
             continue
         V, dV = _volume(x, xdot, j, c)
-        ms, md = _chamber(V, dV, y, b, c, v, out)
+        ms, md = _chamber(V, dV, y, b, 2 * j, c, v, m0 if j == 0 else m1,
+                          h0 if j == 0 else h1, out)  # fmt: skip
         out[a + 2 * j] = ms
         out[a + 2 * j + 1] = -md
     return state_force(y, g, c)
