@@ -14,7 +14,7 @@ from recipdyn.errors import ParameterError
 from recipdyn.model import CompressorParams, compressor_model, ideal_slider_crank
 from recipdyn.model._generated import clearance_acceleration
 from recipdyn.model._generated_drive import free_crank_accelerations
-from recipdyn.model.components import check_fragments
+from recipdyn.model.components.contract import check_fragments
 from recipdyn.model.components.drive import INDUCTION, mean_load_torque
 from recipdyn.model.load import gas_force
 from recipdyn.model.paper_printed import paper_acceleration

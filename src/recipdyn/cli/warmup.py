@@ -16,8 +16,10 @@ def warmup(
     ),
     method: str = typer.Option("dop853", "--method", help="dop853, rk4 or all."),
 ) -> None:
-    """Compile every kernel a run of each model uses (or load it from the cache) and say how
-    long it took; later runs then start at once. 'make run' does this first."""
+    """Compile the kernels each model's run uses ahead, so later runs start at once.
+
+    Each kernel is compiled, or loaded from the cache, and the time it took is said;
+    'make run' does this first."""
     import warnings
 
     from ..errors import ParameterError

@@ -25,8 +25,9 @@ from typing import Any
 import numpy as np
 
 from .base import ODESystem, Signal, rhs_series
-from .components import DRIVES, MOTORS, Assembly, Component, glue_module, load_component
-from .components.load import cycle_outputs, cycle_summary
+from .components.contract import Assembly, Component, glue_module
+from .components.drive import DRIVES, MOTORS
+from .components.load import cycle_outputs, cycle_summary, load_component
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
 from .load import pack_load

@@ -27,8 +27,8 @@ from typing import Any, Literal
 from ..defaults import RC_MIN
 from ..errors import ParameterError
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
+from .gases import GASES
 from .protocol import Param, Schema
-from .realgas import GASES
 
 __all__ = [
     "CompressorParams",

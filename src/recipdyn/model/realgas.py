@@ -33,11 +33,7 @@ import math
 import numpy as np
 
 from .cycle import CYCLE_PARAMS, cycle_data, cycle_states, pressure_force
-
-#: Gases of the compression cycle: ``ideal`` (the polytropic model) or a CoolProp fluid
-#: (real-gas isentropes).
-GASES = ("ideal", "Air", "Nitrogen", "Oxygen", "Argon", "Helium", "Hydrogen", "Methane",
-         "Ethane", "Propane", "CarbonDioxide", "R134a", "R410A", "Ammonia")  # fmt: skip
+from .gases import GASES  # noqa: F401  (re-exported)
 
 __all__ = [
     "GASES",

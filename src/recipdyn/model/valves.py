@@ -90,8 +90,8 @@ import numpy as np
 
 from . import cycle as cy
 from . import realgas as rg
+from .gases import GASES
 from .protocol import Param
-from .realgas import GASES
 
 __all__ = [
     "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",

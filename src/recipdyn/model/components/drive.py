@@ -26,36 +26,19 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-import numba as nb
 import numpy as np
 
 from ...errors import ParameterError
 from ..protocol import Param
 from .contract import Component
 
+#: Where the drive components' compiled functions live (numba loads only when a run does).
+KERNELS = "recipdyn.model.components.drive_kernels"
+
 __all__ = ["PRESCRIBED", "MOTOR", "CONSTANT_TORQUE", "INDUCTION", "DRIVES", "MOTORS",
            "mean_load_torque"]  # fmt: skip
 
 _INF = math.inf
-
-
-@nb.njit(cache=True, inline="always")
-def prescribed_crank(t, y, p, o):
-    """``(theta1, omega1)`` of the prescribed drive (slice ``omega, theta1_0``)."""
-    return p[o + 1] + p[o] * t, p[o]
-
-
-@nb.njit(cache=True, inline="always")
-def constant_torque(w, p, o):
-    """Constant motor torque, N m (slice ``motor_torque``)."""
-    return p[o]
-
-
-@nb.njit(cache=True, inline="always")
-def induction_torque(w, p, o):
-    """Kloss's curve, N m (slice ``omega_s, T_b, s_b``); finite through s = 0."""
-    s = (p[o] - w) / p[o]
-    return 2.0 * p[o + 1] * s * p[o + 2] / (s * s + p[o + 2] * p[o + 2])
 
 
 def _prescribed(values: Mapping[str, Any]) -> np.ndarray:
@@ -103,7 +86,7 @@ def _check_induction(values: Mapping[str, Any]) -> None:
 
 PRESCRIBED = Component(
     "drive", "prescribed", "constant crank speed omega (an infinitely stiff drive)",
-    module=__name__, kernels={"crank": "prescribed_crank"}, pack=_prescribed,
+    module=KERNELS, kernels={"crank": "prescribed_crank"}, pack=_prescribed,
 )  # fmt: skip
 
 _ASSUMED_MOTOR = ("assumed: a 4-pole 50 Hz motor (157 rad/s) through a 7.5:1 belt, referred "
@@ -111,7 +94,7 @@ _ASSUMED_MOTOR = ("assumed: a 4-pole 50 Hz motor (157 rad/s) through a 7.5:1 bel
 
 MOTOR = Component(
     "drive", "motor", "crank angle and speed as states, driven by a motor torque",
-    module=__name__, kernels={}, pack=_motor,
+    module=KERNELS, kernels={}, pack=_motor,
     params=(
         Param("J_drive", "kg*m**2", 3000.0, "motor rotor + flywheel inertia referred to the "
               "crank shaft (drive = motor)", 0.0, _INF, high_open=True, assumed=_ASSUMED_MOTOR,
@@ -122,7 +105,7 @@ MOTOR = Component(
 )  # fmt: skip
 
 CONSTANT_TORQUE = Component(
-    "motor", "constant", "constant motor torque", module=__name__,
+    "motor", "constant", "constant motor torque", module=KERNELS,
     kernels={"torque": "constant_torque"}, pack=_constant,
     params=(
         Param("motor_torque", "N*m", None, "constant motor torque at the crank (motor = "
@@ -132,7 +115,7 @@ CONSTANT_TORQUE = Component(
 )  # fmt: skip
 
 INDUCTION = Component(
-    "motor", "induction", "induction motor, Kloss's torque-speed curve", module=__name__,
+    "motor", "induction", "induction motor, Kloss's torque-speed curve", module=KERNELS,
     kernels={"torque": "induction_torque"}, pack=_induction, check=_check_induction,
     params=(
         Param("motor_sync_speed", "rad/s", 21.0, "synchronous speed referred to the crank "
