@@ -447,7 +447,7 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         page_.click("document.getElementById('run')")
         err = page_.wait("document.getElementById('{\"key\":\"rc\",\"type\":\"ferr\"}')"
                          ".innerText")  # fmt: skip
-        assert err == "rc = -0.001 mm is out of range; allowed: (0, inf] mm"
+        assert err == "rc = -0.001 mm is out of range; allowed: (0, inf) mm"
         assert page_.wait(f"{_POINTS} === 0") and page_.js(
             "document.querySelectorAll('#images img').length") == 0  # fmt: skip
         assert "not run" in page_.js(_STATUS)
