@@ -80,7 +80,7 @@ def sense(
         None, "--snr", help="Signal-to-noise ratio, e.g. 40dB (default), or none."
     ),  # fmt: skip
     full_scale: str = typer.Option(
-        None, "--full-scale", help="ADC range +-, e.g. '490 m/s^2' (default 50 g)."
+        None, "--full-scale", help="ADC range +-, e.g. '490 m/s^2' (default 500 g)."
     ),  # fmt: skip
     bits: str = typer.Option(None, "--bits", help="ADC bits (default 16) or none."),
     accel: bool = typer.Option(True, "--accel/--no-accel", help="Record the accelerometer."),
