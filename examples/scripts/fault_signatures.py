@@ -123,10 +123,12 @@ def features(ds) -> dict:
         "indicated_power_W": a["indicated_power_W"],
         "closing_lag_suction_head_deg": a.get("closing_lag_suction_head_deg", math.nan),
         "opening_suction_head_deg": _opening(last, "suction", "head"),
+        "opening_discharge_head_deg": _opening(last, "discharge", "head"),
         "rod_reversal_falling_deg": r1,
         "rod_reversal_rising_deg": r2,
         "impacts_per_revolution": a.get("impacts_per_revolution", 0.0),
         "impacts_per_revolution_crosshead": a.get("impacts_per_revolution_crosshead", 0.0),
+        "accel_clipped_samples": ds["accel_guide"].attrs["sensor_clipped_samples"],
     }
     whole = signal_features(ds["accel_guide"].values, FS,
                             revs=np.asarray(ds["theta1"].values) / (2.0 * math.pi))  # fmt: skip
