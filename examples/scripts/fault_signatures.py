@@ -87,13 +87,14 @@ def smooth_rod_load(ds) -> np.ndarray:
 
 
 def reversals(ds) -> tuple[float, float]:
-    """Crank angles (deg) where the smoothed rod load (`smooth_rod_load`) changes sign:
-    falling near 35° and rising near 220°."""
+    """Crank angles (deg) where the smoothed rod load (`smooth_rod_load`) changes sign,
+    interpolated linearly between samples: falling near 35° and rising near 220°."""
     th = crank_deg(ds)
     smooth = smooth_rod_load(ds)
     k = np.flatnonzero(np.sign(smooth[1:]) != np.sign(smooth[:-1]))
-    falling = [th[i] for i in k if smooth[i + 1] < smooth[i]]
-    rising = [th[i] for i in k if smooth[i + 1] > smooth[i]]
+    at = {i: th[i] - smooth[i] * (th[i + 1] - th[i]) / (smooth[i + 1] - smooth[i]) for i in k}
+    falling = [at[i] for i in k if smooth[i + 1] < smooth[i]]
+    rising = [at[i] for i in k if smooth[i + 1] > smooth[i]]
     return (falling[0] if falling else math.nan, rising[0] if rising else math.nan)
 
 
