@@ -104,6 +104,23 @@ def revolutions(ds) -> list:
     return [ds.isel(time=np.flatnonzero(turn == k)) for k in np.unique(turn)]
 
 
+#: Threshold of the knock's onset on the accelerometer channel, in g (the crosshead's own
+#: acceleration at 20 rad/s stays below 6 g; the channel's noise is ~0.1 g).
+KNOCK_G = 20.0
+
+
+def knock_onsets(ds) -> tuple[float, float]:
+    """Crank angles (deg) of the knock's onset in each half revolution: the first sample of
+    ``accel_guide`` beyond `KNOCK_G` after 0° and after 180°."""
+    th = crank_deg(ds)
+    big = np.abs(np.asarray(ds["accel_guide"].values)) > KNOCK_G * sensors.G0
+    out = []
+    for lo, hi in ((0.0, 180.0), (180.0, 360.0)):
+        hit = th[big & (th >= lo) & (th < hi)]
+        out.append(float(hit[np.argmin((hit - lo) % 360.0)]) if hit.size else math.nan)
+    return out[0], out[1]
+
+
 #: Accelerometer features (`recipdyn.features.signal_features` columns), per revolution.
 KNOCK = ("rms", "peak", "crest_factor", "kurtosis")
 
@@ -111,7 +128,8 @@ KNOCK = ("rms", "peak", "crest_factor", "kurtosis")
 def features(ds) -> dict:
     """What a diagnoser reads from a run: from the last revolution the thermodynamic figures
     (the run's summary) and the rod load's reversals, the suction plate's opening; over all
-    recorded revolutions the impacts per revolution at each pin, the accelerometer's crank
+    recorded revolutions the impacts per revolution at each pin, the knock's onsets (median
+    over the revolutions, and their largest spread), the accelerometer's crank
     orders 1, 2, 4 and the median, least and largest per-revolution value of its
     time-domain features (the knock differs from one revolution to the next)."""
     a = ds.attrs
@@ -131,6 +149,10 @@ def features(ds) -> dict:
         "impacts_per_revolution_crosshead": a.get("impacts_per_revolution_crosshead", 0.0),
         "accel_clipped_samples": ds["accel_guide"].attrs["sensor_clipped_samples"],
     }
+    onsets = np.array([knock_onsets(r) for r in revs])
+    row["knock_onset_falling_deg"] = float(np.median(onsets[:, 0]))
+    row["knock_onset_rising_deg"] = float(np.median(onsets[:, 1]))
+    row["knock_onset_spread_deg"] = float(np.ptp(onsets, axis=0).max())
     whole = signal_features(ds["accel_guide"].values, FS,
                             revs=np.asarray(ds["theta1"].values) / (2.0 * math.pi))  # fmt: skip
     row.update({f"order_{k}": whole[f"order_{k}"] for k in (1, 2, 4)})
