@@ -182,3 +182,27 @@ def test_the_crank_speed_difference_is_the_reference_s_energy_error(benchmark):
         assert gain_free > 0.1
         assert lost_impacts / 3 < lost_ours < 3 * lost_impacts
         assert cmp[k]["revolutions_at_end"] > cmp["recipdyn"]["revolutions_at_end"]
+
+
+@pytest.mark.parametrize("change", [{"J3": 1.0}, {"mu": 0.0}])
+def test_with_the_slider_kept_level_the_lateral_motion_is_siconos_s(change):
+    """What separates the compliant model from siconos is the slider's rocking: friction at
+    the corners (offset b from the pin) gives the light slider (J3 = 2.7e-6 kg m^2) a moment,
+    and with compliant contacts it tilts and rocks (up to 7 mrad); Newton's impact law at two
+    corners that hit together sets both post-impact velocities to -e times the same approach
+    velocity, which keeps it level (siconos's tilt stays below 4e-15 rad). Hypothesis: with
+    the rocking removed (a slider of large tilt inertia, or no friction) the two models agree
+    on the lateral motion within the reference's own spread plus a small allowance for the
+    impact law (Gonthier's law delivers e = 0.398, not 0.4, and a compliant impact lasts a
+    while): the crossings of the clearance within spread (1.6 deg) + 3 deg (measured 2.1),
+    the lateral position's RMS difference at equal crank angle within spread (0.064 c) +
+    0.05 c (measured 0.043-0.050 c, against 0.28-0.32 c with rocking)."""
+    res = ft.run(FloresTranslational(**change))
+    cmp = ft.compare(res)
+    spread = cmp["direct_vs_combined"]
+    for k in ft.SCHEMES:
+        c = cmp[f"recipdyn_vs_{k}"]
+        assert c["crossings_compared"] == 6
+        assert c["crossings_max_diff_deg"] < spread["crossings_max_diff_deg"] + 3.0
+        assert c["y_c_rms_diff_by_angle"] < spread["y_c_rms_diff_by_angle"] + 0.05
+        assert c["same_surface_fraction"] > 0.99
