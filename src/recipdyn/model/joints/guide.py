@@ -50,7 +50,8 @@ import numba as nb
 
 from .contact import friction_factor, normal_force
 
-__all__ = ["MECH", "INPUTS", "CORNERS", "lagrangian", "generate", "corner_forces",
+__all__ = ["MECH", "INPUTS", "CORNERS", "N_HEAD", "lagrangian", "generate", "corner_forces",
+           "pin_kinematics", "guide_forces", "smallest_factor", "flip_phases",
            "solve_free", "solve_prescribed", "phased_gap_factor", "corner_kinematics",
            "corner_force"]  # fmt: skip
 
@@ -248,6 +249,65 @@ def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, v
     return (c1[0] + c2[0] + c3[0] + c4[0], c1[1] + c2[1] + c3[1] + c4[1],
             c1[2] + c2[2] + c3[2] + c4[2], c1[3] + c2[3] + c3[3] + c4[3],
             c1[4] + c2[4] + c3[4] + c4[4])  # fmt: skip
+
+
+# ---- packed parameters shared by every model built on this joint ------------------------------
+#: After the `MECH` head: the guide's offset below the crank axis, the slider's half-length and
+#: half-height, the radial clearance, the contact stiffness and hysteresis factor, friction
+#: (coefficient, v0, v1, law code), the floor of the approach velocity, the event's length scale.
+(P_D, P_A, P_B, P_C, P_K, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_VMIN,
+ P_SCALE) = range(len(MECH), len(MECH) + 12)  # fmt: skip
+N_HEAD = len(MECH) + 12
+
+
+@nb.njit(cache=True, inline="always")
+def pin_kinematics(p, th1, th1d, th2, th2d):
+    """The pin's lateral position from the guide's centreline and its velocity (x', y')."""
+    r, l = p[0], p[2]
+    s1, c1 = math.sin(th1), math.cos(th1)
+    s2, c2 = math.sin(th2), math.cos(th2)
+    return (r * s1 + l * s2 + p[P_D], -r * s1 * th1d - l * s2 * th2d,
+            r * c1 * th1d + l * c2 * th2d)  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always")
+def guide_forces(p, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
+    """`corner_forces` with the guide's packed parameters."""
+    return corner_forces(y_rel, vx, vy, phi, phid, p[P_A], p[P_B], p[P_C], p[P_K], p[P_CHI],
+                         p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]), p[P_VMIN], v1i, v2i, v3i,
+                         v4i)  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always")
+def smallest_factor(p, y_rel, vx, vy, phi, phid, y, k0):
+    """The smallest phased factor of the four corners (their phases in ``y[k0:k0 + 4]``) and
+    its corner: one event function for every onset and separation."""
+    best, which = math.inf, 0
+    for k in range(4):
+        _, _, pen, _, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[P_A], p[P_B])
+        f = phased_gap_factor(pen - p[P_C], y[k0 + k], p[P_SCALE])
+        if f < best:
+            best, which = f, k
+    return best, which
+
+
+@nb.njit(cache=True, inline="always")
+def flip_phases(p, y_rel, vx, vy, phi, phid, y, k0, out):
+    """The reset at a zero of `smallest_factor`: every corner whose factor has reached the
+    crossing changes phase, the event's own and any other at or below zero (a flat impact
+    puts two corners on their surface at the same instant: both must be reset, or the second
+    would stay in its free-flight phase while it penetrates). At an onset the approach
+    velocity (the penetration rate, floored at the packed ``v_impact_min``) is recorded; at a
+    separation the recorded value turns negative (free flight)."""
+    best = smallest_factor(p, y_rel, vx, vy, phi, phid, y, k0)[0]
+    for k in range(4):
+        _, _, pen, dpen, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[P_A], p[P_B])
+        if phased_gap_factor(pen - p[P_C], y[k0 + k], p[P_SCALE]) > max(best, 0.0):
+            continue
+        if y[k0 + k] > 0.0:
+            out[k0 + k] = -y[k0 + k]
+        else:
+            out[k0 + k] = max(dpen, p[P_VMIN])
 
 
 if __name__ == "__main__":  # pragma: no cover - developer tool

@@ -23,7 +23,6 @@ every run.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numba as nb
@@ -32,7 +31,17 @@ import numpy as np
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, compiled
 from ..joints._guide import guide_energy, guide_system
 from ..joints.contact import FRICTION_LAWS, LAWS, hysteresis_factor
-from ..joints.guide import MECH, corner_forces, corner_kinematics, phased_gap_factor, solve_free
+from ..joints.guide import (
+    P_A,
+    P_B,
+    P_C,
+    corner_kinematics,
+    flip_phases,
+    guide_forces,
+    pin_kinematics,
+    smallest_factor,
+    solve_free,
+)
 
 __all__ = ["FloresTranslational", "STATE_NAMES", "system", "initial_state", "energy",
            "corner_series"]  # fmt: skip
@@ -40,10 +49,6 @@ __all__ = ["FloresTranslational", "STATE_NAMES", "system", "initial_state", "ene
 STATE_NAMES = ("theta1", "theta2", "phi", "theta1_dot", "theta2_dot", "phi_dot", "v_impact_1",
                "v_impact_2", "v_impact_3", "v_impact_4", "W_in", "W_loss")  # fmt: skip
 STATE_UNITS = ("rad",) * 3 + ("rad/s",) * 3 + ("m/s",) * 4 + ("J", "J")
-
-# packed parameters: the generated kernels' MECH first, then the guide and the contact
-(P_D, P_A, P_B, P_C, P_K, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_VMIN,
- P_SCALE) = range(len(MECH), len(MECH) + 12)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -117,22 +122,13 @@ class FloresTranslational:
 
 @nb.njit(cache=True, inline="always")
 def _pin(y, p):
-    """The pin's lateral position from the guide's centreline and its velocity (x', y')."""
-    r, l = p[0], p[2]
-    s1, c1 = math.sin(y[0]), math.cos(y[0])
-    s2, c2 = math.sin(y[1]), math.cos(y[1])
-    y_rel = r * s1 + l * s2 + p[P_D]
-    vx = -r * s1 * y[3] - l * s2 * y[4]
-    vy = r * c1 * y[3] + l * c2 * y[4]
-    return y_rel, vx, vy
+    return pin_kinematics(p, y[0], y[3], y[1], y[4])
 
 
 @nb.njit(cache=True, inline="always")
 def _forces(y, p):
     y_rel, vx, vy = _pin(y, p)
-    return corner_forces(y_rel, vx, vy, y[2], y[5], p[P_A], p[P_B], p[P_C], p[P_K], p[P_CHI],
-                         p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]), p[P_VMIN], y[6], y[7],
-                         y[8], y[9])  # fmt: skip
+    return guide_forces(p, y_rel, vx, vy, y[2], y[5], y[6], y[7], y[8], y[9])
 
 
 @compiled(RHS_SIGNATURE)
@@ -149,45 +145,20 @@ def rhs(t, y, p, out):
     out[11] = lost
 
 
-@nb.njit(cache=True, inline="always")
-def _smallest_factor(y, p):
-    """The smallest phased factor of the four corners and its corner."""
-    y_rel, vx, vy = _pin(y, p)
-    best, which = math.inf, 0
-    for k in range(4):
-        _, _, pen, _, _, _ = corner_kinematics(k, y_rel, vx, vy, y[2], y[5], p[P_A], p[P_B])
-        f = phased_gap_factor(pen - p[P_C], y[6 + k], p[P_SCALE])
-        if f < best:
-            best, which = f, k
-    return best, which
-
-
 @compiled(EVENT_SIGNATURE)
 def contact_event(t, y, p):
     """Falls through 0 at every contact onset and separation of any corner."""
-    return _smallest_factor(y, p)[0]
+    y_rel, vx, vy = _pin(y, p)
+    return smallest_factor(p, y_rel, vx, vy, y[2], y[5], y, 6)[0]
 
 
 @compiled(RHS_SIGNATURE)
 def contact_reset(t, y, p, out):
-    """Every corner whose factor has reached the crossing changes phase: the one whose
-    factor is the event's, and any other at or below zero (a flat impact puts two corners on
-    their surface at the same instant: both must be reset, or the second would stay in its
-    free-flight phase while it penetrates). At an onset the approach velocity (the
-    penetration rate, floored at ``v_impact_min``) is recorded; at a separation the recorded
-    value turns negative (free flight)."""
+    """[`flip_phases`][recipdyn.model.joints.guide.flip_phases] of the corners."""
     for i in range(y.shape[0]):
         out[i] = y[i]
-    best = _smallest_factor(y, p)[0]
     y_rel, vx, vy = _pin(y, p)
-    for k in range(4):
-        _, _, pen, dpen, _, _ = corner_kinematics(k, y_rel, vx, vy, y[2], y[5], p[P_A], p[P_B])
-        if phased_gap_factor(pen - p[P_C], y[6 + k], p[P_SCALE]) > max(best, 0.0):
-            continue
-        if y[6 + k] > 0.0:
-            out[6 + k] = -y[6 + k]
-        else:
-            out[6 + k] = max(dpen, p[P_VMIN])
+    flip_phases(p, y_rel, vx, vy, y[2], y[5], y, 6, out)
 
 
 def system(par: FloresTranslational) -> ODESystem:
