@@ -4,9 +4,8 @@ The slider-crank with the slider free in its guide (recipdyn.model.joints.guide)
 M and b of M qdd = b for q = (theta1, theta2, phi), and the energy T + V.
 """
 
-import math
-
 import numba as nb
+import numpy as np
 
 
 @nb.njit(cache=True)
@@ -37,14 +36,14 @@ def guide_system(y, p, u):
     x1 = _q0 - _q1
     x2 = _p2*_p6
     x3 = _p3*_p5
-    x4 = math.cos(_q0)
+    x4 = np.cos(_q0)
     x5 = _p0*_p10*x4
-    x6 = _p0*math.sin(x1)
+    x6 = _p0*np.sin(x1)
     x7 = _qd1**2*x6
-    x8 = math.cos(_q1)
+    x8 = np.cos(_q1)
     x9 = _p10*x8
     x10 = _qd0**2*x6
-    return (_p1**2*_p4 + _p5*x0 + _p6*x0 + _p7, _p0*(x2 + x3)*math.cos(x1), _p2**2*_p6 + _p3**2*_p5 + _p8, 0, 0, _p9, -_p0*_p11*math.sin(_q0) + _p0*_p12*x4 - _p1*_p10*_p4*x4 + _p14 - _p5*x5 - _p6*x5 - x2*x7 - x3*x7, -_p11*_p2*math.sin(_q1) + _p12*_p2*x8 + x10*x2 + x10*x3 - x2*x9 - x3*x9, _p13)
+    return (_p1**2*_p4 + _p5*x0 + _p6*x0 + _p7, _p0*(x2 + x3)*np.cos(x1), _p2**2*_p6 + _p3**2*_p5 + _p8, 0, 0, _p9, -_p0*_p11*np.sin(_q0) + _p0*_p12*x4 - _p1*_p10*_p4*x4 + _p14 - _p5*x5 - _p6*x5 - x2*x7 - x3*x7, -_p11*_p2*np.sin(_q1) + _p12*_p2*x8 + x10*x2 + x10*x3 - x2*x9 - x3*x9, _p13)
 
 
 @nb.njit(cache=True)
@@ -69,10 +68,10 @@ def guide_energy(y, p):
     _p10 = p[10]
     x0 = (1/2)*_qd0**2
     x1 = (1/2)*_qd1**2
-    x2 = _p10*math.sin(_q0)
+    x2 = _p10*np.sin(_q0)
     x3 = _p0*_p5
     x4 = _p0*_p6
-    x5 = _p10*math.sin(_q1)
+    x5 = _p10*np.sin(_q1)
     x6 = _p0**2*x0
-    x7 = _qd0*_qd1*math.cos(_q0 - _q1)
+    x7 = _qd0*_qd1*np.cos(_q0 - _q1)
     return _p1**2*_p4*x0 + _p1*_p4*x2 + _p2**2*_p6*x1 + _p2*_p6*x5 + _p2*x4*x7 + _p3**2*_p5*x1 + _p3*_p5*x5 + _p3*x3*x7 + _p5*x6 + _p6*x6 + _p7*x0 + _p8*x1 + (1/2)*_p9*_qd2**2 + x2*x3 + x2*x4
