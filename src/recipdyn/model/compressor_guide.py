@@ -247,8 +247,8 @@ SCHEMA = Schema((
           optional=True, group="guide"),
     Param("guide_stiffness", "N/m**1.5", 1e12, "contact stiffness K of a crosshead corner on a "
           "shoe (F = K delta^1.5 ...)", 0.0, _INF, low_open=True,
-          assumed="assumed: stiff steel-on-babbitt shoes; 200 kN rod load gives ~12 um "
-          "penetration", group="guide"),
+          assumed="assumed: stiff shoes; 40 kN of side force on one corner: 12 um",
+          group="guide"),
     Param("guide_contact_law", "", "gonthier", "normal force law at the shoes", choices=LAWS,
           group="guide"),
     Param("guide_restitution", "", 0.5, "nominal restitution of a shoe impact", 0.0, 1.0,
@@ -319,10 +319,11 @@ class CompressorGuide(Model):
     #: With 0.2 mm of play and a tenth of the paper's load the crosshead knocks at every
     #: side-force reversal.
     event_example = {"guide_clearance": 2e-4, "load_amplitude": 2e4}
-    lyapunov_refusal = ("Benettin's method is not offered for compressor-guide: its Jacobian is "
-                        "a finite difference, whose rounding noise in the stiff shoe contact "
-                        "would need ~1e6 tangent steps a revolution (docs/contact.md); use "
-                        "compressor-contact for exponents of a worn machine")  # fmt: skip
+    lyapunov_refusal = ("Benettin's method is not offered for compressor-guide: its tangent "
+                        "integration across the shoe impacts (the saltation matrices of the four "
+                        "corners' event) has not been checked against differences of the flow, "
+                        "as compressor-contact's has; use compressor-contact for exponents of a "
+                        "worn machine")  # fmt: skip
 
     def check(self, values: Mapping[str, Any]) -> None:
         from ..errors import ParameterError
