@@ -184,6 +184,27 @@ def test_the_crank_speed_difference_is_the_reference_s_energy_error(benchmark):
         assert cmp[k]["revolutions_at_end"] > cmp["recipdyn"]["revolutions_at_end"]
 
 
+def test_the_figure_and_table_show_all_three_runs(benchmark):
+    """The benchmark's figure has its six panels, each with the three runs (recipdyn and both
+    siconos schemes; the side-force panel shares the impacts' raster), and the table a row
+    for each quantity with the three runs' numbers."""
+    res, cmp = benchmark
+    fig = ft.figure(res)
+    axes = fig.axes
+    assert len(axes) == 6
+    for a in axes[:5]:
+        assert len(a.lines) >= 3
+    assert [t.get_text() for t in axes[0].get_legend().get_texts()] == [
+        "recipdyn (compliant, Gonthier e = 0.4)", "siconos, direct projection",
+        "siconos, combined projection"]  # fmt: skip
+    # the impacts' raster: one marker per impact of each run
+    marks = sum(len(line.get_xdata()) for line in axes[5].lines)
+    assert marks == sum(cmp[k]["impacts"] for k in ("recipdyn", "direct", "combined"))
+    text = ft.table(cmp)
+    assert text.count("\n|") >= 16
+    assert f"{cmp['recipdyn']['revolutions_at_end']:.4f}" in text
+
+
 @pytest.mark.parametrize("change", [{"J3": 1.0}, {"mu": 0.0}])
 def test_with_the_slider_kept_level_the_lateral_motion_is_siconos_s(change):
     """What separates the compliant model from siconos is the slider's rocking: friction at

@@ -199,6 +199,7 @@ def compare(res: dict[str, Any] | None = None, window: float = 0.06) -> dict[str
             "impacts_by_corner": [sum(1 for x in imp if x[2] == k) for k in range(1, 5)],
             "first_impacts": [(round(t, 5), round(math.degrees(th), 1), k)
                               for t, th, k in imp[:12]],
+            "crossings_deg": [round(float(x), 1) for x in crossings(imp)],
         }  # fmt: skip
     out["recipdyn"]["energy_balance_residual"] = float(
         np.abs(res["energy"] + res["W_loss"] - e0).max() / e0
@@ -245,6 +246,24 @@ def table(cmp: dict[str, Any]) -> str:
     pairs = ("recipdyn_vs_direct", "recipdyn_vs_combined", "direct_vs_combined")
     for label, key, fmt in diffs:
         out.append(f"| {label} | " + " | ".join(fmt.format(cmp[n][key]) for n in pairs) + " |")
+    runs = ("recipdyn", "direct", "combined")
+    out += ["", "| crossing of the clearance (crank angle, deg; + upper, − lower surface) | "
+            "recipdyn | siconos direct | siconos combined |", "|---|---|---|---|"]  # fmt: skip
+    n = max(len(cmp[r]["crossings_deg"]) for r in runs)
+    for i in range(n):
+        cells = []
+        for r in runs:
+            x = cmp[r]["crossings_deg"]
+            cells.append(f"{x[i]:.1f}" if i < len(x) else "")
+        out.append(f"| {i + 1} ({'+' if i % 2 == 0 else '−'}) | " + " | ".join(cells) + " |")
+    out += ["", "| impact (time s, crank angle deg, corner) | recipdyn | siconos direct | "
+            "siconos combined |", "|---|---|---|---|"]  # fmt: skip
+    for i in range(12):
+        cells = []
+        for r in runs:
+            x = cmp[r]["first_impacts"]
+            cells.append(f"{x[i][0]:.4f}, {x[i][1]:.1f}, {x[i][2]}" if i < len(x) else "")
+        out.append(f"| {i + 1} | " + " | ".join(cells) + " |")
     return "\n".join(out) + "\n"
 
 
