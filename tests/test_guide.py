@@ -142,10 +142,12 @@ def test_the_benchmark_follows_siconos_on_the_gross_motion(benchmark):
       one (|y| > c/2): measured 99.5 % / 99.3 % of those crank angles; bound 95 %.
     * the crossings of the clearance (the first impact on the other surface) happen at the
       same crank angles: the first six within the schemes' spread (1.6 deg) plus an
-      allowance of 20 deg for the impact law (measured differences up to 15.4 deg: the
+      allowance of 25 deg for the impact law (measured differences up to 15.4 deg: the
       bounce sequence before a crossing differs, compliant rocking against Newton's law,
-      which keeps the slider level). A slider that never left one surface, or crossed at
-      the wrong phase of the revolution, fails each of them."""
+      which keeps the slider level; K = 1e9 .. 1e12 moves it between 7.7 and 15.4 deg, and
+      25 leaves room for rounding differences between machines). A slider that never left
+      one surface, or crossed at the wrong phase of the revolution, fails each of them; so
+      does Lankarani-Nikravesh's law, which delivers e = 0.70 instead of 0.4 (77 deg)."""
     res, cmp = benchmark
     par = res["par"]
     spread = cmp["direct_vs_combined"]["x_l1_max_diff_by_angle"]
@@ -157,7 +159,7 @@ def test_the_benchmark_follows_siconos_on_the_gross_motion(benchmark):
         assert c["both_on_a_surface_fraction"] > 0.5
         assert c["same_surface_fraction"] > 0.95
         assert c["crossings_compared"] == 6
-        assert c["crossings_max_diff_deg"] < tr_spread + 20.0
+        assert c["crossings_max_diff_deg"] < tr_spread + 25.0
 
 
 def test_the_crank_speed_difference_is_the_reference_s_energy_error(benchmark):
