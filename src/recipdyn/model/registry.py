@@ -38,6 +38,7 @@ _BUILTIN = {
     "compressor-contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
     "compressor-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
     "compressor-contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",  # noqa: E501
+    "compressor-guide": "recipdyn.model.compressor_guide:COMPRESSOR_GUIDE",
 }
 _REGISTERED: dict[str, Model] = {}
 

@@ -1,0 +1,448 @@
+r"""The compressor with clearance in the crosshead guide ("crosshead knock").
+
+The paper's mechanism (crank ``r`` driven at ``omega``, rod ``l`` with centroid at ``ls``, the
+gas load on the crosshead) with ideal pins, and a crosshead that is a body of its own between
+the guide's upper and lower shoes: it moves sideways within the radial clearance
+``guide_clearance`` and tilts, and its four corners (half-length ``crosshead_half_length``,
+half-height ``crosshead_half_height`` about the pin) strike the shoes. The equations are those
+of the slider in a guide, `recipdyn.model.joints.guide` (one sympy derivation for this model
+and the Flores–Leine–Glocker benchmark), with the crank angle prescribed,
+``theta1 = theta1_0 + omega t``: coordinates ``(theta2, phi)``, the rod angle and the
+crosshead's tilt; the crosshead pin is at
+``(r cos theta1 + l cos theta2, r sin theta1 + l sin theta2)`` and the guide's centreline at
+``y = -d``. Each corner's contact is recipdyn's compliant law with Coulomb friction
+(regularised), as at the pins of `compressor-contact`.
+
+Signature: the side force the guide must supply changes sign where the rod's inclination or
+the rod load does (near the dead centres under a load that never reverses, and at the
+rod-load reversals under a reversing one); the crosshead then crosses the clearance and knocks
+on the other shoe, which the guide's accelerometer sees as spikes of the lateral acceleration
+(`guide_acc`) at those crank angles.
+
+State ``(theta2, phi, theta2', phi', v_1..v_4, W_in, W_loss)``: the coordinates and rates, the
+four corners' recorded approach velocities (their sign the phase: > 0 in contact), the work of
+the drive and of the gas on the mechanism and the work lost to the shoes (contact damping and
+friction). ``T + V + U = E0 + W_in - W_loss`` holds along every run (``U`` the shoes' elastic
+energy); the drive's torque is the first row of the same Lagrange equations (`solve_prescribed`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .components.load import cycle_outputs, cycle_summary
+from .joints._guide import guide_energy, guide_system
+from .joints.contact import FRICTION_LAWS, LAWS, delivered_restitution, hysteresis_factor
+from .joints.guide import (
+    N_HEAD,
+    P_A,
+    P_B,
+    P_C,
+    P_CHI,
+    P_FLAW,
+    P_K,
+    P_MU,
+    P_V0,
+    P_V1,
+    P_VMIN,
+    corner_force,
+    flip_phases,
+    guide_forces,
+    pin_kinematics,
+    smallest_factor,
+    solve_prescribed,
+)
+from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
+from .parameters import SCHEMA as LINK_SCHEMA
+from .protocol import Model, Param, Schema
+
+__all__ = ["CompressorGuide", "COMPRESSOR_GUIDE", "ideal_crosshead"]
+
+_INF = math.inf
+STATE_NAMES = ("theta2", "phi", "theta2_dot", "phi_dot", "v_impact_1", "v_impact_2",
+               "v_impact_3", "v_impact_4", "W_in", "W_loss")  # fmt: skip
+STATE_UNITS = ("rad", "rad", "rad/s", "rad/s", "m/s", "m/s", "m/s", "m/s", "J", "J")
+K0 = 4  # first corner phase in the state
+# after the joint's head: the drive, then the load
+P_OMEGA, P_TH10, P_LOADAMP, P_LOADSIGN, P_LOADKIND = range(N_HEAD, N_HEAD + 5)
+P_TABLE = N_HEAD + 5
+
+
+@nb.njit(cache=True, inline="always")
+def _gas(th1, p):
+    if p[P_LOADKIND] == 0.0:
+        return p[P_LOADSIGN] * p[P_LOADAMP] * mu_sincos(math.sin(th1), math.cos(th1))
+    return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
+
+
+@nb.njit(cache=True, inline="always")
+def _core(t, y, p):
+    """Everything the right-hand side and the outputs need: the accelerations, the drive's
+    torque, the gas force, the contact's resultant, power lost and elastic energy, and the
+    pin's kinematics."""
+    w = p[P_OMEGA]
+    th1 = p[P_TH10] + w * t
+    y_rel, vx, vy = pin_kinematics(p, th1, w, y[0], y[2])
+    fx, fy, mz, lost, elastic = guide_forces(p, y_rel, vx, vy, y[1], y[3], y[4], y[5], y[6],
+                                             y[7])  # fmt: skip
+    fg = _gas(th1, p)
+    m = guide_system((th1, y[0], y[1], w, y[2], y[3]), p, (fx + fg, fy, mz, 0.0))
+    a2, aphi, torque = solve_prescribed(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8])
+    return a2, aphi, torque, fg, fx, fy, mz, lost, elastic, th1, y_rel, vx, vy
+
+
+@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out):
+    """The right-hand side for real or complex ``y`` and ``out`` (no arrays allocated)."""
+    a2, aphi, torque, fg, _, _, _, lost, _, _, _, vx, _ = _core(t, y, p)
+    out[0], out[1], out[2], out[3] = y[2], y[3], a2, aphi
+    for k in range(4, 8):
+        out[k] = 0.0
+    out[8] = torque * p[P_OMEGA] + fg * vx
+    out[9] = lost
+
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+#: Imaginary step of the complex-step Jacobian (no difference is taken: any tiny size).
+CS_STEP = 1e-60
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac(t, y, p, J):
+    """The complex step (Squire & Trapp 1998, SIAM Rev. 40, 110-112):
+    ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding on the branch of each switch
+    (contact, clamp, friction law) that the real state takes, as in `compressor_contact`.
+    The work integrals act on nothing (their columns are 0)."""
+    n = y.shape[0]
+    yc = np.empty(n, np.complex128)
+    fc = np.empty(n, np.complex128)
+    for i in range(n):
+        yc[i] = y[i]
+    J[:, :] = 0.0
+    for k in range(8):
+        yc[k] = complex(y[k], CS_STEP)
+        _rhs(t, yc, p, fc)
+        yc[k] = y[k]
+        for i in range(n):
+            J[i, k] = fc[i].imag / CS_STEP
+
+
+@nb.njit(cache=True, inline="always")
+def _pin(t, y, p):
+    w = p[P_OMEGA]
+    return pin_kinematics(p, p[P_TH10] + w * t, w, y[0], y[2])
+
+
+@compiled(EVENT_SIGNATURE)
+def contact_event(t, y, p):
+    """Falls through 0 at every onset and separation of a crosshead corner on a shoe."""
+    y_rel, vx, vy = _pin(t, y, p)
+    return smallest_factor(p, y_rel, vx, vy, y[1], y[3], y, K0)[0]
+
+
+@compiled(RHS_SIGNATURE)
+def contact_reset(t, y, p, out):
+    """[`flip_phases`][recipdyn.model.joints.guide.flip_phases] of the corners."""
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    y_rel, vx, vy = _pin(t, y, p)
+    flip_phases(p, y_rel, vx, vy, y[1], y[3], y, K0, out)
+
+
+@nb.njit(cache=True)
+def _series(t, y, p):
+    """Per sample: x, v, a (axial), lateral position, velocity, acceleration of the pin, the
+    gas force, the drive torque, the side force of the shoes (upper and lower, N), the
+    contact's moment, the energy T + V + U, the number of corners in contact."""
+    n = t.shape[0]
+    out = np.empty((n, 13))
+    r, l = p[0], p[2]
+    w = p[P_OMEGA]
+    for i in range(n):
+        yi = y[i]
+        a2, _, torque, fg, _, _, mz, _, elastic, th1, y_rel, vx, vy = _core(t[i], yi, p)
+        s1, c1 = math.sin(th1), math.cos(th1)
+        s2, c2 = math.sin(yi[0]), math.cos(yi[0])
+        w2 = yi[2]
+        out[i, 0] = r * c1 + l * c2
+        out[i, 1] = vx
+        out[i, 2] = -r * w * w * c1 - l * (c2 * w2 * w2 + s2 * a2)
+        out[i, 3] = y_rel
+        out[i, 4] = vy
+        out[i, 5] = -r * w * w * s1 + l * (c2 * a2 - s2 * w2 * w2)
+        out[i, 6] = fg
+        out[i, 7] = torque
+        up = 0.0
+        low = 0.0
+        inc = 0.0
+        for k in range(4):
+            fk = corner_force(k, y_rel, vx, vy, yi[1], yi[3], p[P_A], p[P_B], p[P_C], p[P_K],
+                              p[P_CHI], p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]), p[P_VMIN],
+                              yi[K0 + k])  # fmt: skip
+            if k < 2:
+                up += fk[5]
+            else:
+                low += fk[5]
+            if fk[5] > 0.0:
+                inc += 1.0
+        out[i, 8] = up
+        out[i, 9] = low
+        out[i, 10] = mz
+        out[i, 11] = guide_energy((th1, yi[0], yi[1], w, yi[2], yi[3]), p) + elastic
+        out[i, 12] = inc
+    return out
+
+
+def _j3(v: Mapping[str, Any]) -> float:
+    if v.get("crosshead_tilt_inertia") is not None:
+        return float(v["crosshead_tilt_inertia"])
+    a, b = v["crosshead_half_length"], v["crosshead_half_height"]
+    return float(v["m3"]) * (a * a + b * b) / 3.0
+
+
+def pack(v: Mapping[str, Any]) -> np.ndarray:
+    mech = (v["r"], 0.0, v["l"], v["ls"], 0.0, v["m2"], v["m3"], 0.0, v["J2"], _j3(v), v["g"])
+    c = float(v["guide_clearance"])
+    head = [*mech, v["d"], v["crosshead_half_length"], v["crosshead_half_height"], c,
+            v["guide_stiffness"], hysteresis_factor(v["guide_contact_law"],
+                                                    v["guide_restitution"]),
+            v["guide_friction"], v["guide_v0"], v["guide_v1"],
+            float(FRICTION_LAWS.index(v["guide_friction_law"])), v["v_impact_min"],
+            v["crosshead_half_height"]]  # fmt: skip
+    kind, data = pack_load(v)
+    head += [v["omega"], v["theta1_0"], v["load_amplitude"],
+             -1.0 if v["load_sign"] == "physical" else 1.0, kind]  # fmt: skip
+    return np.concatenate([np.asarray(head, dtype=np.float64), data])
+
+
+def _link(name: str, **changes) -> Param:
+    from dataclasses import replace
+
+    return replace(LINK_SCHEMA[name], **changes)
+
+
+SCHEMA = Schema((
+    *(_link(k) for k in ("r", "l", "ls", "m2", "m3", "J2", "g", "d")),
+    Param("guide_clearance", "m", 0.0, "radial clearance of the crosshead in its guide (shoe "
+          "to guide: the crosshead's lateral play is twice it); 0 = the ideal guide", 0.0,
+          0.01, assumed="assumed: a new guide; API 618 machines run 0.1-0.3 mm and more worn",
+          group="guide"),
+    Param("crosshead_half_length", "m", 0.15, "half the crosshead shoe's length along the "
+          "guide, about the pin", 0.0, 2.0, low_open=True,
+          assumed="assumed: not given in the paper", group="guide"),
+    Param("crosshead_half_height", "m", 0.1, "half the crosshead's height, pin to shoe face",
+          0.0, 2.0, low_open=True, assumed="assumed: not given in the paper", group="guide"),
+    Param("crosshead_tilt_inertia", "kg*m**2", None, "crosshead's moment of inertia about the "
+          "pin (default: a uniform block, m3 (a^2 + b^2) / 3)", 0.0, _INF, low_open=True,
+          optional=True, group="guide"),
+    Param("guide_stiffness", "N/m**1.5", 1e12, "contact stiffness K of a crosshead corner on a "
+          "shoe (F = K delta^1.5 ...)", 0.0, _INF, low_open=True,
+          assumed="assumed: stiff shoes; 40 kN of side force on one corner: 12 um",
+          group="guide"),
+    Param("guide_contact_law", "", "gonthier", "normal force law at the shoes", choices=LAWS,
+          group="guide"),
+    Param("guide_restitution", "", 0.5, "nominal restitution of a shoe impact", 0.0, 1.0,
+          low_open=True, assumed="assumed: a lubricated shoe", group="guide"),
+    Param("guide_friction", "", 0.05, "Coulomb friction coefficient at the shoes", 0.0, 2.0,
+          assumed="assumed: boundary-lubricated shoe", group="guide"),
+    Param("guide_friction_law", "", "ambrosio", "'ambrosio' (dynamic correction, v0/v1) or "
+          "'tanh'", choices=FRICTION_LAWS, group="guide"),
+    Param("guide_v0", "m/s", 1e-4, "friction: sliding velocity below which there is none", 0.0,
+          _INF, low_open=True, group="guide"),
+    Param("guide_v1", "m/s", 1e-3, "friction: sliding velocity above which it is full Coulomb",
+          0.0, _INF, low_open=True, group="guide"),
+    Param("v_impact_min", "m/s", 1e-3, "floor of the recorded approach velocity (grazing "
+          "contacts)", 0.0, _INF, low_open=True, group="guide"),
+    _link("omega"), _link("theta1_0"),
+    _link("load_amplitude"), _link("load_sign"), _link("load"),
+    *(_link(k) for k in (*CYCLE_PARAMS, "gas", "suction_temperature")),
+), aliases={"speed": "omega", "crank_speed": "omega", "guide_c": "guide_clearance"})  # fmt: skip
+
+
+def ideal_crosshead(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, np.ndarray]:
+    """The ideal guide in closed form (crosshead on ``y = -d``, ideal pins, the crank at
+    constant ``omega``): axial position and acceleration, the rod angle, and the side force the
+    guide must supply (``N > 0``: the lower shoe pushes up), from Newton–Euler for the crosshead
+    and for the rod about the crank pin with the gas force and gravity."""
+    keys = ("r", "l", "ls", "m2", "m3", "J2", "g", "d", "omega")
+    r, l, ls, m2, m3, J2, g, d, w = (float(values[k]) for k in keys)
+    th1 = np.asarray(theta1, dtype=float)
+    s1, c1 = np.sin(th1), np.cos(th1)
+    s2 = -(d + r * s1) / l
+    c2 = np.sqrt(1 - s2**2)
+    w2 = -r * w * c1 / (l * c2)
+    a2 = (r * w**2 * s1 / l + s2 * w2**2) / c2
+    x = r * c1 + l * c2
+    a = -r * w**2 * c1 - l * (c2 * w2**2 + s2 * a2)
+    kind, data = pack_load(values)
+    sign = -1.0 if values["load_sign"] == "physical" else 1.0
+    fg = np.array([gas_force_kernel(float(t), kind, float(values["load_amplitude"]), sign, data)
+                   for t in th1.ravel()]).reshape(th1.shape)  # fmt: skip
+    # crosshead along x: m3 a = fg - Fx  (Fx, Fy: force of the crosshead on the rod's end)
+    fx = fg - m3 * a
+    # rod, moments about the crank pin A: (J2 + m2 ls^2) a2 = -m2 ls (c2 aAy - s2 aAx)
+    #   + l (c2 Fy - s2 Fx) - m2 g ls c2
+    aax, aay = -r * w**2 * c1, -r * w**2 * s1
+    fy = ((J2 + m2 * ls**2) * a2 + m2 * ls * (c2 * aay - s2 * aax) + m2 * g * ls * c2
+          + l * s2 * fx) / (l * c2)  # fmt: skip
+    # crosshead along y (no lateral acceleration): 0 = N - Fy - m3 g (the rod's end pushes the
+    # crosshead with -Fy)
+    side = fy + m3 * g
+    return {"x": x, "a": a, "theta2": np.arcsin(s2), "side_force": side, "gas_force": fg}
+
+
+class CompressorGuide(Model):
+    """The compressor with clearance in the crosshead guide (crosshead knock)."""
+
+    name = "compressor-guide"
+    description = ("compressor with clearance in the crosshead guide: the crosshead moves "
+                   "sideways and tilts between the shoes and knocks on them (Flores, Leine & "
+                   "Glocker 2010 joint, compliant contact)")  # fmt: skip
+    state_names = STATE_NAMES
+    state_units = STATE_UNITS
+    schema = SCHEMA
+    section_signals = (("guide_y", "m"), ("guide_acc", "m/s**2"), ("x", "m"), ("v", "m/s"),
+                       ("a", "m/s**2"))  # fmt: skip
+    vibration_signal = ("guide_acc", "m/s**2")
+    section_pair = ("guide_y", "guide_acc")
+    mean_signals = (("guide_contact", "guide_contact_fraction", "1"),)
+    #: With 0.2 mm of play and a tenth of the paper's load the crosshead knocks at every
+    #: side-force reversal.
+    event_example = {"guide_clearance": 2e-4, "load_amplitude": 2e4}
+    lyapunov_refusal = ("Benettin's method is not offered for compressor-guide: its tangent "
+                        "integration across the shoe impacts (the saltation matrices of the four "
+                        "corners' event) has not been checked against differences of the flow, "
+                        "as compressor-contact's has; use compressor-contact for exponents of a "
+                        "worn machine")  # fmt: skip
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        from ..errors import ParameterError
+
+        dmax = values["l"] - values["r"] - 1e-3
+        if not abs(values["d"]) < dmax:
+            raise ParameterError(f"d = {values['d']!r} m is out of range; allowed: "
+                                 f"(-{dmax:g}, {dmax:g}) m (l - r - 1 mm)")  # fmt: skip
+        if values["guide_v1"] <= values["guide_v0"]:
+            raise ParameterError(f"guide_v1 = {values['guide_v1']!r} m/s must exceed guide_v0 = "
+                                 f"{values['guide_v0']!r} m/s")  # fmt: skip
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        return (Event("impact", contact_event, direction=-1, action="reset",
+                      reset=contact_reset, description="onset or separation of a crosshead "
+                      "corner on a guide shoe (the smallest phased factor falls through 0): "
+                      "at an onset the approach velocity is recorded for the damping "
+                      "law"),)  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> ODESystem:
+        return ODESystem(rhs=rhs, jac=jac, params=pack(values), state_names=self.state_names,
+                         state_units=self.state_units, period=self.period(values),
+                         name=self.name, events=self.events(values), aux_states=6,
+                         passive=(4, 5, 6, 7, 8, 9))  # fmt: skip
+
+    def period(self, values: Mapping[str, Any]) -> float:
+        return 2.0 * math.pi / float(values["omega"])
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The ideal mechanism's state at ``theta1_0`` (the crosshead centred, level, moving
+        along the guide); a corner that touches its shoe already (no clearance) starts in
+        contact."""
+        r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
+        th1 = float(values["theta1_0"])
+        s2 = -(d + r * math.sin(th1)) / l
+        y = np.zeros(len(STATE_NAMES))
+        y[0] = math.asin(s2)
+        y[2] = -r * w * math.cos(th1) / (l * math.cos(y[0]))
+        sign = 1.0 if values["guide_clearance"] == 0 else -1.0
+        y[4:8] = sign * values["v_impact_min"]
+        return y
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Rod angle 0.04 rad and tilt 0.01 rad (perturbations of a few percent of these put
+        the crosshead ~1 mm into a shoe: deep, but where the contact law is smooth on the
+        interface test's steps), rates as the default, approach velocities 1 mm/s."""
+        s = np.maximum(1.0, np.abs(self.initial_state(values)))
+        s[0], s[1] = 0.04, 0.01
+        s[4:8] = 1e-3
+        return s
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        p = pack(values)
+        t = np.ascontiguousarray(t, dtype=float)
+        y = np.ascontiguousarray(y, dtype=float)
+        s = _series(t, y, p)
+        th1 = float(values["theta1_0"]) + float(values["omega"]) * t
+        return {
+            "x": Signal(s[:, 0], "m", "crosshead (pin) displacement along the guide"),
+            "v": Signal(s[:, 1], "m/s", "crosshead velocity along the guide"),
+            "a": Signal(s[:, 2], "m/s**2", "crosshead acceleration along the guide"),
+            "guide_y": Signal(s[:, 3], "m", "crosshead lateral position from the guide's "
+                              "centreline (+ up)"),
+            "guide_v": Signal(s[:, 4], "m/s", "crosshead lateral velocity"),
+            "guide_acc": Signal(s[:, 5], "m/s**2", "crosshead lateral acceleration (what an "
+                                "accelerometer on the guide sees of the knock)"),
+            "tilt": Signal(y[:, 1], "rad", "crosshead tilt in the guide"),
+            "theta1": Signal(th1, "rad", "crank angle"),
+            "theta2": Signal(y[:, 0], "rad", "connecting-rod angle"),
+            "gas_force": Signal(s[:, 6], "N", "gas force on the crosshead along +x"),
+            "drive_torque": Signal(s[:, 7], "N*m", "torque the drive supplies to hold omega"),
+            "shoe_force_upper": Signal(s[:, 8], "N", "normal force of the upper shoe"),
+            "shoe_force_lower": Signal(s[:, 9], "N", "normal force of the lower shoe"),
+            "side_force": Signal(s[:, 9] - s[:, 8], "N", "net side force of the guide on the "
+                                 "crosshead (+ up)"),
+            "guide_contact": Signal((s[:, 12] > 0).astype(float), "", "1 while a corner "
+                                    "touches a shoe"),
+            "energy": Signal(s[:, 11], "J", "kinetic + gravity energy of rod and crosshead + "
+                             "the shoes' elastic energy"),
+            **cycle_outputs(values, th1),
+        }  # fmt: skip
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
+        """Shoe impacts (count, per revolution, largest approach velocity), the crossings of
+        the clearance (an impact on the other shoe), the peak lateral acceleration, the
+        largest penetration, the contact fraction and the energy-balance residual."""
+        t = ds["time"].values
+        revs = (t[-1] - t[0]) / self.period(values) if t.size > 1 else float("nan")
+        out: dict[str, float] = {}
+        if "impact_time" in ds:
+            before = np.column_stack([ds[f"impact_v_impact_{k}"].values for k in range(1, 5)])
+            after = np.column_stack([ds[f"impact_v_impact_{k}_after"].values for k in range(1, 5)])
+            onset = (after > 0) & (before <= 0)
+            n_on = int(onset.sum())
+            vel = after[onset]
+            out.update({
+                "impacts": float(n_on),
+                "impacts_per_revolution": n_on / revs if revs > 0 else float("nan"),
+                "impact_velocity_max_m_s": float(vel.max()) if vel.size else 0.0,
+            })  # fmt: skip
+        E = ds["energy"].values
+        w_in, w_loss = ds["W_in"].values, ds["W_loss"].values
+        bal = E - E[0] - ((w_in - w_in[0]) - (w_loss - w_loss[0]))
+        c = float(values["guide_clearance"])
+        out.update({
+            "peak_abs_guide_acc_m_s2": float(np.abs(ds["guide_acc"].values).max()),
+            "peak_abs_a_m_s2": float(np.abs(ds["a"].values).max()),
+            "max_lateral_excursion_m": float(np.abs(ds["guide_y"].values).max()),
+            "max_lateral_excursion_ratio": float(np.abs(ds["guide_y"].values).max() / c)
+            if c > 0 else float("nan"),
+            "guide_contact_fraction": float(ds["guide_contact"].values.mean()),
+            "energy_lost_in_guide_J": float(w_loss[-1] - w_loss[0]),
+            "energy_balance_residual": float(np.abs(bal).max() / max(np.abs(E).max(), 1e-300)),
+            "restitution_delivered": delivered_restitution(
+                hysteresis_factor(values["guide_contact_law"], values["guide_restitution"])),
+        })  # fmt: skip
+        out.update(cycle_summary(values, ds))
+        return out
+
+
+COMPRESSOR_GUIDE = CompressorGuide()
