@@ -182,13 +182,16 @@ def _toml_value(v: Any) -> str:
     return repr(float(v)) if isinstance(v, float) else str(v)
 
 
-def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
-    """The full, commented TOML config of a run: every parameter of ``model`` (values in SI;
-    units, description, allowed range and assumptions as comments) and every simulation
-    setting. ``recipdyn simulate -c`` reads it back to the same run."""
+def dump_config(model, values: dict[str, Any], settings: dict[str, Any], *,
+                spec: str | None = None) -> str:  # fmt: skip
+    """The full, commented TOML config of a run: the model (``spec``: how it is found again,
+    default its name; a plug-in model's ``file.py:OBJ``), every parameter of ``model`` (values
+    in SI; units, description, allowed range and assumptions as comments), the values it
+    takes beside its schema (a load table) and every simulation setting.
+    ``recipdyn simulate -c`` reads it back to the same run."""
     lines = [f"# recipdyn run configuration: model {model.name!r} ({model.description})",
              "# numbers are SI (the unit in each comment); quantities such as '1 mm' work too",
-             f'model = "{model.name}"', "", "[params]"]  # fmt: skip
+             f"model = {_toml_value(spec or model.name)}", "", "[params]"]  # fmt: skip
     group = None
     for p in model.schema:
         if p.group != group:
@@ -200,10 +203,12 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
         comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
         if v is None:
             lines.append(f"# {p.name} = (derived by the model){comment}")
-        elif p.name == "load_table":
-            lines.append(f"{p.name} = {_toml_value([list(r) for r in v])}{comment}")
         else:
             lines.append(f"{p.name} = {_toml_value(v)}{comment}")
+    for name in model.schema.extras:  # values without a schema row: a table as rows
+        v = values.get(name)
+        if v is not None:
+            lines.append(f"{name} = {_toml_value([list(r) for r in v])}")
     lines += ["", "[simulation]"]
     notes = {"revolutions": "revolutions recorded (periods for other models)",
              "transient": "revolutions discarded first", "fs": "sampling rate, Hz",
@@ -234,17 +239,15 @@ def config_from_record(path: str | Path) -> RunConfig:
         raise ParameterError(f"config {path}: not a recipdyn run (no model and parameters "
                              "recorded)")  # fmt: skip
     m = get_model(str(spec))
+    try:  # the model reads its own record (a table beside its schema included)
+        values = m.values_from_record(attrs)
+    except (ParameterError, TypeError, ValueError) as exc:
+        raise ParameterError(f"config {path}: the recorded parameters are not valid "
+                             f"({exc})") from None  # fmt: skip
     params: dict[str, Any] = {}
-    for p in m.schema:
-        key = f"param_{p.name}"
-        if p.name == "load_table" and "load_table_deg_N" in attrs:
-            flat = [float(x) for x in np.atleast_1d(attrs["load_table_deg_N"])]
-            params[p.name] = [flat[i : i + 2] for i in range(0, len(flat), 2)]
-        elif key in attrs:
-            v = attrs[key]
-            v = v.item() if isinstance(v, np.generic) else v
-            if v != "default":
-                params[p.name] = v
+    for k, v in values.items():
+        if v is not None:
+            params[k] = [list(r) for r in v] if k in m.schema.extras else v
     sim: dict[str, Any] = {}
     for key, name in (
         ("revolutions", "revolutions"),
@@ -260,6 +263,6 @@ def config_from_record(path: str | Path) -> RunConfig:
             sim[name] = v.item() if isinstance(v, np.generic) else v
     try:
         simulation_config, run_config = _config_classes()
-        return run_config(model=m.name, params=params, simulation=simulation_config(**sim))
+        return run_config(model=str(spec), params=params, simulation=simulation_config(**sim))
     except ValidationError as exc:
         raise ParameterError(f"config {path}: recorded settings not valid ({exc})") from None

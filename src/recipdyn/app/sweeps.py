@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.registry import get_model
+from ..model.registry import DEFAULT_MODEL, get_model
 from .form import _display_unit, _factor
 
 __all__ = ["sweep_figure", "point_from_click", "log_ticks"]
@@ -28,7 +28,7 @@ def _open(store: str | Path):
 
 
 def _model(ds):
-    return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or "compressor"))
+    return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or DEFAULT_MODEL))
 
 
 def _axis_unit(ds, dim: str) -> tuple[str, float]:

@@ -31,7 +31,7 @@ from .components.load import cycle_outputs, cycle_summary, load_component
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
 from .load import pack_load
-from .parameters import SCHEMA, CompressorParams, ParameterError
+from .parameters import SCHEMA, CompressorParams, ParameterError, params_from_attrs
 from .protocol import Model
 
 __all__ = [
@@ -222,6 +222,21 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
     )
 
 
+@lru_cache(maxsize=16)
+def _system(p: CompressorParams) -> CompressorModel:
+    # one system per parameter set and process: a streamed run asks for it per block
+    return compressor_model(p)
+
+
+#: The axes and signs of every compressor record (``sign_convention``).
+SIGN_CONVENTION = (
+    "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
+    "centre, x3 = r + l); y up, gravity along -y; crosshead at y3 = -d; gas_force is the force on "
+    "the crosshead along +x: -P (load_sign='physical', gas pushes the piston toward the crank) "
+    "or +P (load_sign='paper', the sign of Eq. 46)."
+)
+
+
 class Compressor(Model):
     """The paper's compressor as a registered model (schema: `parameters.SCHEMA`).
 
@@ -274,7 +289,39 @@ class Compressor(Model):
         self.params(values)  # the ranges that depend on other parameters
 
     def system(self, values: Mapping[str, Any]) -> CompressorModel:
-        return compressor_model(self.params(values))
+        return _system(self.params(values))
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """The record's description of the model, its initial state and its parameters
+        (`CompressorParams.to_attrs`: the load table too, and every assumption)."""
+        p = self.params(values)
+        rule = (
+            "user-set theta_c0"
+            if p.theta_c0 is not None
+            else "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
+        )
+        start = {} if y0 is None else {
+            "theta_c_initial": float(y0[0]),
+            "thetadot_c_initial": float(y0[1]),
+            "theta_c_initial_rule": rule,
+        }  # fmt: skip
+        return {
+            "title": "recipdyn compressor simulation",
+            "model": f"massless-link clearance at the crank pin, equations={p.equations}",
+            "model_description": self.description,
+            "sign_convention": SIGN_CONVENTION,
+            "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), "
+                         "doi:10.21595/jve.2017.18771",
+            **start,
+            "crank_frequency_hz": p.crank_frequency,
+            **{f"param_{k}": v for k, v in p.to_attrs().items()},
+        }  # fmt: skip
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """The values a record holds, its load table included
+        (`recipdyn.model.parameters.params_from_attrs`)."""
+        return vars(params_from_attrs(attrs)).copy()
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         return self.system(values).initial_state()

@@ -21,7 +21,8 @@ turns at a prescribed uniform speed, so ``m1``, ``J1`` and ``rs`` affect only th
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, fields
 from typing import Any, Literal
 
 from ..defaults import RC_MIN
@@ -32,6 +33,7 @@ from .protocol import Param, Schema
 
 __all__ = [
     "CompressorParams",
+    "params_from_attrs",
     "ParameterError",
     "ASSUMED",
     "ASSUMED_CYCLE",
@@ -152,7 +154,7 @@ SCHEMA = Schema((
     Param("motor", "", "induction", "the motor's torque law (drive = motor): 'induction' "
           "(Kloss's curve) or 'constant'", choices=tuple(MOTORS), group="drive"),
     *MOTOR.params, *CONSTANT_TORQUE.params, *INDUCTION.params,
-), aliases={
+), extras=("load_table",), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
 })  # fmt: skip
@@ -376,6 +378,29 @@ def _validate_table(table) -> None:
         if a <= prev:
             raise ParameterError(f"load_table row {i}: angles must increase strictly")
         prev = a
+
+
+def params_from_attrs(attrs: Mapping[str, Any]) -> CompressorParams:
+    """The [`CompressorParams`][recipdyn.model.parameters.CompressorParams] a record's
+    attributes (``param_*``, written from `CompressorParams.to_attrs`) hold, the load table
+    included."""
+    import numpy as np
+
+    kw: dict[str, Any] = {}
+    for f in fields(CompressorParams):
+        if f.name == "load_table":
+            flat = attrs.get("param_load_table_deg_N")
+            if flat is not None:
+                arr = np.asarray(flat, dtype=float).reshape(-1, 2)
+                kw["load_table"] = tuple((float(a), float(b)) for a, b in arr)
+            continue
+        key = f"param_{f.name}"
+        if key in attrs:
+            v = attrs[key]
+            if isinstance(v, np.generic):
+                v = v.item()
+            kw[f.name] = None if v == "default" else v
+    return CompressorParams(**kw)
 
 
 def paper_2d12(**overrides: Any) -> CompressorParams:
