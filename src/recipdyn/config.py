@@ -43,6 +43,10 @@ __all__ = [
 
 #: The compressor's parameters whose values are names (every one with ``choices``).
 _STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
+#: The default model's parameters that choose a component: a ``module:object`` or
+#: ``file.py:OBJ`` value names a component from a user's file, whose parameters only the
+#: loaded model knows (`recipdyn.model.protocol.Model.schema_for`).
+CHOICES = frozenset(_STRING_FIELDS)
 
 
 @functools.cache
@@ -164,10 +168,16 @@ def read_config(path: str | Path) -> RunConfig:
 
 
 def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
-    """Validated values of any model's schema from ``{name: number | quantity string}``."""
+    """Validated values of any model's schema (at these values: a component from a user's
+    file brings its own parameters) from ``{name: number | quantity string}``."""
+    schema = model.schema_for(values)
     out: dict[str, Any] = {}
     for k, v in values.items():
-        p = model.schema[model.schema.resolve(k)]
+        name = schema.resolve(k)
+        if name in schema.extras:  # a value beside the schema (a table as rows)
+            out[name] = tuple(tuple(r) for r in v) if isinstance(v, list) else v
+            continue
+        p = schema[name]
         out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
     return model.parameters(out)
 
@@ -193,7 +203,7 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any], *,
              "# numbers are SI (the unit in each comment); quantities such as '1 mm' work too",
              f"model = {_toml_value(spec or model.name)}", "", "[params]"]  # fmt: skip
     group = None
-    for p in model.schema:
+    for p in model.schema_for(values):
         if p.group != group:
             group = p.group
             lines.append(f"# -- {group}")

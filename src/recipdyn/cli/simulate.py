@@ -28,10 +28,10 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     """
     import dataclasses
 
-    from ..config import build_params, model_values, read_config
+    from ..config import CHOICES, build_params, model_values, read_config
     from ..errors import ParameterError
     from ..model.protocol import UnknownParameterError
-    from ..model.registry import DEFAULT_MODEL, get_model
+    from ..model.registry import DEFAULT_MODEL, get_model, is_spec
     from ..units import parse_assignment
 
     cfg = read_config(config) if config is not None else None
@@ -49,6 +49,8 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     for item in sets or []:
         k, v = parse_assignment(item)
         values[k] = v
+    if m is None and any(is_spec(values.get(k)) for k in CHOICES):
+        m = get_model(DEFAULT_MODEL)  # a component from a user's file: its schema is the model's
     try:
         params = (dataclasses.asdict(build_params(values)) if m is None
                   else model_values(m, values))  # fmt: skip

@@ -82,7 +82,7 @@ def sweep(
     from ..model.registry import model_spec
     from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
 
-    spec = SweepSpec(axes=tuple(parse_axis(p, m) for p in params), measures=measures,
+    spec = SweepSpec(axes=tuple(parse_axis(p, m, base) for p in params), measures=measures,
                      base=base, settings=settings, continuation=continuation,
                      model=model_spec(m))  # fmt: skip
     run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,

@@ -27,9 +27,11 @@ from typing import Any, Literal
 
 from ..defaults import RC_MIN
 from ..errors import ParameterError
+from .components.contract import resolve_component
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .gases import GASES
 from .protocol import Param, Schema
+from .registry import is_spec
 
 __all__ = [
     "CompressorParams",
@@ -160,6 +162,10 @@ SCHEMA = Schema((
 })  # fmt: skip
 
 PARAM_UNITS: dict[str, str] = {p.name: p.unit for p in SCHEMA if p.unit}
+
+#: The parameters that choose a component and may name one from a user's module or file
+#: (``module:object``, ``file.py:OBJ``; `recipdyn.model.components.contract.resolve_component`).
+PLUGGABLE = ("load", "motor")
 
 #: Friendly names accepted by the CLI, configs and sweeps.
 PARAM_ALIASES: dict[str, str] = dict(SCHEMA.aliases)
@@ -292,6 +298,8 @@ class CompressorParams:
 
     def __post_init__(self) -> None:
         for p in SCHEMA:  # the static ranges, declared once in the schema
+            if p.name in PLUGGABLE and is_spec(getattr(self, p.name)):
+                continue  # a component from a user's file (checked when it is loaded)
             p.check(getattr(self, p.name))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
@@ -319,9 +327,14 @@ class CompressorParams:
                     "equations = 'paper-printed' exists for a prescribed crank "
                     "only; allowed with drive = 'motor': equations = 'exact'"
                 )
-            check = MOTORS[self.motor].check
+            check = resolve_component("motor", self.motor, MOTORS).check
             if check is not None:
                 check(asdict(self))
+            if self.motor == "constant" and self.motor_torque is None and is_spec(self.load):
+                raise ParameterError(
+                    f"motor_torque: needed with motor = 'constant' and load = {self.load!r} "
+                    "(its default, the mean load torque, is known for recipdyn's own loads)"
+                )
         if self.discharge_pressure < self.suction_pressure:
             raise ParameterError(
                 f"discharge_pressure = {self.discharge_pressure!r} Pa is out of range; allowed: "

@@ -371,9 +371,16 @@ class Model(ABC):
         elif values is not None and not isinstance(values, Mapping):
             raise ParameterError(f"parameters of model {self.name!r}: expected a mapping of "
                                  f"names to values, got {type(values).__name__}")  # fmt: skip
-        out = self.schema.validate({**(values or {}), **kw})
+        raw = {**(values or {}), **kw}
+        out = self.schema_for(raw).validate(raw)
         self.check(out)
         return out
+
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """The schema at ``values`` (names or aliases, raw or validated): default the class's
+        ``schema``; an assembled model whose parameters choose components from a user's file
+        adds their fragments here (the compressor, `recipdyn.model.components`)."""
+        return self.schema
 
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise
@@ -412,13 +419,15 @@ class Model(ABC):
                "model_description": self.description}  # fmt: skip
         if y0 is not None:
             out["state_initial"] = [float(x) for x in np.atleast_1d(y0)]
-        return {**out, **self.schema.to_attrs(values)}
+        return {**out, **self.schema_for(values).to_attrs(values)}
 
     def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
         """The validated parameter values a record (its attributes, written by
         `record_attrs`) was made with; raise [`ParameterError`][recipdyn.errors.ParameterError]
         if they are not valid."""
-        values = self.schema.from_attrs(attrs)
+        chosen = {p.name: attrs[f"param_{p.name}"] for p in self.schema
+                  if p.choices is not None and f"param_{p.name}" in attrs}  # fmt: skip
+        values = self.schema_for(chosen).from_attrs(attrs)
         self.check(values)
         return values
 

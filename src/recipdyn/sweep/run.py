@@ -100,7 +100,7 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
     for a in spec.axes:
         arr = g.create_array(a.name, shape=(len(a.values),), dtype="f8", dimension_names=[a.name])
         arr[:] = np.asarray(a.values)
-        arr.attrs.update({"units": spec.get_model().schema[a.name].unit or "1",
+        arr.attrs.update({"units": spec.get_model().schema_for(spec.base)[a.name].unit or "1",
                           "scale": a.scale})  # fmt: skip
     one = (1,) * (len(dims) - 1) + (min(point_block(spec.n_points), spec.shape[-1]),)
     for name, (dtype, extra, size, units) in _variables(spec).items():

@@ -14,6 +14,7 @@ import dataclasses
 import hashlib
 import itertools
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -48,17 +49,20 @@ class Axis:
     scale: str = "linear"
 
 
-def parse_axis(text: str, model: str | Model | None = None) -> Axis:
+def parse_axis(text: str, model: str | Model | None = None,
+               base: Mapping[str, Any] | None = None) -> Axis:  # fmt: skip
     """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units,
-    converted to the unit of the parameter in ``model``'s schema; default the compressor)."""
+    converted to the unit of the parameter in ``model``'s schema at the ``base`` values --
+    a component from a user's file brings its parameters; default the compressor)."""
     if "=" not in text:
         raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
     raw_name, rhs = (s.strip() for s in text.split("=", 1))
     m = get_model(model)
-    name = m.schema.resolve(raw_name)
-    if name not in m.schema or m.schema[name].choices is not None:
+    schema = m.schema_for(base or {})
+    name = schema.resolve(raw_name)
+    if name not in schema or schema[name].choices is not None:
         raise ParameterError(f"--param {raw_name}: only numeric parameters can be swept")
-    unit = m.schema[name].unit
+    unit = schema[name].unit
     if ":" in rhs:
         parts = rhs.split(":")
         if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
