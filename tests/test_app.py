@@ -257,7 +257,7 @@ def test_downloaded_config_runs_on_the_command_line(tmp_path):
     out = tmp_path / "run.nc"
     assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
     with xr.open_dataset(out) as ds:
-        assert ds.attrs["param_rc"] == form.params.rc == 0.5e-3
+        assert ds.attrs["param_rc"] == form.params["rc"] == 0.5e-3
         assert ds.attrs["param_omega"] == pytest.approx(10 * math.pi, rel=1e-15)
         assert ds.attrs["sampling_rate_hz"] == 2000.0 and ds.attrs["revolutions"] == 1.0
 
@@ -287,7 +287,7 @@ def test_sweep_figure_and_click(store):
     assert values["rc"] == pytest.approx(np.sqrt(0.2e-3 * 2e-3), rel=1e-12)  # the log middle
     q = click_query(store, {"points": [{"x": 2.1, "y": 0.62}]}, {"run.revolutions": "1"})
     form = read_form(*from_query(q)[:2])
-    assert form.params.rc == values["rc"]  # the text is exact
+    assert form.params["rc"] == values["rc"]  # the text is exact
     assert form.settings["revolutions"] == 1.0
     with pytest.raises(ParameterError, match="not found"):
         sweep_figure(store / "nope")

@@ -244,7 +244,7 @@ def record_speed_hz(attrs) -> float | None:
     spec = attrs.get("model_spec", attrs.get("model_name"))
     try:
         m = get_model(spec)
-        period = m.period(m.schema.from_attrs(attrs)) if m.kind == "ode" else None
+        period = m.period(m.values_from_record(attrs)) if m.kind == "ode" else None
     except (ParameterError, ImportError, AttributeError, KeyError, TypeError, ValueError):
         period = None
     if not period:  # a record of an older recipdyn: its compressor said its speed

@@ -411,6 +411,8 @@ def simulate(
     attrs["config_toml"] = dump_config(m, values, settings, spec=spec)
     _check_validity(m, minima, attrs, values)
     events_ds = _events(m, values, events[0], sol, t_start) if events else None
+    if events_ds is not None:
+        attrs.update(events_ds.attrs)  # what each event is
     recent = ds if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
         if events_ds is not None:

@@ -164,7 +164,7 @@ def status_lines(ds, model) -> list[str]:
     if "solver_nfev" in ds.attrs:
         head += f" | {ds.attrs.get('solver_method')} nfev = {int(ds.attrs['solver_nfev'])}"
     lines = [head]
-    summary = model.run_summary(model.schema.from_attrs(ds.attrs), ds) if ds.sizes[dim] else {}
+    summary = model.run_summary(model.values_from_record(ds.attrs), ds) if ds.sizes[dim] else {}
     for k, v in summary.items():
         lines.append(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}")
     if ds.attrs.get("validity", "ok") != "ok":

@@ -125,7 +125,7 @@ def point_from_click(store: str | Path, click: dict) -> tuple[str, dict[str, Any
     if "x" not in pt:
         raise ParameterError("click: no point")
     coords = {dims[-1]: pt["x"]} if len(dims) == 1 else {dims[1]: pt["x"], dims[0]: pt["y"]}
-    base = m.schema.from_attrs(ds.attrs)
+    base = m.values_from_record(ds.attrs)
     for dim, val in coords.items():
         grid = ds[dim].values
         shown = grid / _axis_unit(ds, dim)[1]

@@ -281,6 +281,7 @@ def simulate(
 
     m = m or get_model()  # every input is valid: the model's module may load now
     period = m.period(params) if m.kind != "map" else None
+    check_settings(kw, period)  # the RK4 step against the default model's period too
     n_samples = kw["revolutions"] * (period or 1.0) * (kw["fs"] if m.kind != "map" else 1.0)
     if stream is None:
         stream = n_samples > STREAM_AUTO and out.suffix.lower() in (".nc", ".zarr")
