@@ -482,6 +482,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
         "spread_second_half": _spread(res), "revolutions": lyap_revolutions,
     }  # fmt: skip
+    if m.kind == "ode" and m.period(values) and getattr(res, "per_period", None) is not None:
+        summary["lyapunov_equations"]["exponents_per_revolution"] = res.per_period.tolist()
     fig = plot_lyapunov_history(res, unit=unit)  # per s or per iteration
     save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
     plt.close(fig)

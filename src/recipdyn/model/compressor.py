@@ -367,7 +367,12 @@ class Compressor(Model):
                     c.check(values)
 
     def system(self, values: Mapping[str, Any]) -> CompressorModel:
-        return _system(self.params(values), tuple(sorted(self.plugged(values).items())))
+        p, extra = self.params(values), tuple(sorted(self.plugged(values).items()))
+        try:
+            hash((p, extra))
+        except TypeError:  # an unhashable value (a table given as lists): built each time
+            return compressor_model(p, dict(extra))
+        return _system(p, extra)
 
     def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
                      ) -> dict[str, Any]:  # fmt: skip

@@ -18,8 +18,13 @@ A *model* is a family of dynamical systems with a typed parameter schema:
   state components) and [`Model.check`][recipdyn.model.protocol.Model.check] (validity checks across
   parameters).
 
+A record of a run says what the model put in it with `Model.record_attrs` and is read back
+with `Model.values_from_record`; an assembled model whose parameters choose a component from a
+user's file gives the schema at those values with `Model.schema_for`.
+
 Models are found by name through [`recipdyn.model.registry`][recipdyn.model.registry]. The layers
-above the model talk to a model only through this class; see ``docs/architecture.md``.
+above the model talk to a model only through this class (no branch on a model's name or
+parameter class: ``tests/test_one_track.py``); see ``docs/architecture.md``.
 """
 
 from __future__ import annotations
