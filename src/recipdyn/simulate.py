@@ -307,7 +307,8 @@ def simulate(
     states = m.states(values)
     t_start = transient * T
     # the output names, from one sample: columns are checked, and the disk, before any work
-    keep = _columns(columns, _names(m.outputs(values, np.array([t_start]), y0[None, :]), states))
+    every = _names(m.outputs(values, np.array([t_start]), y0[None, :]), states)
+    keep = _columns(columns, every)
     if out is not None:
         _check_disk(out, n_float, len(keep) + 2, float32)  # + time, revolution
     events = m.events(values)
@@ -349,8 +350,8 @@ def simulate(
         def sink(t, y):
             outs = _with_states(m.outputs(values, t, y), states, y)
             _track_minima(m, outs, minima)
-            rec = _record(outs, t, period, keep)
-            writer.append(rec)
+            rec = _record(outs, t, period, every)  # all outputs: the model's run summary
+            writer.append(rec[keep])
             tail[:] = [*tail[-1:], rec]
 
     try:
@@ -377,7 +378,8 @@ def simulate(
             raise IntegrationError(f"{failure or ''} {exc}".strip(), sol) from None
         if sol.t.size == 0 and failure is None:
             raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
-        ds = _record(outs, sol.t, period, keep)
+        full = _record(outs, sol.t, period, every)  # (the run summary reads every output)
+        ds = full[keep]
         _track_minima(m, outs, minima)
     attrs: dict[str, Any] = {
         "title": f"recipdyn simulation: {m.name}",
@@ -413,7 +415,7 @@ def simulate(
     events_ds = _events(m, values, events[0], sol, t_start) if events else None
     if events_ds is not None:
         attrs.update(events_ds.attrs)  # what each event is
-    recent = ds if writer is None else xr.concat(tail, "time") if tail else None
+    recent = full if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
         if events_ds is not None:
             recent = recent.merge(events_ds)
