@@ -79,8 +79,7 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
     form = read_form(m, {f.key: f.default_text if f.choices is None else f.default
                          for f in flds})  # fmt: skip
     assert form.ok, form.errors
-    defaults = CompressorParams() if name == "compressor" else m.parameters()
-    assert form.params == defaults  # exact: no unit conversion rounds a default
+    assert form.params == m.parameters()  # exact: no unit conversion rounds a default
     assert panel_for(name, {})  # the Dash components build
 
 
