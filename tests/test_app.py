@@ -5,7 +5,6 @@ change a value with units, see its figures; a bad value shows its error and clea
 click a fault-map cell; download the config and run it with the CLI)."""
 
 import base64
-import dataclasses
 import json
 import math
 import shutil
@@ -472,4 +471,5 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         proc.terminate()
         proc.wait(timeout=30)
         server.shutdown()
-    assert dataclasses.is_dataclass(read_form(*from_query(search)[:2]).params)
+    params = read_form(*from_query(search)[:2]).params  # the model's values, as every model's
+    assert params["rc"] == pytest.approx(2e-3) and params["d"] == pytest.approx(2e-3)
