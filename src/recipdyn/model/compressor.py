@@ -38,7 +38,7 @@ from .components.load import cycle_outputs, cycle_summary, load_component
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
 from .load import pack_load
-from .parameters import PLUGGABLE, SCHEMA, CompressorParams, ParameterError, params_from_attrs
+from .parameters import PLUGGABLE, SCHEMA, CompressorParams, ParameterError
 from .protocol import Model, Schema
 from .registry import absolute_spec, is_spec
 
@@ -376,42 +376,39 @@ class Compressor(Model):
 
     def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
                      ) -> dict[str, Any]:  # fmt: skip
-        """The record's description of the model, its initial state and its parameters
-        (`CompressorParams.to_attrs`: the load table too, and every assumption)."""
+        """Every model's record attributes (`Model.record_attrs`: its parameters, a user's
+        component's too), the axes and signs, the crank frequency, the initial clearance
+        angle and how it was chosen, and what the parameter view adds (the load's
+        description, its table, the list of assumptions)."""
         p = self.params(values)
-        rule = (
-            "user-set theta_c0"
-            if p.theta_c0 is not None
-            else "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
-        )
-        start = {} if y0 is None else {
-            "theta_c_initial": float(y0[0]),
-            "thetadot_c_initial": float(y0[1]),
-            "theta_c_initial_rule": rule,
-        }  # fmt: skip
-        return {
-            "title": "recipdyn compressor simulation",
-            "model": f"massless-link clearance at the crank pin, equations={p.equations}",
-            "model_description": self.description,
+        out = super().record_attrs(values, y0)
+        out.update({
             "sign_convention": SIGN_CONVENTION,
             "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), "
                          "doi:10.21595/jve.2017.18771",
-            **start,
             "crank_frequency_hz": p.crank_frequency,
-            **{f"param_{k}": v for k, v in p.to_attrs().items()},
-            **Schema(tuple(q for q in self.schema_for(values) if q.name not in SCHEMA)
-                     ).to_attrs(values),  # a user's component's fragment
-        }  # fmt: skip
+        })  # fmt: skip
+        if y0 is not None:
+            out["theta_c_initial"] = float(y0[0])
+            out["thetadot_c_initial"] = float(y0[1])
+            out["theta_c_initial_rule"] = (
+                "user-set theta_c0" if p.theta_c0 is not None else
+                "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
+            )  # fmt: skip
+        for k, v in p.to_attrs().items():
+            out.setdefault(f"param_{k}", v)
+        return out
 
     def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
-        """The values a record holds, its load table included
-        (`recipdyn.model.parameters.params_from_attrs`)."""
-        values = vars(params_from_attrs(attrs)).copy()
-        schema = self.schema_for(values)
-        if schema is not self.schema:  # a user's component: its fragment's values too
-            own = Schema(tuple(q for q in schema if q.name not in SCHEMA))
-            values.update(own.from_attrs(attrs))
-            self.check(values)
+        """The values a record holds (`Model.values_from_record`), its load table
+        included."""
+        chosen = {f: attrs[f"param_{f}"] for f in PLUGGABLE if f"param_{f}" in attrs}
+        values = self.schema_for(chosen).from_attrs(attrs)
+        flat = attrs.get("param_load_table_deg_N")
+        if flat is not None and "load_table" in self.schema.extras:
+            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
+            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
+        self.check(values)
         return values
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
