@@ -5,7 +5,6 @@ change a value with units, see its figures; a bad value shows its error and clea
 click a fault-map cell; download the config and run it with the CLI)."""
 
 import base64
-import dataclasses
 import json
 import math
 import shutil
@@ -79,8 +78,7 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
     form = read_form(m, {f.key: f.default_text if f.choices is None else f.default
                          for f in flds})  # fmt: skip
     assert form.ok, form.errors
-    defaults = CompressorParams() if name == "compressor" else m.parameters()
-    assert form.params == defaults  # exact: no unit conversion rounds a default
+    assert form.params == m.parameters()  # exact: no unit conversion rounds a default
     assert panel_for(name, {})  # the Dash components build
 
 
@@ -257,7 +255,7 @@ def test_downloaded_config_runs_on_the_command_line(tmp_path):
     out = tmp_path / "run.nc"
     assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
     with xr.open_dataset(out) as ds:
-        assert ds.attrs["param_rc"] == form.params.rc == 0.5e-3
+        assert ds.attrs["param_rc"] == form.params["rc"] == 0.5e-3
         assert ds.attrs["param_omega"] == pytest.approx(10 * math.pi, rel=1e-15)
         assert ds.attrs["sampling_rate_hz"] == 2000.0 and ds.attrs["revolutions"] == 1.0
 
@@ -287,7 +285,7 @@ def test_sweep_figure_and_click(store):
     assert values["rc"] == pytest.approx(np.sqrt(0.2e-3 * 2e-3), rel=1e-12)  # the log middle
     q = click_query(store, {"points": [{"x": 2.1, "y": 0.62}]}, {"run.revolutions": "1"})
     form = read_form(*from_query(q)[:2])
-    assert form.params.rc == values["rc"]  # the text is exact
+    assert form.params["rc"] == values["rc"]  # the text is exact
     assert form.settings["revolutions"] == 1.0
     with pytest.raises(ParameterError, match="not found"):
         sweep_figure(store / "nope")
@@ -473,4 +471,5 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         proc.terminate()
         proc.wait(timeout=30)
         server.shutdown()
-    assert dataclasses.is_dataclass(read_form(*from_query(search)[:2]).params)
+    params = read_form(*from_query(search)[:2]).params  # the model's values, as every model's
+    assert params["rc"] == pytest.approx(2e-3) and params["d"] == pytest.approx(2e-3)

@@ -77,7 +77,7 @@ def test_schema_is_complete_and_defaults_valid(model):
     from recipdyn.units import to_si
 
     values = model.parameters()
-    assert set(values) == set(model.schema.names)
+    assert set(values) == {*model.schema.names, *model.schema.extras}  # (a table beside it)
     for p in model.schema:
         assert p.description and p.group
         if p.choices is None and p.default is not None:

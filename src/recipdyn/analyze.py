@@ -25,11 +25,9 @@ from .analysis.signal import assess_signal
 from .defaults import ATOL, LYAP_TOL, MAX_MEMORY_SAMPLES, RTOL
 from .io import forcing_frequency, save_figure, write_text
 from .io import jsonable as _plain
-from .model.compressor import compressor_model
 from .model.parameters import ParameterError
 from .plotting import _mpl, axis_label
 from .progress import quiet
-from .simulate import params_from_attrs
 
 __all__ = ["analyze_run", "analyze_signal", "is_record", "MIN_SAMPLES"]
 
@@ -54,10 +52,9 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     path, out = Path(path), Path(out)
     ds = read_dataset(path)
     m = _record_model(ds, path)
-    compressor = m is None or m.name == "compressor"
     dim = "iteration" if "iteration" in ds.dims else "time"
-    vib = "a" if compressor else m.vibration()[0]
-    need = ("a", "v", "x", "time") if compressor else (vib, dim)
+    vib, vib_unit = m.vibration()
+    need = (vib, dim)
     missing = [v for v in need if v not in ds.variables]
     if missing:
         raise ParameterError(f"input {path}: variable(s) {', '.join(missing)} missing; expected "
@@ -77,8 +74,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     fc = forcing_frequency(ds.attrs)
     a = ds[vib].values
     summary: dict[str, Any] = {"input": path.name, "samples": int(t.size), "fs_hz": fs,
-                               "model": m.name if m is not None else "unknown",
-                               "signal": vib}  # fmt: skip
+                               "model": m.name, "signal": vib, "units": vib_unit}  # fmt: skip
 
     with phase("analyze: spectrum and phase portraits"):
         spec = amplitude_spectrum(a, fs)
@@ -89,36 +85,22 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
                       for p in peaks],
         }  # fmt: skip
         fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
-        what = "the crosshead acceleration" if compressor else vib
+        what = ds[vib].attrs.get("long_name") or vib
+        what = f"the {what}" if what != vib else vib
         fig = plot_spectrum(spec, peaks, fmax=fmax, title=f"spectrum of {what}")
         save_figure(fig, out / "spectrum.png", dpi=110)
         plt.close(fig)
-        if compressor:
-            fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
-            plot_phase(ds.x, ds.v, "x (m)", "v (m/s)", ax=axes[0], title="displacement-velocity")
-            plot_phase(ds.v, ds.a, "v (m/s)", "a (m/s$^2$)", ax=axes[1],
-                       title="velocity-acceleration")  # fmt: skip
-            if "theta_c" in ds:
-                plot_phase(ds.theta_c, ds.thetadot_c, "theta_c (rad)", "theta_c' (rad/s)",
-                           ax=axes[2], title="clearance angle")  # fmt: skip
-        else:
-            names = [s for s in m.state_names if s in ds]
-            pairs = list(zip(names, names[1:], strict=False))[:3] or [(names[0], names[0])]
-            fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
-                                     constrained_layout=True, squeeze=False)  # fmt: skip
-            for ax, (u, w) in zip(axes[0], pairs, strict=True):
-                plot_phase(ds[u], ds[w], axis_label(u, ds[u]), axis_label(w, ds[w]), ax=ax,
-                           points=dim == "iteration", title=f"{u}-{w}")  # fmt: skip
+        fig = _phase_portraits(m, ds, dim, plt)
         save_figure(fig, out / "phase_portraits.png", dpi=110)
         plt.close(fig)
 
-    if compressor and fc:
+    if fc and vib_unit == "m/s**2":  # a machine's acceleration: its vibration page
         from .analysis.vibration import crank_angle
 
         revs = crank_angle(a.size, fs, speed_hz=fc, zero_rev=float(t[0]) * fc)
         with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
             summary["vibration"] = vibration_section(
-                a, fs, out, plt, revs=revs, title=f"{path.name}: crosshead acceleration"
+                a, fs, out, plt, revs=revs, title=f"{path.name}: {what.removeprefix('the ')}"
             )
     with phase(f"analyze: exponents from the signal, 0-1 test, surrogates "
                f"({min(a.size, max_signal_samples)} samples)"):  # fmt: skip
@@ -132,59 +114,9 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     lam_err = 0.0
     section = None
     k01 = None
-    if not compressor:
-        lam, lam_err, section, k01 = _equations_any_model(
-            m,
-            ds,
-            dim,
-            out,
-            summary,
-            section_points,
-            lyap_revolutions,
-            rtol,
-            atol,
-            plt,
-            path,
-            phase,
-        )
-    elif "param_rc" in ds.attrs:
-        try:
-            p = params_from_attrs(ds.attrs)
-        except (ParameterError, TypeError, ValueError) as exc:
-            raise ParameterError(f"{path}: the recorded parameters are not valid ({exc})") from None
-        if "theta_c" not in ds or "thetadot_c" not in ds:
-            raise ParameterError(f"{path}: records parameters but not theta_c/thetadot_c")
-        model = compressor_model(p)
-        y0 = np.array([float(ds.theta_c.values[0]), float(ds.thetadot_c.values[0])])
-        t0 = float(t[0])
-        with phase(f"analyze: Poincaré section ({section_points} revolutions)"):
-            sec = stroboscopic_section(model, y0, section_points, t0=t0, rtol=rtol, atol=atol)
-        section = np.c_[sec.v.values, sec.a.values]
-        title = f"Poincaré section, once per revolution ({section_points} points)"
-        fig = plot_phase(sec.v, sec.a, "v (m/s)", "a (m/s$^2$)", points=True, title=title)
-        save_figure(fig, out / "poincare.png", dpi=110)
-        plt.close(fig)
-        if section_points >= 100:
-            k01 = zero_one_test(sec.thetadot_c.values)
-        if p.rc > 0:
-            with phase(f"analyze: Benettin exponents ({lyap_revolutions:g} revolutions)"):
-                res = lyapunov_spectrum(model, y0, lyap_revolutions * p.crank_period, t0=t0,
-                                        rtol=rtol, atol=atol)  # fmt: skip
-            lam, lam_err = res.largest_limit()
-            summary["lyapunov_equations"] = {
-                "lambda1_limit_per_s": lam,
-                "lambda1_limit_error": lam_err,
-                "exponents_per_s": res.exponents.tolist(),
-                "exponents_per_revolution": res.per_period.tolist(),
-                "sum_per_s": res.sum,
-                "spread_second_half": _spread(res),
-                "revolutions": lyap_revolutions,
-            }
-            fig = plot_lyapunov_history(res)
-            save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
-            plt.close(fig)
-        summary["poincare"] = {"points": section_points}
-        summary["zero_one_K"] = k01
+    lam, lam_err, section, k01 = _equations_any_model(
+        m, ds, dim, out, summary, section_points, lyap_revolutions, rtol, atol, plt, path, phase
+    )
     # a simulated record is deterministic by construction: the surrogate test is reported
     # (summary["signal_assessment"]) but does not enter; the signal exponents stand in only
     # when the equations give none
@@ -423,7 +355,9 @@ def is_record(path: str | Path) -> bool:
         return False
     try:
         with xr.open_dataset(path) as ds:
-            return "model_spec" in ds.attrs or "param_rc" in ds.attrs or "model_name" in ds.attrs
+            attrs = ds.attrs  # a model named, or (an older record) its parameters
+            return "model_spec" in attrs or "model_name" in attrs or any(
+                str(k).startswith("param_") for k in attrs)  # fmt: skip
     except Exception:
         return True  # let analyze_run report what is wrong with it
 
@@ -453,17 +387,38 @@ def _spread(res) -> float:
 
 
 def _record_model(ds, path):
-    """The model a record was made with (None for a file that does not say)."""
-    from .model.registry import get_model
+    """The model a record was made with (its spec: a plug-in model's file too). A record
+    with parameters but no model named was written when recipdyn had one model, the
+    default."""
+    from .model.registry import DEFAULT_MODEL, get_model
 
     spec = ds.attrs.get("model_spec") or ds.attrs.get("model_name")
     if spec is None:
-        return get_model("compressor") if "param_rc" in ds.attrs else None
+        if not any(str(k).startswith("param_") for k in ds.attrs):
+            raise ParameterError(f"{path}: names no model and records no parameters; expected "
+                                 "a recipdyn run (NetCDF from 'recipdyn simulate')")  # fmt: skip
+        spec = DEFAULT_MODEL
     try:
         return get_model(str(spec))
     except ParameterError as exc:
         raise ParameterError(f"{path}: made with model {spec!r}, which is not available here "
                              f"({exc})") from None  # fmt: skip
+
+
+def _phase_portraits(m, ds, dim, plt):
+    """Phase portraits of a record: consecutive state components (up to three pairs) and the
+    model's section pair (the compressor's velocity-acceleration)."""
+    names = [s for s in m.state_names if s in ds]
+    pairs = list(zip(names, names[1:], strict=False))[:3] or [(names[0], names[0])]
+    declared = m.pair()
+    if declared not in pairs and all(k in ds for k in declared) and len(pairs) < 3:
+        pairs.append(declared)
+    fig, axes = plt.subplots(1, len(pairs), figsize=(5 * len(pairs), 4.5),
+                             constrained_layout=True, squeeze=False)  # fmt: skip
+    for ax, (u, w) in zip(axes[0], pairs, strict=True):
+        plot_phase(ds[u], ds[w], axis_label(u, ds[u]), axis_label(w, ds[w]), ax=ax,
+                   points=dim == "iteration", title=f"{u}-{w}")  # fmt: skip
+    return fig
 
 
 def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revolutions, rtol,
@@ -472,8 +427,7 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     from .analysis import lyapunov_spectrum_map
 
     try:
-        values = m.schema.from_attrs(ds.attrs)
-        m.check(values)
+        values = m.values_from_record(ds.attrs)
     except (ParameterError, TypeError, ValueError) as exc:
         raise ParameterError(f"{path}: the recorded parameters are not valid ({exc})") from None
     state_names = tuple(s for s, _ in m.states(values))
@@ -484,6 +438,7 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     y0 = np.array([float(ds[s].values[0]) for s in state_names])
     t0 = float(ds[dim].values[0])
     pair = state_names[:2] if len(state_names) >= 2 else state_names * 2
+    declared = m.pair()  # the model's section pair (the compressor's v, a) when it records it
     lam, lam_err, section, k01 = None, 0.0, None, None
     supported = m.lyapunov_supported(values)
     if not supported:
@@ -500,6 +455,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
             with phase(f"analyze: Poincaré section ({section_points} periods)"):
                 sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol,
                                            atol=atol)  # fmt: skip
+            if all(k in sec for k in declared):
+                pair = declared
             section = np.c_[tuple(sec[s].values for s in pair)]
             title = f"Poincaré section, once per period ({section_points})"
             fig = plot_phase(sec[pair[0]], sec[pair[1]], pair[0], pair[1], points=True,
@@ -507,8 +464,11 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
             save_figure(fig, out / "poincare.png", dpi=110)
             plt.close(fig)
             if section_points >= 100:
-                k01 = zero_one_test(sec[m.state_names[0]].values)
+                k01 = zero_one_test(sec[pair[0]].values)
             summary["poincare"] = {"points": section_points}
+        if not m.has_dynamics(values):  # nothing moves but the forcing: no exponents
+            summary["zero_one_K"] = k01
+            return None, 0.0, section, k01
         if not supported:
             summary["zero_one_K"] = k01
             return None, 0.0, section, k01
@@ -522,6 +482,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
         "spread_second_half": _spread(res), "revolutions": lyap_revolutions,
     }  # fmt: skip
+    if m.kind == "ode" and m.period(values) and getattr(res, "per_period", None) is not None:
+        summary["lyapunov_equations"]["exponents_per_revolution"] = res.per_period.tolist()
     fig = plot_lyapunov_history(res, unit=unit)  # per s or per iteration
     save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
     plt.close(fig)
@@ -532,8 +494,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
 def _markdown(s: dict[str, Any]) -> str:
     v = s["verdict"]
     measured = s.get("model") == "none (measured signal)"
-    what = s.get("signal", "signal") if measured else "crosshead acceleration"
-    unit = (s.get("units") or "signal units") if measured else "m/s^2"
+    what = s.get("signal", "signal")
+    unit = (s.get("units") or "signal units").replace("**", "^")
     peaks = s["spectrum"]["peaks"]
     orders = not measured or any(p["crank_order"] for p in peaks)  # a speed was known
     lines = [f"# Analysis of {s['input']}", "", f"**Verdict: {v.get('headline', v['verdict'])}**"
@@ -592,5 +554,5 @@ def _markdown(s: dict[str, Any]) -> str:
                if r["status"] == "inconsistent" else f"refused ({r['reason']})")  # fmt: skip
         lines.append(f"- {name} (signal {s.get('signal', 'a')}): {val}")
     if s.get("zero_one_K") is not None:
-        lines.append(f"- 0-1 test K (stroboscopic theta_c'): {s['zero_one_K']:.3f}")
+        lines.append(f"- 0-1 test K (stroboscopic section): {s['zero_one_K']:.3f}")
     return "\n".join(lines) + "\n"

@@ -106,7 +106,9 @@ def compare_runs(paths: list[str | Path], out: str | Path, *, signal: str | None
             raise ParameterError(f"{p}: no 'time' dimension; compare takes records of "
                                  "'recipdyn simulate' of a flow (not a map)")  # fmt: skip
     if signal is None:
-        signal = "a" if all("a" in ds for ds in runs) else None
+        named = {str(ds.attrs.get("vibration_signal", "a")) for ds in runs}  # the models'
+        signal = next(iter(named)) if len(named) == 1 else None
+        signal = signal if signal is not None and all(signal in ds for ds in runs) else None
         if signal is None:
             common = set.intersection(*({k for k in ds.data_vars if ds[k].dims == ("time",)}
                                         for ds in runs))  # fmt: skip

@@ -43,6 +43,10 @@ __all__ = [
 
 #: The compressor's parameters whose values are names (every one with ``choices``).
 _STRING_FIELDS = {p.name for p in SCHEMA if p.choices is not None}
+#: The default model's parameters that choose a component: a ``module:object`` or
+#: ``file.py:OBJ`` value names a component from a user's file, whose parameters only the
+#: loaded model knows (`recipdyn.model.protocol.Model.schema_for`).
+CHOICES = frozenset(_STRING_FIELDS)
 
 
 @functools.cache
@@ -164,10 +168,16 @@ def read_config(path: str | Path) -> RunConfig:
 
 
 def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
-    """Validated values of any model's schema from ``{name: number | quantity string}``."""
+    """Validated values of any model's schema (at these values: a component from a user's
+    file brings its own parameters) from ``{name: number | quantity string}``."""
+    schema = model.schema_for(values)
     out: dict[str, Any] = {}
     for k, v in values.items():
-        p = model.schema[model.schema.resolve(k)]
+        name = schema.resolve(k)
+        if name in schema.extras:  # a value beside the schema (a table as rows)
+            out[name] = tuple(tuple(r) for r in v) if isinstance(v, list) else v
+            continue
+        p = schema[name]
         out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
     return model.parameters(out)
 
@@ -182,15 +192,18 @@ def _toml_value(v: Any) -> str:
     return repr(float(v)) if isinstance(v, float) else str(v)
 
 
-def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
-    """The full, commented TOML config of a run: every parameter of ``model`` (values in SI;
-    units, description, allowed range and assumptions as comments) and every simulation
-    setting. ``recipdyn simulate -c`` reads it back to the same run."""
+def dump_config(model, values: dict[str, Any], settings: dict[str, Any], *,
+                spec: str | None = None) -> str:  # fmt: skip
+    """The full, commented TOML config of a run: the model (``spec``: how it is found again,
+    default its name; a plug-in model's ``file.py:OBJ``), every parameter of ``model`` (values
+    in SI; units, description, allowed range and assumptions as comments), the values it
+    takes beside its schema (a load table) and every simulation setting.
+    ``recipdyn simulate -c`` reads it back to the same run."""
     lines = [f"# recipdyn run configuration: model {model.name!r} ({model.description})",
              "# numbers are SI (the unit in each comment); quantities such as '1 mm' work too",
-             f'model = "{model.name}"', "", "[params]"]  # fmt: skip
+             f"model = {_toml_value(spec or model.name)}", "", "[params]"]  # fmt: skip
     group = None
-    for p in model.schema:
+    for p in model.schema_for(values):
         if p.group != group:
             group = p.group
             lines.append(f"# -- {group}")
@@ -200,10 +213,12 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any]) -> str:
         comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
         if v is None:
             lines.append(f"# {p.name} = (derived by the model){comment}")
-        elif p.name == "load_table":
-            lines.append(f"{p.name} = {_toml_value([list(r) for r in v])}{comment}")
         else:
             lines.append(f"{p.name} = {_toml_value(v)}{comment}")
+    for name in model.schema.extras:  # values without a schema row: a table as rows
+        v = values.get(name)
+        if v is not None:
+            lines.append(f"{name} = {_toml_value([list(r) for r in v])}")
     lines += ["", "[simulation]"]
     notes = {"revolutions": "revolutions recorded (periods for other models)",
              "transient": "revolutions discarded first", "fs": "sampling rate, Hz",
@@ -234,17 +249,15 @@ def config_from_record(path: str | Path) -> RunConfig:
         raise ParameterError(f"config {path}: not a recipdyn run (no model and parameters "
                              "recorded)")  # fmt: skip
     m = get_model(str(spec))
+    try:  # the model reads its own record (a table beside its schema included)
+        values = m.values_from_record(attrs)
+    except (ParameterError, TypeError, ValueError) as exc:
+        raise ParameterError(f"config {path}: the recorded parameters are not valid "
+                             f"({exc})") from None  # fmt: skip
     params: dict[str, Any] = {}
-    for p in m.schema:
-        key = f"param_{p.name}"
-        if p.name == "load_table" and "load_table_deg_N" in attrs:
-            flat = [float(x) for x in np.atleast_1d(attrs["load_table_deg_N"])]
-            params[p.name] = [flat[i : i + 2] for i in range(0, len(flat), 2)]
-        elif key in attrs:
-            v = attrs[key]
-            v = v.item() if isinstance(v, np.generic) else v
-            if v != "default":
-                params[p.name] = v
+    for k, v in values.items():
+        if v is not None:
+            params[k] = [list(r) for r in v] if k in m.schema.extras else v
     sim: dict[str, Any] = {}
     for key, name in (
         ("revolutions", "revolutions"),
@@ -260,6 +273,6 @@ def config_from_record(path: str | Path) -> RunConfig:
             sim[name] = v.item() if isinstance(v, np.generic) else v
     try:
         simulation_config, run_config = _config_classes()
-        return run_config(model=m.name, params=params, simulation=simulation_config(**sim))
+        return run_config(model=str(spec), params=params, simulation=simulation_config(**sim))
     except ValidationError as exc:
         raise ParameterError(f"config {path}: recorded settings not valid ({exc})") from None

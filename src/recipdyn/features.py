@@ -186,7 +186,9 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         from .io import read_dataset
 
         ds = read_dataset(path)
-        vib = "a" if "a" in ds else next(iter(ds.data_vars))
+        vib = str(ds.attrs.get("vibration_signal", ""))  # the model's, named by the record
+        if vib not in ds:
+            vib = "a" if "a" in ds else next(iter(ds.data_vars))
         t = ds[ds[vib].dims[0]].values
         x, rate = ds[vib].values.astype(float), 1.0 / float(np.median(np.diff(t)))
         labels = _record_labels(ds.attrs, meta)
@@ -242,7 +244,7 @@ def record_speed_hz(attrs) -> float | None:
     spec = attrs.get("model_spec", attrs.get("model_name"))
     try:
         m = get_model(spec)
-        period = m.period(m.schema.from_attrs(attrs)) if m.kind == "ode" else None
+        period = m.period(m.values_from_record(attrs)) if m.kind == "ode" else None
     except (ParameterError, ImportError, AttributeError, KeyError, TypeError, ValueError):
         period = None
     if not period:  # a record of an older recipdyn: its compressor said its speed

@@ -327,6 +327,19 @@ class StreamWriter:
             raise write_error(self.path, exc) from None
         self.n += m
 
+    def _add(self, extra) -> None:
+        if self.zarr:
+            extra.to_zarr(str(self.tmp), mode="a", consolidated=False)
+            self.order += list(extra.data_vars)
+            return
+        for dim, size in extra.sizes.items():
+            if dim not in self.nc.dimensions:
+                self.nc.createDimension(dim, size)
+        for name, v in extra.data_vars.items():
+            var = self.nc.createVariable(name, v.dtype, v.dims, zlib=self.compress, complevel=4)
+            var[:] = v.values
+            var.setncatts(dict(v.attrs))
+
     def _create(self, block) -> None:
         import netCDF4
 
@@ -344,15 +357,18 @@ class StreamWriter:
             if name in block.data_vars and coords:
                 var.coordinates = " ".join(coords)
 
-    def finish(self, attrs: dict, *, partial: bool = False) -> Path | None:
+    def finish(self, attrs: dict, *, partial: bool = False, extra=None) -> Path | None:
         """Move the record into place (``NAME.partial.EXT`` if ``partial``); ``None`` when
-        no sample was written."""
+        no sample was written. ``extra``: a Dataset of variables over other dimensions than
+        ``time`` (a model's events), written whole before the record is moved."""
         path = self.path
         if partial:
             path = path.with_name(path.stem + ".partial" + path.suffix)
         try:
             if self.n == 0:
                 return None
+            if extra is not None and extra.data_vars:
+                self._add(extra)
             if self.zarr:
                 import zarr
 

@@ -17,21 +17,14 @@ from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, LawRangeWarning, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import UniformGrid, check_tolerances
-from .model.compressor import COMPRESSOR, compressor_model
-from .model.parameters import CompressorParams, ParameterError, resolve_name
+from .model.base import Signal
+from .model.parameters import ParameterError, params_from_attrs
 from .model.protocol import Model
 from .model.registry import get_model, model_spec
 from .resources import check_memory
 
 __all__ = ["simulate", "summarize", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
-           "estimate_memory", "STARTUP_REVOLUTIONS"]  # fmt: skip
-
-SIGN_CONVENTION = (
-    "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
-    "centre, x3 = r + l); y up, gravity along -y; crosshead at y3 = -d; gas_force is the force on "
-    "the crosshead along +x: -P (load_sign='physical', gas pushes the piston toward the crank) "
-    "or +P (load_sign='paper', the sign of Eq. 46)."
-)
+           "estimate_memory", "STARTUP_REVOLUTIONS", "model_values"]  # fmt: skip
 
 #: Defaults of [`simulate`][recipdyn.simulate.simulate] (also recorded in every result); see
 #: [`recipdyn.defaults`][recipdyn.defaults].
@@ -63,21 +56,6 @@ def clean_attrs(attrs: dict[str, Any]) -> dict[str, Any]:
             v = [float(x) for x in v] if all(isinstance(x, (int, float)) for x in v) else repr(v)
         out[k] = v
     return out
-
-
-def _coerce_params(params: CompressorParams | None, overrides: dict[str, Any]) -> CompressorParams:
-    if isinstance(params, Mapping):  # a plain mapping of the compressor's parameter values
-        params = CompressorParams(**{resolve_name(k): v for k, v in params.items()})
-    base = CompressorParams() if params is None else params
-    if not isinstance(base, CompressorParams):
-        raise ParameterError(f"params must be CompressorParams or a mapping, got "
-                             f"{type(params).__name__}")  # fmt: skip
-    if not overrides:
-        return base
-    import dataclasses
-
-    names = {resolve_name(k): v for k, v in overrides.items()}
-    return dataclasses.replace(base, **names)
 
 
 def _track_minima(model, outs, minima: dict[str, float]) -> None:
@@ -205,7 +183,7 @@ def _check_law_range(m: Model, values, ds: xr.Dataset, attrs: dict) -> None:
 
 
 def simulate(
-    params: CompressorParams | None = None,
+    params: Mapping[str, Any] | Any | None = None,
     *,
     # the values of DEFAULT_SETTINGS (defaults.SIMULATION), written out so that the signature
     # and the API reference show them (tests/test_docs.py checks they agree)
@@ -225,17 +203,26 @@ def simulate(
     compress: bool = False,
     **overrides: Any,
 ) -> xr.Dataset:
-    """Simulate the compressor and return the crosshead response as a Dataset.
+    """Simulate a model (default: the compressor) and return its outputs as a Dataset.
+
+    Every model goes the same way: its parameters are validated against its schema, its
+    compiled system is integrated, its outputs (`recipdyn.model.protocol.Model.outputs`) are
+    recorded with units, and its `recipdyn.model.protocol.Model.record_attrs` and every
+    setting go into the attributes.
 
     Parameters
     ----------
-    params : CompressorParams, optional
-        Model parameters (default: the paper's base case,
-        [`paper_2d12`][recipdyn.model.parameters.paper_2d12]).
+    params : mapping or parameter dataclass, optional
+        The model's parameter values by name or alias (default: its schema's defaults; for
+        the compressor the paper's base case,
+        [`paper_2d12`][recipdyn.model.parameters.paper_2d12]). A model's parameter dataclass
+        (such as [`CompressorParams`][recipdyn.model.parameters.CompressorParams]) is taken
+        field by field.
     revolutions : float
-        Crank revolutions to record (after the transient).
+        Crank revolutions (forcing periods; time units for an autonomous system, iterations
+        for a map) to record after the transient.
     transient : float
-        Crank revolutions to integrate first and discard.
+        Revolutions to integrate first and discard.
     fs : float
         Output sampling rate, Hz (samples come from the dense output at exact times, like a
         sensor; the integrator's own steps are independent of it).
@@ -244,7 +231,7 @@ def simulate(
     rtol, atol : float
         DOP853 tolerances.
     h : float, optional
-        RK4 step, s (default: 1/20000 of a crank period).
+        RK4 step, s (default: 1/20000 of a forcing period).
     progress : bool
         Show a progress bar (it never changes the result).
     max_memory : float, optional
@@ -253,16 +240,14 @@ def simulate(
     model : str or Model, optional
         A registered model
         ([`recipdyn.model.registry.get_model`][recipdyn.model.registry.get_model]: a name such as
-        ``"duffing"`` or a ``module:object`` path); default the paper's compressor. For other models
-        ``params`` is a mapping of their schema's parameters, ``revolutions`` and ``transient``
-        count forcing periods (time units for an autonomous system, iterations for a map) and the
-        outputs are the model's.
+        ``"duffing"``, a ``module:object`` or ``file.py:OBJ`` path); default the paper's
+        compressor.
     out : str or Path, optional
         Stream the record to this file (``.nc`` or ``.zarr``) block by block as it is
-        computed, so memory stays flat in run length (compressor model); the returned Dataset
-        is then opened lazily from the file. The samples are the same as in memory.
+        computed, so memory stays flat in run length; the returned Dataset is then opened
+        lazily from the file. The samples are the same as in memory.
     columns : list of str, optional
-        Keep only these output variables (default: all).
+        Keep only these output variables (default: all, and every state component).
     float32, compress : bool
         With ``out``: store the signals in single precision; compress NetCDF (zlib).
     **overrides
@@ -271,10 +256,11 @@ def simulate(
     Returns
     -------
     xarray.Dataset
-        Over ``time`` (s): ``x, v, a`` (crosshead), ``theta1, theta2, theta_c, thetadot_c,
-        thetaddot_c``, ``gas_force``, joint and guide forces; units in each variable's attrs;
-        all parameters, assumptions, initial conditions, solver settings and statistics, and the
-        package version in the Dataset's attrs.
+        The model's outputs over ``time`` (s; ``iteration`` for a map), units in each
+        variable's attrs; the compressor's: ``x, v, a`` (crosshead), ``theta1, theta2,
+        theta_c, thetadot_c, thetaddot_c``, ``gas_force``, joint and guide forces. All
+        parameters, assumptions, initial conditions, solver settings and statistics, the
+        model's spec and the package version in the Dataset's attrs.
 
     Raises
     ------
@@ -293,37 +279,47 @@ def simulate(
     >>> ds = recipdyn.simulate(rc=1e-3, d=1e-3, omega=20.0, revolutions=2)  # doctest: +SKIP
     >>> float(ds.a.max())  # doctest: +SKIP
     """
-    if model is not None and get_model(model).name != COMPRESSOR.name:
-        if out is not None or columns is not None:
-            raise ParameterError(f"out/columns: streaming is implemented for the compressor "
-                                 f"model only, not {get_model(model).name!r}")  # fmt: skip
-        return _simulate_model(
-            get_model(model), params, overrides, revolutions=revolutions, transient=transient,
-            fs=fs, method=method, rtol=rtol, atol=atol, h=h, progress=progress,
-            max_memory=max_memory, spec=model_spec(get_model(model)),
-        )  # fmt: skip
-    if params is None and model is not None and not isinstance(model, str):
-        params = model.parameters()  # a Model object's own defaults (a preset of components)
-    p = _coerce_params(params, overrides)
+    m = get_model(model)
+    values = model_values(m, params, overrides)
     _check_run_settings(revolutions, transient, fs, method, rtol, atol)
-    T = p.crank_period
+    spec = model_spec(m)
+    settings = dict(revolutions=revolutions, transient=transient, fs=fs, method=method,
+                    rtol=rtol, atol=atol, h=h)  # fmt: skip
+    if m.kind == "map":
+        return _simulate_map(m, values, settings, max_memory, spec, out, columns, float32,
+                             compress)  # fmt: skip
+    period = m.period(values)
+    T = float(period) if period else 1.0  # one "revolution" = one forcing period
     if method == "rk4" and h is None:
         h = T / RK4_STEPS_PER_REVOLUTION
-    if h is not None and not (is_number(h) and math.isfinite(h) and 0 < h <= T):
-        raise ParameterError(f"h = {h!r} s out of range; allowed: (0, {T:g}] (one revolution)")
+    top = T if period else math.inf
+    if h is not None and not (is_number(h) and math.isfinite(h) and 0 < h <= top):
+        where = f"{top:g}] (one revolution)" if period else "inf)"
+        raise ParameterError(f"h = {h!r} s out of range; allowed: (0, {where}")
     n_float = revolutions * T * fs
     held = min(n_float, 2 * STREAM_BLOCK) if out is not None else n_float  # streamed: a block
     check_memory(
         estimate_memory(held), f"simulate ({n_float:.3g} samples: {revolutions:g} revolutions "
         f"at fs = {fs:g} Hz)", "reduce --revolutions or --fs", max_memory,
     )  # fmt: skip
-    model = compressor_model(p)
-    y0 = model.initial_state()
+    system = m.system(values)
+    y0 = m.initial_state(values)
+    states = m.states(values)
     t_start = transient * T
     # the output names, from one sample: columns are checked, and the disk, before any work
-    keep = _columns(columns, list(model.outputs(np.array([t_start]), y0[None, :])))
+    every = _names(m.outputs(values, np.array([t_start]), y0[None, :]), states)
+    keep = _columns(columns, every)
     if out is not None:
         _check_disk(out, n_float, len(keep) + 2, float32)  # + time, revolution
+    events = m.events(values)
+    if len(events) > 1:
+        raise ParameterError(f"model {m.name!r} declares {len(events)} events; the integrator "
+                             "locates one event function")  # fmt: skip
+    ev_kw: dict[str, Any] = {}
+    if events:
+        e = events[0]
+        ev_kw = dict(event=e.function, event_direction=e.direction, event_action=e.action,
+                     reset=e.reset)  # fmt: skip
     t_end = t_start + revolutions * T
     n = int(math.floor(n_float + 1e-9)) + 1
     # streamed: the output times are made block by block (never all 8 bytes x n at once)
@@ -352,16 +348,16 @@ def simulate(
         writer = StreamWriter(out, float32=float32, compress=compress)
 
         def sink(t, y):
-            outs = model.outputs(t, y)
-            _track_minima(COMPRESSOR, outs, minima)
-            rec = _record(outs, t, T, keep)
-            writer.append(rec)
+            outs = _with_states(m.outputs(values, t, y), states, y)
+            _track_minima(m, outs, minima)
+            rec = _record(outs, t, period, every)  # all outputs: the model's run summary
+            writer.append(rec[keep])
             tail[:] = [*tail[-1:], rec]
 
     try:
         sol = integrate(
-            model, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
-            chunks=chunks, progress=cb, sink=sink, block=STREAM_BLOCK,
+            system, y0, (0.0, t_end), method=method, rtol=rtol, atol=atol, h=h, t_eval=t_eval,
+            chunks=chunks, progress=cb, sink=sink, block=STREAM_BLOCK, **ev_kw,
         )  # fmt: skip
     except IntegrationError as exc:  # keep what was computed: the partial record
         failure, sol = exc, exc.partial
@@ -377,29 +373,22 @@ def simulate(
     wall = time.perf_counter() - t0
     if writer is None:
         try:
-            outs = model.outputs(sol.t, sol.y)
+            outs = _with_states(m.outputs(values, sol.t, sol.y), states, sol.y)
         except ParameterError as exc:  # the state left the feasible geometry before failing
             raise IntegrationError(f"{failure or ''} {exc}".strip(), sol) from None
         if sol.t.size == 0 and failure is None:
             raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
-        ds = _record(outs, sol.t, T, keep)
-        _track_minima(COMPRESSOR, outs, minima)
+        full = _record(outs, sol.t, period, every)  # (the run summary reads every output)
+        ds = full[keep]
+        _track_minima(m, outs, minima)
     attrs: dict[str, Any] = {
-        "title": "recipdyn compressor simulation",
+        "title": f"recipdyn simulation: {m.name}",
         "recipdyn_version": __version__,
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-        "model": f"massless-link clearance at the crank pin, equations={p.equations}",
-        "model_name": COMPRESSOR.name,
-        "model_spec": COMPRESSOR.name,
-        "sign_convention": SIGN_CONVENTION,
-        "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), doi:10.21595/jve.2017.18771",
-        "theta_c_initial": float(y0[0]),
-        "thetadot_c_initial": float(y0[1]),
-        "theta_c_initial_rule": (
-            "user-set theta_c0"
-            if p.theta_c0 is not None
-            else "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
-        ),  # fmt: skip
+        "model": m.name,
+        "model_name": m.name,
+        "model_spec": spec,
+        **m.record_attrs(values, y0),
         "solver_method": method,
         "solver_rtol": rtol,
         "solver_atol": atol,
@@ -412,34 +401,104 @@ def simulate(
         "revolutions": revolutions,
         "transient_revolutions": transient,
         "sampling_rate_hz": fs,
-        "crank_frequency_hz": p.crank_frequency,
-        "min_contact_force_N": minima.get("contact_force", float("nan")),
+        "period": period if period else "none (autonomous: revolutions count time units)",
+        **{f"min_{name}{_unit_suffix(unit)}": minima.get(name, float("nan"))
+           for name, unit, *_ in m.validity_bounds},
         "columns": "all" if columns is None else ",".join(keep),
         "storage": "float32" if (float32 and writer is not None) else "float64",
-    }
-    attrs.update({f"param_{k}": v for k, v in p.to_attrs().items()})
+        "vibration_signal": m.vibration()[0],  # what features and compare read by default
+    }  # fmt: skip
     from .config import dump_config  # pydantic: imported when a run is recorded
 
-    attrs["config_toml"] = dump_config(COMPRESSOR, vars(p), dict(
-        revolutions=revolutions, transient=transient, fs=fs, method=method, rtol=rtol,
-        atol=atol, h=h))  # fmt: skip
-    _check_validity(COMPRESSOR, minima, attrs, vars(p))
-    recent = ds if writer is None else xr.concat(tail, "time") if tail else None
+    attrs["config_toml"] = dump_config(m, values, settings, spec=spec)
+    _check_validity(m, minima, attrs, values)
+    events_ds = _events(m, values, events[0], sol, t_start) if events else None
+    if events_ds is not None:
+        attrs.update(events_ds.attrs)  # what each event is
+    recent = full if writer is None else xr.concat(tail, "time") if tail else None
     if recent is not None and recent.sizes.get("time", 0):
-        attrs.update(clean_attrs(summarize(COMPRESSOR, vars(p), recent, attrs["validity"])))
+        if events_ds is not None:
+            recent = recent.merge(events_ds)
+        _check_law_range(m, values, recent, attrs)
+        attrs.update(clean_attrs(summarize(m, values, recent, attrs["validity"])))
     if writer is not None:
         from .io import open_record
 
-        written = writer.finish(clean_attrs(attrs), partial=failure is not None)
+        written = writer.finish(clean_attrs(attrs), partial=failure is not None,
+                                extra=events_ds)  # fmt: skip
         if written is None and failure is None:
             raise ParameterError("simulate produced no samples: raise --revolutions or --fs")
         ds = open_record(written) if written is not None else xr.Dataset(attrs=clean_attrs(attrs))
         if failure is not None:
             failure.kept_path = written
+    elif events_ds is not None:
+        ds = ds.merge(events_ds)
     ds.attrs = clean_attrs(attrs)
     if failure is not None:
         failure.dataset = ds  # the samples before the failure, with all attributes
         raise failure
+    return ds
+
+
+def model_values(m: Model, params: Any, overrides: Mapping[str, Any]) -> dict[str, Any]:
+    """``m``'s validated parameter values from ``params`` (a mapping by name or alias, a
+    parameter dataclass taken field by field, or None for the defaults) and ``overrides``."""
+    if params is not None and not isinstance(params, Mapping):
+        params = m.parameters(params)  # a parameter dataclass (valid as a whole)
+    return m.parameters({**(params or {}), **overrides})
+
+
+def _names(outs: Mapping[str, Any], states) -> list[str]:
+    """Every output name, then the state components no output already is."""
+    return [*outs, *(s for s, _ in states if s not in outs)]
+
+
+def _with_states(outs: dict[str, Signal], states, y: np.ndarray) -> dict[str, Signal]:
+    """The outputs and every state component (a record always holds the whole state, so
+    that analyze can rebuild the trajectory)."""
+    outs = dict(outs)
+    for i, (name, unit) in enumerate(states):
+        if name not in outs:
+            outs[name] = Signal(np.asarray(y[:, i]), unit, name)
+    return outs
+
+
+def _simulate_map(m: Model, values, settings, max_memory, spec, out, columns, float32,
+                  compress) -> xr.Dataset:  # fmt: skip
+    """`simulate` for a map: iterated, not integrated (a record over ``iteration``)."""
+    from .config import dump_config  # pydantic: imported when a run is recorded
+    from .model.reference.systems import iterate
+
+    n0, n = int(round(settings["transient"])), max(1, int(round(settings["revolutions"])))
+    check_memory(estimate_memory(n), f"simulate ({n} iterations)", "fewer iterations",
+                 max_memory)  # fmt: skip
+    y0 = m.initial_state(values)
+    y = iterate(m.system(values), y0, n, n_transient=n0)
+    t = np.arange(n0 + 1, n0 + n + 1, dtype=float)
+    outs = _with_states(m.outputs(values, t, y), m.states(values), y)
+    keep = _columns(columns, list(outs))
+    ds = xr.Dataset(
+        {k: ("iteration", outs[k].values, {"units": outs[k].units,
+                                           "long_name": outs[k].long_name}) for k in keep},
+        coords={"iteration": ("iteration", t, {"units": "1", "long_name": "iteration"})},
+    )  # fmt: skip
+    ds.attrs = clean_attrs({
+        "recipdyn_version": __version__,
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "model": m.name, "model_name": m.name, "model_spec": spec,
+        **m.record_attrs(values, y0),
+        "revolutions": settings["revolutions"], "transient_revolutions": settings["transient"],
+        "period": "none (a map: revolutions count iterations)",
+        "solver_method": "map iteration", "solver_status": "reached the end",
+        "columns": "all" if columns is None else ",".join(keep),
+        "config_toml": dump_config(m, values, settings, spec=spec),
+    })  # fmt: skip
+    if out is not None:
+        from .io import write_dataset
+
+        if float32:
+            ds = ds.astype({k: np.float32 for k in ds.data_vars})
+        write_dataset(ds, out)
     return ds
 
 
@@ -477,40 +536,17 @@ def _columns(columns, names: list[str]) -> list[str]:
     return cols
 
 
-def _record(outs, t, T: float, keep: list[str]) -> xr.Dataset:
-    """The Dataset of one block (or the whole run) of compressor outputs."""
+def _record(outs, t, period: float | None, keep: list[str]) -> xr.Dataset:
+    """The Dataset of one block (or the whole run) of a model's outputs (with the crank
+    revolutions, or forcing periods, as a second coordinate when the model has a period)."""
     data_vars = {k: ("time", outs[k].values, {"units": outs[k].units,
                                               "long_name": outs[k].long_name})
                  for k in keep}  # fmt: skip
-    return xr.Dataset(
-        data_vars,
-        coords={
-            "time": ("time", t, {"units": "s", "long_name": "time"}),
-            "revolution": ("time", t / T, {"units": "1", "long_name": "crank revolutions"}),
-        },
-    )
-
-
-def params_from_attrs(attrs: dict[str, Any]) -> CompressorParams:
-    """Rebuild the [`CompressorParams`][recipdyn.model.parameters.CompressorParams] recorded in a
-    result's attributes."""
-    import dataclasses
-
-    kw: dict[str, Any] = {}
-    for f in dataclasses.fields(CompressorParams):
-        key = f"param_{f.name}"
-        if f.name == "load_table":
-            flat = attrs.get("param_load_table_deg_N")
-            if flat is not None:
-                arr = np.asarray(flat, dtype=float).reshape(-1, 2)
-                kw["load_table"] = tuple((float(a), float(b)) for a, b in arr)
-            continue
-        if key in attrs:
-            v = attrs[key]
-            if isinstance(v, np.generic):
-                v = v.item()
-            kw[f.name] = None if v == "default" else v
-    return CompressorParams(**kw)
+    coords = {"time": ("time", t, {"units": "s", "long_name": "time"})}
+    if period:
+        coords["revolution"] = ("time", t / float(period),
+                                {"units": "1", "long_name": "crank revolutions"})  # fmt: skip
+    return xr.Dataset(data_vars, coords=coords)
 
 
 def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
@@ -524,91 +560,11 @@ def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
     check_tolerances(rtol, atol)
 
 
-def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, method, rtol,
-                    atol, h, progress, max_memory, spec) -> xr.Dataset:  # fmt: skip
-    """[`simulate`][recipdyn.simulate.simulate] for any registered model other than the
-    compressor."""
-    values = m.parameters(dict(params or {}), **overrides)
-    _check_run_settings(revolutions, transient, fs, method, rtol, atol)
-    period = m.period(values)
-    T = float(period) if period else 1.0  # one "revolution" = one forcing period
-    system = m.system(values)
-    y0 = m.initial_state(values)
-    from .config import dump_config  # pydantic: imported when a run is recorded
-
-    attrs: dict[str, Any] = {
-        "title": f"recipdyn simulation: {m.name}", "recipdyn_version": __version__,
-        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-        "model": m.name, "model_name": m.name, "model_spec": spec,
-        "model_description": m.description,
-        "revolutions": revolutions, "transient_revolutions": transient,
-        "period": period if period else "none (autonomous: revolutions count time units)",
-        "state_initial": [float(x) for x in y0],
-        **m.schema.to_attrs(values),
-        "config_toml": dump_config(m, values, dict(revolutions=revolutions, transient=transient,
-                                                   fs=fs, method=method, rtol=rtol, atol=atol,
-                                                   h=h)),
-    }  # fmt: skip
-    if m.kind == "map":
-        n0, n = int(round(transient)), max(1, int(round(revolutions)))
-        check_memory(estimate_memory(n), f"simulate ({n} iterations)", "fewer iterations",
-                     max_memory)  # fmt: skip
-        from .model.reference.systems import iterate
-
-        y = iterate(system, y0, n, n_transient=n0)
-        t = np.arange(n0 + 1, n0 + n + 1, dtype=float)
-        attrs.update(solver_method="map iteration", solver_status="reached the end")
-        return _dataset(m, values, t, y, "iteration", "1", attrs)
-    n_float = revolutions * T * fs
-    check_memory(estimate_memory(n_float), f"simulate ({n_float:.3g} samples)",
-                 "reduce --revolutions or --fs", max_memory)  # fmt: skip
-    if method == "rk4" and h is None:
-        h = T / RK4_STEPS_PER_REVOLUTION
-    t_start = transient * T
-    t_eval = t_start + np.arange(int(math.floor(n_float + 1e-9)) + 1) / fs
-    failure = None
-    events = m.events(values)
-    if len(events) > 1:
-        raise ParameterError(f"model {m.name!r} declares {len(events)} events; the integrator "
-                             "locates one event function")  # fmt: skip
-    ev_kw = {}
-    if events:
-        e = events[0]
-        ev_kw = dict(event=e.function, event_direction=e.direction, event_action=e.action,
-                     reset=e.reset)  # fmt: skip
-    t0 = time.perf_counter()
-    try:
-        sol = integrate(
-            system, y0, (0.0, t_eval[-1]), method=method, rtol=rtol, atol=atol, h=h,
-            t_eval=t_eval, chunks=max(1, min(1000, int(transient + revolutions))), **ev_kw,
-        )  # fmt: skip
-    except (IntegrationError, Interrupted) as exc:
-        failure, sol = exc, exc.partial
-    attrs.update(solver_method=method, solver_rtol=rtol, solver_atol=atol,
-                 solver_h=h if h is not None else "adaptive", solver_nfev=sol.nfev,
-                 solver_nsteps=sol.nsteps, solver_nreject=sol.nreject,
-                 solver_status=sol.message, solver_wall_time_s=time.perf_counter() - t0,
-                 sampling_rate_hz=fs)  # fmt: skip
-    ds = _dataset(m, values, sol.t, sol.y, "time", m.time_unit, attrs)
-    if m.validity_bounds:
-        minima: dict[str, float] = {}
-        _track_minima(m, ds, minima)
-        _check_validity(m, minima, ds.attrs, values)
-    if events:
-        ds = _with_events(ds, m, values, events[0], sol, t_start)
-    _check_law_range(m, values, ds, ds.attrs)
-    if sol.t.size:
-        ds.attrs.update(clean_attrs(summarize(m, values, ds, ds.attrs.get("validity", "ok"))))
-    if failure is not None:
-        failure.dataset = ds
-        raise failure
-    return ds
-
-
-def _with_events(ds: xr.Dataset, m: Model, values, e, sol, t_start: float) -> xr.Dataset:
+def _events(m: Model, values, e, sol, t_start: float) -> xr.Dataset:
     """The event records of the recorded interval, over an ``NAME_event`` dimension."""
     keep = sol.t_events >= t_start
     dim = f"{e.name}_event"
+    ds = xr.Dataset()
     ds[f"{e.name}_time"] = (dim, sol.t_events[keep], {"units": m.time_unit,
                             "long_name": f"time of {e.name}: {e.description}"})  # fmt: skip
     for i, (s, u) in enumerate(m.states(values)):
@@ -618,16 +574,4 @@ def _with_events(ds: xr.Dataset, m: Model, values, e, sol, t_start: float) -> xr
             ds[f"{e.name}_{s}_after"] = (dim, sol.y_events_after[keep, i], {"units": u,
                                          "long_name": f"{s} after {e.name}"})  # fmt: skip
     ds.attrs[f"events_{e.name}"] = f"{e.description} (direction {e.direction}, {e.action})"
-    return ds
-
-
-def _dataset(m: Model, values, t, y, dim: str, t_units: str, attrs) -> xr.Dataset:
-    outs = m.outputs(values, t, y)
-    data_vars = {k: (dim, s.values, {"units": s.units, "long_name": s.long_name})
-                 for k, s in outs.items()}  # fmt: skip
-    for i, (name, unit) in enumerate(m.states(values)):
-        if name not in data_vars:  # the whole state is always recorded (analyze rebuilds it)
-            data_vars[name] = (dim, np.asarray(y[:, i]), {"units": unit, "long_name": name})
-    ds = xr.Dataset(data_vars, coords={dim: (dim, t, {"units": t_units, "long_name": dim})})
-    ds.attrs = clean_attrs(attrs)
     return ds

@@ -15,7 +15,6 @@ import numpy as np
 from ..analysis.poincare import strobe_times
 from ..analysis.spectrum import amplitude_spectrum, display_band
 from ..errors import ModelValidityWarning
-from ..model.registry import DEFAULT_MODEL
 from .form import Form
 
 __all__ = ["simulate_form", "views", "images", "status_lines", "period_of", "POINTS"]
@@ -39,10 +38,7 @@ def simulate_form(form: Form):
               method=s["method"], rtol=s["rtol"], atol=s["atol"])  # fmt: skip
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if form.model.name == DEFAULT_MODEL:
-            ds = simulate(form.params, **kw)
-        else:
-            ds = simulate(form.params, model=form.model, **kw)
+        ds = simulate(form.params, model=form.model, **kw)
     notes = [str(w.message) for w in caught if not issubclass(w.category, ModelValidityWarning)]
     return ds, list(dict.fromkeys(notes))
 
@@ -50,13 +46,10 @@ def simulate_form(form: Form):
 def period_of(ds) -> float | None:
     """The forcing period of a record (the crank period for the compressors), from its
     attributes; None for an autonomous system or a map."""
-    if "param_omega" in ds.attrs and "time" in ds.dims:
-        return 2.0 * np.pi / float(ds.attrs["param_omega"])
-    period = ds.attrs.get("period")
-    try:
-        return float(period)
-    except (TypeError, ValueError):
-        return None
+    from ..io import forcing_frequency
+
+    fc = forcing_frequency(ds.attrs) if "time" in ds.dims else None
+    return 1.0 / fc if fc else None
 
 
 def _label(ds, name: str) -> str:
@@ -171,7 +164,7 @@ def status_lines(ds, model) -> list[str]:
     if "solver_nfev" in ds.attrs:
         head += f" | {ds.attrs.get('solver_method')} nfev = {int(ds.attrs['solver_nfev'])}"
     lines = [head]
-    summary = model.run_summary(model.schema.from_attrs(ds.attrs), ds) if ds.sizes[dim] else {}
+    summary = model.run_summary(model.values_from_record(ds.attrs), ds) if ds.sizes[dim] else {}
     for k, v in summary.items():
         lines.append(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}")
     if ds.attrs.get("validity", "ok") != "ok":

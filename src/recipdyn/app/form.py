@@ -181,7 +181,7 @@ class Form:
     """A read form: the model, its validated parameters, the run settings and the errors."""
 
     model: Any
-    params: Any = None  #: CompressorParams (compressor) or a dict of validated values
+    params: Any = None  #: the model's validated values (a dict)
     settings: dict[str, Any] = dataclasses.field(default_factory=dict)
     errors: dict[str, str] = dataclasses.field(default_factory=dict)  #: field key -> message
     general: str = ""  #: an error that belongs to no single field
@@ -229,14 +229,9 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
         return form
     values = {f.name: raw[f.key] for f in flds if not f.key.startswith(RUN)}
     try:
-        if m.name == DEFAULT_MODEL:
-            from ..config import build_params
-
-            # the compressor's own parameter class and its checks across parameters; an
-            # empty optional field (None) is its default: derived by the model
-            form.params = build_params({k: v for k, v in values.items() if v is not None})
-        else:
-            form.params = m.parameters(values)
+        # the schema's ranges, then the model's checks across parameters; an empty optional
+        # field (None) is derived by the model
+        form.params = m.parameters(values)
     except (ParameterError, TypeError, ValueError) as exc:
         key = _owner(str(exc), [f.key for f in flds])
         if key is None:
@@ -254,7 +249,7 @@ def _check_length(form: Form) -> None:
         n = s["revolutions"]
         what = f"{n:.4g} iterations"
     else:
-        period = form.params.crank_period if m.name == DEFAULT_MODEL else m.period(form.params)
+        period = m.period(form.params)
         n = s["revolutions"] * (float(period) if period else 1.0) * s["fs"]
         what = f"{n:.4g} samples"
     if n > MAX_SAMPLES:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.registry import get_model
+from ..model.registry import DEFAULT_MODEL, get_model
 from .form import _display_unit, _factor
 
 __all__ = ["sweep_figure", "point_from_click", "log_ticks"]
@@ -28,7 +28,7 @@ def _open(store: str | Path):
 
 
 def _model(ds):
-    return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or "compressor"))
+    return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or DEFAULT_MODEL))
 
 
 def _axis_unit(ds, dim: str) -> tuple[str, float]:
@@ -125,7 +125,7 @@ def point_from_click(store: str | Path, click: dict) -> tuple[str, dict[str, Any
     if "x" not in pt:
         raise ParameterError("click: no point")
     coords = {dims[-1]: pt["x"]} if len(dims) == 1 else {dims[1]: pt["x"], dims[0]: pt["y"]}
-    base = m.schema.from_attrs(ds.attrs)
+    base = m.values_from_record(ds.attrs)
     for dim, val in coords.items():
         grid = ds[dim].values
         shown = grid / _axis_unit(ds, dim)[1]

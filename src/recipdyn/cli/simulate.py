@@ -19,17 +19,19 @@ _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (d
 def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     """(model, parameters, simulation settings) from the options and an optional config.
 
-    For the compressor the parameters are a CompressorParams, for any other model a dict of
-    its schema's values; ``--rc/--d/--omega`` apply to every model whose schema has them. The
-    default model's parameters are validated without loading its compiled code; with
+    The parameters are a dict of the model's validated values, for every model;
+    ``--rc/--d/--omega`` apply to every model whose schema has them. The default model's
+    values are validated by its schema module, without loading its compiled code; with
     ``load=False`` its model is returned as ``None`` (``get_model()`` loads it), so that bad
-    input is answered before heavy imports.
-    Another model's schema lives beside its kernels: naming one loads them.
+    input is answered before heavy imports. Another model's schema lives beside its kernels:
+    naming one loads them.
     """
-    from ..config import build_params, model_values, read_config
+    import dataclasses
+
+    from ..config import CHOICES, build_params, model_values, read_config
     from ..errors import ParameterError
     from ..model.protocol import UnknownParameterError
-    from ..model.registry import DEFAULT_MODEL, get_model
+    from ..model.registry import DEFAULT_MODEL, get_model, is_spec
     from ..units import parse_assignment
 
     cfg = read_config(config) if config is not None else None
@@ -47,8 +49,11 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     for item in sets or []:
         k, v = parse_assignment(item)
         values[k] = v
+    if m is None and any(is_spec(values.get(k)) for k in CHOICES):
+        m = get_model(DEFAULT_MODEL)  # a component from a user's file: its schema is the model's
     try:
-        params = build_params(values) if m is None else model_values(m, values)
+        params = (dataclasses.asdict(build_params(values)) if m is None
+                  else model_values(m, values))  # fmt: skip
     except UnknownParameterError as exc:
         raise _unknown_parameter(exc, name) from None
     if m is None and load:
@@ -176,12 +181,7 @@ def _prepare(m, params, method: str) -> None:
 
     if m.kind == "map":  # iterated, not integrated: nothing to prepare
         return
-    if m.name == "compressor":
-        from ..model.compressor import compressor_model
-
-        system = compressor_model(params)
-    else:
-        system = m.system(params)
+    system = m.system(params)
     own = system.acting_event
     loop = kernels.dop853_kernel if method == "dop853" else kernels.fixed_step_kernel
     if _cache_cold((loop, system.rhs, getattr(own, "function", None),
@@ -261,8 +261,9 @@ def simulate(
     for name, val in (("method", method), ("rtol", rtol), ("atol", atol)):
         if val is not None:
             kw[name] = val
-    # the forcing period bounds the RK4 step (the compressor's is known without its kernels)
-    period = params.crank_period if m is None else m.period(params) if m.kind != "map" else None
+    # the forcing period bounds the RK4 step (the library checks it again for the default
+    # model, whose kernels are not loaded yet)
+    period = None if m is None or m.kind == "map" else m.period(params)
     check_settings(kw, period)
     limit = max_memory_bytes(max_memory)
     if limit is not None and not limit > 0:
@@ -276,7 +277,12 @@ def simulate(
         allowed = ", ".join(f"{k} ({v})" for k, v in DATASET_FORMATS.items())
         raise ParameterError(f"output {out}: unknown extension {out.suffix or '(none)'!r}; "
                              f"allowed: {allowed}")  # fmt: skip
-    n_samples = kw["revolutions"] * period * kw["fs"] if m is None else 0.0
+    from ..model.registry import get_model
+
+    m = m or get_model()  # every input is valid: the model's module may load now
+    period = m.period(params) if m.kind != "map" else None
+    check_settings(kw, period)  # the RK4 step against the default model's period too
+    n_samples = kw["revolutions"] * (period or 1.0) * (kw["fs"] if m.kind != "map" else 1.0)
     if stream is None:
         stream = n_samples > STREAM_AUTO and out.suffix.lower() in (".nc", ".zarr")
     extra = {}
@@ -286,8 +292,7 @@ def simulate(
         extra.update(out=out, float32=float32, compress=compress)
     elif float32 or compress:
         raise ParameterError("--float32/--compress apply to streamed runs: add --stream")
-    if m is None:  # the default model's run (other models' runs are checked by the library)
-        _check_resources(out, n_samples, stream, float32, extra.get("columns"), limit)
+    _check_resources(out, n_samples, stream, float32, extra.get("columns"), limit)
     with refused_leaves_nothing(out):
         _run(m, params, kw, out, stream, extra, limit, figure, progress)
 
@@ -306,16 +311,10 @@ def subsidence_note(params) -> str | None:
     |d| < l - r - rc, where the rod can no longer reach the crosshead), so the run is warned,
     not refused.
     """
-    get = params.get if isinstance(params, dict) else lambda k: getattr(params, k, None)
-    d, r, l, rc = get("d"), get("r"), get("l"), get("rc")
+    d, r = params.get("d"), params.get("r")
     if d is None or not r or abs(d) <= SUBSIDENCE_FRACTION * r:
         return None
-    reach = (
-        ""
-        if isinstance(params, dict)
-        # (the contact models' own reach differs)
-        else (f" (the equations hold to |d| < l - r - rc = {1e3 * (l - r - rc):.0f} mm)")
-    )
+    reach = ""  # each model states its own reach in its schema (``recipdyn models NAME``)
     return (f"d = {1e3 * d:g} mm is {abs(d) / r:.2g} crank radii: a crosshead subsidence (worn "
             f"shoes or guide) is at most a few mm (the paper's largest: 5 mm = 0.04 r); above "
             f"{SUBSIDENCE_FRACTION:g} r = {1e3 * SUBSIDENCE_FRACTION * r:g} mm this is an offset "
@@ -324,14 +323,12 @@ def subsidence_note(params) -> str | None:
 
 def _dump_config(m, params, kw: dict, dump_config: Path) -> None:
     """``--dump-config``: the run's full TOML config, to a file or ('-') standard output."""
-    import dataclasses
-
     from ..config import dump_config as dump
     from ..io import write_text
-    from ..model.registry import get_model
+    from ..model.registry import get_model, model_spec
 
-    values = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else params
-    text = dump(m or get_model(), values, kw)
+    m = m or get_model()
+    text = dump(m, params, kw, spec=model_spec(m))
     if str(dump_config) == "-":
         typer.echo(text, nl=False)
     else:
@@ -360,8 +357,8 @@ def _run(m, params, kw: dict, out: Path, stream: bool, extra: dict, max_memory, 
     from ..integrate import IntegrationError
     from ..io import check_output, save_figure, write_dataset
     from ..model.registry import get_model
+    from ..simulate import _unit_suffix, summarize
     from ..simulate import simulate as run_sim
-    from ..simulate import summarize
 
     out = check_output(out)
     m = m or get_model()
@@ -393,44 +390,36 @@ def _run(m, params, kw: dict, out: Path, stream: bool, extra: dict, max_memory, 
     for key in ("validity", "law_range"):
         if ds.attrs.get(key, "ok") != "ok":
             typer.echo(f"warning: {ds.attrs[key]}", err=True)
-    if m.name != "compressor":
-        typer.echo(f"wrote {out}  ({m.name}: {dict(ds.sizes)})")
-        summary = summarize(m, m.schema.from_attrs(ds.attrs), ds, validity) if ds.sizes else {}
-        _echo_summary(summary)
-        report(summary=summary)
-        if figure:
-            from ..plotting import _mpl, mark_invalid, model_figure
-
-            fig = mark_invalid(model_figure(ds), ds.attrs)
-            typer.echo(f"wrote {save_figure(fig, out.with_suffix('.png'), dpi=130)}")
-            _mpl().close(fig)
-            _cycle_png(ds, out)
-        return
-    typer.echo(f"wrote {out}  ({ds.sizes['time']} samples, nfev={ds.attrs['solver_nfev']})")
-    if stream and ds.sizes["time"] > FIGURE_SAMPLES:  # the figure shows the last part
-        ds = ds.isel(time=slice(-FIGURE_SAMPLES, None))
+    dim = "iteration" if "iteration" in ds.dims else "time"
+    nfev = ds.attrs.get("solver_nfev")
+    typer.echo(f"wrote {out}  ({m.name}: {ds.sizes[dim]} samples"
+               + (f", nfev={nfev})" if nfev is not None else ")"))  # fmt: skip
+    if stream and ds.sizes[dim] > FIGURE_SAMPLES:  # the figure shows the last part
+        ds = ds.isel({dim: slice(-FIGURE_SAMPLES, None)})
         typer.echo(f"figure and summary: the last {FIGURE_SAMPLES} samples")
     ds = ds.load()
-    if not {"x", "v", "a", "theta_c", "gas_force", "contact_force"} <= set(ds.data_vars):
-        typer.echo("figure and summary need all outputs: not drawn (--columns)")
-        return
+    values = m.values_from_record(ds.attrs)
     if figure:
-        from ..plotting import _mpl, mark_invalid, response_figure
+        from ..plotting import _mpl, mark_invalid, model_figure
 
-        fig = mark_invalid(response_figure(ds), ds.attrs)
-        png = save_figure(fig, out.with_suffix(".png"), dpi=130)
+        fig = mark_invalid(model_figure(ds), ds.attrs)
+        typer.echo(f"wrote {save_figure(fig, out.with_suffix('.png'), dpi=130)}")
         _mpl().close(fig)
-        typer.echo(f"wrote {png}")
         _cycle_png(ds, out)
-    summary = summarize(m, m.schema.from_attrs(ds.attrs), ds, validity)
-    peak = summary.pop("peak_abs_a_m_s2")
-    typer.echo(
-        f"peak |a| = {peak:.4g} m/s^2, x in [{ds.x.min().item():.5f}, "
-        f"{ds.x.max().item():.5f}] m, min contact force = {ds.attrs['min_contact_force_N']:.4g} N"
-    )
+    summary = summarize(m, values, ds, validity) if ds.sizes.get(dim) else {}
+    vib, unit = m.vibration()
+    found = {}
+    key = next((k for k in summary if k.startswith(f"peak_abs_{vib}")), None)
+    if key is not None:
+        found[f"peak_{vib}"] = summary.pop(key)
+        typer.echo(f"peak |{vib}| = {found[f'peak_{vib}']:.4g} {unit}")
+    for name, unit_, *_ in m.validity_bounds:  # the smallest value of each bounded output
+        low = ds.attrs.get(f"min_{name}{_unit_suffix(unit_)}")
+        if low is not None:
+            found[f"min_{name}"] = float(low)
+            typer.echo(f"min {name} = {float(low):.4g} {unit_}")
     _echo_summary(summary)
-    report(peak_a=peak, x_min=ds.x.min().item(), x_max=ds.x.max().item(),
-           min_contact_force=float(ds.attrs["min_contact_force_N"]), summary=summary)  # fmt: skip
+    report(**found, summary=summary)
 
 
 def _cycle_png(ds, out: Path) -> None:

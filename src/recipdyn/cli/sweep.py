@@ -79,11 +79,12 @@ def sweep(
     m, base, _ = _collect_model(model, None, None, None, sets, config)
     if dask_local is not None or scheduler is not None:
         backend = "dask"
+    from ..model.registry import model_spec
     from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
 
-    spec = SweepSpec(axes=tuple(parse_axis(p, m) for p in params), measures=measures,
+    spec = SweepSpec(axes=tuple(parse_axis(p, m, base) for p in params), measures=measures,
                      base=base, settings=settings, continuation=continuation,
-                     model=model or m.name)  # fmt: skip
+                     model=model_spec(m))  # fmt: skip
     run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,
                   max_memory=limit)  # fmt: skip
     with refused_leaves_nothing(out):

@@ -19,20 +19,28 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from dataclasses import fields as dataclass_fields
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
 from .base import ODESystem, Signal, rhs_series
-from .components.contract import Assembly, Component, glue_module
+from .components.contract import (
+    Assembly,
+    Component,
+    check_fragments,
+    glue_module,
+    resolve_component,
+)
 from .components.drive import DRIVES, MOTORS
 from .components.load import cycle_outputs, cycle_summary, load_component
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
 from .load import pack_load
-from .parameters import SCHEMA, CompressorParams, ParameterError
-from .protocol import Model
+from .parameters import PLUGGABLE, SCHEMA, CompressorParams, ParameterError
+from .protocol import Model, Schema
+from .registry import absolute_spec, is_spec
 
 __all__ = [
     "CompressorModel", "compressor_model", "equilibrium_theta_c", "pack_params", "Compressor",
@@ -57,20 +65,24 @@ def pack_params(p: CompressorParams) -> np.ndarray:
 
 def assembly(p: CompressorParams) -> tuple[Assembly, dict[str, Component]]:
     """The components ``p`` chooses and their assembly (drive, its torque law, load: the
-    load last, since a table's length varies)."""
+    load last, since a table's length varies). A load or torque law may come from a user's
+    module or file (``load = "file.py:OBJ"``, `resolve_component`)."""
     v = vars(p)
-    parts = {"drive": DRIVES[p.drive], "load": load_component(v)}
+    load = resolve_component("load", p.load, {}) if is_spec(p.load) else load_component(v)
+    parts = {"drive": DRIVES[p.drive], "load": load}
     if p.drive == "motor":
-        parts["motor"] = MOTORS[p.motor]
+        parts["motor"] = resolve_component("motor", p.motor, MOTORS)
     order = [parts[f] for f in ("drive", "motor", "load") if f in parts]
     return Assembly(N_HEAD, tuple(order)), parts
 
 
-def pack_assembled(p: CompressorParams) -> tuple[np.ndarray, dict[str, int], dict]:
-    """The parameter vector of the assembled kernels, each part's offset, the parts."""
+def pack_assembled(p: CompressorParams, extra: Mapping[str, Any] | None = None
+                   ) -> tuple[np.ndarray, dict[str, int], dict]:  # fmt: skip
+    """The parameter vector of the assembled kernels, each part's offset, the parts
+    (``extra``: the values of components from a user's file, beside ``p``'s)."""
     asm, parts = assembly(p)
     head = np.array([getattr(p, k) for k in HEAD], dtype=np.float64)
-    vec, offsets = asm.pack(head, vars(p))
+    vec, offsets = asm.pack(head, {**vars(p), **(extra or {})})
     return vec, offsets, parts
 
 
@@ -81,16 +93,30 @@ def _kernels(equations: str, drive: str, motor: str | None, load: str,
     numba)."""
     from .components.load import LOADS
 
+    load_c = resolve_component("load", load, LOADS)
+    motor_c = None if motor is None else resolve_component("motor", motor, MOTORS)
     src = glue_source(
         equations=equations,
         drive=DRIVES[drive],
-        load=LOADS[load],
-        motor=None if motor is None else MOTORS[motor],
+        load=load_c,
+        motor=motor_c,
         offsets=dict(offsets),
     )
-    stem = f"compressor_{drive}_{load}_{equations}".replace("-", "_")  # fmt: skip
-    mod = glue_module(src, stem if motor is None else f"{stem}_{motor}")
+    for c in (load_c, motor_c):  # a user's file: its edits give a new glue file, never stale
+        if c is not None and c.module not in ("recipdyn", "") and not c.module.startswith(
+                "recipdyn."):  # fmt: skip
+            src += f"\n# {c.family} = {c.module}: {_source_digest(c.module)}\n"
+    stem = f"compressor_{drive}_{load_c.name}_{equations}".replace("-", "_")  # fmt: skip
+    mod = glue_module(src, stem if motor_c is None else f"{stem}_{motor_c.name}")
     return mod.rhs, mod.jac, mod.rhs_jac, mod.observe
+
+
+def _source_digest(module: str) -> str:
+    import hashlib
+    import sys
+
+    path = getattr(sys.modules.get(module), "__file__", None)
+    return hashlib.sha1(open(path, "rb").read()).hexdigest()[:16] if path else "?"
 
 
 @dataclass(frozen=True)
@@ -182,19 +208,21 @@ def mechanism_outputs(p: CompressorParams, k, thc, thcd, thcdd, fg) -> dict[str,
     }  # fmt: skip
 
 
-def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
+def compressor_model(p: CompressorParams | None = None,
+                     extra: Mapping[str, Any] | None = None) -> CompressorModel:  # fmt: skip
     """Build the ODE model for ``p`` (default: the paper's base case), assembled from the
-    components ``p`` chooses (`assembly`)."""
+    components ``p`` chooses (`assembly`); ``extra``: the parameter values of components
+    from a user's file (`Compressor.schema_for`)."""
     p = CompressorParams() if p is None else p
     if not isinstance(p, CompressorParams):
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
-    vec, offsets, parts = pack_assembled(p)
+    vec, offsets, parts = pack_assembled(p, extra)
     motor = parts.get("motor")
     rhs, jac, rhs_jac, observe = _kernels(
         p.equations,
         p.drive,
-        None if motor is None else motor.name,
-        parts["load"].name,
+        None if motor is None else (p.motor if is_spec(p.motor) else motor.name),
+        p.load if is_spec(p.load) else parts["load"].name,
         tuple(sorted(offsets.items())),
     )
     names, units = ("theta_c", "thetadot_c"), ("rad", "rad/s")
@@ -220,6 +248,40 @@ def compressor_model(p: CompressorParams | None = None) -> CompressorModel:
         observer=observe,
         **extra,
     )
+
+
+@lru_cache(maxsize=16)
+def _system(p: CompressorParams, extra: tuple[tuple[str, Any], ...] = ()) -> CompressorModel:
+    # one system per parameter set and process: a streamed run asks for it per block
+    return compressor_model(p, dict(extra))
+
+
+@lru_cache(maxsize=32)
+def _plugged_schema(chosen: tuple[tuple[str, str], ...]) -> Schema:
+    """The compressor's schema with the components ``(family, spec)`` from users' files: each
+    spec one more choice of its family's parameter, each fragment appended (a name may
+    belong to one component only)."""
+    from dataclasses import replace
+
+    from .components.load import LOADS
+
+    builtin = {"load": LOADS, "motor": MOTORS}
+    comps = [resolve_component(f, spec, builtin[f]) for f, spec in chosen]
+    check_fragments(comps, base=SCHEMA.params)
+    specs = dict(chosen)
+    params = tuple(replace(p, choices=(*p.choices, specs[p.name])) if p.name in specs else p
+                   for p in SCHEMA)  # fmt: skip
+    return Schema(params + tuple(q for c in comps for q in c.params), aliases=SCHEMA.aliases,
+                  extras=SCHEMA.extras)  # fmt: skip
+
+
+#: The axes and signs of every compressor record (``sign_convention``).
+SIGN_CONVENTION = (
+    "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
+    "centre, x3 = r + l); y up, gravity along -y; crosshead at y3 = -d; gas_force is the force on "
+    "the crosshead along +x: -P (load_sign='physical', gas pushes the piston toward the crank) "
+    "or +P (load_sign='paper', the sign of Eq. 46)."
+)
 
 
 class Compressor(Model):
@@ -268,13 +330,86 @@ class Compressor(Model):
 
     @staticmethod
     def params(values: Mapping[str, Any]) -> CompressorParams:
-        return CompressorParams(**values)
+        """The [`CompressorParams`][recipdyn.model.parameters.CompressorParams] view of
+        ``values`` (the values of components from a user's file left out: `plugged`)."""
+        return CompressorParams(**{k: v for k, v in values.items() if k in _FIELDS})
+
+    @staticmethod
+    def plugged(values: Mapping[str, Any]) -> dict[str, Any]:
+        """The values of components from a user's file (their own fragments)."""
+        return {k: v for k, v in values.items() if k not in _FIELDS}
+
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """`parameters.SCHEMA`, or with a load or a torque law from a user's module or file
+        (``load = "file.py:OBJ"``) that component's fragment added (adding one is one file:
+        docs/components.md)."""
+        chosen = tuple((f, absolute_spec(values[f])) for f in PLUGGABLE if is_spec(values.get(f)))
+        return _plugged_schema(chosen) if chosen else self.schema
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        """Validated values; a component spec (``file.py:OBJ``) is made absolute, so records
+        and worker processes find its file from any folder."""
+        if values is not None and not isinstance(values, Mapping):
+            values = super().parameters(values)  # a CompressorParams, valid as a whole
+        raw = {**(values or {}), **kw}
+        for f in PLUGGABLE:
+            if is_spec(raw.get(f)):
+                raw[f] = absolute_spec(raw[f])
+        return super().parameters(raw)
 
     def check(self, values: Mapping[str, Any]) -> None:
         self.params(values)  # the ranges that depend on other parameters
+        for f in PLUGGABLE:  # a user's component's own checks
+            if is_spec(values.get(f)):
+                c = resolve_component(f, values[f], {})
+                if c.check is not None:
+                    c.check(values)
 
     def system(self, values: Mapping[str, Any]) -> CompressorModel:
-        return compressor_model(self.params(values))
+        p, extra = self.params(values), tuple(sorted(self.plugged(values).items()))
+        try:
+            hash((p, extra))
+        except TypeError:  # an unhashable value (a table given as lists): built each time
+            return compressor_model(p, dict(extra))
+        return _system(p, extra)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """Every model's record attributes (`Model.record_attrs`: its parameters, a user's
+        component's too), the axes and signs, the crank frequency, the initial clearance
+        angle and how it was chosen, and what the parameter view adds (the load's
+        description, its table, the list of assumptions)."""
+        p = self.params(values)
+        out = super().record_attrs(values, y0)
+        out.update({
+            "sign_convention": SIGN_CONVENTION,
+            "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), "
+                         "doi:10.21595/jve.2017.18771",
+            "crank_frequency_hz": p.crank_frequency,
+        })  # fmt: skip
+        if y0 is not None:
+            out["theta_c_initial"] = float(y0[0])
+            out["thetadot_c_initial"] = float(y0[1])
+            out["theta_c_initial_rule"] = (
+                "user-set theta_c0" if p.theta_c0 is not None else
+                "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
+            )  # fmt: skip
+        for k, v in p.to_attrs().items():
+            out.setdefault(f"param_{k}", v)
+        return out
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """The values a record holds (`Model.values_from_record`), its load table
+        included."""
+        chosen = {f: attrs[f"param_{f}"] for f in PLUGGABLE if f"param_{f}" in attrs}
+        values = self.schema_for(chosen).from_attrs(attrs)
+        flat = attrs.get("param_load_table_deg_N")
+        if flat is not None and "load_table" in self.schema.extras:
+            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
+            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
+        self.check(values)
+        return values
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         return self.system(values).initial_state()
@@ -292,6 +427,8 @@ class Compressor(Model):
         (`recipdyn.model.components.load.cycle_summary`)."""
         return cycle_summary(values, ds)
 
+
+_FIELDS = frozenset(f.name for f in dataclass_fields(CompressorParams))
 
 #: The registered instance (``recipdyn --model compressor``, the default).
 COMPRESSOR = Compressor()

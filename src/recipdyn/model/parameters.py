@@ -21,17 +21,21 @@ turns at a prescribed uniform speed, so ``m1``, ``J1`` and ``rs`` affect only th
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, fields
 from typing import Any, Literal
 
 from ..defaults import RC_MIN
 from ..errors import ParameterError
+from .components.contract import resolve_component
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .gases import GASES
 from .protocol import Param, Schema
+from .registry import is_spec
 
 __all__ = [
     "CompressorParams",
+    "params_from_attrs",
     "ParameterError",
     "ASSUMED",
     "ASSUMED_CYCLE",
@@ -152,12 +156,16 @@ SCHEMA = Schema((
     Param("motor", "", "induction", "the motor's torque law (drive = motor): 'induction' "
           "(Kloss's curve) or 'constant'", choices=tuple(MOTORS), group="drive"),
     *MOTOR.params, *CONSTANT_TORQUE.params, *INDUCTION.params,
-), aliases={
+), extras=("load_table",), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",
     "crank_radius": "r", "rod_length": "l",
 })  # fmt: skip
 
 PARAM_UNITS: dict[str, str] = {p.name: p.unit for p in SCHEMA if p.unit}
+
+#: The parameters that choose a component and may name one from a user's module or file
+#: (``module:object``, ``file.py:OBJ``; `recipdyn.model.components.contract.resolve_component`).
+PLUGGABLE = ("load", "motor")
 
 #: Friendly names accepted by the CLI, configs and sweeps.
 PARAM_ALIASES: dict[str, str] = dict(SCHEMA.aliases)
@@ -290,6 +298,8 @@ class CompressorParams:
 
     def __post_init__(self) -> None:
         for p in SCHEMA:  # the static ranges, declared once in the schema
+            if p.name in PLUGGABLE and is_spec(getattr(self, p.name)):
+                continue  # a component from a user's file (checked when it is loaded)
             p.check(getattr(self, p.name))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
@@ -317,9 +327,14 @@ class CompressorParams:
                     "equations = 'paper-printed' exists for a prescribed crank "
                     "only; allowed with drive = 'motor': equations = 'exact'"
                 )
-            check = MOTORS[self.motor].check
+            check = resolve_component("motor", self.motor, MOTORS).check
             if check is not None:
                 check(asdict(self))
+            if self.motor == "constant" and self.motor_torque is None and is_spec(self.load):
+                raise ParameterError(
+                    f"motor_torque: needed with motor = 'constant' and load = {self.load!r} "
+                    "(its default, the mean load torque, is known for recipdyn's own loads)"
+                )
         if self.discharge_pressure < self.suction_pressure:
             raise ParameterError(
                 f"discharge_pressure = {self.discharge_pressure!r} Pa is out of range; allowed: "
@@ -376,6 +391,29 @@ def _validate_table(table) -> None:
         if a <= prev:
             raise ParameterError(f"load_table row {i}: angles must increase strictly")
         prev = a
+
+
+def params_from_attrs(attrs: Mapping[str, Any]) -> CompressorParams:
+    """The [`CompressorParams`][recipdyn.model.parameters.CompressorParams] a record's
+    attributes (``param_*``, written from `CompressorParams.to_attrs`) hold, the load table
+    included."""
+    import numpy as np
+
+    kw: dict[str, Any] = {}
+    for f in fields(CompressorParams):
+        if f.name == "load_table":
+            flat = attrs.get("param_load_table_deg_N")
+            if flat is not None:
+                arr = np.asarray(flat, dtype=float).reshape(-1, 2)
+                kw["load_table"] = tuple((float(a), float(b)) for a, b in arr)
+            continue
+        key = f"param_{f.name}"
+        if key in attrs:
+            v = attrs[key]
+            if isinstance(v, np.generic):
+                v = v.item()
+            kw[f.name] = None if v == "default" else v
+    return CompressorParams(**kw)
 
 
 def paper_2d12(**overrides: Any) -> CompressorParams:

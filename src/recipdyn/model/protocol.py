@@ -18,8 +18,13 @@ A *model* is a family of dynamical systems with a typed parameter schema:
   state components) and [`Model.check`][recipdyn.model.protocol.Model.check] (validity checks across
   parameters).
 
+A record of a run says what the model put in it with `Model.record_attrs` and is read back
+with `Model.values_from_record`; an assembled model whose parameters choose a component from a
+user's file gives the schema at those values with `Model.schema_for`.
+
 Models are found by name through [`recipdyn.model.registry`][recipdyn.model.registry]. The layers
-above the model talk to a model only through this class; see ``docs/architecture.md``.
+above the model talk to a model only through this class (no branch on a model's name or
+parameter class: ``tests/test_one_track.py``); see ``docs/architecture.md``.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, is_dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -171,6 +176,10 @@ class Schema:
 
     params: tuple[Param, ...]
     aliases: Mapping[str, str] = field(default_factory=dict)
+    #: Values the model takes beside its parameters, without a row (a table such as the
+    #: compressor's ``load_table``): default None, passed through `validate` unchecked (the
+    #: model's `Model.check` checks them), recorded by the model's `Model.record_attrs`.
+    extras: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         names = [p.name for p in self.params]
@@ -198,7 +207,7 @@ class Schema:
         """The parameter's name for ``name`` or an alias; raise
         `UnknownParameterError` (with the closest names) on unknown names."""
         name = self.aliases.get(name, name)
-        if name not in self:
+        if name not in self and name not in self.extras:
             raise UnknownParameterError(name, {*self.names, *self.aliases})
         return name
 
@@ -207,10 +216,11 @@ class Schema:
 
     def validate(self, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """Defaults updated with ``values`` (names or aliases), each checked against its range."""
-        out = self.defaults()
+        out = {**self.defaults(), **dict.fromkeys(self.extras)}
         for k, v in (values or {}).items():
             out[self.resolve(k)] = v
-        return {p.name: p.check(out[p.name]) for p in self.params}
+        checked = {p.name: p.check(out[p.name]) for p in self.params}
+        return {**checked, **{e: out[e] for e in self.extras}}
 
     def units(self) -> dict[str, str]:
         return {p.name: p.unit for p in self.params}
@@ -356,11 +366,26 @@ class Model(ABC):
     def dim(self) -> int:
         return len(self.state_names)
 
-    def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
-        """Validated parameter values: defaults updated with ``values`` and ``kw``."""
-        out = self.schema.validate({**(values or {}), **kw})
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        """Validated parameter values: defaults updated with ``values`` (a mapping by name or
+        alias, or a parameter dataclass taken field by field, such as the compressor's
+        ``CompressorParams``) and ``kw``."""
+        if is_dataclass(values) and not isinstance(values, type):
+            values = {f.name: getattr(values, f.name) for f in fields(values)}
+        elif values is not None and not isinstance(values, Mapping):
+            raise ParameterError(f"parameters of model {self.name!r}: expected a mapping of "
+                                 f"names to values, got {type(values).__name__}")  # fmt: skip
+        raw = {**(values or {}), **kw}
+        out = self.schema_for(raw).validate(raw)
         self.check(out)
         return out
+
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """The schema at ``values`` (names or aliases, raw or validated): default the class's
+        ``schema``; an assembled model whose parameters choose components from a user's file
+        adds their fragments here (the compressor, `recipdyn.model.components`)."""
+        return self.schema
 
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise
@@ -387,6 +412,29 @@ class Model(ABC):
         return {n: Signal(np.asarray(y[:, i]), u, n)
                 for i, (n, u) in enumerate(zip(self.state_names, self.state_units,
                                                strict=True))}  # fmt: skip
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """What a record of a run from the initial state ``y0`` says about the model: its
+        title, description and initial state (when given), and its parameters
+        (``param_NAME`` with units and assumption notes, `Schema.to_attrs`).
+        `recipdyn.simulate` writes them, a sweep store the ``param_*`` ones;
+        `values_from_record` reads them back."""
+        out = {"title": f"recipdyn simulation: {self.name}", "model": self.name,
+               "model_description": self.description}  # fmt: skip
+        if y0 is not None:
+            out["state_initial"] = [float(x) for x in np.atleast_1d(y0)]
+        return {**out, **self.schema_for(values).to_attrs(values)}
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """The validated parameter values a record (its attributes, written by
+        `record_attrs`) was made with; raise [`ParameterError`][recipdyn.errors.ParameterError]
+        if they are not valid."""
+        chosen = {p.name: attrs[f"param_{p.name}"] for p in self.schema
+                  if p.choices is not None and f"param_{p.name}" in attrs}  # fmt: skip
+        values = self.schema_for(chosen).from_attrs(attrs)
+        self.check(values)
+        return values
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Figures of merit of one simulated run (``ds``: the labelled result of

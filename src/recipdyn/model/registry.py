@@ -23,7 +23,8 @@ from ..errors import ParameterError
 from .protocol import Model, close_matches
 
 __all__ = ["get_model", "model_names", "register", "models_with_parameter", "model_spec",
-           "DEFAULT_MODEL", "ENTRY_POINT_GROUP"]  # fmt: skip
+           "load_object", "is_spec", "absolute_spec", "DEFAULT_MODEL",
+           "ENTRY_POINT_GROUP"]  # fmt: skip
 
 DEFAULT_MODEL = "compressor"
 ENTRY_POINT_GROUP = "recipdyn.models"
@@ -75,10 +76,17 @@ def _load_path(spec: str) -> object:
             # a stable name (numba's on-disk cache records it; hash() would change per process)
             digest = hashlib.sha1(str(path.resolve()).encode()).hexdigest()[:12]
             mod_id = f"recipdyn_user_model_{path.stem}_{digest}"
-            mspec = importlib.util.spec_from_file_location(mod_id, path)
-            module = importlib.util.module_from_spec(mspec)
-            sys.modules[mod_id] = module  # picklable by reference in worker processes
-            mspec.loader.exec_module(module)
+            if mod_id in sys.modules:  # loaded once per process (its objects stay the same)
+                module = sys.modules[mod_id]
+            else:
+                mspec = importlib.util.spec_from_file_location(mod_id, path)
+                module = importlib.util.module_from_spec(mspec)
+                sys.modules[mod_id] = module  # picklable by reference in worker processes
+                try:
+                    mspec.loader.exec_module(module)
+                except BaseException:
+                    del sys.modules[mod_id]
+                    raise
         else:
             module = importlib.import_module(module_name)
     except ParameterError:
@@ -90,6 +98,30 @@ def _load_path(spec: str) -> object:
         return getattr(module, attr)
     except AttributeError:
         raise ParameterError(f"model {spec!r}: {module_name} has no {attr!r}") from None
+
+
+def is_spec(text: object) -> bool:
+    """Whether ``text`` names an object by path (``module:object`` or ``file.py:OBJ``)
+    rather than by a registered name."""
+    return isinstance(text, str) and ":" in text.strip()
+
+
+def absolute_spec(spec: str) -> str:
+    """``spec`` with a file path made absolute (``file.py:OBJ`` finds the same file from
+    any folder: records and worker processes store it); a ``module:object`` as it is."""
+    where, _, name = spec.strip().rpartition(":")
+    return f"{Path(where).resolve()}:{name}" if where.endswith(".py") else spec.strip()
+
+
+def load_object(spec: str, what: str = "object") -> object:
+    """The object ``spec`` (``module:object`` or ``file.py:OBJ``) names, imported once per
+    process (a file under a stable module name, so numba's disk cache and worker processes
+    find it again); [`ParameterError`][recipdyn.errors.ParameterError] if it cannot be
+    loaded."""
+    try:
+        return _load_path(absolute_spec(spec))
+    except ParameterError as exc:
+        raise ParameterError(str(exc).replace("model ", f"{what} ", 1)) from None
 
 
 def get_model(spec: str | Model | None = None) -> Model:

@@ -56,16 +56,26 @@ def wrap_around_mean(angle) -> tuple[np.ndarray, float]:
     return centre + np.angle(np.exp(1j * (a - centre))), centre
 
 
+def _store_model(ds):
+    """The model a sweep store was made with (its spec: a plug-in model's file too), or None
+    for one that is not available here."""
+    from ..model.registry import DEFAULT_MODEL, get_model
+
+    try:
+        return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model")
+                             or DEFAULT_MODEL))  # fmt: skip
+    except Exception:  # a store from a model that is not installed here
+        return None
+
+
 def _mark_invalid(ax, ds, x, y, done) -> None:
     """Mark the points where the model left its validity region (``min_<output>`` below the
     bound the model declares, e.g. a negative joint contact force): red crosses on a map, red
     bands on a curve, with a legend entry."""
-    from ..model.registry import get_model
-
-    try:
-        bounds = get_model(ds.attrs.get("model", "compressor")).validity_bounds
-    except Exception:  # a store from a model that is not installed here
+    m = _store_model(ds)
+    if m is None:
         return
+    bounds = m.validity_bounds
     for name, unit, bound, *_ in bounds:
         var = f"min_{name}"
         if var not in ds:
@@ -89,11 +99,8 @@ def _run_signals(ds) -> list[tuple[str, str]]:
     """(variable, label) of the model's run means and maxima stored in ``ds`` (e.g. the time
     fraction in contact, the largest eccentricity ratio), skipping variables that are NaN
     everywhere (a joint that is not modelled)."""
-    from ..model.registry import get_model
-
-    try:
-        m = get_model(ds.attrs.get("model", "compressor"))
-    except Exception:  # a store from a model that is not installed here
+    m = _store_model(ds)
+    if m is None:
         return []
     out = []
     for _o, name, unit in (*m.mean_signals, *m.max_signals):
@@ -200,8 +207,9 @@ def sweep_figures(ds: xr.Dataset, out: Path) -> list[Path]:
                 ax.plot(xs[done].ravel(), y[done].ravel(), ",k", alpha=0.6)
                 ax.plot(xs[done].ravel(), y[done].ravel(), ".k", ms=1.0, alpha=0.5)
                 ax.set_xlabel(xlabel)
-                compressor = ds.attrs.get("model", "compressor") == "compressor"
-                ax.set_ylabel(f"{ylab}, " + ("once per revolution" if compressor else
+                m = _store_model(ds)  # sampled once per forcing period, or at a map's points
+                periodic = m is not None and m.kind == "ode" and bool(m.period(m.parameters()))
+                ax.set_ylabel(f"{ylab}, " + ("once per period" if periodic else
                                              "at the section points"))  # fmt: skip
                 ax.set_title(f"Bifurcation diagram ({y.shape[1]} section points per value"
                              f"{wrapped})")  # fmt: skip

@@ -34,7 +34,7 @@ import sys
 import time
 import warnings
 import zlib
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -88,8 +88,7 @@ def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | N
         v["lambda_sum"] = ("f8", (), None, lam_unit)
     if "verdict" in spec.measures:
         v["verdict"] = ("str", (), None, "")
-    base = spec.base if isinstance(spec.base, Mapping) else vars(spec.base)
-    v["y_final"] = ("f8", ("state",), len(m.states(base)), "")
+    v["y_final"] = ("f8", ("state",), len(m.states(spec.base)), "")
     return v
 
 
@@ -101,7 +100,7 @@ def _create_store(path: Path, spec: SweepSpec) -> None:
     for a in spec.axes:
         arr = g.create_array(a.name, shape=(len(a.values),), dtype="f8", dimension_names=[a.name])
         arr[:] = np.asarray(a.values)
-        arr.attrs.update({"units": spec.get_model().schema[a.name].unit or "1",
+        arr.attrs.update({"units": spec.get_model().schema_for(spec.base)[a.name].unit or "1",
                           "scale": a.scale})  # fmt: skip
     one = (1,) * (len(dims) - 1) + (min(point_block(spec.n_points), spec.shape[-1]),)
     for name, (dtype, extra, size, units) in _variables(spec).items():
@@ -425,7 +424,7 @@ def _check_resources(spec: SweepSpec, out: Path, backend, workers, dask_local,
         periods = []
         for _, p in _corners(spec):
             pp = spec.point_params(p)
-            periods.append(pp.crank_period if hasattr(pp, "crank_period") else m.period(pp) or 1.0)
+            periods.append(m.period(pp) or 1.0)
         samples = s.get("revolutions", 5.0) * max(periods) * s.get("fs", 1e4)
         n_par = 1 if backend == "serial" or spec.continuation else (
             dask_local or workers or os.cpu_count() or 1)  # fmt: skip

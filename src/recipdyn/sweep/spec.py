@@ -3,8 +3,9 @@
 ``--param omega=10:150:281`` (start:stop:count, linear), ``--param clearance=0.1mm:5mm:50:log``
 (logarithmic), ``--param d=0,0.1mm,1mm`` (explicit list). One ``--param`` gives a 1-D sweep, two
 give the outer-product grid (fault map). Values carry units (pint) and are converted to SI;
-every grid point is validated as a [`CompressorParams`][recipdyn.model.parameters.CompressorParams]
-before anything runs, so a value outside a parameter's range is reported up front.
+every grid point is validated by the model's schema and checks
+([`Model.parameters`][recipdyn.model.protocol.Model.parameters]) before anything runs, so a
+value outside a parameter's range is reported up front.
 """
 
 from __future__ import annotations
@@ -21,9 +22,8 @@ import numpy as np
 
 from ..defaults import SWEEP
 from ..errors import ParameterError, is_number
-from ..model.parameters import CompressorParams, resolve_name
 from ..model.protocol import Model
-from ..model.registry import get_model
+from ..model.registry import DEFAULT_MODEL, get_model
 from ..units import to_si
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
@@ -49,17 +49,20 @@ class Axis:
     scale: str = "linear"
 
 
-def parse_axis(text: str, model: str | Model | None = None) -> Axis:
+def parse_axis(text: str, model: str | Model | None = None,
+               base: Mapping[str, Any] | None = None) -> Axis:  # fmt: skip
     """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units,
-    converted to the unit of the parameter in ``model``'s schema; default the compressor)."""
+    converted to the unit of the parameter in ``model``'s schema at the ``base`` values --
+    a component from a user's file brings its parameters; default the compressor)."""
     if "=" not in text:
         raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
     raw_name, rhs = (s.strip() for s in text.split("=", 1))
     m = get_model(model)
-    name = resolve_name(raw_name) if m.name == "compressor" else m.schema.resolve(raw_name)
-    if name not in m.schema or m.schema[name].choices is not None:
+    schema = m.schema_for(base or {})
+    name = schema.resolve(raw_name)
+    if name not in schema or schema[name].choices is not None:
         raise ParameterError(f"--param {raw_name}: only numeric parameters can be swept")
-    unit = m.schema[name].unit
+    unit = schema[name].unit
     if ":" in rhs:
         parts = rhs.split(":")
         if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
@@ -102,12 +105,13 @@ class SweepSpec:
 
     axes: tuple[Axis, ...]
     measures: tuple[str, ...]
-    #: The base case: CompressorParams for the compressor, else a mapping of the model's values.
-    base: Any = field(default_factory=CompressorParams)
+    #: The base case: the model's values (a mapping, or its parameter dataclass such as
+    #: CompressorParams; stored as the validated mapping), default the model's defaults.
+    base: Any = None
     settings: dict[str, Any] = field(default_factory=dict)
     continuation: bool = False
     #: A registered model name or module:object path (see recipdyn.model.registry).
-    model: str = "compressor"
+    model: str = DEFAULT_MODEL
 
     def __post_init__(self):
         unknown = set(self.settings) - set(SWEEP) - {"lyap_tol"}
@@ -118,10 +122,7 @@ class SweepSpec:
         given = {k: v for k, v in self.settings.items() if v is not None}  # None = default
         object.__setattr__(self, "settings", {**SWEEP, **given})
         m = self.get_model()
-        if m.name != "compressor" and not isinstance(self.base, Mapping):
-            object.__setattr__(self, "base", m.parameters())
-        elif m.name != "compressor":
-            object.__setattr__(self, "base", m.parameters(dict(self.base)))
+        object.__setattr__(self, "base", m.parameters(self.base))
         if not 1 <= len(self.axes) <= 2:
             raise ParameterError(f"a sweep needs 1 or 2 --param axes, got {len(self.axes)}")
         if len({a.name for a in self.axes}) != len(self.axes):
@@ -179,29 +180,25 @@ class SweepSpec:
         return get_model(self.model)
 
     def point_params(self, point) -> Any:
-        """The point's parameters: CompressorParams for the compressor, else a dict."""
+        """The point's validated parameter values."""
         values = point[1] if isinstance(point, tuple) else point
         try:
-            if isinstance(self.base, CompressorParams):
-                return dataclasses.replace(self.base, **values)
             return self.get_model().parameters({**self.base, **values})
         except ParameterError as exc:
             raise ParameterError(f"sweep point {values}: {exc}") from None
 
     def base_attrs(self) -> dict[str, Any]:
         """The base case's parameters as result attributes."""
-        if isinstance(self.base, CompressorParams):
-            return self.base.to_attrs()
-        return {
-            k[len("param_") :]: v for k, v in self.get_model().schema.to_attrs(self.base).items()
-        }
+        attrs = self.get_model().record_attrs(self.base)
+        return {k[len("param_") :]: v for k, v in attrs.items() if k.startswith("param_")}
 
     def to_json(self) -> str:
         return json.dumps(
             dict(axes=[dataclasses.asdict(a) for a in self.axes], measures=list(self.measures),
-                 base=dataclasses.asdict(self.base) if isinstance(self.base, CompressorParams)
-                 else dict(self.base), settings=self.settings, continuation=self.continuation,
-                 **({} if self.model == "compressor" else {"model": self.model})),
+                 base=dict(self.base), settings=self.settings, continuation=self.continuation,
+                 # (the default model is not named: the digests of stores made before
+                 # sweeps took other models stay the same)
+                 **({} if self.model == DEFAULT_MODEL else {"model": self.model})),
             sort_keys=True, default=str,
         )  # fmt: skip
 

@@ -21,10 +21,9 @@ from ..analysis import (
     zero_one_test,
 )
 from ..defaults import LYAP_TOL
+from ..errors import ParameterError
 from ..integrate import IntegrationError, integrate
-from ..model.compressor import compressor_model
-from ..model.parameters import CompressorParams, ParameterError
-from ..model.registry import get_model
+from ..model.registry import DEFAULT_MODEL, get_model
 
 __all__ = ["run_point", "N_PEAKS"]
 
@@ -36,9 +35,9 @@ def run_point(task: dict[str, Any]) -> dict[str, Any]:
     """Compute the requested measures for one point.
 
     ``task``: ``index`` (tuple), ``model`` (a registered name or module:object, default the
-    compressor), ``params`` (CompressorParams for the compressor, else a dict of the model's
-    values), ``measures``, ``settings``, optional ``y0`` (continuation). Returns ``{"index",
-    "error", "y_final", <measure arrays>}``; failures (integrator, infeasible geometry) are
+    compressor), ``params`` (the model's validated values), ``measures``, ``settings``,
+    optional ``y0`` (continuation). Returns ``{"index", "error", "y_final", <measure
+    arrays>}``; failures (integrator, infeasible geometry) are
     caught and returned as ``error``.
     """
     out: dict[str, Any] = {"index": task["index"], "error": ""}
@@ -57,39 +56,27 @@ def run_points(tasks: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 class _Point:
-    """One point's system, period, initial state and outputs, for any registered model.
-
-    The compressor keeps the exact calls it always had (``compressor_model(p)``), so its
-    results are bit-identical to before the model interface.
-    """
+    """One point's system, period, initial state and outputs, for any registered model
+    (through its protocol only)."""
 
     def __init__(self, model_spec: str, p: Any):
         m = get_model(model_spec)
         self.model = m
-        if isinstance(p, CompressorParams):
-            self.system = compressor_model(p)
-            self.T = p.crank_period
-            self.y_init = self.system.initial_state()
-            self.outputs = self.system.outputs
-            self.fc = p.crank_frequency
-            self.dynamic = p.rc > 0
-            self.bounded = m.validity_applies(vars(p))
-        else:
-            self.system = m.system(p)
-            period = m.period(p)
-            self.T = float(period) if period else 1.0
-            self.y_init = m.initial_state(p)
-            self.outputs = lambda t, y, _m=m, _p=p: _m.outputs(_p, t, y)
-            self.fc = 1.0 / period if period else None
-            self.dynamic = m.has_dynamics(p)
-            self.bounded = m.validity_applies(p)
+        self.system = m.system(p)
+        period = m.period(p)
+        self.T = float(period) if period else 1.0
+        self.y_init = m.initial_state(p)
+        self.outputs = lambda t, y, _m=m, _p=p: _m.outputs(_p, t, y)
+        self.fc = 1.0 / period if period else None
+        self.dynamic = m.has_dynamics(p)
+        self.bounded = m.validity_applies(p)
         self.sections = [k for k, _ in m.sections()]
         self.pair = m.pair()
         self.vib = m.vibration()[0]
 
 
 def _compute(task: dict[str, Any]) -> dict[str, Any]:
-    pt = _Point(task.get("model", "compressor"), task["params"])
+    pt = _Point(task.get("model", DEFAULT_MODEL), task["params"])
     measures, s, y0 = task["measures"], task["settings"], task.get("y0")
     if pt.model.kind == "map":
         return _compute_map(pt, measures, s, y0)

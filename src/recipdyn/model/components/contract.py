@@ -43,7 +43,7 @@ import numpy as np
 
 from ..protocol import Param
 
-__all__ = ["Component", "Assembly", "check_fragments", "glue_module"]
+__all__ = ["Component", "Assembly", "check_fragments", "glue_module", "resolve_component"]
 
 
 def _no_params(values: Mapping[str, Any]) -> np.ndarray:
@@ -96,6 +96,28 @@ class Component:
                 f"{self.family} component {self.name!r} provides no {role!r} kernel "
                 f"(it provides: {', '.join(self.kernels)})"
             ) from None
+
+
+def resolve_component(family: str, name: str, builtin: Mapping[str, Component]) -> Component:
+    """The component of ``family`` that ``name`` chooses: a built-in one by its name, or one
+    from a user's module or file by its spec (``module:object``, ``file.py:OBJ``: adding a
+    component is one file, recipdyn untouched). Raise
+    [`ParameterError`][recipdyn.errors.ParameterError] naming the family and the choices."""
+    from ...errors import ParameterError
+    from ..registry import is_spec, load_object
+
+    if name in builtin:
+        return builtin[name]
+    if not is_spec(name):
+        raise ParameterError(f"{family} = {name!r}; allowed: "
+                             f"{', '.join(repr(k) for k in builtin)} or a component's "
+                             "module:object / file.py:OBJ")  # fmt: skip
+    obj = load_object(name, what=f"{family} component")
+    if not isinstance(obj, Component) or obj.family != family:
+        got = f"a {obj.family} component" if isinstance(obj, Component) else type(obj).__name__
+        raise ParameterError(f"{family} = {name!r} is {got}, not a {family} component "
+                             "(recipdyn.model.components.contract.Component)")  # fmt: skip
+    return obj
 
 
 def check_fragments(components: Iterable[Component], base: Iterable[Param] = ()) -> None:
