@@ -3,7 +3,8 @@
 Three groups, by what the record must hold:
 
 ``base`` (an acceleration channel and the crank speed)
-    The vibration features of `recipdyn.features.signal_features` (RMS, peak, crest factor, kurtosis, spectral shape, crank orders 1-10) and the impacts
+    The vibration features of `recipdyn.features.signal_features` (RMS, peak, crest
+    factor, kurtosis, spectral shape, crank orders 1-10) and the impacts
     per revolution.
 ``angle`` (a tacho whose mark is at outer dead centre)
     Where in the revolution the vibration energy sits: the share of the high-passed

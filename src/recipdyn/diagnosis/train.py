@@ -68,7 +68,7 @@ def _hgb_classifier(seed: int):
     from sklearn.ensemble import HistGradientBoostingClassifier
 
     return HistGradientBoostingClassifier(
-        max_iter=200, learning_rate=0.1, max_leaf_nodes=15, early_stopping=False, random_state=seed
+        max_iter=100, learning_rate=0.1, max_leaf_nodes=8, early_stopping=False, random_state=seed
     )
 
 
@@ -76,7 +76,7 @@ def _hgb_regressor(seed: int):
     from sklearn.ensemble import HistGradientBoostingRegressor
 
     return HistGradientBoostingRegressor(
-        max_iter=200, learning_rate=0.1, max_leaf_nodes=15, early_stopping=False, random_state=seed
+        max_iter=100, learning_rate=0.1, max_leaf_nodes=8, early_stopping=False, random_state=seed
     )
 
 
@@ -245,9 +245,16 @@ def curve(x, tacho, fs, f_rev, points: int = CURVE_POINTS) -> np.ndarray:
 def train(folder: str | Path, *, seed: int = 0, progress: bool = True) -> tuple[Diagnoser, dict]:
     """Train a diagnoser on the training conditions of the data set in ``folder`` and
     evaluate it on the test conditions; returns ``(diagnoser, evaluation)``."""
-    from .. import __version__
+    from threadpoolctl import threadpool_limits
 
     folder = Path(folder)
+    with threadpool_limits(1):  # OpenMP threads on a loaded machine cost 10x, not save
+        return _train(folder, seed)
+
+
+def _train(folder: Path, seed: int) -> tuple[Diagnoser, dict]:
+    from .. import __version__
+
     df, card = read_features(folder)
     names = [c[2:] for c in df.columns if c.startswith("f_")]
     classes = list(card["spec"]["classes"])
@@ -471,13 +478,15 @@ TRUSTED_PREFIXES = ("sklearn.", "numpy.", "builtins.", "collections.")
 
 def save(diag: Diagnoser, path: str | Path) -> Path:
     """Write ``diag`` to a skops file (written to a temporary file, then renamed)."""
+    import zipfile
+
     import skops.io as sio
 
     from ..io import atomic_path
 
     path = Path(path)
     with atomic_path(path) as tmp:
-        sio.dump(diag.state, tmp)
+        sio.dump(diag.state, tmp, compression=zipfile.ZIP_DEFLATED, compresslevel=9)
     return path
 
 
