@@ -5,7 +5,8 @@ channels by name); the crank angle comes from a once-per-revolution tacho whose 
 outer dead centre, or from a constant speed (then the features that need the angle are left
 out and the diagnosis is less sharp). Before any answer, the record must lie in the
 diagnoser's training domain: its crank speed and sampling rate inside the training ranges,
-its features no farther from the training records than the held-out conditions were
+the frequency at which its impacts ring inside the training sensor band, its
+features no farther from the training records than the held-out conditions were
 (`recipdyn.diagnosis.train.Diagnoser.ood`). Otherwise the diagnosis is withheld, with the
 reason.
 """
@@ -26,6 +27,9 @@ __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
 
 #: Slack on the training range of the crank speed and the sampling rate (relative).
 RANGE_SLACK = 0.02
+#: Slack on the training range of the impacts' ringing frequency (relative; the Welch
+#: spectrum's resolution is fs/1024, ~10 Hz, and the resonance's peak is broad: Q = 10).
+RING_SLACK = 0.1
 
 
 def default_model_path() -> Path:
@@ -223,6 +227,17 @@ def diagnose_arrays(
             f"sampling rate {fs:g} Hz is outside the training range "
             f"{lo:g}..{hi:g} Hz (it shapes the spectral features); resample the "
             "record or train on that rate",
+            t0,
+        )
+    lo, hi = st["ring_range"]
+    ring = row["acc_ring_hz"]
+    if not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
+        return _refuse(
+            res,
+            f"the impacts ring at {ring:.0f} Hz, outside the training sensor "
+            f"band ({lo:.0f}..{hi:.0f} Hz: the mounting resonances of the data "
+            "set): another sensor or mounting; train on a data set with its "
+            "resonance",
             t0,
         )
     d, thr, subset = diag.ood(X[0])

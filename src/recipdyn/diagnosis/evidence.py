@@ -40,6 +40,17 @@ def _highpass(x, fs):
     return sosfiltfilt(sos, x)
 
 
+def ringing_hz(x, fs: float) -> float:
+    """The frequency at which the impacts ring: the peak of the acceleration's Welch spectrum
+    above `HIGHPASS_HZ` (on a machine with impacts, the sensor's mounting resonance or the
+    structure's mode the sensor sees; it tells the sensor band a record was taken with)."""
+    from scipy.signal import welch
+
+    f, p = welch(np.asarray(x, float), fs=fs, nperseg=min(1024, len(x)))
+    band = f > HIGHPASS_HZ
+    return float(f[band][np.argmax(p[band])]) if band.any() else math.nan
+
+
 def _whole_revs(revs):
     """Sample mask of the whole revolutions a crank angle covers, and their count."""
     r = np.asarray(revs, dtype=float)
@@ -142,6 +153,7 @@ def record_features(
     for k, v in signal_features(x, fs, revs=r).items():
         row[f"acc_{k}"] = float(v)
     row["acc_impacts_per_rev"] = impacts(x, fs, r)["per_rev"]
+    row["acc_ring_hz"] = ringing_hz(x, fs)
     mask, n_revs, start = _whole_revs(r)
     ok_angle = angle and n_revs >= 1
     e = _highpass(x, fs) ** 2

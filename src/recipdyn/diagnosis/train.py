@@ -313,6 +313,7 @@ def _train(folder: Path, seed: int) -> tuple[Diagnoser, dict]:
         "ood_threshold": thresholds,
         "speed_range": [float(speed.min()), float(speed.max())],
         "fs_range": [float(train_df.fs.min()), float(train_df.fs.max())],
+        "ring_range": [float(train_df.f_acc_ring_hz.min()), float(train_df.f_acc_ring_hz.max())],
         "train_labels": train_df.label.tolist(),
         "train_severity": train_df.severity.to_numpy(float),
         "train_records": train_df.record.to_numpy(int),
