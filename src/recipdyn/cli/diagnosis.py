@@ -41,9 +41,10 @@ def dataset(
     force: bool = typer.Option(False, help="Overwrite an existing data set in OUT."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
 ) -> None:
-    """Build a labelled data set: fault classes x severities x operating conditions x sensor
-    settings, simulated and sensed; signals in Zarr, features and labels in Parquet, a data
-    card; split by operating condition."""
+    """Build a labelled data set of simulated, sensed records, split by operating condition.
+
+    Fault classes x severities x operating conditions x sensor settings; signals in Zarr,
+    features and labels in Parquet, a data card (docs/diagnosis.md)."""
     from ..diagnosis.classes import class_names
     from ..diagnosis.dataset import DatasetSpec, build_dataset
 
@@ -90,8 +91,10 @@ def train(
         help="Folder for the evaluation's tables and figures (default: next to the model).",
     ),
 ) -> None:
-    """Train the class and severity diagnosers on the training conditions and evaluate them
-    on the held-out ones; write the model (skops) and the evaluation."""
+    """Train the fault class and severity diagnosers on a data set and evaluate them.
+
+    Trained on the training conditions, evaluated on the held-out ones; writes the model
+    (skops) and the evaluation's tables and figures."""
     from ..diagnosis.report import write_report
     from ..diagnosis.train import save
     from ..diagnosis.train import train as train_fn
@@ -136,8 +139,10 @@ def diagnose(
     ),
     out: Path = typer.Option(None, "--out", "-o", help="Folder for the overlay figure."),
 ) -> None:
-    """Diagnose a record: class probabilities, severity with its interval, the evidence, and
-    the closest simulated record; refuses a record outside the training domain."""
+    """Diagnose a record: fault class, severity and evidence, or a refusal with its reason.
+
+    Class probabilities, the severity with its interval, impacts and deciding features, the
+    closest simulated record overlaid; a record outside the training domain is refused."""
     from ..diagnosis.diagnose import diagnose as diagnose_fn
     from ..errors import ParameterError
 
