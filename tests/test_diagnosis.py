@@ -317,3 +317,12 @@ def test_cli_refuses_bad_settings_in_one_line(capsys):
     assert main(["diagnose", "missing.csv"]) == 2  # neither --speed nor --tacho
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "n_conditions" in err[0] and "speed and tacho" in err[1]
+
+
+def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
+    pytest.importorskip("dask.distributed")
+    spec = DatasetSpec(n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"),
+                       test_fraction=0.5, seed=3)  # fmt: skip
+    a = build_dataset(tmp_path / "d", spec, backend="dask", dask_local=1, progress=False)
+    b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
+    assert read_features(a)[0].equals(read_features(b)[0])
