@@ -5,7 +5,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 OUT ?= out
 
-.PHONY: env warmup run test test-fast bench lint format docs clean
+.PHONY: env warmup run test test-fast bench lint format docs clean diagnoser
 
 $(STAMP): pyproject.toml requirements/constraints.txt
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) on PATH (set PYTHON=...)"; exit 2; }
@@ -47,3 +47,9 @@ format: $(STAMP)
 
 clean:
 	rm -rf $(VENV) $(OUT) site .pytest_cache
+
+# the diagnoser shipped with recipdyn (docs/diagnosis.md): the default data set (12 operating
+# conditions x 8 classes x 4 severities, 384 records, ~12 min on 2 cores), trained, evaluated
+diagnoser: warmup
+	$(VENV)/bin/recipdyn dataset -o $(OUT)/diagnoser-data --conditions 12 --resume
+	$(VENV)/bin/recipdyn train $(OUT)/diagnoser-data -o src/recipdyn/diagnosis/data/default.skops --report $(OUT)/diagnoser-report

@@ -21,6 +21,7 @@ LAYERS = [
     {"simulate", "io_signal", "sensors"},  # sensors read records
     {"plotting", "analyze", "compare", "animate"},
     {"sweep", "features"},  # features reads sweep stores
+    {"diagnosis"},  # data sets, diagnosers: simulate + sensors + features, sweep's backends
     {"reproduce", "app"},
     {"cli", "__main__"},
 ]  # fmt: skip

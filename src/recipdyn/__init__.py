@@ -62,6 +62,7 @@ _LAZY = {
     "get_model": "model.registry",
     "model_names": "model.registry",
     "analyze_signal": "analyze",
+    "diagnose": "diagnosis",
     "SweepSpec": "sweep",
     "parse_axis": "sweep",
     "run_sweep": "sweep",

@@ -136,6 +136,7 @@ def _register() -> None:
     from . import analyze as _analyze  # noqa: F401  (commands register on import)
     from . import animate as _animate  # noqa: F401
     from . import compare as _compare  # noqa: F401
+    from . import diagnosis as _diagnosis  # noqa: F401
     from . import features as _features  # noqa: F401
     from . import models as _models  # noqa: F401
     from . import reproduce as _reproduce  # noqa: F401

@@ -1,0 +1,165 @@
+"""``recipdyn dataset``, ``recipdyn train`` and ``recipdyn diagnose``: fault diagnosis from
+physics-generated records (docs/diagnosis.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from . import app, refused_leaves_nothing, report, with_json
+
+
+def _levels(text: str) -> tuple[float, ...]:
+    from ..errors import ParameterError
+
+    try:
+        return tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise ParameterError(
+            f"levels = {text!r}; allowed: a comma list of severities in "
+            "(0, 1], e.g. 0.25,0.5,0.75,1"
+        ) from None
+
+
+@app.command()
+def dataset(
+    out: Path = typer.Option(Path("out/dataset"), "--out", "-o", help="Data set folder."),
+    conditions: int = typer.Option(16, "--conditions", "-n", help="Operating conditions drawn."),
+    levels: str = typer.Option("0.25,0.5,0.75,1", help="Severity levels in (0, 1]."),
+    snr: float = typer.Option(20.0, "--snr", help="Accelerometer SNR, dB."),
+    revolutions: float = typer.Option(2.0, help="Revolutions recorded per record."),
+    transient: float = typer.Option(1.0, help="Revolutions discarded first."),
+    classes: str = typer.Option(None, help="Comma list of classes (default: all)."),
+    test_fraction: float = typer.Option(0.25, help="Share of the conditions held out."),
+    seed: int = typer.Option(0, help="Seed of the conditions, the split and the noise."),
+    backend: str = typer.Option("processes", help="serial, processes or dask."),
+    workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
+    dask_local: int = typer.Option(None, "--dask-local", help="Start a LocalCluster of N workers."),
+    scheduler: str = typer.Option(None, help="Existing Dask scheduler, tcp://HOST:PORT."),
+    resume: bool = typer.Option(False, help="Continue an interrupted data set in OUT."),
+    force: bool = typer.Option(False, help="Overwrite an existing data set in OUT."),
+    progress: bool = typer.Option(True, "--progress/--no-progress"),
+) -> None:
+    """Build a labelled data set of simulated, sensed records, split by operating condition.
+
+    Fault classes x severities x operating conditions x sensor settings; signals in Zarr,
+    features and labels in Parquet, a data card (docs/diagnosis.md)."""
+    from ..diagnosis.classes import class_names
+    from ..diagnosis.dataset import DatasetSpec, build_dataset
+
+    kw = {} if classes is None else {"classes": tuple(c.strip() for c in classes.split(","))}
+    spec = DatasetSpec(
+        n_conditions=conditions,
+        levels=_levels(levels),
+        snr_db=snr,
+        revolutions=revolutions,
+        transient=transient,
+        test_fraction=test_fraction,
+        seed=seed,
+        **kw,
+    )
+    if dask_local is not None or scheduler is not None:
+        backend = "dask"
+    with refused_leaves_nothing(out):
+        build_dataset(
+            out,
+            spec,
+            backend=backend,
+            workers=workers,
+            dask_local=dask_local,
+            scheduler=scheduler,
+            resume=resume,
+            force=force,
+            progress=progress,
+        )
+    typer.echo(
+        f"wrote {out}/features.parquet, {out}/signals.zarr, {out}/datacard.md "
+        f"({len(spec.classes)} of {len(class_names())} classes)"
+    )
+
+
+@app.command()
+@with_json
+def train(
+    data: Path = typer.Argument(..., help="A data set folder ('recipdyn dataset')."),
+    out: Path = typer.Option(Path("out/diagnoser.skops"), "--out", "-o", help="Model file."),
+    seed: int = typer.Option(0, help="Seed of the learners and the calibration split."),
+    report_dir: Path = typer.Option(
+        None,
+        "--report",
+        help="Folder for the evaluation's tables and figures (default: next to the model).",
+    ),
+) -> None:
+    """Train the fault class and severity diagnosers on a data set and evaluate them.
+
+    Trained on the training conditions, evaluated on the held-out ones; writes the model
+    (skops) and the evaluation's tables and figures."""
+    from ..diagnosis.report import write_report
+    from ..diagnosis.train import save
+    from ..diagnosis.train import train as train_fn
+
+    if out.suffix != ".skops":
+        from ..errors import ParameterError
+
+        raise ParameterError(f"--out {out}: use a .skops file")
+    diag, ev = train_fn(data, seed=seed)
+    with refused_leaves_nothing(out):
+        save(diag, out)
+    folder = report_dir or out.with_suffix("")
+    paths = write_report(ev, diag, folder)
+    f = ev["full"]
+    typer.echo(
+        f"accuracy {f['accuracy']:.3f} (moderate and severe {f['accuracy_moderate_severe']:.3f}), "
+        f"ECE {f['ece']:.3f}, severity median relative error "
+        f"{ev['severity_median_relative_error']:.3f}, 90 % interval coverage "
+        f"{ev['severity_coverage']:.3f}; condition-only accuracy "
+        f"{ev['condition_only']['accuracy']:.3f} (chance {ev['condition_only']['chance']:.3f})"
+    )
+    typer.echo(f"wrote {out}; evaluation in {paths[0].parent}")
+    report(model=str(out), evaluation=ev)
+
+
+@app.command()
+@with_json
+def diagnose(
+    record: Path = typer.Argument(..., help="A record: CSV/TSV/WAV/MAT/NetCDF/Parquet."),
+    channel: str = typer.Option(
+        "accel_guide", "--channel", "-c", help="Acceleration channel (m/s**2)."
+    ),
+    fs: str = typer.Option(None, "--fs", help="Sampling rate, if the file does not give it."),
+    speed: str = typer.Option(None, "--speed", help="Crank speed, e.g. 191rpm."),
+    tacho: str = typer.Option(
+        None, "--tacho", help="Once-per-revolution pulse channel (mark at outer dead centre)."
+    ),
+    p_head: str = typer.Option(None, "--p-head", help="Head-end pressure channel (Pa)."),
+    p_crank: str = typer.Option(None, "--p-crank", help="Crank-end pressure channel (Pa)."),
+    model: Path = typer.Option(
+        None, "--model", "-m", help="Diagnoser file (default: the one shipped with recipdyn)."
+    ),
+    out: Path = typer.Option(None, "--out", "-o", help="Folder for the overlay figure."),
+) -> None:
+    """Diagnose a record: fault class, severity and evidence, or a refusal with its reason.
+
+    Class probabilities, the severity with its interval, impacts and deciding features, the
+    closest simulated record overlaid; a record outside the training domain is refused."""
+    from ..diagnosis.diagnose import diagnose as diagnose_fn
+    from ..errors import ParameterError
+
+    if (speed is None) == (tacho is None):
+        raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
+    res = diagnose_fn(
+        record,
+        channel=channel,
+        fs=fs,
+        speed=speed,
+        tacho=tacho,
+        p_head=p_head,
+        p_crank=p_crank,
+        model=model,
+        out=out,
+    )
+    if res.refused:
+        raise ParameterError(f"diagnose {record.name}: refused: {res.reason}")
+    typer.echo(res.text())
+    report(**res.summary())

@@ -1,0 +1,636 @@
+"""A labelled, physics-generated data set for fault diagnosis (``recipdyn dataset``).
+
+Design: ``n_conditions`` operating conditions (speed, suction and discharge pressure, rod and
+crosshead masses, the accelerometer's mounting resonance and the sampling rate), drawn
+uniformly from `CONDITIONS` with a seeded generator; at each condition
+every fault class at every severity level (the healthy machine as often as each fault, so the
+classes are balanced); each record sensed at the data set's SNR (`recipdyn.sensors`) with its
+own noise seed. The conditions are split whole into train and test sets, so no condition is
+shared between them.
+
+Layout of ``OUT``:
+
+``signals.zarr``
+    One array per sensed channel (``accel_guide``, ``p_head_sensor``, ``p_crank_sensor``,
+    ``tacho``), record by sample (float32, NaN after a record's ``n_samples``), the features
+    (``features``, record by feature) and ``done``/``error`` per record.
+``features.parquet``
+    One row per finished record: labels (class, severity, the fault parameter's value), the
+    condition, the sensor settings, the split and every feature.
+``datacard.json``, ``datacard.md``
+    What each class and severity means physically, the ranges, the class balance, the seeds,
+    the recipdyn version and the measured throughput.
+
+The unit of work, `make_record`, is pure and picklable (the same code serially, in a process
+pool or on Dask); only the coordinating process writes. A record counts as finished only
+after its arrays are written; ``done`` is written last, so an interrupted build resumes
+(``resume=True``) with every finished record kept.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+import traceback
+import warnings
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .classes import BASELINE, CONDITIONS, MODEL, class_names, get_class
+
+__all__ = [
+    "DatasetSpec",
+    "design",
+    "make_record",
+    "build_dataset",
+    "read_features",
+    "CHANNELS",
+    "split_of",
+]
+
+#: The sensed channels stored per record.
+CHANNELS = ("accel_guide", "p_head_sensor", "p_crank_sensor", "tacho")
+BACKENDS = ("serial", "processes", "dask")
+
+
+@dataclass(frozen=True)
+class DatasetSpec:
+    """What a data set holds.
+
+    Parameters
+    ----------
+    n_conditions : int
+        Operating conditions drawn (each gets every class at every level).
+    levels : tuple of float
+        Severity levels in (0, 1] (`FaultClass.value` maps them to the fault parameter).
+    snr_db : float
+        Accelerometer signal-to-noise ratio, dB.
+    revolutions, transient : float
+        Crank revolutions recorded after ``transient`` revolutions discarded.
+    test_fraction : float
+        Share of the conditions held out for testing (at least one condition).
+    seed : int
+        Seed of the conditions, the split and every record's sensor noise.
+    classes : tuple of str
+        Class names (default: all of `CLASSES`).
+    """
+
+    n_conditions: int = 16
+    levels: tuple[float, ...] = (0.25, 0.5, 0.75, 1.0)
+    snr_db: float = 20.0
+    revolutions: float = 2.0
+    transient: float = 1.0
+    test_fraction: float = 0.25
+    seed: int = 0
+    classes: tuple[str, ...] = field(default_factory=lambda: tuple(class_names()))
+
+    def __post_init__(self):
+        if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
+            raise ParameterError(
+                f"n_conditions = {self.n_conditions!r}; allowed: an integer "
+                ">= 2 (one for training, one for testing)"
+            )
+        if not self.levels or not all(0 < s <= 1 for s in self.levels):
+            raise ParameterError(f"levels = {self.levels!r}; allowed: severities in (0, 1]")
+        if not -20 <= self.snr_db <= 200:
+            raise ParameterError(f"snr_db = {self.snr_db!r}; allowed: [-20, 200] dB")
+        if not 1 <= self.revolutions <= 100:
+            raise ParameterError(f"revolutions = {self.revolutions!r}; allowed: [1, 100]")
+        if not 0 <= self.transient <= 100:
+            raise ParameterError(f"transient = {self.transient!r}; allowed: [0, 100]")
+        if not 0 < self.test_fraction < 1:
+            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
+        if not (isinstance(self.seed, int) and 0 <= self.seed < 2**63):
+            raise ParameterError(f"seed = {self.seed!r}; allowed: an integer >= 0")
+        for c in self.classes:
+            get_class(c)
+        if "healthy" not in self.classes:
+            raise ParameterError("classes: must include 'healthy' (the baseline)")
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), sort_keys=True)
+
+
+def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
+    rng = np.random.default_rng([spec.seed, 0])
+    out = []
+    for _ in range(spec.n_conditions):
+        c = {k: r.draw(rng) for k, r in CONDITIONS.items()}
+        c["fs"] = round(c["fs"] / 100.0) * 100.0
+        out.append(c)
+    return out
+
+
+def split_of(spec: DatasetSpec) -> list[str]:
+    """``"train"`` or ``"test"`` per condition (seeded; at least one of each)."""
+    n_test = min(max(1, round(spec.test_fraction * spec.n_conditions)), spec.n_conditions - 1)
+    perm = np.random.default_rng([spec.seed, 1]).permutation(spec.n_conditions)
+    test = set(perm[:n_test].tolist())
+    return ["test" if i in test else "train" for i in range(spec.n_conditions)]
+
+
+def design(spec: DatasetSpec) -> list[dict[str, Any]]:
+    """The records of ``spec``: one task per (condition, class, level), in a fixed order."""
+    tasks = []
+    splits = split_of(spec)
+    for ci, cond in enumerate(_conditions(spec)):
+        for name in spec.classes:
+            fc = get_class(name)
+            for li, s in enumerate(spec.levels):
+                idx = len(tasks)
+                params = dict(BASELINE)
+                params.update(
+                    {
+                        k: cond[k]
+                        for k in ("omega", "suction_pressure", "discharge_pressure", "m2", "m3")
+                    }
+                )
+                params.update(fc.overrides(s))
+                tasks.append(
+                    {
+                        "index": idx,
+                        "condition": ci,
+                        "split": splits[ci],
+                        "label": name,
+                        "level": li,
+                        "severity": float(s) if fc.parameter else 0.0,
+                        "fault_value": fc.value(s) if fc.parameter else math.nan,
+                        "params": params,
+                        "fs": cond["fs"],
+                        "resonance_hz": cond["resonance_hz"],
+                        "snr_db": spec.snr_db,
+                        "revolutions": spec.revolutions,
+                        "transient": spec.transient,
+                        "noise_seed": int(spec.seed * 1_000_003 + idx),
+                    }
+                )
+    return tasks
+
+
+def n_samples_max(tasks) -> int:
+    return max(
+        int(math.ceil(t["revolutions"] * 2 * math.pi / t["params"]["omega"] * t["fs"])) + 2
+        for t in tasks
+    )
+
+
+def simulate_record(task: dict[str, Any]):
+    """The sensed record (an xarray Dataset) of one task."""
+    from .. import sensors
+    from ..simulate import simulate
+
+    with warnings.catch_warnings():  # the healthy pins stretch Hertz's law (docs/diagnosis.md)
+        warnings.simplefilter("ignore")
+        ds = simulate(
+            model=MODEL,
+            revolutions=task["revolutions"],
+            transient=task["transient"],
+            fs=task["fs"],
+            **task["params"],
+        )
+    return sensors.record(
+        ds,
+        accelerometer=sensors.Accelerometer(
+            snr_db=task["snr_db"], resonance_hz=task["resonance_hz"]
+        ),
+        pressure=sensors.PressureTransducer(),
+        tacho=sensors.Tacho(),
+        seed=task["noise_seed"],
+    )
+
+
+def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
+    """A record's features from its sensed channels: the crank angle from the tacho's first
+    edge and the record's constant crank speed (a short record has too few pulses for
+    the speed to be read from them)."""
+    from ..analysis.vibration import tacho_times
+    from .evidence import record_features
+
+    x = channels["accel_guide"]
+    edges = tacho_times(channels["tacho"], fs)
+    if edges.size == 0:
+        raise ValueError("no tacho edge in the record")
+    revs = (np.arange(x.size) / fs - edges[0]) * speed_hz
+    return record_features(
+        x, fs, revs, p_head=channels.get("p_head_sensor"), p_crank=channels.get("p_crank_sensor")
+    )
+
+
+def make_record(task: dict[str, Any]) -> dict[str, Any]:
+    """Simulate, sense and featurise one record (pure: the result depends on ``task`` only).
+
+    Returns ``{"index", "error", "channels", "features", "seconds"}``; a failure is returned
+    as ``error`` (the build goes on)."""
+    t0 = time.perf_counter()
+    out: dict[str, Any] = {"index": task["index"], "error": ""}
+    try:
+        rec = simulate_record(task)
+        ch = {c: np.asarray(rec[c].values, dtype=np.float32) for c in CHANNELS}
+        out["channels"] = ch
+        speed = task["params"]["omega"] / (2 * math.pi)
+        out["features"] = features_of(
+            {k: v.astype(float) for k, v in ch.items()}, task["fs"], speed
+        )
+    except Exception as exc:  # noqa: BLE001 - recorded; the data set goes on
+        out["error"] = f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)}"
+    out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def _make_records(tasks):
+    return [make_record(t) for t in tasks]
+
+
+def feature_names() -> list[str]:
+    """The feature columns, in order (from a synthetic record: the names do not depend on
+    the values)."""
+    from .evidence import record_features
+
+    fs, n = 10_000.0, 8_000
+    t = np.arange(n) / fs
+    x = np.sin(2 * np.pi * 40 * t) + 0.01 * np.cos(2 * np.pi * 1700 * t)
+    return list(record_features(x, fs, 3.0 * t, p_head=2 + x, p_crank=2 - x))
+
+
+def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool):
+    import zarr
+
+    n, m = len(tasks), n_samples_max(tasks)
+    names = feature_names()
+    if path.exists() and not force:
+        g = zarr.open_group(str(path), mode="r+")
+        if g.attrs.get("spec_json") != spec.to_json():
+            raise ParameterError(
+                f"{path.parent}: holds a data set of another spec; use "
+                "another --out, or --force to start over"
+            )
+        if not resume:
+            raise ParameterError(
+                f"{path.parent}: a data set exists; --resume to continue it, --force to start over"
+            )
+        return g, names
+    g = zarr.open_group(str(path), mode="w")
+    chunk = (1, m)
+    for c in CHANNELS:
+        g.create_array(c, shape=(n, m), chunks=chunk, dtype="f4", fill_value=np.nan)
+    g.create_array(
+        "features", shape=(n, len(names)), chunks=(1, len(names)), dtype="f8", fill_value=np.nan
+    )
+    g.create_array("n_samples", shape=(n,), chunks=(n,), dtype="i8", fill_value=0)
+    g.create_array("done", shape=(n,), chunks=(1,), dtype=bool, fill_value=False)
+    g.create_array("error", shape=(n,), chunks=(1,), dtype=str)
+    g.create_array("seconds", shape=(n,), chunks=(1,), dtype="f8", fill_value=np.nan)
+    from .. import __version__
+
+    g.attrs.update(
+        {
+            "spec_json": spec.to_json(),
+            "feature_names": names,
+            "recipdyn_version": __version__,
+            "channels": list(CHANNELS),
+        }
+    )
+    return g, names
+
+
+def _write(g, res: dict[str, Any], names: list[str]) -> None:
+    i = res["index"]
+    if not res["error"]:
+        for c, y in res["channels"].items():
+            row = np.full(g[c].shape[1], np.nan, np.float32)
+            row[: y.size] = y[: row.size]
+            g[c][i, :] = row
+        g["n_samples"][i] = int(res["channels"]["accel_guide"].size)
+        g["features"][i, :] = np.array([res["features"][k] for k in names], float)
+    g["error"][i] = res["error"][:2000]
+    g["seconds"][i] = res["seconds"]
+    g["done"][i] = True  # last: a record is done once its data are written
+
+
+def build_dataset(
+    out: str | Path,
+    spec: DatasetSpec = DatasetSpec(),
+    *,
+    backend: str = "processes",
+    workers: int | None = None,
+    dask_local: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    force: bool = False,
+    progress: bool = True,
+    on_record: Callable[[dict[str, Any]], None] | None = None,
+) -> Path:
+    """Build (or resume) the data set of ``spec`` in the folder ``out``; returns ``out``.
+
+    ``backend``: ``serial``, ``processes`` (``workers``, default all cores) or ``dask``
+    (``dask_local`` workers of a local cluster, or ``scheduler``, an existing one).
+    ``on_record`` is called in this process after each record is stored (tests use it to
+    interrupt a build). Raises `ParameterError` for bad settings or an existing data set
+    without ``resume``/``force``; [`Interrupted`][recipdyn.errors.Interrupted] on SIGINT/SIGTERM,
+    with every finished record kept."""
+    from ..errors import deferred_signals
+    from ..locking import RunLock
+
+    if backend not in BACKENDS:
+        raise ParameterError(f"backend = {backend!r}; allowed: {', '.join(BACKENDS)}")
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+        raise ParameterError(f"workers = {workers!r}; allowed: an integer >= 1")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {out}: is a file; expected a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    tasks = design(spec)
+    with RunLock(out, "dataset"):
+        g, names = _open_store(out / "signals.zarr", spec, tasks, resume, force)
+        done = np.asarray(g["done"][:])
+        todo = [t for t in tasks if not done[t["index"]]]
+        n_workers = 1 if backend == "serial" else (workers or dask_local or os.cpu_count() or 1)
+        t0 = time.perf_counter()
+        count = {"n": 0, "failed": 0, "last": t0}
+
+        def accept(res):
+            _write(g, res, names)
+            count["n"] += 1
+            count["failed"] += bool(res["error"])
+            now = time.perf_counter()
+            if progress and (now - count["last"] > 2.0 or count["n"] == len(todo)):
+                rate = count["n"] / (now - t0)
+                left = (len(todo) - count["n"]) / rate if rate > 0 else math.nan
+                print(
+                    f"dataset: {count['n']}/{len(todo)} records ({count['failed']} failed), "
+                    f"{rate:.2f} records/s, {left:.0f} s left",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                count["last"] = now
+            if on_record is not None:
+                on_record(res)
+
+        with deferred_signals() as pending:
+            if backend == "serial":
+                for t in todo:
+                    accept(make_record(t))
+                    pending.check()
+            elif backend == "processes":
+                from ..parallel import run_unordered
+
+                run_unordered(make_record, todo, n_workers, accept, pending)
+            else:
+                n_workers = _run_dask(todo, dask_local, scheduler, workers, accept, pending)
+        wall = time.perf_counter() - t0
+        throughput = {
+            "records": count["n"],
+            "failed": count["failed"],
+            "wall_s": wall,
+            "workers": n_workers,
+            "backend": backend,
+            "records_per_s_per_core": count["n"] / wall / n_workers
+            if wall > 0 and count["n"]
+            else math.nan,
+            "reused": len(tasks) - len(todo),
+        }
+        _finish(out, g, spec, tasks, names, throughput)
+    if progress:
+        print(
+            f"dataset: {count['n']} computed ({count['failed']} failed), "
+            f"{len(tasks) - len(todo)} reused, {wall:.1f} s -> {out}",
+            file=sys.stderr,
+        )
+    return out
+
+
+def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
+    """Recompute every finished record's features from its stored channels (after the
+    features changed; the simulation is not repeated) and rewrite the table and card."""
+    import zarr
+
+    folder = Path(folder)
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="r+")
+    spec = DatasetSpec(
+        **{
+            k: tuple(v) if isinstance(v, list) else v
+            for k, v in json.loads(g.attrs["spec_json"]).items()
+        }
+    )
+    tasks = design(spec)
+    names = feature_names()
+    if g["features"].shape[1] != len(names):
+        old = np.asarray(g["features"][:])
+        del g["features"]
+        g.create_array(
+            "features",
+            shape=(old.shape[0], len(names)),
+            chunks=(1, len(names)),
+            dtype="f8",
+            fill_value=np.nan,
+        )
+    done, err = np.asarray(g["done"][:]), np.asarray(g["error"][:])
+    for t in tasks:
+        i = t["index"]
+        if not done[i] or err[i]:
+            continue
+        n = int(g["n_samples"][i])
+        ch = {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
+        f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
+        g["features"][i, :] = np.array([f[k] for k in names], float)
+    g.attrs["feature_names"] = names
+    card = json.loads((folder / "datacard.json").read_text(encoding="utf-8"))
+    _finish(folder, g, spec, tasks, names, card["throughput"])
+    return folder
+
+
+def _run_dask(todo, dask_local, scheduler, workers, accept, pending) -> int:
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler:
+        client = Client(scheduler)
+        n = max(1, len(client.scheduler_info().get("workers", {})))
+    else:
+        n = dask_local or workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+        client = Client(cluster)
+    try:
+        futures = as_completed([client.submit(_make_records, [t], pure=False) for t in todo])
+        for fut in futures:
+            for res in fut.result():
+                accept(res)
+            pending.check()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return n
+
+
+def _table(g, tasks, names: list[str]):
+    import pandas as pd
+
+    done = np.asarray(g["done"][:])
+    err = np.asarray(g["error"][:])
+    feats = np.asarray(g["features"][:])
+    rows = []
+    for t in tasks:
+        i = t["index"]
+        if not done[i] or err[i]:
+            continue
+        p = t["params"]
+        row = {
+            "record": i,
+            "condition": t["condition"],
+            "split": t["split"],
+            "label": t["label"],
+            "level": t["level"],
+            "severity": t["severity"],
+            "fault_value": t["fault_value"],
+            "omega": p["omega"],
+            "suction_pressure": p["suction_pressure"],
+            "discharge_pressure": p["discharge_pressure"],
+            "m2": p["m2"],
+            "m3": p["m3"],
+            "fs": t["fs"],
+            "resonance_hz": t["resonance_hz"],
+            "snr_db": t["snr_db"],
+            "noise_seed": t["noise_seed"],
+        }
+        row.update({f"f_{k}": v for k, v in zip(names, feats[i], strict=True)})
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+#: Columns of the feature table that describe the condition (not the fault).
+CONDITION_COLUMNS = (
+    "omega",
+    "suction_pressure",
+    "discharge_pressure",
+    "m2",
+    "m3",
+    "fs",
+    "resonance_hz",
+)
+
+
+def _finish(out: Path, g, spec: DatasetSpec, tasks, names, throughput) -> None:
+    from .. import __version__
+    from ..io import atomic_path
+
+    df = _table(g, tasks, names)
+    with atomic_path(out / "features.parquet") as tmp:
+        df.to_parquet(tmp, index=False)
+    card = datacard(spec, df, throughput, __version__)
+    with atomic_path(out / "datacard.json") as tmp:
+        Path(tmp).write_text(json.dumps(card, indent=1, default=float), encoding="utf-8")
+    with atomic_path(out / "datacard.md") as tmp:
+        Path(tmp).write_text(datacard_markdown(card), encoding="utf-8")
+
+
+def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str, Any]:
+    """The data card: what the data set holds and how it was made."""
+    classes = []
+    for name in spec.classes:
+        fc = get_class(name)
+        classes.append(
+            {
+                "name": fc.name,
+                "parameter": fc.parameter,
+                "meaning": fc.meaning,
+                "unit": fc.unit,
+                "scale": fc.scale,
+                "values": [fc.value(s) for s in spec.levels] if fc.parameter else [],
+            }
+        )
+    balance = {}
+    if len(df):
+        for split in ("train", "test"):
+            sub = df[df.split == split]
+            balance[split] = {k: int(v) for k, v in sub.label.value_counts().sort_index().items()}
+    return {
+        "recipdyn_version": version,
+        "model": MODEL,
+        "baseline": BASELINE,
+        "spec": asdict(spec),
+        "classes": classes,
+        "conditions": {
+            k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
+            for k, r in CONDITIONS.items()
+        },
+        "sensors": {
+            "accelerometer": f"recipdyn.sensors.Accelerometer(snr_db={spec.snr_db}, "
+            "resonance_hz=<condition>), other settings default",
+            "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
+            "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
+        },
+        "seeds": {
+            "conditions": [spec.seed, 0],
+            "split": [spec.seed, 1],
+            "noise": f"{spec.seed} * 1000003 + record index",
+        },
+        "split": "by operating condition: no condition has records in both train and test",
+        "records": int(len(df)),
+        "balance": balance,
+        "throughput": throughput,
+    }
+
+
+def datacard_markdown(card: dict[str, Any]) -> str:
+    s = card["spec"]
+    lines = [
+        f"# Data card (recipdyn {card['recipdyn_version']})",
+        "",
+        f"Model `{card['model']}`, healthy baseline {card['baseline']}; "
+        f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
+        f"{len(s['levels'])} severity levels {s['levels']}; {s['revolutions']} "
+        f"revolutions after {s['transient']}; accelerometer SNR {s['snr_db']} dB; "
+        f"seed {s['seed']}. {card['split']}.",
+        "",
+        "| class | parameter | values at the levels | meaning |",
+        "|---|---|---|---|",
+    ]
+    for c in card["classes"]:
+        vals = ", ".join(f"{v:.3g}" for v in c["values"]) + f" {c['unit']}" if c["values"] else ""
+        lines.append(f"| {c['name']} | {c['parameter'] or ''} | {vals} | {c['meaning']} |")
+    lines += ["", "| condition | range | meaning |", "|---|---|---|"]
+    for k, r in card["conditions"].items():
+        lines.append(f"| {k} | {r['lo']:g} .. {r['hi']:g} {r['unit']} | {r['meaning']} |")
+    lines += [
+        "",
+        "Class balance (records): " + json.dumps(card["balance"]),
+        "",
+        "Throughput: " + json.dumps(card["throughput"], default=float),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def read_features(folder: str | Path):
+    """The feature table and the data card of a data set folder."""
+    import pandas as pd
+
+    folder = Path(folder)
+    table, card = folder / "features.parquet", folder / "datacard.json"
+    if not table.exists() or not card.exists():
+        raise ParameterError(
+            f"{folder}: not a data set (no features.parquet/datacard.json); "
+            "build one with 'recipdyn dataset'"
+        )
+    return pd.read_parquet(table), json.loads(card.read_text(encoding="utf-8"))
+
+
+def records_done(folder: str | Path) -> np.ndarray:
+    import zarr
+
+    return np.asarray(zarr.open_group(str(Path(folder) / "signals.zarr"), mode="r")["done"][:])
+
+
+def classes_of(card) -> list:
+    return [get_class(n) for n in card["spec"]["classes"]]

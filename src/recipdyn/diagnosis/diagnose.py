@@ -1,0 +1,373 @@
+"""Diagnose one record (``recipdyn diagnose RECORD``, `recipdyn.diagnose`).
+
+The record is read like ``recipdyn analyze`` reads one (CSV/TSV/WAV/MAT/NetCDF/Parquet,
+channels by name); the crank angle comes from a once-per-revolution tacho whose mark is at
+outer dead centre, or from a constant speed (then the features that need the angle are left
+out and the diagnosis is less sharp). Before any answer, the record must lie in the
+diagnoser's training domain: its crank speed and sampling rate inside the training ranges,
+the frequency at which its impacts ring inside the training sensor band, its
+features no farther from the training records than the held-out conditions were
+(`recipdyn.diagnosis.train.Diagnoser.ood`). Otherwise the diagnosis is withheld, with the
+reason.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .classes import get_class
+
+__all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
+
+#: Slack on the training range of the crank speed and the sampling rate (relative).
+RANGE_SLACK = 0.02
+#: Slack on the training range of the impacts' ringing frequency (relative; the Welch
+#: spectrum's resolution is fs/1024, ~10 Hz, and the resonance's peak is broad: Q = 10).
+RING_SLACK = 0.1
+
+
+def default_model_path() -> Path:
+    """The diagnoser shipped with recipdyn (built by ``make diagnoser``)."""
+    return Path(__file__).parent / "data" / "default.skops"
+
+
+@dataclass
+class Diagnosis:
+    """The answer for one record (``refused``: withheld, with ``reason``)."""
+
+    refused: bool
+    reason: str = ""
+    probabilities: dict[str, float] = field(default_factory=dict)
+    label: str = ""
+    severity: float = float("nan")
+    severity_interval: tuple[float, float] = (float("nan"), float("nan"))
+    value: float = float("nan")
+    value_interval: tuple[float, float] = (float("nan"), float("nan"))
+    unit: str = ""
+    evidence: dict[str, Any] = field(default_factory=dict)
+    ood: dict[str, float] = field(default_factory=dict)
+    figure: str | None = None
+    seconds: float = float("nan")
+
+    def summary(self) -> dict[str, Any]:
+        return {k: v for k, v in self.__dict__.items()}
+
+    def text(self) -> str:
+        if self.refused:
+            return f"refused: {self.reason}"
+        probs = ", ".join(
+            f"{k} {v:.2f}" for k, v in sorted(self.probabilities.items(), key=lambda kv: -kv[1])[:4]
+        )
+        lines = [f"diagnosis: {self.label} (p = {self.probabilities[self.label]:.2f}); {probs}"]
+        if self.label != "healthy":
+            lo, hi = self.value_interval
+            lines.append(
+                f"severity {self.severity:.2f} (90 % interval {self.severity_interval[0]:.2f}"
+                f"..{self.severity_interval[1]:.2f}): {get_class(self.label).parameter} = "
+                f"{self.value:.3g} {self.unit} ({min(lo, hi):.3g}..{max(lo, hi):.3g})"
+            )
+        ev = self.evidence
+        lines.append(
+            f"impacts: {ev['impacts_per_rev']:.1f} per revolution"
+            + (
+                f" at crank angles {', '.join(f'{a:.0f}' for a in ev['impact_angles_deg'])} deg"
+                if ev.get("impact_angles_deg")
+                else ""
+            )
+        )
+        lines.append(
+            "deciding features (robust z against the healthy training records): "
+            + ", ".join(f"{k} {v:+.1f}" for k, v in ev["deciding"])
+        )
+        if "pressure_deviation" in ev:
+            pd_ = ev["pressure_deviation"]
+            lines.append(
+                f"head-end pressure shape: largest deviation from the closest healthy "
+                f"simulated record {pd_['max']:.3f} (of its range) at {pd_['angle_deg']:.0f} deg"
+            )
+        lines.append(
+            f"in domain: distance {self.ood['distance']:.2f} <= {self.ood['threshold']:.2f} "
+            f"({self.ood['features']})"
+        )
+        if self.figure:
+            lines.append(f"closest simulated record overlaid: {self.figure}")
+        lines.append(
+            "trained on simulation only; not validated on a measured compressor (docs/diagnosis.md)"
+        )
+        return "\n".join(lines)
+
+
+def _read(path, column, fs):
+    from ..io_signal import read_signal
+
+    return read_signal(path, column=column, fs=fs)
+
+
+def diagnose(
+    record: str | Path,
+    *,
+    channel: str = "accel_guide",
+    fs=None,
+    speed=None,
+    tacho: str | None = None,
+    p_head: str | None = None,
+    p_crank: str | None = None,
+    model=None,
+    out: str | Path | None = None,
+) -> Diagnosis:
+    """Diagnose the record in the file ``record``.
+
+    Parameters
+    ----------
+    record : path
+        A signal file (the formats of ``recipdyn analyze``).
+    channel : str
+        The acceleration channel (m/s**2).
+    fs : float or str, optional
+        Sampling rate, if the file does not give it.
+    speed : str or float, optional
+        Constant crank speed (e.g. ``"191 rpm"``); or
+    tacho : str, optional
+        The once-per-revolution pulse channel (mark at outer dead centre).
+    p_head, p_crank : str, optional
+        Chamber pressure channels (Pa), if recorded.
+    model : path or Diagnoser, optional
+        Default: the diagnoser shipped with recipdyn.
+    out : path, optional
+        Folder for the overlay figure (none without it).
+
+    Returns
+    -------
+    Diagnosis
+        ``refused=True`` with ``reason`` for a record outside the training domain.
+    """
+    from ..io_signal import speed_hz
+
+    if (speed is None) == (tacho is None):
+        raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
+    sig = _read(record, channel, fs)
+    x, rate = np.asarray(sig.x, float), float(sig.fs)
+    tach = _read(record, tacho, rate).x if tacho is not None else None
+    ph = _read(record, p_head, rate).x if p_head is not None else None
+    pc = _read(record, p_crank, rate).x if p_crank is not None else None
+    return diagnose_arrays(
+        x, rate, tacho=tach, speed_hz=speed_hz(speed), p_head=ph, p_crank=pc, model=model, out=out
+    )
+
+
+def _load(model):
+    from .train import Diagnoser, load
+
+    if isinstance(model, Diagnoser):
+        return model
+    return load(default_model_path() if model is None else model)
+
+
+def diagnose_arrays(
+    x,
+    fs: float,
+    *,
+    tacho=None,
+    speed_hz: float | None = None,
+    p_head=None,
+    p_crank=None,
+    model=None,
+    out=None,
+) -> Diagnosis:
+    """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed)."""
+    from ..analysis.vibration import crank_angle, tacho_times
+    from .evidence import impacts, record_features
+
+    t0 = time.perf_counter()
+    diag = _load(model)
+    x = np.asarray(x, float)
+    if tacho is not None:
+        edges = tacho_times(np.asarray(tacho, float), fs)
+        if edges.size < 3:
+            raise ParameterError(
+                f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
+            )
+        revs = crank_angle(x.size, fs, pulses=edges)
+        keep = np.isfinite(revs)
+    else:
+        if speed_hz is None:
+            raise ParameterError("speed and tacho: give one")
+        revs = crank_angle(x.size, fs, speed_hz=speed_hz)
+        keep = np.ones(x.size, bool)
+    sl = np.flatnonzero(keep)
+    sl = slice(sl[0], sl[-1] + 1)
+    x, revs = x[sl], revs[sl]
+    ph = None if p_head is None else np.asarray(p_head, float)[sl]
+    pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
+    row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
+    names = diag.names
+    X = np.array([[row[n] for n in names]], float)
+    st = diag.state
+    f_rev = row["speed_hz"]
+    res = Diagnosis(refused=False)
+    lo, hi = st["speed_range"]
+    if not lo * (1 - RANGE_SLACK) <= f_rev <= hi * (1 + RANGE_SLACK):
+        return _refuse(
+            res,
+            f"crank speed {f_rev:.3g} Hz ({f_rev * 60:.0f} rpm) is outside "
+            f"the training range {lo:.3g}..{hi:.3g} Hz; train a diagnoser on a "
+            "data set that covers it",
+            t0,
+        )
+    lo, hi = st["fs_range"]
+    if not lo * (1 - RANGE_SLACK) <= fs <= hi * (1 + RANGE_SLACK):
+        return _refuse(
+            res,
+            f"sampling rate {fs:g} Hz is outside the training range "
+            f"{lo:g}..{hi:g} Hz (it shapes the spectral features); resample the "
+            "record or train on that rate",
+            t0,
+        )
+    lo, hi = st["ring_range"]
+    ring = row["acc_ring_hz"]
+    if not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
+        return _refuse(
+            res,
+            f"the impacts ring at {ring:.0f} Hz, outside the training sensor "
+            f"band ({lo:.0f}..{hi:.0f} Hz: the mounting resonances of the data "
+            "set): another sensor or mounting; train on a data set with its "
+            "resonance",
+            t0,
+        )
+    d, thr, subset = diag.ood(X[0])
+    res.ood = {"distance": d, "threshold": thr, "features": subset}
+    if d > thr:
+        return _refuse(
+            res,
+            f"the record's features lie {d / thr:.1f} times farther from the "
+            f"training records than the held-out conditions' (distance {d:.2f}, "
+            f"threshold {thr:.2f}, features: {subset}): another sensor band, "
+            "another machine or a fault outside the data set",
+            t0,
+        )
+    proba = diag.predict_proba(X)[0]
+    classes = diag.classes
+    k = int(np.argmax(proba))
+    res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
+    res.label = classes[k]
+    if res.label != "healthy":
+        s, slo, shi = diag.severity(X, res.label)
+        fc = get_class(res.label)
+        res.severity, res.severity_interval = float(s[0]), (float(slo[0]), float(shi[0]))
+        res.value = fc.value(res.severity)
+        res.value_interval = (
+            fc.value(res.severity_interval[0]),
+            fc.value(res.severity_interval[1]),
+        )
+        res.unit = fc.unit
+    imp = impacts(x, fs, revs)
+    res.evidence = {
+        "impacts_per_rev": imp["per_rev"],
+        "impact_angles_deg": _top_angles(imp) if tacho is not None else [],
+        "deciding": _deciding(diag, X[0]),
+    }
+    j = _closest(diag, X[0], res.label)
+    if ph is not None and tacho is not None:
+        from .train import curve
+
+        healthy = _closest(diag, X[0], "healthy")
+        mine = curve(ph, None, fs, f_rev, 64)
+        ref = np.asarray(st["library_p_head"][healthy], float)[
+            :: st["library_p_head"].shape[1] // 64
+        ]
+        a = (mine - mine.min()) / np.ptp(mine)
+        b = (ref - np.nanmin(ref)) / np.nanmax(ref - np.nanmin(ref))
+        dev = np.abs(a - b)
+        res.evidence["pressure_deviation"] = {
+            "max": float(np.nanmax(dev)),
+            "angle_deg": float(np.nanargmax(dev) * 360 / 64),
+        }
+    res.evidence["closest_record"] = {
+        "label": st["train_labels"][j],
+        "severity": float(st["train_severity"][j]),
+        "record": int(st["train_records"][j]),
+    }
+    if out is not None:
+        res.figure = str(overlay_figure(diag, j, x, tacho, fs, f_rev, Path(out), res))
+    res.seconds = time.perf_counter() - t0
+    return res
+
+
+def _refuse(res: Diagnosis, reason: str, t0: float) -> Diagnosis:
+    res.refused, res.reason = True, reason
+    res.seconds = time.perf_counter() - t0
+    return res
+
+
+def _top_angles(imp, n: int = 6) -> list[float]:
+    order = np.argsort(imp["sizes"])[::-1][:n]
+    return sorted(round(imp["angles_deg"][i], 1) for i in order)
+
+
+def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
+    """The features farthest (robust z) from the healthy training records."""
+    st = diag.state
+    healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
+    Z = st["Z_train"].astype(float)[healthy]
+    z = (row - st["center"]) / st["scale"]
+    med = np.nanmedian(Z, axis=0)
+    spread = np.nanpercentile(Z, 75, axis=0) - np.nanpercentile(Z, 25, axis=0)
+    spread = np.where(spread > 0, spread, np.nanstd(Z, axis=0) + 1e-12)
+    dz = (z - med) / spread
+    ok = np.isfinite(dz)
+    order = np.argsort(-np.abs(np.where(ok, dz, 0)))[:n]
+    return [(diag.names[i], float(dz[i])) for i in order if ok[i]]
+
+
+def _closest(diag, row, label: str) -> int:
+    from .train import K_NEIGHBOURS, _cols, available, knn_distance  # noqa: F401
+
+    st = diag.state
+    idx = np.array([i for i, lab in enumerate(st["train_labels"]) if lab == label])
+    cols = _cols(diag.names, available(row, diag.names))
+    z = (row - st["center"]) / st["scale"]
+    Z = st["Z_train"].astype(float)[idx][:, cols]
+    d = np.sqrt(np.mean((Z - z[cols]) ** 2, axis=1))
+    return int(idx[np.argmin(d)])
+
+
+def overlay_figure(diag, j: int, x, tacho, fs: float, f_rev: float, out: Path, res) -> Path:
+    """The record's first whole revolution and the closest simulated record's, against the
+    crank angle (from the tacho's mark; with a speed only, from the record's start)."""
+    from ..mplstyle import _mpl
+    from .train import CURVE_POINTS, curve
+
+    plt = _mpl()
+    out.mkdir(parents=True, exist_ok=True)
+    ang = np.arange(CURVE_POINTS) * 360.0 / CURVE_POINTS
+    mine = curve(x, None, fs, f_rev)  # x is already cut to start at the tacho's first edge
+    sim = np.asarray(diag.state["library_accel"][j], float)
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    ax.plot(ang, mine, lw=0.8, label="record")
+    ev = res.evidence["closest_record"]
+    ax.plot(
+        ang,
+        sim,
+        lw=0.8,
+        alpha=0.8,
+        label=f"closest simulated: {ev['label']}, severity {ev['severity']:.2f}",
+    )
+    ax.set_xlabel(
+        "crank angle after the tacho mark (deg)"
+        if tacho is not None
+        else "crank angle after the record's start (deg)"
+    )
+    ax.set_ylabel("acceleration (m/s²)")
+    ax.set_xlim(0, 360)
+    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title(f"diagnosis: {res.label} (p = {res.probabilities[res.label]:.2f})")
+    path = out / "diagnosis_overlay.png"
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path

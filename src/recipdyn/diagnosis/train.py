@@ -1,0 +1,535 @@
+"""Train and evaluate diagnosers on a data set (``recipdyn train``).
+
+* **Class**: scikit-learn's `HistGradientBoostingClassifier`. Why not LightGBM: the same
+  algorithm (histogram gradient boosting), but a compiled dependency more; scikit-learn's
+  handles missing features natively (a record without pressure channels or a tacho), is
+  deterministic for a fixed ``random_state`` and persists with skops.
+* **Severity**: one `HistGradientBoostingRegressor` per fault class on the severity in [0, 1],
+  with **split-conformal** intervals: a quarter of the training conditions (whole conditions)
+  is held out to calibrate the absolute residuals, so the interval's coverage is that of a
+  new operating condition (Vovk et al. 2005; Angelopoulos & Bates 2021, sec. 1).
+* **Out of distribution**: the features are scaled by the training median and interquartile
+  range; a record's distance to its `K_NEIGHBOURS`-th nearest training record (over the
+  features the record has) is compared with the 99th percentile of the same distance for the
+  calibration conditions, times `OOD_MARGIN`; the crank speed and the sampling rate must lie
+  in the training ranges.
+
+Evaluation (on the held-out test conditions): accuracy, confusion matrix, per-class recall,
+the reliability diagram and expected calibration error of the top-class probability, the
+detection limit of each fault (the smallest severity level from which every level's recall is
+at least 90 %), the severity's median relative error and the intervals' coverage, the
+permutation importance of the features, and a classifier trained on the operating condition
+alone (it must be at chance).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .classes import get_class
+from .dataset import CONDITION_COLUMNS, read_features
+from .evidence import feature_groups
+
+__all__ = [
+    "train",
+    "evaluate",
+    "Diagnoser",
+    "save",
+    "load",
+    "K_NEIGHBOURS",
+    "OOD_MARGIN",
+    "expected_calibration_error",
+    "detection_limits",
+]
+
+#: Neighbours of the out-of-distribution distance.
+K_NEIGHBOURS = 3
+#: Margin on the calibration conditions' 99th percentile of that distance.
+OOD_MARGIN = 1.5
+#: Quantiles of the training records' ringing frequency that bound the sensor band accepted.
+RING_QUANTILES = (0.05, 0.95)
+#: Nominal coverage of the severity intervals.
+COVERAGE = 0.9
+#: Feature subsets by the channels a record has.
+AVAILABILITY = {
+    "full": ("base", "angle", "pressure"),
+    "no_pressure": ("base", "angle"),
+    "vibration_only": ("base",),
+}
+#: Samples per revolution of the stored angle-domain curves (the overlay's library).
+CURVE_POINTS = 256
+
+
+def _hgb_classifier(seed: int):
+    from sklearn.ensemble import HistGradientBoostingClassifier
+
+    return HistGradientBoostingClassifier(
+        max_iter=100, learning_rate=0.1, max_leaf_nodes=8, early_stopping=False, random_state=seed
+    )
+
+
+def _hgb_regressor(seed: int):
+    from sklearn.ensemble import HistGradientBoostingRegressor
+
+    return HistGradientBoostingRegressor(
+        max_iter=100, learning_rate=0.1, max_leaf_nodes=8, early_stopping=False, random_state=seed
+    )
+
+
+def _augment(X: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The rows three times: all features, without the pressure group, base only (a record
+    without pressure channels, or without a tacho); returns the rows and the source index."""
+    groups = feature_groups(names)
+    idx = {n: i for i, n in enumerate(names)}
+    blocks = []
+    for keep in AVAILABILITY.values():
+        Y = X.copy()
+        for g, cols in groups.items():
+            if g not in keep:
+                Y[:, [idx[c] for c in cols]] = np.nan
+        blocks.append(Y)
+    return np.vstack(blocks), np.tile(np.arange(X.shape[0]), len(blocks))
+
+
+def _scaler(X):
+    med = np.nanmedian(X, axis=0)
+    q1, q3 = np.nanpercentile(X, [25, 75], axis=0)
+    iqr = q3 - q1
+    sd = np.nanstd(X, axis=0)
+    scale = np.where(iqr > 0, iqr, np.where(sd > 0, sd, 1.0))
+    return med, scale
+
+
+def knn_distance(Z_ref: np.ndarray, Z: np.ndarray, cols: np.ndarray, k: int) -> np.ndarray:
+    """RMS-per-feature distance of each row of ``Z`` to its ``k``-th nearest row of
+    ``Z_ref`` over the columns ``cols``."""
+    A, B = Z_ref[:, cols], Z[:, cols]
+    d = np.sqrt(np.maximum(((B[:, None, :] - A[None, :, :]) ** 2).mean(axis=2), 0.0))
+    return np.sort(d, axis=1)[:, min(k, A.shape[0]) - 1]
+
+
+def available(row: np.ndarray, names: list[str]) -> str:
+    """Which availability subset a feature row has (`AVAILABILITY`)."""
+    groups = feature_groups(names)
+    idx = {n: i for i, n in enumerate(names)}
+    has = {g for g, cols in groups.items() if np.isfinite(row[[idx[c] for c in cols]]).any()}
+    for name, keep in AVAILABILITY.items():
+        if set(keep) <= has:
+            return name
+    return "vibration_only"
+
+
+def _cols(names, subset: str) -> np.ndarray:
+    groups = feature_groups(names)
+    keep = [n for g in AVAILABILITY[subset] for n in groups[g]]
+    return np.array([names.index(n) for n in keep])
+
+
+def expected_calibration_error(proba: np.ndarray, y: np.ndarray, bins: int = 10):
+    """Top-label expected calibration error (Guo et al. 2017, eq. 3) and the reliability
+    diagram's bins: ``(ece, [(mean confidence, accuracy, count), ...])``."""
+    conf = proba.max(axis=1)
+    correct = proba.argmax(axis=1) == y
+    edges = np.linspace(0, 1, bins + 1)
+    ece, diagram = 0.0, []
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        m = (conf > lo) & (conf <= hi)
+        if m.any():
+            ece += m.mean() * abs(conf[m].mean() - correct[m].mean())
+            diagram.append((float(conf[m].mean()), float(correct[m].mean()), int(m.sum())))
+    return float(ece), diagram
+
+
+def detection_limits(labels, levels, severities, predicted, classes, threshold=0.9):
+    """Per fault class: the recall at each severity level and the detection limit, the
+    smallest level from which every level's recall is at least ``threshold`` (None: not
+    reached)."""
+    out = {}
+    for c in classes:
+        if c == "healthy":
+            continue
+        m = labels == c
+        recall = {}
+        for lv in sorted(set(severities[m].tolist())):
+            mm = m & (severities == lv)
+            recall[float(lv)] = float((predicted[mm] == c).mean())
+        limit = None
+        for lv in sorted(recall, reverse=True):
+            if recall[lv] >= threshold:
+                limit = lv
+            else:
+                break
+        fc = get_class(c)
+        out[c] = {
+            "recall_by_severity": recall,
+            "limit_severity": limit,
+            "limit_value": fc.value(limit) if limit is not None else None,
+            "unit": fc.unit,
+        }
+    return out
+
+
+class Diagnoser:
+    """A trained diagnoser: the classifier, the severity regressors with their conformal
+    half-widths, the out-of-distribution reference, the angle-domain library and the data
+    card it was trained on. Build with `train`; persist with `save` / `load`."""
+
+    def __init__(self, state: dict[str, Any]):
+        self.state = state
+
+    @property
+    def classes(self) -> list[str]:
+        return list(self.state["classes"])
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.state["feature_names"])
+
+    @property
+    def card(self) -> dict:
+        return json.loads(self.state["datacard_json"])
+
+    def predict_proba(self, X: np.ndarray) -> np.ndarray:
+        return self.state["classifier"].predict_proba(np.asarray(X, float))
+
+    def severity(self, X: np.ndarray, label: str):
+        """Severity in [0, 1] and its `COVERAGE` interval for class ``label``."""
+        reg = self.state["regressors"].get(label)
+        if reg is None:
+            n = np.asarray(X).shape[0]
+            return np.zeros(n), np.zeros(n), np.zeros(n)
+        s = np.clip(reg.predict(np.asarray(X, float)), 0.0, 1.0)
+        q = float(self.state["conformal"][label])
+        return s, np.clip(s - q, 0, 1), np.clip(s + q, 0, 1)
+
+    def ood(self, row: np.ndarray) -> tuple[float, float, str]:
+        """(distance, threshold, subset) of one feature row."""
+        names = self.names
+        subset = available(row, names)
+        cols = _cols(names, subset)
+        z = (np.asarray(row, float) - self.state["center"]) / self.state["scale"]
+        d = knn_distance(self.state["Z_train"].astype(float), z[None, :], cols, K_NEIGHBOURS)
+        return float(d[0]), float(self.state["ood_threshold"][subset]), subset
+
+
+def _split_train(df, seed: int):
+    conds = np.array(sorted(df.condition.unique()))
+    rng = np.random.default_rng([seed, 2])
+    n_cal = max(1, round(len(conds) / 4)) if len(conds) > 1 else 0
+    cal = set(rng.permutation(conds)[:n_cal].tolist())
+    is_cal = df.condition.isin(cal).to_numpy()
+    return ~is_cal, is_cal
+
+
+def curve(x, tacho, fs, f_rev, points: int = CURVE_POINTS) -> np.ndarray:
+    """One revolution of ``x`` from the tacho's first edge (or the record's start) at
+    ``points`` crank angles (linear interpolation)."""
+    from ..analysis.vibration import tacho_times
+
+    t = np.arange(x.size) / fs
+    t0 = 0.0
+    if tacho is not None:
+        e = tacho_times(tacho, fs)
+        if e.size and e[0] + 1 / f_rev <= t[-1]:
+            t0 = float(e[0])
+    tq = t0 + np.arange(points) / points / f_rev
+    if tq[-1] > t[-1]:
+        return np.full(points, np.nan)
+    return np.interp(tq, t, x)
+
+
+def train(folder: str | Path, *, seed: int = 0, progress: bool = True) -> tuple[Diagnoser, dict]:
+    """Train a diagnoser on the training conditions of the data set in ``folder`` and
+    evaluate it on the test conditions; returns ``(diagnoser, evaluation)``."""
+    from threadpoolctl import threadpool_limits
+
+    folder = Path(folder)
+    with threadpool_limits(1):  # OpenMP threads on a loaded machine cost 10x, not save
+        return _train(folder, seed)
+
+
+def _train(folder: Path, seed: int) -> tuple[Diagnoser, dict]:
+    from .. import __version__
+
+    df, card = read_features(folder)
+    names = [c[2:] for c in df.columns if c.startswith("f_")]
+    classes = list(card["spec"]["classes"])
+    train_df = df[df.split == "train"].reset_index(drop=True)
+    test_df = df[df.split == "test"].reset_index(drop=True)
+    if train_df.label.nunique() < len(classes) or test_df.empty:
+        raise ParameterError(
+            f"{folder}: the training conditions lack some classes or there "
+            "is no test condition; build a larger data set"
+        )
+    X = train_df[[f"f_{n}" for n in names]].to_numpy(float)
+    y = train_df.label.map({c: i for i, c in enumerate(classes)}).to_numpy()
+    Xa, src = _augment(X, names)
+    clf = _hgb_classifier(seed).fit(Xa, y[src])
+    proper, cal = _split_train(train_df, seed)
+    regs, conformal = {}, {}
+    for c in classes:
+        if c == "healthy":
+            continue
+        m = (train_df.label == c).to_numpy()
+        Xc, sc = _augment(X[m & proper], names)
+        s = train_df.severity.to_numpy()[m & proper]
+        reg = _hgb_regressor(seed).fit(Xc, s[sc])
+        Xcal, scal = _augment(X[m & cal], names)
+        resid = np.abs(
+            np.clip(reg.predict(Xcal), 0, 1) - train_df.severity.to_numpy()[m & cal][scal]
+        )
+        n = resid.size
+        qlev = min(1.0, math.ceil((n + 1) * COVERAGE) / n) if n else 1.0
+        conformal[c] = float(np.quantile(resid, qlev, method="higher")) if n else 1.0
+        regs[c] = reg
+    center, scale = _scaler(X[proper])
+    Zp = (X[proper] - center) / scale
+    Zc = (X[cal] - center) / scale
+    thresholds = {}
+    for subset in AVAILABILITY:
+        cols = _cols(names, subset)
+        d = knn_distance(Zp, Zc, cols, K_NEIGHBOURS)
+        thresholds[subset] = float(np.quantile(d, 0.99) * OOD_MARGIN)
+    speed = train_df.f_speed_hz.to_numpy()
+    acc_curves, p_curves = _library(folder, train_df)
+    fingerprints = _fingerprints(train_df, card, names, clf, classes)
+    state = {
+        "format": 1,
+        "recipdyn_version": __version__,
+        "sklearn_version": _sk_version(),
+        "datacard_json": json.dumps(card, default=float),
+        "classes": classes,
+        "feature_names": names,
+        "classifier": clf,
+        "regressors": regs,
+        "conformal": conformal,
+        "center": center,
+        "scale": scale,
+        "Z_train": ((X - center) / scale).astype(np.float32),
+        "ood_threshold": thresholds,
+        "speed_range": [float(speed.min()), float(speed.max())],
+        "fs_range": [float(train_df.fs.min()), float(train_df.fs.max())],
+        # the central 90 % (a few records with few impacts peak elsewhere: RING_QUANTILES)
+        "ring_range": [float(np.nanquantile(train_df.f_acc_ring_hz, q)) for q in RING_QUANTILES],
+        "train_labels": train_df.label.tolist(),
+        "train_severity": train_df.severity.to_numpy(float),
+        "train_records": train_df.record.to_numpy(int),
+        "library_accel": acc_curves,
+        "library_p_head": p_curves,
+        "fingerprints_json": json.dumps(fingerprints, default=float),
+    }
+    for k in ("center", "scale"):
+        state[k] = np.asarray(state[k], float)
+    diag = Diagnoser(state)
+    return diag, evaluate(diag, test_df, train_df, seed=seed)
+
+
+def _library(folder, train_df):
+    import zarr
+
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="r")
+    recs = train_df.record.to_numpy(int)
+    acc = np.full((recs.size, CURVE_POINTS), np.nan, np.float32)
+    ph = np.full((recs.size, CURVE_POINTS), np.nan, np.float32)
+    for j, i in enumerate(recs):
+        n = int(g["n_samples"][i])
+        fs = float(train_df.fs.iloc[j])
+        f_rev = float(train_df.omega.iloc[j]) / (2 * np.pi)
+        tach = np.asarray(g["tacho"][i, :n], float)
+        acc[j] = curve(np.asarray(g["accel_guide"][i, :n], float), tach, fs, f_rev)
+        ph[j] = curve(np.asarray(g["p_head_sensor"][i, :n], float), tach, fs, f_rev)
+    return acc.astype(np.float16), ph
+
+
+def _fingerprints(train_df, card, names, clf, classes) -> list[dict[str, Any]]:
+    """Records whose physics a diagnoser pins: their tasks, features and predicted
+    probabilities (the healthy machine, the ring leak and the suction-valve leak at the first
+    training condition)."""
+    from .dataset import DatasetSpec, design
+
+    spec = DatasetSpec(
+        **{k: tuple(v) if isinstance(v, list) else v for k, v in card["spec"].items()}
+    )
+    tasks = {t["index"]: t for t in design(spec)}
+    first = train_df.condition.min()
+    out = []
+    for c in ("healthy", "ring_leak", "suction_valve_leak"):
+        sub = train_df[(train_df.condition == first) & (train_df.label == c)]
+        if sub.empty:
+            continue
+        r = sub.iloc[-1]
+        x = np.array([[r[f"f_{n}"] for n in names]], float)
+        out.append(
+            {
+                "task": tasks[int(r.record)],
+                "features": dict(zip(names, x[0].tolist(), strict=True)),
+                "proba": clf.predict_proba(x)[0].tolist(),
+            }
+        )
+    return out
+
+
+def _sk_version() -> str:
+    import sklearn
+
+    return sklearn.__version__
+
+
+def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, Any]:
+    """The evaluation on held-out conditions (see the module docstring)."""
+    from sklearn.metrics import confusion_matrix
+
+    classes, names = diag.classes, diag.names
+    X = test_df[[f"f_{n}" for n in names]].to_numpy(float)
+    y = test_df.label.map({c: i for i, c in enumerate(classes)}).to_numpy()
+    res: dict[str, Any] = {
+        "n_test": int(len(test_df)),
+        "n_train": int(len(train_df)),
+        "test_conditions": sorted(int(c) for c in test_df.condition.unique()),
+    }
+    Xa, src = _augment(X, names)
+    for (subset, _), k in zip(AVAILABILITY.items(), range(3), strict=True):
+        rows = slice(k * X.shape[0], (k + 1) * X.shape[0])
+        proba = diag.predict_proba(Xa[rows])
+        pred = proba.argmax(axis=1)
+        ece, diagram = expected_calibration_error(proba, y)
+        moderate = (test_df.label == "healthy").to_numpy() | (test_df.severity >= 0.5).to_numpy()
+        res[subset] = {
+            "accuracy": float((pred == y).mean()),
+            "accuracy_moderate_severe": float((pred == y)[moderate].mean()),
+            "ece": ece,
+            "reliability": diagram,
+            "confusion": confusion_matrix(y, pred, labels=range(len(classes))).tolist(),
+            "recall": {c: float((pred[y == i] == i).mean()) for i, c in enumerate(classes)},
+            "detection": detection_limits(
+                test_df.label.to_numpy(),
+                None,
+                test_df.severity.to_numpy(),
+                np.array(classes)[pred],
+                classes,
+            ),
+        }
+        if subset == "full":
+            res["predicted"] = np.array(classes)[pred].tolist()
+            res["proba"] = proba.tolist()
+    # severity, given the true class
+    sev: dict[str, Any] = {}
+    rel_all, cover_all = [], []
+    for c in classes:
+        if c == "healthy":
+            continue
+        m = (test_df.label == c).to_numpy()
+        if not m.any():
+            continue
+        s, lo, hi = diag.severity(X[m], c)
+        true = test_df.severity.to_numpy()[m]
+        fc = get_class(c)
+        v_hat = np.array([fc.value(v) for v in s])
+        v_true = np.array([fc.value(v) for v in true])
+        rel = np.abs(v_hat - v_true) / np.abs(v_true - (1.0 if c == "weak_valve_spring" else 0))
+        cover = (true >= lo - 1e-12) & (true <= hi + 1e-12)
+        sev[c] = {
+            "median_relative_error": float(np.median(rel)),
+            "coverage": float(cover.mean()),
+            "half_width": float(diag.state["conformal"][c]),
+            "n": int(m.sum()),
+        }
+        rel_all += rel.tolist()
+        cover_all += cover.tolist()
+    res["severity"] = sev
+    res["severity_median_relative_error"] = float(np.median(rel_all)) if rel_all else math.nan
+    res["severity_coverage"] = float(np.mean(cover_all)) if cover_all else math.nan
+    res["condition_only"] = condition_only(train_df, test_df, classes, seed)
+    res["importance"] = _importance(diag, X, y, seed)
+    from .diagnose import RING_SLACK
+
+    lo, hi = diag.state["ring_range"]
+    ring = X[:, names.index("acc_ring_hz")]
+    out_band = ~((ring >= lo * (1 - RING_SLACK)) & (ring <= hi * (1 + RING_SLACK)))
+    far = np.array([diag.ood(row)[0] > diag.ood(row)[1] for row in X])
+    res["ood_false_refusals"] = float(np.mean(out_band | far))
+    return res
+
+
+def condition_only(train_df, test_df, classes, seed: int) -> dict[str, float]:
+    """Accuracy of a classifier that sees only the operating condition and the sensor
+    settings, against chance (1 / number of classes) and its binomial bound on the test
+    size (chance + 3 standard deviations)."""
+    cols = list(CONDITION_COLUMNS)
+    ytr = train_df.label.map({c: i for i, c in enumerate(classes)}).to_numpy()
+    yte = test_df.label.map({c: i for i, c in enumerate(classes)}).to_numpy()
+    clf = _hgb_classifier(seed).fit(train_df[cols].to_numpy(float), ytr)
+    acc = float((clf.predict(test_df[cols].to_numpy(float)) == yte).mean())
+    p = 1.0 / len(classes)
+    bound = p + 3 * math.sqrt(p * (1 - p) / len(test_df))
+    return {"accuracy": acc, "chance": p, "bound": bound}
+
+
+def _importance(diag, X, y, seed) -> list[tuple[str, float]]:
+    from sklearn.inspection import permutation_importance
+
+    r = permutation_importance(
+        diag.state["classifier"], X, y, n_repeats=3, random_state=seed, scoring="accuracy"
+    )
+    order = np.argsort(r.importances_mean)[::-1][:15]
+    return [(diag.names[i], float(r.importances_mean[i])) for i in order]
+
+
+#: Types a diagnoser file may hold (checked before loading: skops refuses anything else).
+TRUSTED_PREFIXES = ("sklearn.", "numpy.", "builtins.", "collections.")
+
+
+def save(diag: Diagnoser, path: str | Path) -> Path:
+    """Write ``diag`` to a skops file (written to a temporary file, then renamed)."""
+    import zipfile
+
+    import skops.io as sio
+
+    from ..io import atomic_path
+
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        sio.dump(diag.state, tmp, compression=zipfile.ZIP_DEFLATED, compresslevel=9)
+    return path
+
+
+def load(path: str | Path, *, check_version: bool = True) -> Diagnoser:
+    """Read a diagnoser file; refuses one written by another recipdyn or scikit-learn version
+    (its predictions would not be those evaluated) and one holding untrusted types."""
+    import skops.io as sio
+
+    from .. import __version__
+
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(
+            f"diagnoser {path}: file not found; build one with 'recipdyn train DATASET -o FILE'"
+        )
+    try:
+        untrusted = sio.get_untrusted_types(file=path)
+    except Exception as exc:  # noqa: BLE001
+        raise ParameterError(f"diagnoser {path}: not a skops file ({type(exc).__name__})") from None
+    bad = [t for t in untrusted if not t.startswith(TRUSTED_PREFIXES)]
+    if bad:
+        raise ParameterError(f"diagnoser {path}: holds untrusted types {bad}; refused")
+    state = sio.load(path, trusted=untrusted)
+    if not isinstance(state, dict) or state.get("format") != 1:
+        raise ParameterError(f"diagnoser {path}: not a recipdyn diagnoser")
+    if check_version:
+        for what, have, want in (
+            ("recipdyn", state["recipdyn_version"], __version__),
+            ("scikit-learn", state["sklearn_version"], _sk_version()),
+        ):
+            if have != want:
+                raise ParameterError(
+                    f"diagnoser {path}: trained with {what} {have}, this is {what} {want}; "
+                    "retrain it ('recipdyn train DATASET -o FILE', or 'make diagnoser' for "
+                    "the default one)"
+                )
+    return Diagnoser(state)
