@@ -131,6 +131,67 @@ def remove_orphans(folder: str | Path) -> int:
     return n
 
 
+def lazy_dask() -> None:
+    """Let xarray build datasets without importing dask until dask is in use.
+
+    xarray asks of every array it wraps whether it is a dask array, and answers by importing
+    ``dask.array`` (0.5-1 s of a 10-revolution ``simulate``). No array can be a dask array
+    before ``dask.array`` is imported, so until then the answer is "no" without the import;
+    once anything imports it (a chunked read, a sweep), xarray's own answer is used. Installs
+    once per process; a no-op if xarray's internals differ from the version this was written
+    for (2025.x-2026.x: ``xarray.namedarray.pycompat``), which then imports dask as before.
+    """
+    import sys
+
+    try:
+        from xarray.namedarray import pycompat
+
+        cache = pycompat._cached_duck_array_modules
+        base = pycompat.DuckArrayModule
+    except (ImportError, AttributeError):  # pragma: no cover - another xarray
+        return
+    if "dask" in cache:
+        return
+
+    class _DaskOnDemand(base):
+        def __init__(self) -> None:  # no import here
+            pass
+
+        def _real(self):
+            real = base("dask")
+            cache["dask"] = real
+            return real
+
+        @property
+        def type(self):
+            return self._real().type if "dask.array" in sys.modules else ()
+
+        def __getattr__(self, name: str):  # module, version, available: xarray's answer
+            return getattr(self._real(), name)
+
+    cache["dask"] = _DaskOnDemand()
+
+
+@contextlib.contextmanager
+def _no_unused_scheduler() -> Iterator[None]:
+    """While writing NetCDF, xarray asks dask which scheduler runs (to choose a lock), and
+    dask asks ``distributed`` for a client, importing both (~0.5 s). In a process that has not
+    imported them there is no dask array to schedule and no client: this answers so (as if
+    they were not installed), then puts everything back."""
+    import sys
+
+    hidden = [n for n in ("dask", "distributed") if n not in sys.modules]
+    hidden += [f"{n}.{sub}" for n in hidden for sub in ("base", "distributed")]
+    for name in hidden:
+        sys.modules[name] = None  # an import of it raises ImportError, which xarray expects
+    try:
+        yield
+    finally:
+        for name in hidden:
+            if sys.modules.get(name, 0) is None:
+                del sys.modules[name]
+
+
 def write_dataset(ds, path: str | Path) -> Path:
     """Write a Dataset in the format its extension names (.nc, .csv, .zarr, .mat), atomically.
 
@@ -148,7 +209,8 @@ def write_dataset(ds, path: str | Path) -> Path:
             return path
         with atomic_path(path) as tmp:
             if fmt == "NetCDF":
-                ds.to_netcdf(tmp)
+                with _no_unused_scheduler():
+                    ds.to_netcdf(tmp)
             elif fmt == "MAT":
                 _write_mat(ds, tmp)
             else:
@@ -249,6 +311,8 @@ def read_dataset(path: str | Path, *, what: str = "input",
                  expected: str = "a recipdyn run (NetCDF from 'recipdyn simulate')"):  # fmt: skip
     """Open a NetCDF file as a loaded Dataset, refusing clearly when it is not what is needed."""
     import xarray as xr
+
+    lazy_dask()
 
     path = Path(path)
     if not path.exists():
