@@ -1,5 +1,5 @@
-"""recipdyn.io: datasets are built and written without loading dask or distributed unless they
-are in use, and dask arrays are still recognised once they are."""
+"""recipdyn.io: datasets are built and written without loading dask, pint or distributed
+unless they are in use, and dask arrays and quantities are still recognised once they are."""
 
 from __future__ import annotations
 
@@ -13,11 +13,12 @@ _PROBE = r"""
 import json, sys
 import numpy as np
 import xarray as xr
-from recipdyn.io import lazy_dask, write_dataset
+from recipdyn.io import lazy_duck_arrays, write_dataset
 
-lazy_dask()
+lazy_duck_arrays()
 ds = xr.Dataset({"a": ("time", np.arange(50.0))}, coords={"time": np.arange(50.0) / 10})
-out = {"dask_array_after_build": "dask.array" in sys.modules}
+out = {"dask_array_after_build": "dask.array" in sys.modules,
+       "pint_after_build": "pint" in sys.modules}
 write_dataset(ds, sys.argv[1] + "/plain.nc")
 out["distributed_after_write"] = "distributed" in sys.modules
 out["hidden_left"] = sorted(k for k, v in sys.modules.items() if v is None and "dask" in k
@@ -32,24 +33,29 @@ out["chunks"] = list(chunked.chunks["time"])
 write_dataset(chunked, sys.argv[1] + "/chunked.nc")
 out["chunked_equal"] = bool(xr.open_dataset(sys.argv[1] + "/chunked.nc").a.values.tolist()
                             == list(np.arange(50.0)))
+import pint
+q = xr.DataArray(pint.UnitRegistry().Quantity(np.arange(3.0), "m"), dims="x")
+out["quantity_kept"] = isinstance(q.data, pint.Quantity)
 print(json.dumps(out))
 """
 
 
 def test_records_are_built_and_written_without_dask_until_it_is_used(tmp_path):
-    """xarray asks of every array whether it is a dask array (importing dask.array) and, when
-    writing NetCDF, which dask scheduler runs (importing distributed): half a second of a short
-    simulate. Until dask.array is imported nothing can be a dask array, so `lazy_dask` answers
-    no without importing it; the write hides the unimported schedulers and puts them back.
-    Once dask.array is imported, chunked data are dask arrays again and are written whole."""
+    """xarray asks of every array whether it is a dask array or a pint quantity (importing
+    dask.array and pint) and, when writing NetCDF, which dask scheduler runs (importing
+    distributed): about a second of a short simulate. Until they are imported nothing can be
+    one, so `lazy_duck_arrays` answers no without importing them; the write hides the
+    unimported schedulers and puts them back. Once imported, chunked data are dask arrays
+    again and are written whole, and a quantity stays a quantity."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     done = subprocess.run([sys.executable, "-c", _PROBE, str(tmp_path)], env=env,
                           capture_output=True, text=True, timeout=300)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
     res = json.loads(done.stdout.strip().splitlines()[-1])
-    assert res == {"dask_array_after_build": False, "distributed_after_write": False,
-                   "hidden_left": [], "plain_equal": True, "recognised": True,
-                   "chunks": [10] * 5, "chunked_equal": True}  # fmt: skip
+    assert res == {"dask_array_after_build": False, "pint_after_build": False,
+                   "distributed_after_write": False, "hidden_left": [], "plain_equal": True,
+                   "recognised": True, "chunks": [10] * 5, "chunked_equal": True,
+                   "quantity_kept": True}  # fmt: skip
 
 
 def test_a_torn_unit_cache_file_is_parsed_again(tmp_path, monkeypatch):

@@ -131,15 +131,16 @@ def remove_orphans(folder: str | Path) -> int:
     return n
 
 
-def lazy_dask() -> None:
-    """Let xarray build datasets without importing dask until dask is in use.
+def lazy_duck_arrays() -> None:
+    """Let xarray build datasets without importing dask or pint until they are in use.
 
-    xarray asks of every array it wraps whether it is a dask array, and answers by importing
-    ``dask.array`` (0.5-1 s of a 10-revolution ``simulate``). No array can be a dask array
-    before ``dask.array`` is imported, so until then the answer is "no" without the import;
-    once anything imports it (a chunked read, a sweep), xarray's own answer is used. Installs
-    once per process; a no-op if xarray's internals differ from the version this was written
-    for (2025.x-2026.x: ``xarray.namedarray.pycompat``), which then imports dask as before.
+    xarray asks of every array it wraps whether it is a dask array or a pint quantity, and
+    answers by importing ``dask.array`` and ``pint`` (together 0.5-1 s of a 10-revolution
+    ``simulate``). No array can be a dask array before ``dask.array`` is imported, nor a
+    quantity before ``pint`` is, so until then the answer is "no" without the import; once
+    anything imports them (a chunked read, a sweep, a unit conversion), xarray's own answer is
+    used. Installs once per process; a no-op if xarray's internals differ from the version this
+    was written for (``xarray.namedarray.pycompat``), which then imports them as before.
     """
     import sys
 
@@ -150,26 +151,28 @@ def lazy_dask() -> None:
         base = pycompat.DuckArrayModule
     except (ImportError, AttributeError):  # pragma: no cover - another xarray
         return
-    if "dask" in cache:
-        return
 
-    class _DaskOnDemand(base):
-        def __init__(self) -> None:  # no import here
-            pass
+    class _OnDemand(base):
+        def __init__(self, mod: str, marker: str) -> None:  # no import here
+            self._mod, self._marker = mod, marker
 
         def _real(self):
-            real = base("dask")
-            cache["dask"] = real
+            real = base(self._mod)
+            cache[self._mod] = real
             return real
 
         @property
         def type(self):
-            return self._real().type if "dask.array" in sys.modules else ()
+            return self._real().type if self._marker in sys.modules else ()
 
         def __getattr__(self, name: str):  # module, version, available: xarray's answer
+            if name.startswith("_"):
+                raise AttributeError(name)
             return getattr(self._real(), name)
 
-    cache["dask"] = _DaskOnDemand()
+    for mod, marker in (("dask", "dask.array"), ("pint", "pint")):
+        if mod not in cache:
+            cache[mod] = _OnDemand(mod, marker)
 
 
 @contextlib.contextmanager
@@ -312,7 +315,7 @@ def read_dataset(path: str | Path, *, what: str = "input",
     """Open a NetCDF file as a loaded Dataset, refusing clearly when it is not what is needed."""
     import xarray as xr
 
-    lazy_dask()
+    lazy_duck_arrays()
 
     path = Path(path)
     if not path.exists():

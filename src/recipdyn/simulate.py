@@ -17,7 +17,7 @@ from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, LawRangeWarning, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import UniformGrid, check_tolerances
-from .io import lazy_dask
+from .io import lazy_duck_arrays
 from .model.compressor import COMPRESSOR, compressor_model
 from .model.parameters import CompressorParams, ParameterError, resolve_name
 from .model.protocol import Model
@@ -27,7 +27,7 @@ from .resources import check_memory
 __all__ = ["simulate", "summarize", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
            "estimate_memory", "STARTUP_REVOLUTIONS"]  # fmt: skip
 
-lazy_dask()  # a record is built without importing dask (io.lazy_dask)
+lazy_duck_arrays()  # a record is built without importing dask or pint (io)
 
 SIGN_CONVENTION = (
     "x along the cylinder axis from the crank centre toward the cylinder (theta1 = 0: outer dead "
