@@ -25,7 +25,8 @@ run: warmup
 	$(VENV)/bin/recipdyn reproduce --out $(OUT)
 
 # the suite in parallel: one worker per logical CPU, at most 4 (each holds ~1 GB), a test file
-# on one worker (its module fixtures, a shared run or sweep store, are computed once);
+# on one worker (its module fixtures, a shared run or sweep store, are computed once; the
+# per-model checks of test_models.py go out by model: tests/conftest.py);
 # TEST_JOBS=0 runs it in this process, TEST_JOBS=N on N workers
 TEST_JOBS ?= logical
 test: $(STAMP)
