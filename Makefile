@@ -24,8 +24,14 @@ warmup: $(STAMP)
 run: warmup
 	$(VENV)/bin/recipdyn reproduce --out $(OUT)
 
+# the suite in parallel: one worker per logical CPU, at most 4 (each holds ~1 GB), a test file
+# on one worker (its module fixtures, a shared run or sweep store, are computed once; the
+# per-model checks of test_models.py go out by model: tests/conftest.py);
+# TEST_JOBS=0 runs it in this process, TEST_JOBS=N on N workers
+TEST_JOBS ?= logical
 test: $(STAMP)
-	$(PY) -m pytest -q --timeout=1200
+	$(PY) -m pytest -q --timeout=1200 -n $(TEST_JOBS) --maxprocesses=4 --dist loadfile \
+		--durations=25
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -m "not slow" -x

@@ -107,6 +107,29 @@ def test_dense_signal_drawn_as_envelope_with_zoom():
         plt.close(fig)
 
 
+def test_is_dense_counts_prominent_peaks_as_find_peaks_does(rng):
+    """is_dense skips SciPy's signal module when a signal has too few local maxima to be dense;
+    the answer is the one the prominence count gives, for smooth signals, plateaus, ripple
+    that only rounding would show, and dense rings."""
+    from scipy.signal import find_peaks
+
+    t = np.linspace(0.0, 1.0, 20_000)
+    cases = {
+        "slow": np.sin(2 * np.pi * 3 * t),
+        "plateaus": np.round(np.sin(2 * np.pi * 40 * t), 1),
+        "ripple": np.sin(2 * np.pi * 3 * t) + 1e-6 * rng.standard_normal(t.size),
+        "ring": np.sin(2 * np.pi * 3 * t) + 0.2 * np.sin(2 * np.pi * 900 * t),
+        "noise": rng.standard_normal(t.size),
+    }
+    answers = set()
+    for name, y in cases.items():
+        for cols in (100, 400, 1000):
+            expected = find_peaks(y, prominence=0.01 * np.ptp(y))[0].size > cols / 3
+            assert is_dense(y, cols) == expected, (name, cols)
+            answers.add(expected)
+    assert answers == {True, False}
+
+
 def test_dense_orbit_is_drawn_as_density():
     """A dense orbit becomes its occupation density: the histogram sums to 1 over the cells
     the orbit visits; a sparse one stays a line."""

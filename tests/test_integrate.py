@@ -207,20 +207,24 @@ def test_numba_cache_folder_follows_the_sources(tmp_path):
     changed modification time of one module gives another folder, restoring it the same one,
     and a fresh process puts NUMBA_CACHE_DIR under the user's cache with that fingerprint."""
     import os
+    import shutil
     import subprocess
     import sys
 
     import recipdyn
-    from recipdyn.model import valves
 
     fp = recipdyn._source_fingerprint()
-    st = os.stat(valves.__file__)
-    try:
-        os.utime(valves.__file__, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
-        assert recipdyn._source_fingerprint() != fp
-    finally:
-        os.utime(valves.__file__, ns=(st.st_atime_ns, st.st_mtime_ns))
-    assert recipdyn._source_fingerprint() == fp
+    # a copy of the package is touched, never the sources other processes are running from
+    copy = tmp_path / "copy" / "recipdyn"
+    shutil.copytree(os.path.dirname(recipdyn.__file__), copy, copy_function=shutil.copy2,
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    valves = copy / "model" / "valves.py"
+    before = recipdyn._source_fingerprint(str(copy))
+    st = os.stat(valves)
+    os.utime(valves, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+    assert recipdyn._source_fingerprint(str(copy)) != before
+    os.utime(valves, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert recipdyn._source_fingerprint(str(copy)) == before
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env["XDG_CACHE_HOME"] = str(tmp_path)
     out = subprocess.run([sys.executable, "-c", "import os, recipdyn; "
@@ -234,6 +238,46 @@ def test_numba_cache_folder_follows_the_sources(tmp_path):
                           "print(valves.state_force._cache._cache_path)"], env=env, check=True,
                          capture_output=True, text=True).stdout.strip()  # fmt: skip
     assert out.startswith(os.path.join(str(tmp_path), "recipdyn", "numba", fp))
+
+
+def test_concurrent_cache_saves_keep_every_signature(tmp_path, monkeypatch):
+    """Two writers saving two signatures of one function into numba's cache at once (parallel
+    test workers or a process pool on a fresh machine): the second waits for the first, so
+    the index keeps both entries, each naming its own code. Without the lock the second reads
+    the index before the first has written it, both take the same data file, and one signature
+    is lost or points at the other's code (model/base.py, _serialise_cache_saves)."""
+    import threading
+
+    from numba.core.caching import IndexDataCacheFile
+
+    loaded, go = threading.Event(), threading.Event()
+    plain = IndexDataCacheFile._load_index
+
+    def load_then_wait(self):  # the first writer pauses between reading and writing the index
+        out = plain(self)
+        if threading.current_thread().name == "first":
+            loaded.set()
+            go.wait(timeout=10)
+        return out
+
+    monkeypatch.setattr(IndexDataCacheFile, "_load_index", load_then_wait)
+    stamp = ("source", 1)
+    writers = [IndexDataCacheFile(str(tmp_path), "f", stamp) for _ in range(2)]
+    first = threading.Thread(target=writers[0].save, args=("sig one", "code one"), name="first")
+    second = threading.Thread(target=writers[1].save, args=("sig two", "code two"))
+    first.start()
+    assert loaded.wait(timeout=10)
+    second.start()
+    second.join(timeout=1.0)  # it waits on the lock while the first holds it
+    waited = second.is_alive()
+    go.set()
+    first.join(timeout=10)
+    second.join(timeout=10)
+    monkeypatch.setattr(IndexDataCacheFile, "_load_index", plain)
+    index = IndexDataCacheFile(str(tmp_path), "f", stamp)
+    assert waited
+    assert index.load("sig one") == "code one"
+    assert index.load("sig two") == "code two"
 
 
 @compiled(RHS_SIGNATURE)

@@ -248,3 +248,31 @@ def test_issue31_valves_command_gives_no_api618_verdict(tmp_path, capsys):
     assert "api618_pin_reversal = invalid" in io.out and "= pass" not in io.out
     assert "--model compressor-contact-valves" in io.out
     assert io.err.count("warning: contact_force reaches") == 1
+
+
+def test_a_record_alone_loads_no_plotting_or_distributed_stack(tmp_path):
+    """A warm 'simulate --no-figure' writes its record without importing what it does not
+    use: dask.array, distributed and pint (xarray's duck-array and scheduler checks, about a
+    second of the command; io.lazy_duck_arrays), SciPy's signal and statistics modules, or
+    matplotlib. Checked in a fresh interpreter by what it loaded, not by time."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "r.nc"
+    probe = (
+        "import sys, json\n"
+        "from recipdyn.cli import main\n"
+        f"code = main(['simulate', '-n', '0.5', '--fs', '2000', '--no-figure', '--no-progress',"
+        f" '-o', {str(out)!r}])\n"
+        "mods = ('dask.array', 'distributed', 'pint', 'scipy.signal', 'scipy.stats', "
+        "'matplotlib')\n"
+        "print(json.dumps(dict(code=code, loaded=[m for m in mods if m in sys.modules])))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=1200)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == {"code": 0, "loaded": []}
+    assert out.exists()

@@ -20,15 +20,16 @@ import types
 from .resources import cache_dir as _cache_dir
 
 
-def _source_fingerprint() -> str:
-    """A hash of every module's path, size and modification time. numba invalidates a cached
-    function when its own file changes, but not when a function it calls (and inlined) from
-    another file does, which let stale machine code run after an edit or an upgrade; one cache
-    folder per state of the sources rules that out (~1 ms at import)."""
+def _source_fingerprint(root: str | None = None) -> str:
+    """A hash of every module's path, size and modification time (of this package, or of the
+    package folder ``root``). numba invalidates a cached function when its own file changes,
+    but not when a function it calls (and inlined) from another file does, which let stale
+    machine code run after an edit or an upgrade; one cache folder per state of the sources
+    rules that out (~1 ms at import)."""
     import hashlib
 
     h = hashlib.sha1()
-    root = os.path.dirname(os.path.abspath(__file__))
+    root = root or os.path.dirname(os.path.abspath(__file__))
     for dirpath, dirnames, files in os.walk(root):
         dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
         for f in sorted(files):

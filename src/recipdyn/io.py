@@ -131,6 +131,70 @@ def remove_orphans(folder: str | Path) -> int:
     return n
 
 
+def lazy_duck_arrays() -> None:
+    """Let xarray build datasets without importing dask or pint until they are in use.
+
+    xarray asks of every array it wraps whether it is a dask array or a pint quantity, and
+    answers by importing ``dask.array`` and ``pint`` (together 0.5-1 s of a 10-revolution
+    ``simulate``). No array can be a dask array before ``dask.array`` is imported, nor a
+    quantity before ``pint`` is, so until then the answer is "no" without the import; once
+    anything imports them (a chunked read, a sweep, a unit conversion), xarray's own answer is
+    used. Installs once per process; a no-op if xarray's internals differ from the version this
+    was written for (``xarray.namedarray.pycompat``), which then imports them as before.
+    """
+    import sys
+
+    try:
+        from xarray.namedarray import pycompat
+
+        cache = pycompat._cached_duck_array_modules
+        base = pycompat.DuckArrayModule
+    except (ImportError, AttributeError):  # pragma: no cover - another xarray
+        return
+
+    class _OnDemand(base):
+        def __init__(self, mod: str, marker: str) -> None:  # no import here
+            self._mod, self._marker = mod, marker
+
+        def _real(self):
+            real = base(self._mod)
+            cache[self._mod] = real
+            return real
+
+        @property
+        def type(self):
+            return self._real().type if self._marker in sys.modules else ()
+
+        def __getattr__(self, name: str):  # module, version, available: xarray's answer
+            if name.startswith("_"):
+                raise AttributeError(name)
+            return getattr(self._real(), name)
+
+    for mod, marker in (("dask", "dask.array"), ("pint", "pint")):
+        if mod not in cache:
+            cache[mod] = _OnDemand(mod, marker)
+
+
+@contextlib.contextmanager
+def _no_unused_scheduler() -> Iterator[None]:
+    """While writing NetCDF, xarray asks dask which scheduler runs (to choose a lock), and
+    dask asks ``distributed`` for a client, importing it (~0.4 s). In a process that has not
+    imported ``distributed`` there is no client: this answers so (as if it were not
+    installed), then puts everything back."""
+    import sys
+
+    hidden = [n for n in ("distributed", "dask.distributed") if "distributed" not in sys.modules
+              and n not in sys.modules]  # fmt: skip
+    for name in hidden:
+        sys.modules[name] = None  # an import of it raises ImportError, which dask expects
+    try:
+        yield
+    finally:
+        for name in hidden:
+            if sys.modules.get(name, 0) is None:
+                del sys.modules[name]
+
+
 def write_dataset(ds, path: str | Path) -> Path:
     """Write a Dataset in the format its extension names (.nc, .csv, .zarr, .mat), atomically.
 
@@ -148,7 +212,8 @@ def write_dataset(ds, path: str | Path) -> Path:
             return path
         with atomic_path(path) as tmp:
             if fmt == "NetCDF":
-                ds.to_netcdf(tmp)
+                with _no_unused_scheduler():
+                    ds.to_netcdf(tmp)
             elif fmt == "MAT":
                 _write_mat(ds, tmp)
             else:
@@ -249,6 +314,8 @@ def read_dataset(path: str | Path, *, what: str = "input",
                  expected: str = "a recipdyn run (NetCDF from 'recipdyn simulate')"):  # fmt: skip
     """Open a NetCDF file as a loaded Dataset, refusing clearly when it is not what is needed."""
     import xarray as xr
+
+    lazy_duck_arrays()
 
     path = Path(path)
     if not path.exists():

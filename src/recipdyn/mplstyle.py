@@ -38,12 +38,18 @@ def is_dense(y, columns: int, per_column: float = 1 / 3) -> bool:
     """True when ``y`` has more than ``per_column * columns`` clear oscillations (prominence
     above 1 % of its range): drawn as a line it fills the axes as a solid block."""
     import numpy as np
-    from scipy.signal import find_peaks
 
     y = np.asarray(y, dtype=float)
     span = float(np.ptp(y)) if y.size else 0.0
     if y.size < 3 * columns or not span > 0:
         return False
+    # every peak find_peaks reports is a rise followed by a fall or a plateau: when there are
+    # too few of those, the answer is known without SciPy's signal module (~0.8 s to import)
+    dy = np.diff(y)
+    if np.count_nonzero((dy[:-1] > 0) & (dy[1:] <= 0)) <= per_column * columns:
+        return False
+    from scipy.signal import find_peaks
+
     peaks, _ = find_peaks(y, prominence=0.01 * span)
     return peaks.size > per_column * columns
 

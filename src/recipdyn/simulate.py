@@ -17,6 +17,7 @@ from .defaults import RK4_STEPS_PER_REVOLUTION, SIMULATION
 from .errors import Interrupted, LawRangeWarning, ModelValidityWarning, is_number
 from .integrate import METHODS, IntegrationError, integrate
 from .integrate.solve import UniformGrid, check_tolerances
+from .io import lazy_duck_arrays
 from .model.base import Signal
 from .model.parameters import ParameterError, params_from_attrs
 from .model.protocol import Model
@@ -25,6 +26,8 @@ from .resources import check_memory
 
 __all__ = ["simulate", "summarize", "DEFAULT_SETTINGS", "clean_attrs", "params_from_attrs",
            "estimate_memory", "STARTUP_REVOLUTIONS", "model_values"]  # fmt: skip
+
+lazy_duck_arrays()  # a record is built without importing dask or pint (io)
 
 #: Defaults of [`simulate`][recipdyn.simulate.simulate] (also recorded in every result); see
 #: [`recipdyn.defaults`][recipdyn.defaults].

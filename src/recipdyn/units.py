@@ -46,8 +46,8 @@ def _ureg():
     pint = _import_pint()
     try:  # the parsed unit definitions are cached: 0.1 s instead of 1 s
         ureg = pint.UnitRegistry(cache_folder=os.path.join(cache_dir(), "pint"))
-    except OSError:  # an unwritable cache folder
-        ureg = pint.UnitRegistry()
+    except Exception:  # an unwritable cache folder, or a cache file another process is
+        ureg = pint.UnitRegistry()  # writing (pint writes it in place): parse without it
     ureg.define("rev = 2 * pi * radian = revolution")
     return ureg
 

@@ -68,6 +68,51 @@ RHS_JAC_SIGNATURE = _nbt.void(
 )
 
 
+def _serialise_cache_saves() -> None:
+    """Make numba's save of a cache entry one step across processes.
+
+    numba saves a compiled function by reading the function's cache index, adding the new
+    signature under the first free data-file name, writing the index back and then the code
+    (`numba.core.caching.IndexDataCacheFile.save`). Two processes compiling two signatures
+    of one function at once (parallel test workers, a process pool on a fresh machine) can
+    interleave so that one entry is lost or, worse, names the other signature's code. An
+    exclusive ``flock`` on a file beside the index, held through the save, rules that out;
+    loading needs no lock (numba writes each file to a temporary name and renames it). numba's
+    internals are pinned with numba (requirements/constraints.txt); without ``fcntl`` or that
+    class nothing changes."""
+    import os
+
+    try:
+        import fcntl
+
+        from numba.core.caching import IndexDataCacheFile
+    except ImportError:  # pragma: no cover - not POSIX, or another numba
+        return
+    plain = IndexDataCacheFile.save
+    if getattr(plain, "recipdyn_locked", False):
+        return
+
+    def save(self, key, data):
+        try:
+            fd = os.open(self._index_path + ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError:  # a read-only cache: numba's own save reports what it reports
+            return plain(self, key, data)
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            except OSError:  # pragma: no cover - no flock on this file system
+                pass
+            return plain(self, key, data)
+        finally:
+            os.close(fd)  # releases the lock
+
+    save.recipdyn_locked = True
+    IndexDataCacheFile.save = save
+
+
+_serialise_cache_saves()
+
+
 def compiled(signature, *, allocates: bool = False):
     """Declare a compiled kernel: ``numba.njit(cache=True)``, compiled on first use.
 
