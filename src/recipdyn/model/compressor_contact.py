@@ -51,8 +51,6 @@ from . import valves as va
 from ._compressor_contact import both_accelerations, crank_accelerations, crosshead_accelerations
 from .base import (
     EVENT_SIGNATURE,
-    JAC_SIGNATURE,
-    RHS_JAC_SIGNATURE,
     RHS_SIGNATURE,
     Event,
     ODESystem,
@@ -60,7 +58,6 @@ from .base import (
     compiled,
 )
 from .components.load import cycle_outputs, cycle_summary
-from .cycle import N_CYCLE
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -70,7 +67,7 @@ from .joints.contact import (
     normal_force,
     short_bearing_forces,
 )
-from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
+from .load import CYCLE_PARAMS
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -90,7 +87,10 @@ NHEAD = len(MECH) + len(INPUTS)
 (P_R, P_L, P_LS, P_M2, P_M3, P_J2, P_G, P_D, P_OMEGA, P_TH10,
  P_FGAS, P_F1X, P_F1Y, P_F2X, P_F2Y, P_TROD) = range(NHEAD)  # fmt: skip
 (P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY,
- P_VMIN, P_LOADAMP, P_LOADSIGN, P_LOADKIND, P_TABLE) = range(NHEAD, NHEAD + 19)  # fmt: skip
+ P_VMIN) = range(NHEAD, NHEAD + 15)  # fmt: skip
+#: The joints' part of the parameter vector; the load component's slice follows
+#: (`recipdyn.model.components.contract.Assembly`).
+N_PACKED = NHEAD + 15
 
 
 #: The state, the same for every joint configuration (a rigid joint's components stay 0).
@@ -257,25 +257,10 @@ def _joints(t, y, p, cfg):
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
-#: Load kind of the dynamic valves (`compressor_contact_valves`): the gas force follows
-#: the chamber pressures of the state (gas states from
-#: [`G_GAS`][recipdyn.model.compressor_contact.G_GAS], mass counters from
-#: [`G_AUX`][recipdyn.model.compressor_contact.G_AUX]; the cycle data, then the valve data, after
-#: ``P_TABLE``).
-LOAD_STATE = 3.0
+#: The first gas state and the first mass counter of a load with states (the dynamic valves),
+#: after the joints' twelve.
 G_GAS = len(STATE_NAMES)
 G_AUX = G_GAS + va.N_GAS
-
-
-@nb.njit(cache=True, inline="always")
-def _gas(t, y, p, s1, c1):
-    """The gas force on the crosshead (``s1``, ``c1``: sin and cos of the crank angle)."""
-    if p[P_LOADKIND] == 0.0:  # the paper's load
-        return p[P_LOADSIGN] * p[P_LOADAMP] * mu_sincos(s1, c1)
-    if p[P_LOADKIND] == LOAD_STATE:
-        return va.state_force(y, G_GAS, p[P_TABLE:])
-    th1 = p[P_TH10] + p[P_OMEGA] * t
-    return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 
 @nb.njit(cache=True)
@@ -298,11 +283,12 @@ def _ideal_crank_power(t, y, p, yd, f2):
 
 
 @nb.njit(cache=True, inline="always")
-def _mechanism(t, y, p, out, cfg):
+def _accelerate(t, y, p, out, cfg, j, fg):
     """The mechanism's derivatives ``out[:12]`` (real or complex ``y``, ``out``; no arrays
-    allocated); returns (crosshead velocity, cos theta2) for the gas."""
-    f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = _joints(t, y, p, cfg)
-    fg = _gas(t, y, p, s1, c1)
+    allocated) from the joints' forces ``j`` (`_joints`) and the gas force ``fg`` (the load
+    component's, in the generated glue: `recipdyn.model.components.contact`); returns
+    (crosshead velocity, cos theta2) for a load with states."""
+    f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = j
     # the generated kernels' INPUTS, then sin and cos of the crank angle
     u = (fg, f1[0], f1[1], f2[0], f2[1], f1[2] + f2[2], s1, c1)
     for i in range(4):
@@ -326,135 +312,15 @@ def _mechanism(t, y, p, out, cfg):
     return v3, c2
 
 
-@nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out, cfg):
-    v3, c2 = _mechanism(t, y, p, out, cfg)
-    if p[P_LOADKIND] == LOAD_STATE:  # the cylinder gas and valve plates follow the crosshead
-        x3 = p[P_R] * math.cos(p[P_TH10] + p[P_OMEGA] * t) + y[0] + p[P_L] * c2 - y[2]
-        c = p[P_TABLE:]
-        va.gas_rhs(x3, v3, y, G_GAS, G_AUX, c, c[N_CYCLE:], out)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_crank(t, y, p, out):
-    _rhs(t, y, p, out, 0)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_crosshead(t, y, p, out):
-    _rhs(t, y, p, out, 1)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_both(t, y, p, out):
-    _rhs(t, y, p, out, 2)
-
-
-@nb.njit(cache=True)
-def _fd_jac(t, y, p, J, cfg):
-    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates)."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
-    c = p[P_C1] if cfg == 0 else (p[P_C2] if cfg == 1 else min(p[P_C1], p[P_C2]))
-    for k in range(n):
-        # positions by the clearance, rates by c omega, work integrals 1 J; the gas states
-        # (dynamic valves) at least 1e-3 of their unit (a lift, a plate velocity)
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
-        h = 1e-5 * max(abs(y[k]), scale)
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m], cfg)
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
-
-
 #: Imaginary step of the complex-step Jacobian: any size far below the states' works (the
 #: derivative's error is O(h^2) relative, and no difference is taken).
 CS_STEP = 1e-60
-
-
-@nb.njit(cache=True)
-def _cs_columns(t, y, p, f, J, cfg, skip_rigid):
-    """The right-hand side ``f`` and the Jacobian ``J`` by the complex step (Squire & Trapp
-    1998, SIAM Rev. 40, 110-112; Martins, Sturdza & Alonso 2003, ACM TOMS 29, 245-262):
-    ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding since no difference is taken, on the
-    branch of each switch (contact, clamp, friction law) that the real state takes; ``f`` is
-    the real part of the same evaluations (``Re f(y + i h e_k) = f(y) + O(h^2)``, h = 1e-60:
-    equal to the real right-hand side to rounding), so it costs nothing extra.
-
-    The work integrals act on nothing (their columns are 0). With ``skip_rigid`` the columns
-    of a rigid joint's states (eccentricity, rate, approach velocity: constant 0, passive in
-    Benettin's method, whose tangent vectors have no components along them) are left 0 too:
-    half the evaluations of a one-pin model."""
-    n = y.shape[0]
-    yc = np.empty(n, np.complex128)
-    fc = np.empty(n, np.complex128)
-    for i in range(n):
-        yc[i] = y[i]
-    J[:, :] = 0.0
-    first = True
-    for k in range(I_WIN):
-        if skip_rigid and _RIGID_MASK[cfg, k]:
-            continue
-        yc[k] = complex(y[k], CS_STEP)
-        _mechanism(t, yc, p, fc, cfg)
-        yc[k] = y[k]
-        for i in range(n):
-            J[i, k] = fc[i].imag / CS_STEP
-        if first:
-            for i in range(n):
-                f[i] = fc[i].real
-            first = False
-
-
-@nb.njit(cache=True)
-def _cs_jac(t, y, p, J, cfg):
-    """The full Jacobian of `_cs_columns` (exact at any state, rigid states too)."""
-    f = np.empty(y.shape[0])
-    _cs_columns(t, y, p, f, J, cfg, False)
-
-
-@nb.njit(cache=True)
-def _jac(t, y, p, J, cfg):
-    """Complex step for the mechanism; central differences with the dynamic valves (their
-    plate and flow laws are not written for complex states; Benettin is refused there)."""
-    if p[P_LOADKIND] == LOAD_STATE:
-        _fd_jac(t, y, p, J, cfg)
-    else:
-        _cs_jac(t, y, p, J, cfg)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_crank(t, y, p, J):
-    _jac(t, y, p, J, 0)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_crosshead(t, y, p, J):
-    _jac(t, y, p, J, 1)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_both(t, y, p, J):
-    _jac(t, y, p, J, 2)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_crank(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 0, True)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_crosshead(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 1, True)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_both(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 2, True)
+# (the complex step, Squire & Trapp 1998, SIAM Rev. 40, 110-112; Martins, Sturdza & Alonso
+# 2003, ACM TOMS 29, 245-262: ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding since no
+# difference is taken, on the branch of each switch (contact, clamp, friction law) that the
+# real state takes; ``f`` is the real part of the same evaluations. The work integrals act on
+# nothing (their columns are 0); with ``skip_rigid`` the columns of a rigid joint's states are
+# left 0 too. Written into the glue, `recipdyn.model.components.contact`.)
 
 
 @compiled(EVENT_SIGNATURE)
@@ -545,19 +411,37 @@ def record_both(t, y, p, out):
     _flip(y, contact_factor(y, p, 2)[1], p, out)
 
 
-#: The rigid joint's eccentricity and its rate (constant 0: no degrees of freedom).
-KERNELS = {  # joints -> (rhs, jac, event, reset, config code, rhs and jac in one call)
-    "crank": (rhs_crank, jac_crank, onset_crank, record_crank, 0, rhs_jac_crank),
-    "crosshead": (
-        rhs_crosshead,
-        jac_crosshead,
-        onset_crosshead,
-        record_crosshead,
-        1,
-        rhs_jac_crosshead,
-    ),
-    "both": (rhs_both, jac_both, onset_both, record_both, 2, rhs_jac_both),
-}
+#: Joint configuration codes of the compiled kernels (literals in the generated glue).
+CFG = {"crank": 0, "crosshead": 1, "both": 2}
+
+
+def load_part(values: Mapping[str, Any]):
+    """The load component the values choose (`recipdyn.model.components.load`): a table when
+    ``load_table`` is given (a measured indicator diagram, or a real gas's cycle tabulated
+    from CoolProp), else the ``load`` parameter's."""
+    from .components.load import load_component
+
+    return load_component(values)
+
+
+@lru_cache(maxsize=32)
+def _glue(joints: str, load: str):
+    from .components.contact import glue_source
+    from .components.contract import glue_module
+    from .components.load import LOADS, VALVES
+
+    part = VALVES if load == VALVES.name else LOADS[load]
+    src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED,
+                      first_state=G_GAS)  # fmt: skip
+    return glue_module(src, f"contact_{joints}_{load}")
+
+
+def kernels(values: Mapping[str, Any], load=None):
+    """The generated glue of the joints and the load ``values`` choose (or ``load``): a
+    module with ``rhs``, ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe`` and
+    ``fd_jac`` (`recipdyn.model.components.contact`)."""
+    part = load_part(values) if load is None else load
+    return _glue(values["clearance_joints"], part.name)
 
 
 def _link(name: str, **changes) -> Param:
@@ -668,7 +552,11 @@ def overlap_half_angle(R_j: float, c: float, delta: float) -> float:
     return math.degrees(math.acos(min(1.0, max(-1.0, cos_phi))))
 
 
-def pack(values: Mapping[str, Any]) -> np.ndarray:
+def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
+    """The joints' parameters (layout: the ``P_*`` constants), then the slice of the load
+    component (``load``, default: the one the values choose, `load_part`)."""
+    from .components.contract import Assembly
+
     v = values
     head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
     head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
@@ -676,10 +564,11 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
              hysteresis_factor(v["contact_law"], v["restitution"]), v["friction"], v["v0"],
              v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
              v["oil_viscosity"] if v["joint"] == "lubricated" else 0.0, v["bearing_length"],
-             v["eps_dry"], v["v_impact_min"], v["load_amplitude"],
-             -1.0 if v["load_sign"] == "physical" else 1.0]  # fmt: skip
-    kind, data = pack_load(v)
-    return np.concatenate([np.asarray([*head, kind], dtype=np.float64), data])
+             v["eps_dry"], v["v_impact_min"]]  # fmt: skip
+    part = load_part(v) if load is None else load
+    vec, offsets = Assembly(N_PACKED, (part,)).pack(np.asarray(head, dtype=np.float64), v)
+    assert offsets["load"] == N_PACKED  # a literal in the glue
+    return vec
 
 
 def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
@@ -701,28 +590,6 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     elastic = stiffness(values, "crank") * d1**2.5 / 2.5
     elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
     return {"mechanical": kin + pot, "elastic": elastic}
-
-
-@nb.njit(cache=True)
-def _joint_series(cfg, t, y, p):
-    """Per sample: both joints' rows of `_pair` (14), the accelerations e1'', e2''
-    (4), theta2', x3', gas force."""
-    n = t.shape[0]
-    out = np.zeros((n, 21))
-    d = np.empty(y.shape[1])
-    for i in range(n):
-        yi = y[i].copy()
-        _rhs(t[i], yi, p, d, cfg)
-        f1, f2, _, _, th2d, v3, _, _, _ = _joints(t[i], yi, p, cfg)
-        for k in range(7):
-            out[i, k] = f1[k]
-            out[i, 7 + k] = f2[k]
-        out[i, 14:18] = d[4:8]
-        out[i, 18] = th2d
-        out[i, 19] = v3
-        th1 = p[P_TH10] + p[P_OMEGA] * t[i]
-        out[i, 20] = _gas(t[i], yi, p, math.sin(th1), math.cos(th1))
-    return out
 
 
 class CompressorContact(Model):
@@ -768,9 +635,53 @@ class CompressorContact(Model):
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
 
+    def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
+        """Validated values; besides the schema's, a force table as the massless link takes
+        it: ``load_table`` (rows of crank angle in deg and force in N, or a CSV file of them,
+        `recipdyn.model.load.read_load_table`) or ``pressure_table`` (a measured indicator
+        diagram, a CSV file, `recipdyn.model.load.read_pressure_table`, with this run's bore,
+        rod diameter and frame pressure). The table replaces the ``load`` (the table load
+        component)."""
+        v = {**(values or {}), **kw}
+        table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
+        out = super().parameters(v)
+        tab = self._table(out, table, ptab)
+        if tab is not None:
+            out["load_table"] = tab
+        return out
+
+    @staticmethod
+    def _table(values: Mapping[str, Any], table: Any, ptab: Any) -> Any:
+        from ..errors import ParameterError
+        from .load import read_load_table, read_pressure_table
+        from .parameters import _validate_table
+
+        if table is not None and ptab is not None:
+            raise ParameterError("pressure_table and load_table: give one of them")
+        if ptab is not None:
+            return read_pressure_table(ptab, bore=values["bore"],
+                                       rod_diameter=values["rod_diameter"],
+                                       frame_pressure=values["frame_pressure"])  # fmt: skip
+        if table is None:
+            return None
+        if not isinstance(table, (list, tuple)):
+            return read_load_table(table)
+        rows = tuple(tuple(float(x) for x in row) for row in table)
+        _validate_table(rows)
+        return rows
+
+    def load_part(self, values: Mapping[str, Any]):
+        """The load component of this model for ``values`` (`load_part`)."""
+        return load_part(values)
+
+    def kernels(self, values: Mapping[str, Any]):
+        """The generated glue of the joints and the load (`kernels`)."""
+        return kernels(values, self.load_part(values))
+
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         joints = values["clearance_joints"]
-        _, _, onset, record, *_ = KERNELS[joints]
+        k = self.kernels(values)
+        onset, record = k.event, k.reset
         if joints == "both":
             return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
@@ -782,8 +693,9 @@ class CompressorContact(Model):
                       "velocity is recorded for the damping law"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
-        rhs, jac, *_, rhs_jac = KERNELS[values["clearance_joints"]]
-        return ODESystem(rhs=rhs, jac=jac, rhs_jac=rhs_jac, params=pack(values),
+        k = self.kernels(values)
+        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
+                         params=pack(values, self.load_part(values)),
                          state_names=self.state_names,
                          state_units=self.state_units, period=self.period(values),
                          name=self.name, events=self.events(values), aux_states=4,
@@ -808,7 +720,8 @@ class CompressorContact(Model):
                 "gas",
                 "suction_temperature",
             )
-            cp = CompressorParams(rs=0.0, **{k: values[k] for k in keys})
+            cp = CompressorParams(rs=0.0, load_table=values.get("load_table"),
+                                  **{k: values[k] for k in keys})  # fmt: skip
             ang = equilibrium_theta_c(cp)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
@@ -841,8 +754,7 @@ class CompressorContact(Model):
         s = self.system(values)
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
-        cfg = KERNELS[values["clearance_joints"]][4]
-        j = _joint_series(cfg, t, y, s.params)
+        j = self.kernels(values).observe(t, y, s.params)
         r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
         th1 = float(values["theta1_0"]) + w * t
         e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))
