@@ -167,6 +167,9 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
     """Validated values of any model's schema from ``{name: number | quantity string}``."""
     out: dict[str, Any] = {}
     for k, v in values.items():
+        if k in ("load_table", "pressure_table") and k not in model.schema.names:
+            out[k] = v  # a table or its file: the model's parameters() reads it or refuses it
+            continue
         p = model.schema[model.schema.resolve(k)]
         out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
     return model.parameters(out)
@@ -245,6 +248,10 @@ def config_from_record(path: str | Path) -> RunConfig:
             v = v.item() if isinstance(v, np.generic) else v
             if v != "default":
                 params[p.name] = v
+    flat = attrs.get("param_load_table_deg_N")
+    if flat is not None and "load_table" not in params:  # a table load (no schema row)
+        flat = [float(x) for x in np.atleast_1d(flat)]
+        params["load_table"] = [flat[i : i + 2] for i in range(0, len(flat), 2)]
     sim: dict[str, Any] = {}
     for key, name in (
         ("revolutions", "revolutions"),

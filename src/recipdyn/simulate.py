@@ -545,6 +545,8 @@ def _simulate_model(m: Model, params, overrides, *, revolutions, transient, fs, 
         "period": period if period else "none (autonomous: revolutions count time units)",
         "state_initial": [float(x) for x in y0],
         **m.schema.to_attrs(values),
+        **({} if values.get("load_table") is None else {  # a table load (no schema row)
+            "param_load_table_deg_N": [float(x) for row in values["load_table"] for x in row]}),
         "config_toml": dump_config(m, values, dict(revolutions=revolutions, transient=transient,
                                                    fs=fs, method=method, rtol=rtol, atol=atol,
                                                    h=h)),

@@ -86,11 +86,12 @@ NHEAD = len(MECH) + len(INPUTS)
 # stay 0: the forces are passed per call, as the tuple ``u``).
 (P_R, P_L, P_LS, P_M2, P_M3, P_J2, P_G, P_D, P_OMEGA, P_TH10,
  P_FGAS, P_F1X, P_F1Y, P_F2X, P_F2Y, P_TROD) = range(NHEAD)  # fmt: skip
+# The oil viscosity of each pin (P_OIL crank pin, P_OIL2 crosshead pin) is 0 at a dry joint.
 (P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY,
- P_VMIN) = range(NHEAD, NHEAD + 15)  # fmt: skip
+ P_VMIN, P_OIL2) = range(NHEAD, NHEAD + 16)  # fmt: skip
 #: The joints' part of the parameter vector; the load component's slice follows
 #: (`recipdyn.model.components.contract.Assembly`).
-N_PACKED = NHEAD + 15
+N_PACKED = NHEAD + 16
 
 
 #: The state, the same for every joint configuration (a rigid joint's components stay 0).
@@ -197,7 +198,7 @@ def _kinematics(t, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
 
 
 @nb.njit(cache=True, inline="always")
-def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p):
+def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
     """Forces of one clearance joint, e = (ex, ey) from the journal centre to the bearing
     centre, journal and bearing turning at w_j and w_b: the tuple (F_x, F_y (on the bearing),
     T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost)."""
@@ -224,9 +225,9 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p):
         fnn = fn
         ftt = ft
         lost = (fn - K * delta * np.sqrt(delta)) * drho - ft * vt
-    if p[P_OIL] > 0.0:
+    if oil > 0.0:
         # film forces on the journal, along its eccentricity -n and t_j = k x (-n) = -t
-        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, p[P_OIL], p[P_LB],
+        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, oil, p[P_LB],
                                        Rj, c, p[P_EPSDRY])  # fmt: skip
         bx = fr * nx + fth * tx  # on the bearing: minus the force on the journal
         by = fr * ny + fth * ty
@@ -249,11 +250,13 @@ def _joints(t, y, p, cfg):
     f1 = (z, z, z, z, z, z, z)
     f2 = (z, z, z, z, z, z, z)
     if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
-        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]), p)
+        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
+                   p[P_OIL], p)  # fmt: skip
         vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
         p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
     if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
-        f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]), p)
+        f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]),
+                   p[P_OIL2], p)  # fmt: skip
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
@@ -413,6 +416,43 @@ def record_both(t, y, p, out):
 
 #: Joint configuration codes of the compiled kernels (literals in the generated glue).
 CFG = {"crank": 0, "crosshead": 1, "both": 2}
+#: The joint family at each pin: its parameter and the joints it may be (the massless link
+#: exists at the crank pin only, and only in the massless-link model).
+PIN_CHOICES = {"crank_joint": ("link", "ideal", "contact", "lubricated"),
+               "crosshead_joint": ("ideal", "contact", "lubricated")}  # fmt: skip
+
+
+def joint_types(values: Mapping[str, Any]) -> tuple[str, str]:
+    """The joint at the crank pin and at the crosshead pin (``ideal``, ``contact``,
+    ``lubricated``): ``crank_joint`` and ``crosshead_joint`` where given, else from
+    ``clearance_joints`` (where the clearance is) and ``joint`` (dry or lubricated)."""
+    where = values.get("clearance_joints", "crank")
+    kind = "lubricated" if values.get("joint", "dry") == "lubricated" else "contact"
+    crank = values.get("crank_joint") or ("ideal" if where == "crosshead" else kind)
+    cross = values.get("crosshead_joint") or ("ideal" if where == "crank" else kind)
+    return crank, cross
+
+
+def _resolve_joints(values: dict[str, Any]) -> None:
+    """Write the joint family of each pin and the clearance configuration it makes into
+    ``values``; refuse, in one line, a combination that does not exist here."""
+    from ..errors import ParameterError
+
+    crank, cross = joint_types(values)
+    if crank == "link":
+        raise ParameterError(
+            "crank_joint = 'link' is out of range for this model; allowed: 'ideal', 'contact', "
+            "'lubricated' (the massless link is the compressor model's: --model compressor)"
+        )
+    if crank == "ideal" and cross == "ideal":
+        raise ParameterError(
+            "crank_joint = crosshead_joint = 'ideal': no clearance joint left; allowed: "
+            "'contact' or 'lubricated' at one pin at least (the ideal mechanism: --model "
+            "compressor with rc = 0)"
+        )
+    values["crank_joint"], values["crosshead_joint"] = crank, cross
+    values["clearance_joints"] = ("both" if "ideal" not in (crank, cross) else
+                                  "crank" if cross == "ideal" else "crosshead")  # fmt: skip
 
 
 def load_part(values: Mapping[str, Any]):
@@ -462,7 +502,15 @@ SCHEMA = Schema((
     _link("d", low_ref="-(l - r - 1.5 (rc + rc_crosshead))",
           high_ref="l - r - 1.5 (rc + rc_crosshead)"),
     Param("joint", "", "dry", "'dry' contact-impact or 'lubricated' (oil film + dry contact "
-          "beyond eps_dry)", choices=("dry", "lubricated"), group="joint"),
+          "beyond eps_dry) at each clearance joint (crank_joint, crosshead_joint set one pin)",
+          choices=("dry", "lubricated"), group="joint"),
+    Param("crank_joint", "", None, "the crank-pin joint: 'ideal', 'contact' (dry) or "
+          "'lubricated' (default: from clearance_joints and joint; 'link', the massless link, "
+          "is the compressor model's)", choices=PIN_CHOICES["crank_joint"], optional=True,
+          group="joint"),
+    Param("crosshead_joint", "", None, "the crosshead-pin joint: 'ideal', 'contact' (dry) or "
+          "'lubricated' (default: from clearance_joints and joint)",
+          choices=PIN_CHOICES["crosshead_joint"], optional=True, group="joint"),
     Param("contact_law", "", "lankarani-nikravesh", "normal force law (hysteresis damping)",
           choices=LAWS, group="joint"),
     Param("restitution", "", 0.9, "nominal coefficient of restitution of the law", 0.0, 1.0,
@@ -558,13 +606,15 @@ def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
     from .components.contract import Assembly
 
     v = values
+    pins = joint_types(v)
     head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
     head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
              v["rc_crosshead"], stiffness(v, "crosshead"), v["crosshead_pin_radius"],
              hysteresis_factor(v["contact_law"], v["restitution"]), v["friction"], v["v0"],
              v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
-             v["oil_viscosity"] if v["joint"] == "lubricated" else 0.0, v["bearing_length"],
-             v["eps_dry"], v["v_impact_min"]]  # fmt: skip
+             v["oil_viscosity"] if pins[0] == "lubricated" else 0.0, v["bearing_length"],
+             v["eps_dry"], v["v_impact_min"],
+             v["oil_viscosity"] if pins[1] == "lubricated" else 0.0]  # fmt: skip
     part = load_part(v) if load is None else load
     vec, offsets = Assembly(N_PACKED, (part,)).pack(np.asarray(head, dtype=np.float64), v)
     assert offsets["load"] == N_PACKED  # a literal in the glue
@@ -644,7 +694,9 @@ class CompressorContact(Model):
         component)."""
         v = {**(values or {}), **kw}
         table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
-        out = super().parameters(v)
+        out = self.schema.validate(v)
+        _resolve_joints(out)
+        self.check(out)
         tab = self._table(out, table, ptab)
         if tab is not None:
             out["load_table"] = tab
