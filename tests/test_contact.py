@@ -4,6 +4,7 @@ closed form, the limits of the compressor model with it, its energy balance and 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numba as nb
 import numpy as np
@@ -700,3 +701,27 @@ def test_a_pressure_table_drives_the_contact_joint_from_the_cli(tmp_path):
 
     back = model_values(M, read_config(out).params)["load_table"]
     assert np.array_equal(np.array(back), np.array(tab))
+
+
+def test_a_record_of_the_old_joint_parameters_runs_again(tmp_path):
+    """A record written before the joint family existed (``clearance_joints = both``, ``joint
+    = lubricated``; tests/data/contact_both_lubricated_v0.nc, 0.05 revolution at 150 rad/s)
+    reads as the joint family of each pin, and ``simulate -c`` of it gives its trajectory
+    again: the same equations and solver settings. Bound 1e-6 of each signal's range (the
+    record's own numbers on this machine are reproduced to the bit; another CPU's rounding,
+    grown over ~10^3 steps with impacts, stays far below)."""
+    import xarray as xr
+
+    from recipdyn.cli import main
+
+    old = Path(__file__).parent / "data" / "contact_both_lubricated_v0.nc"
+    out = tmp_path / "again.nc"
+    assert main(["simulate", "-c", str(old), "-o", str(out), "--no-progress"]) == 0
+    a, b = xr.open_dataset(old), xr.open_dataset(out)
+    assert "param_crank_joint" not in a.attrs
+    assert (b.attrs["param_crank_joint"], b.attrs["param_crosshead_joint"]) == (
+        "lubricated", "lubricated")  # fmt: skip
+    assert b.attrs["model_name"] == a.attrs["model_name"] == "compressor-contact"
+    for k in ("ex", "ey", "ex_crosshead", "ey_crosshead", "a", "joint_force"):
+        x, y = a[k].values, b[k].values
+        assert x.shape == y.shape and np.abs(x - y).max() <= 1e-6 * np.ptp(x), k
