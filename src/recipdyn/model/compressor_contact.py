@@ -27,12 +27,13 @@ energy of rod and crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic ene
 work of the gas force and of the crank through the journal, ``W_loss`` the work lost in the joint:
 contact damping, friction and the oil film's share).
 
-The Jacobian is the complex step of the right-hand side (`_cs_jac`): the compiled
-kernels take complex states, and ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no
-difference is taken), on the branch of each switch the state is on. It replaced a central
-difference whose rounding noise (~1e-4 of the contact stiffness terms) kept Benettin's
-tangent integration at ~10^6 steps a revolution; Lyapunov exponents are now computed from the
-equations, with the contact onsets' saltation matrices (tests/test_contact.py checks the
+The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
+`recipdyn.model.components.contact`): the compiled kernels take complex states, and
+``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no difference is taken), on the
+branch of each switch the state is on. A central difference's rounding noise (~1e-4 of the
+contact stiffness terms) would keep Benettin's tangent integration at ~10^6 steps a
+revolution; Lyapunov exponents are computed from the equations, with the contact onsets'
+saltation matrices (tests/test_contact.py checks the
 tangent flow against differences of the flow across impacts).
 """
 
@@ -155,7 +156,7 @@ def generate() -> str:
             "clearance at the crank pin, the crosshead pin, or both.", '"""', "",
             "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
     # numpy's scalar functions instead of math's: the same machine code for real arguments,
-    # and the kernels also take complex ones (the complex-step Jacobian, `_cs_jac`)
+    # and the kernels also take complex ones (the complex-step Jacobian, the glue's ``cs_jac``)
     # sin and cos of the crank angle come from the caller (computed once per call)
     bodies = []
     for j in JOINTS:
