@@ -120,8 +120,7 @@ def test_simulated_gas_force_is_the_cycle_and_the_report_has_api618(tmp_path, ca
     import xarray as xr
 
     from recipdyn.cli import main
-    from recipdyn.model import CompressorParams
-    from recipdyn.model.load import gas_force
+    from recipdyn.model import CompressorParams, gas_force
 
     out = tmp_path / "c.nc"
     code = main(["simulate", "--set", "load=cycle", "--set", "discharge_pressure=4 bar",
@@ -424,9 +423,8 @@ def test_real_gas_drives_the_contact_joint_model_too():
     record has the cylinder pressures, whose force agrees with the tabulated one to the table's
     linear interpolation error (0.25 deg steps: ~1e-4 of the peak on smooth parts; 2e-3 of the
     peak is asked of the median, the valve events being kinks)."""
-    from recipdyn.model import CompressorParams
+    from recipdyn.model import CompressorParams, gas_force
     from recipdyn.model.cycle import pressure_force
-    from recipdyn.model.load import gas_force
     from recipdyn.simulate import simulate
 
     v = dict(load="cycle", gas="Air", discharge_pressure=4e5)
