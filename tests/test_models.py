@@ -36,8 +36,8 @@ PRESETS = {
         "load_amplitude": 2e4},
     "compressor-contact[crank_joint=ideal,crosshead_joint=lubricated,load=cycle]": {
         "crank_joint": "ideal", "crosshead_joint": "lubricated", "load": "cycle"},
-    "compressor-contact-valves[crank_joint=contact,crosshead_joint=lubricated]": {
-        "crank_joint": "contact", "crosshead_joint": "lubricated"},
+    "compressor-contact-valves[crank_joint=ideal,crosshead_joint=contact]": {
+        "crank_joint": "ideal", "crosshead_joint": "contact"},
 }  # fmt: skip
 MODELS = [*model_names(), EXAMPLE, *PRESETS]
 
