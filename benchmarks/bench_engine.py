@@ -32,9 +32,9 @@ def _numpy_rhs(p):
     """theta_c'' from the sympy expression, lambdified to plain numpy (no compilation)."""
     import sympy as sp
 
+    from recipdyn.model import gas_force
     from recipdyn.model.derivation import SYMBOLS as S
     from recipdyn.model.derivation import structured_equations
-    from recipdyn.model.load import gas_force
 
     sub = {S[k]: getattr(p, k) for k in ("r", "l", "ls", "m2", "m3", "J2", "g", "rc", "d")}
     sub[S["omega"]] = p.omega

@@ -16,7 +16,7 @@ from recipdyn.model._generated import clearance_acceleration
 from recipdyn.model._generated_drive import free_crank_accelerations
 from recipdyn.model.components.contract import check_fragments
 from recipdyn.model.components.drive import INDUCTION, mean_load_torque
-from recipdyn.model.load import gas_force
+from recipdyn.model.components.load import gas_force
 from recipdyn.model.paper_printed import paper_acceleration
 
 TABLE = ((0.0, -1.0e4), (90.0, -5.0e4), (180.0, 2.0e4), (270.0, -3.0e4))

@@ -120,8 +120,7 @@ def test_simulated_gas_force_is_the_cycle_and_the_report_has_api618(tmp_path, ca
     import xarray as xr
 
     from recipdyn.cli import main
-    from recipdyn.model import CompressorParams
-    from recipdyn.model.load import gas_force
+    from recipdyn.model import CompressorParams, gas_force
 
     out = tmp_path / "c.nc"
     code = main(["simulate", "--set", "load=cycle", "--set", "discharge_pressure=4 bar",
@@ -163,20 +162,20 @@ def test_cycle_bad_input_exit_2(tmp_path, capsys, args, words):
 
 
 def test_contact_joint_takes_the_cycle_load():
-    """The contact-impact model reads the same load parameters: its packed gas force is the
-    cycle kernel's."""
-    from recipdyn.model.compressor_contact import _gas
-    from recipdyn.model.load import pack_load
+    """The contact-impact model reads the same load parameters: the gas force it records (the
+    glue's observer, the function that was integrated) is the cycle kernel's on the cycle
+    data of the values."""
+    from recipdyn.model.cycle import cycle_data
     from recipdyn.model.registry import get_model
 
     m = get_model("compressor-contact")
-    values = m.schema.validate({"load": "cycle", "discharge_pressure": 5e5})
-    sysm = m.system(values)
-    c = pack_load(values)[1]
-    for t in (0.0, 0.05, 0.2):
-        th1 = values["theta1_0"] + values["omega"] * t
-        y = m.initial_state(values)  # the state matters only to the dynamic valves
-        assert _gas(t, y, sysm.params, np.sin(th1), np.cos(th1)) == cycle_force_kernel(th1, c)
+    values = m.parameters({"load": "cycle", "discharge_pressure": 5e5})
+    c = cycle_data(values)
+    t = np.array([0.0, 0.05, 0.2])
+    y = np.tile(m.initial_state(values), (3, 1))  # the state matters only to dynamic valves
+    got = m.outputs(values, t, y)["gas_force"].values
+    th1 = values["theta1_0"] + values["omega"] * t
+    assert list(got) == [cycle_force_kernel(x, c) for x in th1]
 
 
 def test_cycle_figure_shows_the_cycle(tmp_path):
@@ -424,9 +423,8 @@ def test_real_gas_drives_the_contact_joint_model_too():
     record has the cylinder pressures, whose force agrees with the tabulated one to the table's
     linear interpolation error (0.25 deg steps: ~1e-4 of the peak on smooth parts; 2e-3 of the
     peak is asked of the median, the valve events being kinks)."""
-    from recipdyn.model import CompressorParams
+    from recipdyn.model import CompressorParams, gas_force
     from recipdyn.model.cycle import pressure_force
-    from recipdyn.model.load import gas_force
     from recipdyn.simulate import simulate
 
     v = dict(load="cycle", gas="Air", discharge_pressure=4e5)

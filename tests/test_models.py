@@ -20,15 +20,24 @@ from recipdyn.model.base import DiscreteMap, ODESystem
 from recipdyn.model.registry import get_model, model_names
 
 EXAMPLE = str(Path(__file__).parents[1] / "examples" / "pendulum.py") + ":PENDULUM"
-#: Component combinations of the assembled compressor (model/components) that pass the same
-#: tests as the registered models: every drive and torque law, loads, the ideal joint.
+#: Component combinations (model/components) that pass the same tests as the registered
+#: models: every drive and torque law, loads, the ideal joint; the joint family of the contact
+#: model with a new combination (oil at the crank pin, dry contact at the crosshead pin).
+#: ``MODEL[k=v,...]``: the model MODEL with these defaults.
 PRESETS = {
     "compressor[load=cycle]": {"load": "cycle"},
     "compressor[drive=motor]": {"drive": "motor"},
     "compressor[drive=motor,motor=constant,load=cycle]": {"drive": "motor", "motor": "constant",
                                                           "load": "cycle"},
     "compressor[drive=motor,rc=0]": {"drive": "motor", "rc": 0.0},
+    "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
+        "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
+        "load_amplitude": 2e4},
 }  # fmt: skip
+# Not in the list yet: an ideal crank pin fails the sweep test (the contact model's section
+# signals name the crank pin's ``ex``, which such a run does not record: a KeyError in the
+# sweep's Poincare measure, with clearance_joints = crosshead too); the dynamic valves with a
+# lubricated pin fail the Jacobian check in a rate column (their central-difference Jacobian).
 MODELS = [*model_names(), EXAMPLE, *PRESETS]
 
 
@@ -36,14 +45,14 @@ def _ids(x):
     return Path(x.split(":")[0]).stem if ":" in x else x
 
 
-def _preset(over):
+def _preset(name, over):
     """The compressor with other defaults: the same model class, its schema's defaults
     replaced, so every test below runs the combination as it runs a registered model."""
     from dataclasses import replace
 
     from recipdyn.model.protocol import Schema
 
-    base = get_model("compressor")
+    base = get_model(name.split("[")[0])
     schema = Schema(tuple(replace(p, default=over.get(p.name, p.default)) for p in base.schema),
                     base.schema.aliases)  # fmt: skip
     model = type(base)()
@@ -60,7 +69,7 @@ def _set_args(model):
 @pytest.fixture(params=MODELS, ids=_ids)
 def model(request):
     if request.param in PRESETS:
-        return _preset(PRESETS[request.param])
+        return _preset(request.param, PRESETS[request.param])
     return get_model(request.param)
 
 

@@ -173,10 +173,12 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
     schema = model.schema_for(values)
     out: dict[str, Any] = {}
     for k, v in values.items():
-        name = schema.resolve(k)
-        if name in schema.extras:  # a value beside the schema (a table as rows)
-            out[name] = tuple(tuple(r) for r in v) if isinstance(v, list) else v
+        if k in ("load_table", "pressure_table") and k not in schema.names:
+            # a table (rows) or its file beside the schema: the model's parameters() reads it
+            # or refuses it
+            out[k] = tuple(tuple(r) for r in v) if isinstance(v, list) else v
             continue
+        name = schema.resolve(k)
         p = schema[name]
         out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
     return model.parameters(out)
@@ -257,7 +259,8 @@ def config_from_record(path: str | Path) -> RunConfig:
     params: dict[str, Any] = {}
     for k, v in values.items():
         if v is not None:
-            params[k] = [list(r) for r in v] if k in m.schema.extras else v
+            table = k in m.schema.extras or k == "load_table"
+            params[k] = [list(r) for r in v] if table else v
     sim: dict[str, Any] = {}
     for key, name in (
         ("revolutions", "revolutions"),

@@ -72,6 +72,8 @@ class Field:
         """The value of ``text`` in SI, checked against the range (`ParameterError`
         naming the field, the value and the range otherwise)."""
         if self.choices is not None:
+            if self.optional and (text is None or str(text).lower() in ("", "default", "none")):
+                return None  # derived by the model (a joint family from the older parameters)
             value = str(text)
             if value not in self.choices:
                 raise ParameterError(f"{self.name} = {value!r}; allowed: {self.range_text()}")

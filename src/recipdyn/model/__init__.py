@@ -14,7 +14,7 @@ _LAZY = {
     "CompressorModel": "compressor", "compressor_model": "compressor",
     "equilibrium_theta_c": "compressor",
     "ideal_slider_crank": "kinematics", "joint_forces": "kinematics", "kinematics": "kinematics",
-    "gas_force": "load", "mu_paper": "load", "read_load_table": "load",
+    "gas_force": "components.load", "mu_paper": "load", "read_load_table": "load",
     "ASSUMED": "parameters", "CompressorParams": "parameters", "ParameterError": "parameters",
     "paper_2d12": "parameters",
 }  # fmt: skip

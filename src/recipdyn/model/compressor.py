@@ -37,30 +37,14 @@ from .components.drive import DRIVES, MOTORS
 from .components.load import cycle_outputs, cycle_summary, load_component
 from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import joint_forces, kinematics
-from .load import pack_load
 from .parameters import PLUGGABLE, SCHEMA, CompressorParams, ParameterError
 from .protocol import Model, Schema
 from .registry import absolute_spec, is_spec
 
 __all__ = [
-    "CompressorModel", "compressor_model", "equilibrium_theta_c", "pack_params", "Compressor",
+    "CompressorModel", "compressor_model", "equilibrium_theta_c", "Compressor",
     "COMPRESSOR",
 ]  # fmt: skip
-
-# The packed layout of the dynamic-valve model (compressor_valves.py), whose kernels are not yet
-# assembled from components; this model's own vector is pack_assembled's.
-P_R, P_RS, P_L, P_LS, P_M1, P_M2, P_M3, P_J1, P_J2, P_G = range(10)
-P_RC, P_D, P_OMEGA, P_TH10, P_LOADKIND, P_LOADAMP, P_LOADSIGN, P_TABLE = range(10, 18)
-
-
-def pack_params(p: CompressorParams) -> np.ndarray:
-    """Flat float64 vector of the dynamic-valve model's kernels (layout: the ``P_*``
-    constants)."""
-    kind, data = pack_load(vars(p))
-    head = [p.r, p.rs, p.l, p.ls, p.m1, p.m2, p.m3, p.J1, p.J2, p.g, p.rc, p.d, p.omega]
-    head += [p.theta1_0, kind, p.load_amplitude]
-    head += [-1.0 if p.load_sign == "physical" else 1.0]
-    return np.concatenate([np.asarray(head, dtype=np.float64), data])
 
 
 def assembly(p: CompressorParams) -> tuple[Assembly, dict[str, Component]]:

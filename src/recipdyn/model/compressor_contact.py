@@ -27,12 +27,13 @@ energy of rod and crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic ene
 work of the gas force and of the crank through the journal, ``W_loss`` the work lost in the joint:
 contact damping, friction and the oil film's share).
 
-The Jacobian is the complex step of the right-hand side (`_cs_jac`): the compiled
-kernels take complex states, and ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no
-difference is taken), on the branch of each switch the state is on. It replaced a central
-difference whose rounding noise (~1e-4 of the contact stiffness terms) kept Benettin's
-tangent integration at ~10^6 steps a revolution; Lyapunov exponents are now computed from the
-equations, with the contact onsets' saltation matrices (tests/test_contact.py checks the
+The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
+`recipdyn.model.components.contact`): the compiled kernels take complex states, and
+``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no difference is taken), on the
+branch of each switch the state is on. A central difference's rounding noise (~1e-4 of the
+contact stiffness terms) would keep Benettin's tangent integration at ~10^6 steps a
+revolution; Lyapunov exponents are computed from the equations, with the contact onsets'
+saltation matrices (tests/test_contact.py checks the
 tangent flow against differences of the flow across impacts).
 """
 
@@ -51,8 +52,6 @@ from . import valves as va
 from ._compressor_contact import both_accelerations, crank_accelerations, crosshead_accelerations
 from .base import (
     EVENT_SIGNATURE,
-    JAC_SIGNATURE,
-    RHS_JAC_SIGNATURE,
     RHS_SIGNATURE,
     Event,
     ODESystem,
@@ -60,7 +59,6 @@ from .base import (
     compiled,
 )
 from .components.load import cycle_outputs, cycle_summary
-from .cycle import N_CYCLE
 from .joints.contact import (
     FRICTION_LAWS,
     LAWS,
@@ -70,7 +68,7 @@ from .joints.contact import (
     normal_force,
     short_bearing_forces,
 )
-from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
+from .load import CYCLE_PARAMS
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -89,8 +87,12 @@ NHEAD = len(MECH) + len(INPUTS)
 # stay 0: the forces are passed per call, as the tuple ``u``).
 (P_R, P_L, P_LS, P_M2, P_M3, P_J2, P_G, P_D, P_OMEGA, P_TH10,
  P_FGAS, P_F1X, P_F1Y, P_F2X, P_F2Y, P_TROD) = range(NHEAD)  # fmt: skip
+# The oil viscosity of each pin (P_OIL crank pin, P_OIL2 crosshead pin) is 0 at a dry joint.
 (P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY,
- P_VMIN, P_LOADAMP, P_LOADSIGN, P_LOADKIND, P_TABLE) = range(NHEAD, NHEAD + 19)  # fmt: skip
+ P_VMIN, P_OIL2) = range(NHEAD, NHEAD + 16)  # fmt: skip
+#: The joints' part of the parameter vector; the load component's slice follows
+#: (`recipdyn.model.components.contract.Assembly`).
+N_PACKED = NHEAD + 16
 
 
 #: The state, the same for every joint configuration (a rigid joint's components stay 0).
@@ -154,7 +156,7 @@ def generate() -> str:
             "clearance at the crank pin, the crosshead pin, or both.", '"""', "",
             "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
     # numpy's scalar functions instead of math's: the same machine code for real arguments,
-    # and the kernels also take complex ones (the complex-step Jacobian, `_cs_jac`)
+    # and the kernels also take complex ones (the complex-step Jacobian, the glue's ``cs_jac``)
     # sin and cos of the crank angle come from the caller (computed once per call)
     bodies = []
     for j in JOINTS:
@@ -197,7 +199,7 @@ def _kinematics(t, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
 
 
 @nb.njit(cache=True, inline="always")
-def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p):
+def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
     """Forces of one clearance joint, e = (ex, ey) from the journal centre to the bearing
     centre, journal and bearing turning at w_j and w_b: the tuple (F_x, F_y (on the bearing),
     T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost)."""
@@ -224,9 +226,9 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, p):
         fnn = fn
         ftt = ft
         lost = (fn - K * delta * np.sqrt(delta)) * drho - ft * vt
-    if p[P_OIL] > 0.0:
+    if oil > 0.0:
         # film forces on the journal, along its eccentricity -n and t_j = k x (-n) = -t
-        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, p[P_OIL], p[P_LB],
+        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, oil, p[P_LB],
                                        Rj, c, p[P_EPSDRY])  # fmt: skip
         bx = fr * nx + fth * tx  # on the bearing: minus the force on the journal
         by = fr * ny + fth * ty
@@ -249,33 +251,20 @@ def _joints(t, y, p, cfg):
     f1 = (z, z, z, z, z, z, z)
     f2 = (z, z, z, z, z, z, z)
     if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
-        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]), p)
+        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
+                   p[P_OIL], p)  # fmt: skip
         vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
         p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
     if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
-        f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]), p)
+        f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]),
+                   p[P_OIL2], p)  # fmt: skip
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
-#: Load kind of the dynamic valves (`compressor_contact_valves`): the gas force follows
-#: the chamber pressures of the state (gas states from
-#: [`G_GAS`][recipdyn.model.compressor_contact.G_GAS], mass counters from
-#: [`G_AUX`][recipdyn.model.compressor_contact.G_AUX]; the cycle data, then the valve data, after
-#: ``P_TABLE``).
-LOAD_STATE = 3.0
+#: The first gas state and the first mass counter of a load with states (the dynamic valves),
+#: after the joints' twelve.
 G_GAS = len(STATE_NAMES)
 G_AUX = G_GAS + va.N_GAS
-
-
-@nb.njit(cache=True, inline="always")
-def _gas(t, y, p, s1, c1):
-    """The gas force on the crosshead (``s1``, ``c1``: sin and cos of the crank angle)."""
-    if p[P_LOADKIND] == 0.0:  # the paper's load
-        return p[P_LOADSIGN] * p[P_LOADAMP] * mu_sincos(s1, c1)
-    if p[P_LOADKIND] == LOAD_STATE:
-        return va.state_force(y, G_GAS, p[P_TABLE:])
-    th1 = p[P_TH10] + p[P_OMEGA] * t
-    return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
 
 
 @nb.njit(cache=True)
@@ -298,11 +287,12 @@ def _ideal_crank_power(t, y, p, yd, f2):
 
 
 @nb.njit(cache=True, inline="always")
-def _mechanism(t, y, p, out, cfg):
+def _accelerate(t, y, p, out, cfg, j, fg):
     """The mechanism's derivatives ``out[:12]`` (real or complex ``y``, ``out``; no arrays
-    allocated); returns (crosshead velocity, cos theta2) for the gas."""
-    f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = _joints(t, y, p, cfg)
-    fg = _gas(t, y, p, s1, c1)
+    allocated) from the joints' forces ``j`` (`_joints`) and the gas force ``fg`` (the load
+    component's, in the generated glue: `recipdyn.model.components.contact`); returns
+    (crosshead velocity, cos theta2) for a load with states."""
+    f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = j
     # the generated kernels' INPUTS, then sin and cos of the crank angle
     u = (fg, f1[0], f1[1], f2[0], f2[1], f1[2] + f2[2], s1, c1)
     for i in range(4):
@@ -326,135 +316,15 @@ def _mechanism(t, y, p, out, cfg):
     return v3, c2
 
 
-@nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out, cfg):
-    v3, c2 = _mechanism(t, y, p, out, cfg)
-    if p[P_LOADKIND] == LOAD_STATE:  # the cylinder gas and valve plates follow the crosshead
-        x3 = p[P_R] * math.cos(p[P_TH10] + p[P_OMEGA] * t) + y[0] + p[P_L] * c2 - y[2]
-        c = p[P_TABLE:]
-        va.gas_rhs(x3, v3, y, G_GAS, G_AUX, c, c[N_CYCLE:], out)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_crank(t, y, p, out):
-    _rhs(t, y, p, out, 0)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_crosshead(t, y, p, out):
-    _rhs(t, y, p, out, 1)
-
-
-@compiled(RHS_SIGNATURE)
-def rhs_both(t, y, p, out):
-    _rhs(t, y, p, out, 2)
-
-
-@nb.njit(cache=True)
-def _fd_jac(t, y, p, J, cfg):
-    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates)."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
-    c = p[P_C1] if cfg == 0 else (p[P_C2] if cfg == 1 else min(p[P_C1], p[P_C2]))
-    for k in range(n):
-        # positions by the clearance, rates by c omega, work integrals 1 J; the gas states
-        # (dynamic valves) at least 1e-3 of their unit (a lift, a plate velocity)
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
-        h = 1e-5 * max(abs(y[k]), scale)
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m], cfg)
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
-
-
 #: Imaginary step of the complex-step Jacobian: any size far below the states' works (the
 #: derivative's error is O(h^2) relative, and no difference is taken).
 CS_STEP = 1e-60
-
-
-@nb.njit(cache=True)
-def _cs_columns(t, y, p, f, J, cfg, skip_rigid):
-    """The right-hand side ``f`` and the Jacobian ``J`` by the complex step (Squire & Trapp
-    1998, SIAM Rev. 40, 110-112; Martins, Sturdza & Alonso 2003, ACM TOMS 29, 245-262):
-    ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding since no difference is taken, on the
-    branch of each switch (contact, clamp, friction law) that the real state takes; ``f`` is
-    the real part of the same evaluations (``Re f(y + i h e_k) = f(y) + O(h^2)``, h = 1e-60:
-    equal to the real right-hand side to rounding), so it costs nothing extra.
-
-    The work integrals act on nothing (their columns are 0). With ``skip_rigid`` the columns
-    of a rigid joint's states (eccentricity, rate, approach velocity: constant 0, passive in
-    Benettin's method, whose tangent vectors have no components along them) are left 0 too:
-    half the evaluations of a one-pin model."""
-    n = y.shape[0]
-    yc = np.empty(n, np.complex128)
-    fc = np.empty(n, np.complex128)
-    for i in range(n):
-        yc[i] = y[i]
-    J[:, :] = 0.0
-    first = True
-    for k in range(I_WIN):
-        if skip_rigid and _RIGID_MASK[cfg, k]:
-            continue
-        yc[k] = complex(y[k], CS_STEP)
-        _mechanism(t, yc, p, fc, cfg)
-        yc[k] = y[k]
-        for i in range(n):
-            J[i, k] = fc[i].imag / CS_STEP
-        if first:
-            for i in range(n):
-                f[i] = fc[i].real
-            first = False
-
-
-@nb.njit(cache=True)
-def _cs_jac(t, y, p, J, cfg):
-    """The full Jacobian of `_cs_columns` (exact at any state, rigid states too)."""
-    f = np.empty(y.shape[0])
-    _cs_columns(t, y, p, f, J, cfg, False)
-
-
-@nb.njit(cache=True)
-def _jac(t, y, p, J, cfg):
-    """Complex step for the mechanism; central differences with the dynamic valves (their
-    plate and flow laws are not written for complex states; Benettin is refused there)."""
-    if p[P_LOADKIND] == LOAD_STATE:
-        _fd_jac(t, y, p, J, cfg)
-    else:
-        _cs_jac(t, y, p, J, cfg)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_crank(t, y, p, J):
-    _jac(t, y, p, J, 0)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_crosshead(t, y, p, J):
-    _jac(t, y, p, J, 1)
-
-
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac_both(t, y, p, J):
-    _jac(t, y, p, J, 2)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_crank(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 0, True)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_crosshead(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 1, True)
-
-
-@compiled(RHS_JAC_SIGNATURE, allocates=True)
-def rhs_jac_both(t, y, p, f, J):
-    _cs_columns(t, y, p, f, J, 2, True)
+# (the complex step, Squire & Trapp 1998, SIAM Rev. 40, 110-112; Martins, Sturdza & Alonso
+# 2003, ACM TOMS 29, 245-262: ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding since no
+# difference is taken, on the branch of each switch (contact, clamp, friction law) that the
+# real state takes; ``f`` is the real part of the same evaluations. The work integrals act on
+# nothing (their columns are 0); with ``skip_rigid`` the columns of a rigid joint's states are
+# left 0 too. Written into the glue, `recipdyn.model.components.contact`.)
 
 
 @compiled(EVENT_SIGNATURE)
@@ -545,19 +415,74 @@ def record_both(t, y, p, out):
     _flip(y, contact_factor(y, p, 2)[1], p, out)
 
 
-#: The rigid joint's eccentricity and its rate (constant 0: no degrees of freedom).
-KERNELS = {  # joints -> (rhs, jac, event, reset, config code, rhs and jac in one call)
-    "crank": (rhs_crank, jac_crank, onset_crank, record_crank, 0, rhs_jac_crank),
-    "crosshead": (
-        rhs_crosshead,
-        jac_crosshead,
-        onset_crosshead,
-        record_crosshead,
-        1,
-        rhs_jac_crosshead,
-    ),
-    "both": (rhs_both, jac_both, onset_both, record_both, 2, rhs_jac_both),
-}
+#: Joint configuration codes of the compiled kernels (literals in the generated glue).
+CFG = {"crank": 0, "crosshead": 1, "both": 2}
+#: The joint family at each pin: its parameter and the joints it may be (the massless link
+#: exists at the crank pin only, and only in the massless-link model).
+PIN_CHOICES = {"crank_joint": ("link", "ideal", "contact", "lubricated"),
+               "crosshead_joint": ("ideal", "contact", "lubricated")}  # fmt: skip
+
+
+def joint_types(values: Mapping[str, Any]) -> tuple[str, str]:
+    """The joint at the crank pin and at the crosshead pin (``ideal``, ``contact``,
+    ``lubricated``): ``crank_joint`` and ``crosshead_joint`` where given, else from
+    ``clearance_joints`` (where the clearance is) and ``joint`` (dry or lubricated)."""
+    where = values.get("clearance_joints", "crank")
+    kind = "lubricated" if values.get("joint", "dry") == "lubricated" else "contact"
+    crank = values.get("crank_joint") or ("ideal" if where == "crosshead" else kind)
+    cross = values.get("crosshead_joint") or ("ideal" if where == "crank" else kind)
+    return crank, cross
+
+
+def _resolve_joints(values: dict[str, Any]) -> None:
+    """Write the joint family of each pin and the clearance configuration it makes into
+    ``values``; refuse, in one line, a combination that does not exist here."""
+    from ..errors import ParameterError
+
+    crank, cross = joint_types(values)
+    if crank == "link":
+        raise ParameterError(
+            "crank_joint = 'link' is out of range for this model; allowed: 'ideal', 'contact', "
+            "'lubricated' (the massless link is the compressor model's: --model compressor)"
+        )
+    if crank == "ideal" and cross == "ideal":
+        raise ParameterError(
+            "crank_joint = crosshead_joint = 'ideal': no clearance joint left; allowed: "
+            "'contact' or 'lubricated' at one pin at least (the ideal mechanism: --model "
+            "compressor with rc = 0)"
+        )
+    values["crank_joint"], values["crosshead_joint"] = crank, cross
+    values["clearance_joints"] = ("both" if "ideal" not in (crank, cross) else
+                                  "crank" if cross == "ideal" else "crosshead")  # fmt: skip
+
+
+def load_part(values: Mapping[str, Any]):
+    """The load component the values choose (`recipdyn.model.components.load`): a table when
+    ``load_table`` is given (a measured indicator diagram, or a real gas's cycle tabulated
+    from CoolProp), else the ``load`` parameter's."""
+    from .components.load import load_component
+
+    return load_component(values)
+
+
+@lru_cache(maxsize=32)
+def _glue(joints: str, load: str):
+    from .components.contact import glue_source
+    from .components.contract import glue_module
+    from .components.load import LOADS, VALVES
+
+    part = VALVES if load == VALVES.name else LOADS[load]
+    src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED,
+                      first_state=G_GAS)  # fmt: skip
+    return glue_module(src, f"contact_{joints}_{load}")
+
+
+def kernels(values: Mapping[str, Any], load=None):
+    """The generated glue of the joints and the load ``values`` choose (or ``load``): a
+    module with ``rhs``, ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe`` and
+    ``fd_jac`` (`recipdyn.model.components.contact`)."""
+    part = load_part(values) if load is None else load
+    return _glue(values["clearance_joints"], part.name)
 
 
 def _link(name: str, **changes) -> Param:
@@ -578,7 +503,15 @@ SCHEMA = Schema((
     _link("d", low_ref="-(l - r - 1.5 (rc + rc_crosshead))",
           high_ref="l - r - 1.5 (rc + rc_crosshead)"),
     Param("joint", "", "dry", "'dry' contact-impact or 'lubricated' (oil film + dry contact "
-          "beyond eps_dry)", choices=("dry", "lubricated"), group="joint"),
+          "beyond eps_dry) at each clearance joint (crank_joint, crosshead_joint set one pin)",
+          choices=("dry", "lubricated"), group="joint"),
+    Param("crank_joint", "", None, "the crank-pin joint: 'ideal', 'contact' (dry) or "
+          "'lubricated' (default: from clearance_joints and joint; 'link', the massless link, "
+          "is the compressor model's)", choices=PIN_CHOICES["crank_joint"], optional=True,
+          group="joint"),
+    Param("crosshead_joint", "", None, "the crosshead-pin joint: 'ideal', 'contact' (dry) or "
+          "'lubricated' (default: from clearance_joints and joint)",
+          choices=PIN_CHOICES["crosshead_joint"], optional=True, group="joint"),
     Param("contact_law", "", "lankarani-nikravesh", "normal force law (hysteresis damping)",
           choices=LAWS, group="joint"),
     Param("restitution", "", 0.9, "nominal coefficient of restitution of the law", 0.0, 1.0,
@@ -668,18 +601,25 @@ def overlap_half_angle(R_j: float, c: float, delta: float) -> float:
     return math.degrees(math.acos(min(1.0, max(-1.0, cos_phi))))
 
 
-def pack(values: Mapping[str, Any]) -> np.ndarray:
+def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
+    """The joints' parameters (layout: the ``P_*`` constants), then the slice of the load
+    component (``load``, default: the one the values choose, `load_part`)."""
+    from .components.contract import Assembly
+
     v = values
+    pins = joint_types(v)
     head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
     head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
              v["rc_crosshead"], stiffness(v, "crosshead"), v["crosshead_pin_radius"],
              hysteresis_factor(v["contact_law"], v["restitution"]), v["friction"], v["v0"],
              v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
-             v["oil_viscosity"] if v["joint"] == "lubricated" else 0.0, v["bearing_length"],
-             v["eps_dry"], v["v_impact_min"], v["load_amplitude"],
-             -1.0 if v["load_sign"] == "physical" else 1.0]  # fmt: skip
-    kind, data = pack_load(v)
-    return np.concatenate([np.asarray([*head, kind], dtype=np.float64), data])
+             v["oil_viscosity"] if pins[0] == "lubricated" else 0.0, v["bearing_length"],
+             v["eps_dry"], v["v_impact_min"],
+             v["oil_viscosity"] if pins[1] == "lubricated" else 0.0]  # fmt: skip
+    part = load_part(v) if load is None else load
+    vec, offsets = Assembly(N_PACKED, (part,)).pack(np.asarray(head, dtype=np.float64), v)
+    assert offsets["load"] == N_PACKED  # a literal in the glue
+    return vec
 
 
 def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
@@ -701,28 +641,6 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     elastic = stiffness(values, "crank") * d1**2.5 / 2.5
     elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
     return {"mechanical": kin + pot, "elastic": elastic}
-
-
-@nb.njit(cache=True)
-def _joint_series(cfg, t, y, p):
-    """Per sample: both joints' rows of `_pair` (14), the accelerations e1'', e2''
-    (4), theta2', x3', gas force."""
-    n = t.shape[0]
-    out = np.zeros((n, 21))
-    d = np.empty(y.shape[1])
-    for i in range(n):
-        yi = y[i].copy()
-        _rhs(t[i], yi, p, d, cfg)
-        f1, f2, _, _, th2d, v3, _, _, _ = _joints(t[i], yi, p, cfg)
-        for k in range(7):
-            out[i, k] = f1[k]
-            out[i, 7 + k] = f2[k]
-        out[i, 14:18] = d[4:8]
-        out[i, 18] = th2d
-        out[i, 19] = v3
-        th1 = p[P_TH10] + p[P_OMEGA] * t[i]
-        out[i, 20] = _gas(t[i], yi, p, math.sin(th1), math.cos(th1))
-    return out
 
 
 class CompressorContact(Model):
@@ -768,9 +686,73 @@ class CompressorContact(Model):
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
 
+    def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
+        """Validated values; besides the schema's, a force table as the massless link takes
+        it: ``load_table`` (rows of crank angle in deg and force in N, or a CSV file of them,
+        `recipdyn.model.load.read_load_table`) or ``pressure_table`` (a measured indicator
+        diagram, a CSV file, `recipdyn.model.load.read_pressure_table`, with this run's bore,
+        rod diameter and frame pressure). The table replaces the ``load`` (the table load
+        component)."""
+        v = {**(values or {}), **kw}
+        table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
+        out = self.schema.validate(v)
+        _resolve_joints(out)
+        self.check(out)
+        tab = self._table(out, table, ptab)
+        if tab is not None:
+            out["load_table"] = tab
+        return out
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """`Model.record_attrs`, with a table load's rows (``param_load_table_deg_N``: it has
+        no schema row)."""
+        out = super().record_attrs(values, y0)
+        if values.get("load_table") is not None:
+            out["param_load_table_deg_N"] = [float(x) for row in values["load_table"] for x in row]
+        return out
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """`Model.values_from_record`, the table load's rows included."""
+        values = super().values_from_record(attrs)
+        flat = attrs.get("param_load_table_deg_N")
+        if flat is not None:
+            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
+            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
+        return values
+
+    @staticmethod
+    def _table(values: Mapping[str, Any], table: Any, ptab: Any) -> Any:
+        from ..errors import ParameterError
+        from .load import read_load_table, read_pressure_table
+        from .parameters import _validate_table
+
+        if table is not None and ptab is not None:
+            raise ParameterError("pressure_table and load_table: give one of them")
+        if ptab is not None:
+            return read_pressure_table(ptab, bore=values["bore"],
+                                       rod_diameter=values["rod_diameter"],
+                                       frame_pressure=values["frame_pressure"])  # fmt: skip
+        if table is None:
+            return None
+        if not isinstance(table, (list, tuple)):
+            return read_load_table(table)
+        rows = tuple(tuple(float(x) for x in row) for row in table)
+        _validate_table(rows)
+        return rows
+
+    def load_part(self, values: Mapping[str, Any]):
+        """The load component of this model for ``values`` (`load_part`)."""
+        return load_part(values)
+
+    def kernels(self, values: Mapping[str, Any]):
+        """The generated glue of the joints and the load (`kernels`)."""
+        return kernels(values, self.load_part(values))
+
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         joints = values["clearance_joints"]
-        _, _, onset, record, *_ = KERNELS[joints]
+        k = self.kernels(values)
+        onset, record = k.event, k.reset
         if joints == "both":
             return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
@@ -782,8 +764,9 @@ class CompressorContact(Model):
                       "velocity is recorded for the damping law"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
-        rhs, jac, *_, rhs_jac = KERNELS[values["clearance_joints"]]
-        return ODESystem(rhs=rhs, jac=jac, rhs_jac=rhs_jac, params=pack(values),
+        k = self.kernels(values)
+        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
+                         params=pack(values, self.load_part(values)),
                          state_names=self.state_names,
                          state_units=self.state_units, period=self.period(values),
                          name=self.name, events=self.events(values), aux_states=4,
@@ -808,7 +791,8 @@ class CompressorContact(Model):
                 "gas",
                 "suction_temperature",
             )
-            cp = CompressorParams(rs=0.0, **{k: values[k] for k in keys})
+            cp = CompressorParams(rs=0.0, load_table=values.get("load_table"),
+                                  **{k: values[k] for k in keys})  # fmt: skip
             ang = equilibrium_theta_c(cp)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
@@ -841,8 +825,7 @@ class CompressorContact(Model):
         s = self.system(values)
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
-        cfg = KERNELS[values["clearance_joints"]][4]
-        j = _joint_series(cfg, t, y, s.params)
+        j = self.kernels(values).observe(t, y, s.params)
         r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
         th1 = float(values["theta1_0"]) + w * t
         e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))

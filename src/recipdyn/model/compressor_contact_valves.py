@@ -3,8 +3,9 @@ r"""The contact-impact clearance joint driven by the cylinder gas with dynamic v
 `compressor_contact` (journal free in its bearing: flight, impacts, friction, oil film)
 with the gas load of `valves`: the chamber pressures and masses and the valve plates are
 states integrated with the eccentricities, the chamber volumes follow the crosshead of the
-joint's own state, and the gas force follows the pressures (load kind
-`LOAD_STATE` of the contact kernels). This is the pairing the
+joint's own state, and the gas force follows the pressures (the load component
+`recipdyn.model.components.load.VALVES`, a load with states, joined to the joints by the
+generated glue of `recipdyn.model.components.contact`). This is the pairing the
 double-acting cycle needs: its rod load reverses twice a revolution, where the massless link of
 ``compressor-valves`` leaves its validity and the journal really crosses its clearance.
 
@@ -17,8 +18,8 @@ the valve impacts share one: the minimum of the joints' phased contact factors
 each moving plate moves toward. Every factor is positive between its events and falls through
 0 at one, and its reset makes it positive again (a joint changes phase, an onset recording the
 approach velocity; a plate rebounds or rests), so the minimum falls through 0 at each event and
-two events however close are both located. (A product of signed factors, used before
-2026-11-24, lost both events of a pair closer than a quarter step.)
+two events however close are both located (a product of signed factors would lose both
+events of a pair closer than a quarter step).
 
 The Jacobian is a fourth-order central difference over the whole state (the valve laws are
 not written for the contact model's complex-step Jacobian); Benettin's method is refused as
@@ -30,13 +31,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-import numba as nb
 import numpy as np
 
 from . import compressor_contact as cc
 from . import cycle as cy
 from . import valves as va
-from .base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .base import Event, ODESystem, Signal
+from .components.load import VALVES
 from .protocol import Schema
 
 __all__ = ["CompressorContactValves", "COMPRESSOR_CONTACT_VALVES"]
@@ -45,59 +46,9 @@ G0, A0 = cc.G_GAS, cc.G_AUX
 STATE_NAMES = (*cc.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
 STATE_UNITS = (*cc.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
 N_STATE = len(STATE_NAMES)
-P_VALVE = cc.P_TABLE + cy.N_CYCLE
+#: The valve data in the parameter vector: after the joints' and the cycle's.
+P_VALVE = cc.N_PACKED + cy.N_CYCLE
 
-
-@nb.njit(cache=True, inline="always")
-def _event(y, p, cfg):
-    return min(cc.contact_factor(y, p, cfg)[0], va.valve_event(y, G0, p[P_VALVE:]))
-
-
-@nb.njit(cache=True)
-def _reset(y, p, cfg, out):
-    """The factor at zero acts: a valve plate rebounds or rests, a joint changes phase."""
-    valve = va.valve_event(y, G0, p[P_VALVE:])
-    f, j = cc.contact_factor(y, p, cfg)
-    if abs(valve) < abs(f):
-        va.valve_reset(y, G0, p[P_VALVE:], out)
-        return
-    for i in range(y.shape[0]):
-        out[i] = y[i]
-    cc._flip(y, j, p, out)
-
-
-@compiled(EVENT_SIGNATURE)
-def event_crank(t, y, p):
-    return _event(y, p, 0)
-
-
-@compiled(EVENT_SIGNATURE)
-def event_crosshead(t, y, p):
-    return _event(y, p, 1)
-
-
-@compiled(EVENT_SIGNATURE)
-def event_both(t, y, p):
-    return _event(y, p, 2)
-
-
-@compiled(RHS_SIGNATURE)
-def reset_crank(t, y, p, out):
-    _reset(y, p, 0, out)
-
-
-@compiled(RHS_SIGNATURE)
-def reset_crosshead(t, y, p, out):
-    _reset(y, p, 1, out)
-
-
-@compiled(RHS_SIGNATURE)
-def reset_both(t, y, p, out):
-    _reset(y, p, 2, out)
-
-
-EVENTS = {"crank": (event_crank, reset_crank), "crosshead": (event_crosshead, reset_crosshead),
-          "both": (event_both, reset_both)}  # fmt: skip
 
 _DROP = {"load", "load_amplitude", "load_sign", "gas"}
 SCHEMA = Schema((*(p for p in cc.SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
@@ -106,11 +57,9 @@ _LOAD = {"load": "cycle", "load_amplitude": 0.0, "load_sign": "physical", "gas":
 
 
 def pack(values: Mapping[str, Any]) -> np.ndarray:
-    """The contact model's vector with the cycle data (load kind ``LOAD_STATE``), then the
-    valve data."""
-    head = cc.pack({**values, **_LOAD})
-    head[cc.P_LOADKIND] = cc.LOAD_STATE
-    return np.concatenate([head, va.pack_valves(values, head[cc.P_TABLE : P_VALVE])])
+    """The contact model's vector, then the cycle data and the valve data (the load component
+    `recipdyn.model.components.load.VALVES`)."""
+    return cc.pack(values, load=VALVES)
 
 
 class CompressorContactValves(cc.CompressorContact):
@@ -129,20 +78,34 @@ class CompressorContactValves(cc.CompressorContact):
         "compressor-contact with load=cycle (ideal valves)"
     )
 
+    def load_part(self, values: Mapping[str, Any]):
+        return VALVES
+
+    @staticmethod
+    def _table(values: Mapping[str, Any], table: Any, ptab: Any) -> None:
+        if table is not None or ptab is not None:
+            from ..errors import ParameterError
+
+            raise ParameterError(
+                f"{'load_table' if table is not None else 'pressure_table'}: not for the "
+                "dynamic valves, whose gas force follows the chamber pressures; use --model "
+                "compressor-contact for a table load"
+            )
+
     def _values(self, values: Mapping[str, Any]) -> dict[str, Any]:
         return {**values, **_LOAD}
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
-        fn, reset = EVENTS[values["clearance_joints"]]
-        return (Event("impact", fn, direction=-1, action="reset", reset=reset,
+        k = self.kernels(values)
+        return (Event("impact", k.event, direction=-1, action="reset", reset=k.reset,
                       description="a contact onset or separation, or a valve plate reaching "
                       "its seat or guard (one event function: the minimum of the factors): "
                       "an onset records the approach velocity, a plate rebounds or "
                       "rests"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
-        rhs, jac, *_ = cc.KERNELS[values["clearance_joints"]]
-        return ODESystem(rhs=rhs, jac=jac, params=pack(values), state_names=STATE_NAMES,
+        k = self.kernels(values)
+        return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=STATE_NAMES,
                          state_units=STATE_UNITS, period=self.period(values), name=self.name,
                          events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
 
@@ -175,7 +138,7 @@ class CompressorContactValves(cc.CompressorContact):
         s = self.system(values)
         dy = rhs_series(s.rhs, s.params, t, y)
         sig.update(va.gas_outputs(values, sig["x"].values, y, dy, G0, A0,
-                                  s.params[cc.P_TABLE:P_VALVE]))  # fmt: skip
+                                  s.params[cc.N_PACKED:P_VALVE]))  # fmt: skip
         return sig
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
@@ -185,7 +148,7 @@ class CompressorContactValves(cc.CompressorContact):
             p = self.system(values).params
             ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
                                                        for k in STATE_NAMES]))  # fmt: skip
-            cfg = cc.KERNELS[values["clearance_joints"]][4]
+            cfg = cc.CFG[values["clearance_joints"]]
             contact = np.array([abs(cc.contact_factor(e, p, cfg)[0]) for e in ev])
             valve = np.array([abs(va.valve_event(e, G0, p[P_VALVE:])) for e in ev])
             is_valve = valve < contact

@@ -35,8 +35,16 @@ from typing import Any
 import numba as nb
 import numpy as np
 
+from ..errors import ParameterError
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
-from .components.load import cycle_outputs, cycle_summary
+from .components.load import (
+    cycle_force,
+    cycle_outputs,
+    cycle_summary,
+    force_series,
+    load_component,
+    table_force,
+)
 from .joints._guide import guide_energy, guide_system
 from .joints.contact import FRICTION_LAWS, LAWS, delivered_restitution, hysteresis_factor
 from .joints.guide import (
@@ -58,7 +66,7 @@ from .joints.guide import (
     smallest_factor,
     solve_prescribed,
 )
-from .load import CYCLE_PARAMS, gas_force_kernel, mu_sincos, pack_load
+from .load import CYCLE_PARAMS, mu_sincos
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
 
@@ -72,13 +80,19 @@ K0 = 4  # first corner phase in the state
 # after the joint's head: the drive, then the load
 P_OMEGA, P_TH10, P_LOADAMP, P_LOADSIGN, P_LOADKIND = range(N_HEAD, N_HEAD + 5)
 P_TABLE = N_HEAD + 5
+#: The load components this model's kernel calls (their index is packed at P_LOADKIND).
+GUIDE_LOADS = ("paper", "table", "cycle")
 
 
 @nb.njit(cache=True, inline="always")
 def _gas(th1, p):
+    # which of GUIDE_LOADS (set by pack from the load component, never by a user): each
+    # component's own kernel reads its own slice at P_TABLE
     if p[P_LOADKIND] == 0.0:
         return p[P_LOADSIGN] * p[P_LOADAMP] * mu_sincos(math.sin(th1), math.cos(th1))
-    return gas_force_kernel(th1, p[P_LOADKIND], p[P_LOADAMP], p[P_LOADSIGN], p[P_TABLE:])
+    if p[P_LOADKIND] == 1.0:
+        return table_force(th1, p, P_TABLE)
+    return cycle_force(th1, p, P_TABLE)
 
 
 @nb.njit(cache=True, inline="always")
@@ -219,9 +233,14 @@ def pack(v: Mapping[str, Any]) -> np.ndarray:
             v["guide_friction"], v["guide_v0"], v["guide_v1"],
             float(FRICTION_LAWS.index(v["guide_friction_law"])), v["v_impact_min"],
             v["crosshead_half_height"]]  # fmt: skip
-    kind, data = pack_load(v)
+    part = load_component(v)
+    if part.name not in GUIDE_LOADS:
+        raise ParameterError(f"load = {part.name!r}: compressor-guide takes the "
+                             f"{', '.join(GUIDE_LOADS)} loads")  # fmt: skip
+    data = np.asarray(part.pack(v), dtype=np.float64)
     head += [v["omega"], v["theta1_0"], v["load_amplitude"],
-             -1.0 if v["load_sign"] == "physical" else 1.0, kind]  # fmt: skip
+             -1.0 if v["load_sign"] == "physical" else 1.0,
+             float(GUIDE_LOADS.index(part.name))]  # fmt: skip
     return np.concatenate([np.asarray(head, dtype=np.float64), data])
 
 
@@ -284,10 +303,7 @@ def ideal_crosshead(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, 
     a2 = (r * w**2 * s1 / l + s2 * w2**2) / c2
     x = r * c1 + l * c2
     a = -r * w**2 * c1 - l * (c2 * w2**2 + s2 * a2)
-    kind, data = pack_load(values)
-    sign = -1.0 if values["load_sign"] == "physical" else 1.0
-    fg = np.array([gas_force_kernel(float(t), kind, float(values["load_amplitude"]), sign, data)
-                   for t in th1.ravel()]).reshape(th1.shape)  # fmt: skip
+    fg = force_series(values, th1)
     # crosshead along x: m3 a = fg - Fx  (Fx, Fy: force of the crosshead on the rod's end)
     fx = fg - m3 * a
     # rod, moments about the crank pin A: (J2 + m2 ls^2) a2 = -m2 ls (c2 aAy - s2 aAx)

@@ -46,24 +46,11 @@ from .base import (
     compiled,
     rhs_series,
 )
-from .compressor import (
-    P_D,
-    P_G,
-    P_J2,
-    P_L,
-    P_LS,
-    P_M2,
-    P_M3,
-    P_OMEGA,
-    P_R,
-    P_RC,
-    P_TABLE,
-    P_TH10,
-    Compressor,
-    equilibrium_theta_c,
-    mechanism_outputs,
-    pack_params,
-)  # fmt: skip
+from .components.contract import Assembly
+from .components.drive import PRESCRIBED
+from .components.load import VALVES
+from .components.mechanism import HEAD, N_HEAD
+from .compressor import Compressor, equilibrium_theta_c, mechanism_outputs
 from .kinematics import kinematics
 from .parameters import SCHEMA as LINK_SCHEMA
 from .parameters import CompressorParams
@@ -71,9 +58,13 @@ from .protocol import Schema
 
 __all__ = ["CompressorValves", "COMPRESSOR_VALVES"]
 
-#: Offsets in the packed vector: the cycle data, then the valve data.
-P_CYCLE = P_TABLE
-P_VALVE = P_TABLE + cy.N_CYCLE
+#: The packed vector: the mechanism's head (`recipdyn.model.components.mechanism.HEAD`), the
+#: prescribed drive's slice (omega, theta1_0), then the valve load's (the cycle data, then the
+#: valve data).
+(P_R, P_RS, P_L, P_LS, P_M1, P_M2, P_M3, P_J1, P_J2, P_G, P_RC, P_D) = range(N_HEAD)
+P_OMEGA, P_TH10, P_CYCLE = N_HEAD, N_HEAD + 1, N_HEAD + 2
+P_VALVE = P_CYCLE + cy.N_CYCLE
+_ASSEMBLY = Assembly(N_HEAD, (PRESCRIBED, VALVES))
 #: Offsets in the state: the gas states, then the mass counters.
 G0 = 2
 A0 = G0 + va.N_GAS
@@ -188,9 +179,13 @@ def _cparams(values: Mapping[str, Any]) -> CompressorParams:
 
 
 def pack(values: Mapping[str, Any]) -> np.ndarray:
-    """Packed vector: the massless-link model's (with the cycle data), then the valves'."""
-    head = pack_params(_cparams(values))
-    return np.concatenate([head, va.pack_valves(values, head[P_CYCLE:P_VALVE])])
+    """Packed vector: the mechanism's head, the prescribed drive's slice, the valve load's
+    (layout: the ``P_*`` constants)."""
+    p = _cparams(values)
+    head = np.array([getattr(p, k) for k in HEAD], dtype=np.float64)
+    vec, offsets = _ASSEMBLY.pack(head, values)
+    assert offsets["drive"] == P_OMEGA and offsets["load"] == P_CYCLE
+    return vec
 
 
 class CompressorValves(Compressor):

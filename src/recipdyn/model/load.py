@@ -36,16 +36,14 @@ import math
 import numba as nb
 import numpy as np
 
-from .cycle import CYCLE_PARAMS, cycle_data, cycle_force_kernel, pressure_force
+from .cycle import CYCLE_PARAMS, pressure_force
 
 __all__ = [
     "mu_paper",
     "mu_kernel",
-    "gas_force",
-    "gas_force_kernel",
     "read_load_table",
     "read_pressure_table",
-    "pack_load",
+    "pack_table",
     "CYCLE_PARAMS",
 ]
 
@@ -89,62 +87,12 @@ def mu_paper(theta1) -> np.ndarray:
     return np.vectorize(mu_kernel, otypes=[np.float64])(th)
 
 
-@nb.njit(cache=True)
-def gas_force_kernel(theta1: float, kind: float, amp: float, sign: float, table) -> float:
-    """Force on the crosshead along +x, N (compiled; see module docstring).
-
-    ``kind`` 0 = paper model, 1 = table (``table`` is ``[n, angles_rad(n), forces_N(n)]``),
-    2 = compression cycle (``table`` is
-    [`recipdyn.model.cycle.pack_cycle`][recipdyn.model.cycle.pack_cycle]'s vector).
-    """
-    if kind == 0.0:
-        return sign * amp * mu_kernel(theta1)
-    if kind == 2.0:
-        return cycle_force_kernel(theta1, table)
-    n = int(table[0])
-    ang = table[1 : 1 + n]
-    val = table[1 + n : 1 + 2 * n]
-    phi = theta1 % (2.0 * _PI)
-    j = np.searchsorted(ang, phi)  # ang[j-1] < phi <= ang[j]
-    if j == 0 or j == n:  # wrap-around segment between the last and the first node
-        a0, f0 = ang[n - 1], val[n - 1]
-        a1, f1 = ang[0] + 2.0 * _PI, val[0]
-        if phi < a0:
-            phi += 2.0 * _PI
-    else:
-        a0, f0, a1, f1 = ang[j - 1], val[j - 1], ang[j], val[j]
-    return f0 + (f1 - f0) * (phi - a0) / (a1 - a0)
-
-
 def pack_table(table) -> np.ndarray:
     """Pack ``((deg, N), ...)`` rows as ``[n, angles_rad, forces]`` for the kernel."""
     if table is None:
         return np.zeros(1)
     arr = np.asarray(table, dtype=np.float64)
     return np.concatenate([[len(arr)], np.deg2rad(arr[:, 0]), arr[:, 1]])
-
-
-def pack_load(v) -> tuple[float, np.ndarray]:
-    """``(kind, data)`` of the load for the compiled kernels from a mapping of parameter values
-    (``load``, ``load_table`` and the cycle's parameters; the mechanism's ``r``, ``l``, ``d``)."""
-    if v.get("load_table") is not None:
-        return 1.0, pack_table(v["load_table"])
-    if v.get("load", "paper") == "cycle" and v.get("gas", "ideal") != "ideal":
-        from .realgas import real_gas_force_table  # CoolProp: tabulated once, then a table
-
-        return 1.0, pack_table(real_gas_force_table(v))
-    if v.get("load", "paper") == "cycle":
-        return 2.0, cycle_data(v)
-    return 0.0, pack_table(None)
-
-
-def gas_force(theta1, params) -> np.ndarray:
-    """Force on the crosshead along +x (N) at crank angle(s) theta1 for ``params``."""
-    kind, tab = pack_load(vars(params))
-    sign = -1.0 if params.load_sign == "physical" else 1.0
-    th = np.atleast_1d(np.asarray(theta1, dtype=np.float64))
-    out = np.array([gas_force_kernel(x, kind, params.load_amplitude, sign, tab) for x in th])
-    return out.reshape(np.shape(theta1))
 
 
 def read_load_table(path, *, area: float | None = None) -> tuple[tuple[float, float], ...]:

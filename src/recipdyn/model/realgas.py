@@ -16,7 +16,7 @@ with ``P(rho, s)`` from CoolProp's Helmholtz equations of state. The re-expanded
 
 CoolProp cannot be called from compiled code, so the pressures are computed once per parameter
 set on a 0.25 deg grid (cached), and the kernels interpolate the resulting force table like
-any tabulated load ([`recipdyn.model.load.gas_force_kernel`][recipdyn.model.load.gas_force_kernel]);
+any tabulated load (the ``table`` load component, `recipdyn.model.components.load`);
 the cost of a run is that of a table load plus the table (96 CoolProp flashes along the isentrope,
 ~0.2 s, once).
 

@@ -48,16 +48,13 @@ def _prescribed(values: Mapping[str, Any]) -> np.ndarray:
 def mean_load_torque(values: Mapping[str, Any], n: int = 7200) -> float:
     """Mean torque the gas load asks of the crank over one revolution of the ideal mechanism
     (rc = 0) at constant speed: ``-(1/2 pi) integral F(theta1) dx3/dtheta1 dtheta1``, N m."""
-    from ..load import gas_force_kernel, pack_load
+    from .load import force_series
 
-    kind, data = pack_load(values)
     th = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
     r, l, d = float(values["r"]), float(values["l"]), float(values["d"])
     u = d + r * np.sin(th)
     dx3 = -r * np.sin(th) - u * r * np.cos(th) / np.sqrt(l * l - u * u)
-    sign = -1.0 if values.get("load_sign", "physical") == "physical" else 1.0
-    amp = float(values.get("load_amplitude", 0.0))
-    F = np.array([gas_force_kernel(x, kind, amp, sign, data) for x in th])
+    F = force_series(values, th)
     return float(-np.mean(F * dx3))
 
 

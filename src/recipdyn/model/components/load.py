@@ -6,9 +6,23 @@ r"""Load components: the force of the gas on the crosshead along +x, ``F(theta1)
   indicator diagram through `recipdyn.model.load.read_pressure_table`, or the real-gas
   cycle tabulated once from CoolProp), slice ``n, angles (rad), forces (N)``;
 * ``cycle``: the compression cycle with ideal valves and polytropic gas
-  (`recipdyn.model.cycle`), slice `recipdyn.model.cycle.cycle_data`.
+  (`recipdyn.model.cycle`), slice `recipdyn.model.cycle.cycle_data`;
+* ``valves``: the cylinder gas with dynamic plate valves (`recipdyn.model.valves`), a load
+  with states: the chamber pressures, masses and plates (12) and four mass counters
+  (auxiliary); slice `recipdyn.model.cycle.cycle_data`, then
+  `recipdyn.model.valves.pack_valves`.
 
-Each is one compiled function ``force(theta1, p, o)`` reading its slice at offset ``o``.
+A load without states is one compiled function ``force(theta1, p, o)`` reading its slice at
+offset ``o``; a load may add ``force_sc(sin theta1, cos theta1, p, o)``, the same force from
+the sine and cosine of the crank angle, for a joint that has them (the contact joint's
+kinematics). A load with states provides, with ``g`` (``a``) the index of its first state
+(auxiliary state) in ``y``:
+
+* ``state_force(y, g, p, o)``: the force on the crosshead from the states;
+* ``state_rhs(x3, x3', y, g, a, p, o, out)``: the derivatives of its states, for the
+  crosshead at ``x3`` moving at ``x3'``;
+* ``event(y, g, p, o)`` and ``reset(y, g, p, o, out)``: its event factor (positive between
+  events, falling through 0 at one) and the state after the event.
 """
 
 from __future__ import annotations
@@ -20,8 +34,10 @@ from typing import Any
 import numba as nb
 import numpy as np
 
+from .. import valves as va
 from ..base import Signal
 from ..cycle import (
+    N_CYCLE,
     cycle_data,
     cycle_force_kernel,
     cycle_states,
@@ -29,15 +45,18 @@ from ..cycle import (
     pin_reversal_summary,
     volumetric_efficiency,
 )
-from ..load import mu_kernel, pack_table
+from ..load import mu_kernel, mu_sincos, pack_table
 from .contract import Component
 
 __all__ = [
     "PAPER",
     "TABLE",
     "CYCLE",
+    "VALVES",
     "LOADS",
     "load_component",
+    "force_series",
+    "gas_force",
     "cycle_gas_states",
     "cycle_outputs",
     "cycle_summary",
@@ -50,6 +69,13 @@ _TWO_PI = 2.0 * math.pi
 def paper_force(th1, p, o):
     """The paper's load (slice ``amplitude, sign``)."""
     return p[o + 1] * p[o] * mu_kernel(th1)
+
+
+@nb.njit(cache=True, inline="always")
+def paper_force_sc(s1, c1, p, o):
+    """The paper's load from ``sin theta1`` and ``cos theta1`` (`recipdyn.model.load.mu_sincos`:
+    equal to `paper_force` to rounding, without reducing the angle)."""
+    return p[o + 1] * p[o] * mu_sincos(s1, c1)
 
 
 @nb.njit(cache=True)
@@ -77,6 +103,36 @@ def cycle_force(th1, p, o):
     return cycle_force_kernel(th1, p[o:])
 
 
+@nb.njit(cache=True, inline="always")
+def valves_force(y, g, p, o):
+    """The gas force of the chamber pressures ``y[g]``, ``y[g + 6]``."""
+    return va.state_force(y, g, p[o:])
+
+
+@nb.njit(cache=True, inline="always")
+def valves_rhs(x, xdot, y, g, a, p, o, out):
+    """The chambers' and plates' derivatives (`recipdyn.model.valves.gas_rhs`)."""
+    c = p[o:]
+    va.gas_rhs(x, xdot, y, g, a, c, c[N_CYCLE:], out)
+
+
+@nb.njit(cache=True, inline="always")
+def valves_event(y, g, p, o):
+    """The smallest plate factor (`recipdyn.model.valves.valve_event`)."""
+    return va.valve_event(y, g, p[o + N_CYCLE :])
+
+
+@nb.njit(cache=True, inline="always")
+def valves_reset(y, g, p, o, out):
+    """A plate's impact (`recipdyn.model.valves.valve_reset`)."""
+    va.valve_reset(y, g, p[o + N_CYCLE :], out)
+
+
+def _valves(values: Mapping[str, Any]) -> np.ndarray:
+    c = cycle_data(values)
+    return np.concatenate([c, va.pack_valves(values, c)])
+
+
 def _paper(values: Mapping[str, Any]) -> np.ndarray:
     sign = -1.0 if values.get("load_sign", "physical") == "physical" else 1.0
     return np.array([values["load_amplitude"], sign], dtype=np.float64)
@@ -91,12 +147,22 @@ def _table(values: Mapping[str, Any]) -> np.ndarray:
     return pack_table(table)
 
 
-PAPER = Component("load", "paper", "the paper's piecewise load, Eq. (1)-(2)",
-                  module=__name__, kernels={"force": "paper_force"}, pack=_paper)  # fmt: skip
+PAPER = Component("load", "paper", "the paper's piecewise load, Eq. (1)-(2)", module=__name__,
+                  kernels={"force": "paper_force", "force_sc": "paper_force_sc"},
+                  pack=_paper)  # fmt: skip
 TABLE = Component("load", "table", "a periodic force table (measured p-theta, or a real gas)",
                   module=__name__, kernels={"force": "table_force"}, pack=_table)  # fmt: skip
 CYCLE = Component("load", "cycle", "the compression cycle, ideal valves, polytropic gas",
                   module=__name__, kernels={"force": "cycle_force"}, pack=cycle_data)  # fmt: skip
+
+VALVES = Component(
+    "load", "valves", "the cylinder gas with dynamic plate valves (pressures, plates as states)",
+    module=__name__, pack=_valves, params=va.SCHEMA_PARAMS,
+    kernels={"state_force": "valves_force", "state_rhs": "valves_rhs",
+             "event": "valves_event", "reset": "valves_reset"},
+    states=tuple(zip(va.GAS_STATE_NAMES, va.GAS_STATE_UNITS, strict=True)),
+    aux_states=tuple(zip(va.AUX_STATE_NAMES, va.AUX_STATE_UNITS, strict=True)),
+)  # fmt: skip
 
 LOADS = {c.name: c for c in (PAPER, TABLE, CYCLE)}
 
@@ -109,6 +175,25 @@ def load_component(values: Mapping[str, Any]) -> Component:
     if values.get("load", "paper") == "cycle" and values.get("gas", "ideal") != "ideal":
         return TABLE
     return LOADS[values.get("load", "paper")]
+
+
+def force_series(values: Mapping[str, Any], theta1) -> np.ndarray:
+    """The force on the crosshead along +x (N) of the load the values choose
+    (`load_component`) at crank angle(s) ``theta1``: its compiled ``force`` on its own slice
+    (offset 0), the arithmetic of a run."""
+    import importlib
+
+    part = load_component(values)
+    vec = np.asarray(part.pack(values), dtype=np.float64)
+    fn = getattr(importlib.import_module(part.module), part.kernel("force"))
+    th = np.atleast_1d(np.asarray(theta1, dtype=np.float64))
+    return np.array([fn(x, vec, 0) for x in th]).reshape(np.shape(theta1))
+
+
+def gas_force(theta1, params) -> np.ndarray:
+    """Force on the crosshead along +x (N) at crank angle(s) theta1 for ``params`` (a
+    `recipdyn.model.parameters.CompressorParams`; `force_series`)."""
+    return force_series(vars(params), theta1)
 
 
 def cycle_gas_states(theta1: np.ndarray, values: Mapping[str, Any]) -> dict[str, np.ndarray]:

@@ -50,7 +50,7 @@ def equilibrium_theta_c(p, t: float = 0.0) -> float:
     away (``F_x > 0``, the paper's sign, rod in tension). theta2 depends weakly on theta_c
     (``|d theta2/d theta_c| <= rc/(l cos theta2)``), so a fixed-point iteration converges.
     """
-    from ..load import gas_force
+    from .load import gas_force
 
     th1 = p.theta1_0 + p.omega * t
     F = float(gas_force(th1, p))
