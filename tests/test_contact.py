@@ -725,3 +725,26 @@ def test_a_record_of_the_old_joint_parameters_runs_again(tmp_path):
     for k in ("ex", "ey", "ex_crosshead", "ey_crosshead", "a", "joint_force"):
         x, y = a[k].values, b[k].values
         assert x.shape == y.shape and np.abs(x - y).max() <= 1e-6 * np.ptp(x), k
+
+
+def test_a_sweep_with_an_ideal_crank_pin_records_its_poincare_sections(tmp_path):
+    """With the crank pin ideal (clearance at the crosshead pin only) the run records the crank
+    pin's eccentricity as exactly zero, so the sweep's Poincare measure, whose section signals
+    name it, completes (it failed with a KeyError on ``ex``), and its other section signals
+    are the run's own."""
+    from recipdyn.sweep import SweepSpec, open_sweep, parse_axis, run_sweep
+
+    m = get_model("compressor-contact")
+    base = m.parameters(crank_joint="ideal", crosshead_joint="contact", omega=150.0,
+                        load_amplitude=2e4)  # fmt: skip
+    axis = parse_axis("load_amplitude=2e4:2.02e4:2", "compressor-contact")
+    settings = dict(revolutions=2.0, transient=1.0, points=4, fs=200.0, rtol=1e-9, atol=1e-11)
+    spec = SweepSpec(axes=(axis,), measures=("poincare", "peak"), settings=settings,
+                     model="compressor-contact", base=base)  # fmt: skip
+    ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False)).load()
+    assert ds.done.values.all() and not any(ds.error.values), ds.error.values
+    names = [v for v in ds.data_vars if "ex" in v and "crosshead" not in v]
+    assert names, list(ds.data_vars)
+    for v in names:  # the ideal pin's eccentricity: exactly zero at every section point
+        vals = ds[v].values
+        assert np.all(vals[np.isfinite(vals)] == 0.0), (v, vals)

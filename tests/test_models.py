@@ -34,10 +34,9 @@ PRESETS = {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
 }  # fmt: skip
-# Not in the list yet: an ideal crank pin fails the sweep test (the contact model's section
-# signals name the crank pin's ``ex``, which such a run does not record: a KeyError in the
-# sweep's Poincare measure, with clearance_joints = crosshead too); the dynamic valves with a
-# lubricated pin fail the Jacobian check in a rate column (their central-difference Jacobian).
+# Not in the list yet: the dynamic valves with a lubricated pin fail the Jacobian check in a
+# rate column (their central-difference Jacobian). An ideal crank pin's sweep is checked in
+# tests/test_contact.py (its section signals name the crank pin's ``ex``: zero there).
 MODELS = [*model_names(), EXAMPLE, *PRESETS]
 
 

@@ -881,6 +881,10 @@ class CompressorContact(Model):
                 "joint_force" + key: Signal(np.hypot(f[:, 0], f[:, 1]), "N", f"{where} joint "
                                             "force magnitude"),
             })  # fmt: skip
+        if "ex" not in sig:  # an ideal crank pin: no eccentricity (the section signals name it)
+            zero = np.zeros_like(t)
+            sig["ex"] = Signal(zero, "m", "crank-pin eccentricity x (ideal pin: 0)")
+            sig["ey"] = Signal(zero.copy(), "m", "crank-pin eccentricity y (ideal pin: 0)")
         return sig
 
     def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
