@@ -327,6 +327,7 @@ def simulate(
     n = int(math.floor(n_float + 1e-9)) + 1
     # streamed: the output times are made block by block (never all 8 bytes x n at once)
     t_eval = UniformGrid(t_start, fs, n) if out is not None else t_start + np.arange(n) / fs
+    t_last = t_start + (n - 1) / fs  # the last sample: events after it are not recorded
     bar = None
     cb = None
     if progress:
@@ -415,7 +416,7 @@ def simulate(
 
     attrs["config_toml"] = dump_config(m, values, settings, spec=spec)
     _check_validity(m, minima, attrs, values)
-    events_ds = _events(m, values, events[0], sol, t_start) if events else None
+    events_ds = _events(m, values, events[0], sol, t_start, t_last) if events else None
     if events_ds is not None:
         attrs.update(events_ds.attrs)  # what each event is
     recent = full if writer is None else xr.concat(tail, "time") if tail else None
@@ -563,9 +564,10 @@ def _check_run_settings(revolutions, transient, fs, method, rtol, atol) -> None:
     check_tolerances(rtol, atol)
 
 
-def _events(m: Model, values, e, sol, t_start: float) -> xr.Dataset:
-    """The event records of the recorded interval, over an ``NAME_event`` dimension."""
-    keep = sol.t_events >= t_start
+def _events(m: Model, values, e, sol, t_start: float, t_last: float) -> xr.Dataset:
+    """The event records of the recorded interval (first to last sample), over an
+    ``NAME_event`` dimension."""
+    keep = (sol.t_events >= t_start) & (sol.t_events <= t_last)
     dim = f"{e.name}_event"
     ds = xr.Dataset()
     ds[f"{e.name}_time"] = (dim, sol.t_events[keep], {"units": m.time_unit,

@@ -111,12 +111,16 @@ class CompressorModel(ODESystem):
     #: ``observe(t, y, p) -> (n, 3)``: crank angle, crank speed and gas force at each sample,
     #: from the compiled functions that were integrated (the generated glue)
     observer: Any = None
+    #: the values of components from a user's file, ``((name, value), ...)`` (beside ``cparams``)
+    plugged: tuple = ()
 
     def initial_state(self) -> np.ndarray:
         """``(theta_c0, thetadot_c0)`` (with a motor, then ``theta1_0, omega, 0, 0``);
         default theta_c0: `equilibrium_theta_c` + offset."""
         p = self.cparams
-        thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
+        thc0 = p.theta_c0
+        if thc0 is None:
+            thc0 = equilibrium_theta_c(p, extra=dict(self.plugged))
         y0 = [thc0 + p.theta_c_offset, p.thetadot_c0]
         if p.drive == "motor":
             y0 += [p.theta1_0, p.omega, 0.0, 0.0]
@@ -200,6 +204,7 @@ def compressor_model(p: CompressorParams | None = None,
     p = CompressorParams() if p is None else p
     if not isinstance(p, CompressorParams):
         raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
+    plugged = tuple(sorted((extra or {}).items()))
     vec, offsets, parts = pack_assembled(p, extra)
     motor = parts.get("motor")
     rhs, jac, rhs_jac, observe = _kernels(
@@ -230,6 +235,7 @@ def compressor_model(p: CompressorParams | None = None,
         attrs=p.to_attrs(),
         cparams=p,
         observer=observe,
+        plugged=plugged,
         **extra,
     )
 

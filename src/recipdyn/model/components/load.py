@@ -46,7 +46,7 @@ from ..cycle import (
     volumetric_efficiency,
 )
 from ..load import mu_kernel, mu_sincos, pack_table
-from .contract import Component
+from .contract import Component, resolve_component
 
 __all__ = [
     "PAPER",
@@ -174,7 +174,7 @@ def load_component(values: Mapping[str, Any]) -> Component:
         return TABLE
     if values.get("load", "paper") == "cycle" and values.get("gas", "ideal") != "ideal":
         return TABLE
-    return LOADS[values.get("load", "paper")]
+    return resolve_component("load", values.get("load", "paper"), LOADS)  # a user's too
 
 
 def force_series(values: Mapping[str, Any], theta1) -> np.ndarray:
