@@ -99,3 +99,24 @@ def test_infeasible_geometry_is_rejected():
     object.__setattr__(p, "d", 0.5)  # bypass validation to reach the kinematic check
     with pytest.raises(ParameterError, match="infeasible"):
         _rod_angle(p, np.array([np.pi / 2]), np.array([np.pi / 2]))
+
+
+@pytest.mark.parametrize("d", [0.0, 2e-3])
+def test_ideal_mechanism_forces_agree_with_newton_euler_of_the_clearance_model(d, rng):
+    """The closed form of the rigid mechanism (`ideal_mechanism`: moments about the crank pin)
+    and `joint_forces` (Newton-Euler on the rod's centroid, written independently for the
+    clearance link) give the same pin and guide forces at rc = 0 under any gas force: both are
+    exact, so they agree to rounding (1e-9 of the largest force)."""
+    from recipdyn.model.kinematics import ideal_mechanism, joint_forces
+
+    p = CompressorParams(rc=0.0, d=d, omega=20.0)
+    t = np.linspace(0.0, 2 * np.pi / p.omega, 97)
+    gas = rng.uniform(-2e5, 2e5, t.size)
+    k = kinematics(p, t, np.zeros_like(t), np.zeros_like(t), np.zeros_like(t))
+    nf = joint_forces(p, k, np.zeros_like(t), gas)
+    m = ideal_mechanism(vars(p), p.theta1_0 + p.omega * t, gas)
+    scale = np.max(np.abs(gas))
+    np.testing.assert_allclose(m["a"], k.a3, rtol=0, atol=1e-9 * p.r * p.omega**2)
+    np.testing.assert_allclose(m["side_force"], nf.guide, rtol=0, atol=1e-9 * scale)
+    # the crank-pin force on the rod balances the crosshead-pin force and the rod's inertia
+    np.testing.assert_allclose(nf.Fx, p.m2 * k.ax2 - m["force_x"], rtol=0, atol=1e-9 * scale)

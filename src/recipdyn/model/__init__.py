@@ -13,7 +13,7 @@ _LAZY = {
     "ODESystem": "base", "DiscreteMap": "base", "Signal": "base",
     "CompressorModel": "compressor", "compressor_model": "compressor",
     "equilibrium_theta_c": "compressor",
-    "ideal_slider_crank": "kinematics", "joint_forces": "kinematics", "kinematics": "kinematics",
+    "ideal_slider_crank": "kinematics", "ideal_mechanism": "kinematics", "joint_forces": "kinematics", "kinematics": "kinematics",
     "gas_force": "components.load", "mu_paper": "load", "read_load_table": "load",
     "ASSUMED": "parameters", "CompressorParams": "parameters", "ParameterError": "parameters",
     "paper_2d12": "parameters",

@@ -66,6 +66,7 @@ from .joints.guide import (
     smallest_factor,
     solve_prescribed,
 )
+from .kinematics import ideal_mechanism
 from .load import CYCLE_PARAMS, mu_sincos
 from .parameters import SCHEMA as LINK_SCHEMA
 from .protocol import Model, Param, Schema
@@ -293,28 +294,10 @@ def ideal_crosshead(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, 
     constant ``omega``): axial position and acceleration, the rod angle, and the side force the
     guide must supply (``N > 0``: the lower shoe pushes up), from Newton–Euler for the crosshead
     and for the rod about the crank pin with the gas force and gravity."""
-    keys = ("r", "l", "ls", "m2", "m3", "J2", "g", "d", "omega")
-    r, l, ls, m2, m3, J2, g, d, w = (float(values[k]) for k in keys)
-    th1 = np.asarray(theta1, dtype=float)
-    s1, c1 = np.sin(th1), np.cos(th1)
-    s2 = -(d + r * s1) / l
-    c2 = np.sqrt(1 - s2**2)
-    w2 = -r * w * c1 / (l * c2)
-    a2 = (r * w**2 * s1 / l + s2 * w2**2) / c2
-    x = r * c1 + l * c2
-    a = -r * w**2 * c1 - l * (c2 * w2**2 + s2 * a2)
-    fg = force_series(values, th1)
-    # crosshead along x: m3 a = fg - Fx  (Fx, Fy: force of the crosshead on the rod's end)
-    fx = fg - m3 * a
-    # rod, moments about the crank pin A: (J2 + m2 ls^2) a2 = -m2 ls (c2 aAy - s2 aAx)
-    #   + l (c2 Fy - s2 Fx) - m2 g ls c2
-    aax, aay = -r * w**2 * c1, -r * w**2 * s1
-    fy = ((J2 + m2 * ls**2) * a2 + m2 * ls * (c2 * aay - s2 * aax) + m2 * g * ls * c2
-          + l * s2 * fx) / (l * c2)  # fmt: skip
-    # crosshead along y (no lateral acceleration): 0 = N - Fy - m3 g (the rod's end pushes the
-    # crosshead with -Fy)
-    side = fy + m3 * g
-    return {"x": x, "a": a, "theta2": np.arcsin(s2), "side_force": side, "gas_force": fg}
+    fg = force_series(values, np.asarray(theta1, dtype=float))
+    m = ideal_mechanism(values, theta1, fg)
+    return {"x": m["x"], "a": m["a"], "theta2": m["theta2"], "side_force": m["side_force"],
+            "gas_force": fg}  # fmt: skip
 
 
 class CompressorGuide(Model):

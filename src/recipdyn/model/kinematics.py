@@ -39,7 +39,8 @@ import numpy as np
 
 from .parameters import CompressorParams, ParameterError
 
-__all__ = ["Kinematics", "kinematics", "ideal_slider_crank", "joint_forces", "JointForces"]
+__all__ = ["Kinematics", "kinematics", "ideal_mechanism", "ideal_slider_crank", "joint_forces",
+           "JointForces"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -132,31 +133,61 @@ def kinematics(p: CompressorParams, t, theta_c, thetadot_c, thetaddot_c, *, thet
     return Kinematics(th1, th2, th2d, th2dd, x2, y2, ax2, ay2, x3, v3, a3)
 
 
+def ideal_mechanism(values, theta1, gas_force=0.0) -> dict[str, np.ndarray]:
+    """The ideal (rigid-joint) offset slider-crank in closed form, the crank at constant
+    ``omega``: the crosshead's motion, the rod's angular motion and the pin forces, from
+    Newton-Euler for the crosshead and for the rod about the crank pin.
+
+    ``values``: a mapping with ``r, l, ls, m2, m3, J2, g, d, omega`` (SI); ``theta1``: crank
+    angles (rad); ``gas_force``: the force on the crosshead along x (N). With
+    ``sin(theta2) = -(d + r sin(theta1)) / l``::
+
+        theta2'  = -r omega cos(theta1) / (l cos(theta2))
+        theta2'' = (r omega^2 sin(theta1) / l + sin(theta2) theta2'^2) / cos(theta2)
+        x3 = r cos(theta1) + l cos(theta2),   x3'' = -r omega^2 cos(theta1)
+             - l (cos(theta2) theta2'^2 + sin(theta2) theta2'')
+        crosshead x:   m3 x3'' = F_gas - F_x
+        rod about A:   (J2 + m2 ls^2) theta2'' = -m2 ls (c2 a_Ay - s2 a_Ax)
+                       + l (c2 F_y - s2 F_x) - m2 g ls c2
+        crosshead y:   0 = N - F_y - m3 g
+
+    ``F_x, F_y`` are the force of the crosshead pin on the rod's end, ``N`` the side force the
+    guide supplies (positive: the lower shoe pushes up).
+
+    Returns a dict of arrays: ``x, v, a`` (crosshead, m, m/s, m/s^2), ``theta2, omega2,
+    alpha2`` (rod), ``force_x, force_y`` (N), ``side_force`` (N).
+    """
+    keys = ("r", "l", "ls", "m2", "m3", "J2", "g", "d", "omega")
+    r, l, ls, m2, m3, J2, g, d, w = (float(values[k]) for k in keys)
+    th1 = np.asarray(theta1, dtype=float)
+    s1, c1 = np.sin(th1), np.cos(th1)
+    s2 = -(d + r * s1) / l
+    c2 = np.sqrt(1 - s2**2)
+    w2 = -r * w * c1 / (l * c2)
+    a2 = (r * w**2 * s1 / l + s2 * w2**2) / c2
+    x = r * c1 + l * c2
+    v = -r * w * s1 - l * s2 * w2
+    a = -r * w**2 * c1 - l * (c2 * w2**2 + s2 * a2)
+    fx = gas_force - m3 * a
+    aax, aay = -r * w**2 * c1, -r * w**2 * s1
+    fy = ((J2 + m2 * ls**2) * a2 + m2 * ls * (c2 * aay - s2 * aax) + m2 * g * ls * c2
+          + l * s2 * fx) / (l * c2)  # fmt: skip
+    return {"x": x, "v": v, "a": a, "theta2": np.arcsin(s2), "omega2": w2, "alpha2": a2,
+            "force_x": fx, "force_y": fy, "side_force": fy + m3 * g}  # fmt: skip
+
+
 def ideal_slider_crank(p: CompressorParams, t):
-    """Closed-form crosshead motion of the ideal (rc = 0) offset slider-crank.
-
-    With ``u(t) = d + r sin(theta1)`` and ``theta1 = theta1_0 + omega t``::
-
-        x3 = r cos(theta1) + sqrt(l^2 - u^2)
-        v3 = -r omega sin(theta1) - u u' / sqrt(l^2 - u^2),        u' = r omega cos(theta1)
-        a3 = -r omega^2 cos(theta1) - (u'^2 + u u'') / s - (u u')^2 / s^3,
-             u'' = -r omega^2 sin(theta1),  s = sqrt(l^2 - u^2)
+    """Closed-form crosshead motion of the ideal (rc = 0) offset slider-crank at the times
+    ``t``, ``theta1 = theta1_0 + omega t``
+    ([`ideal_mechanism`][recipdyn.model.kinematics.ideal_mechanism]).
 
     Returns
     -------
     (x3, v3, a3) : tuple of ndarray, in m, m/s, m/s^2.
     """
     t = np.asarray(t, dtype=float)
-    w = p.omega
-    th1 = p.theta1_0 + w * t
-    u = p.d + p.r * np.sin(th1)
-    du = p.r * w * np.cos(th1)
-    ddu = -p.r * w**2 * np.sin(th1)
-    s = np.sqrt(p.l**2 - u**2)
-    x3 = p.r * np.cos(th1) + s
-    v3 = -p.r * w * np.sin(th1) - u * du / s
-    a3 = -p.r * w**2 * np.cos(th1) - (du**2 + u * ddu) / s - (u * du) ** 2 / s**3
-    return x3, v3, a3
+    m = ideal_mechanism(vars(p), p.theta1_0 + p.omega * t)
+    return m["x"], m["v"], m["a"]
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from ..model.kinematics import ideal_mechanism
+
 __all__ = ["PARAMS", "ideal", "run", "figure", "findings"]
 
 #: The benchmark's parameters (masses 0.30 / 0.21 / 0.14 kg and inertias 1e-4 / 2.5e-4 /
@@ -40,24 +42,10 @@ PARAMS: dict[str, Any] = dict(
 def ideal(values: dict[str, Any], t: np.ndarray) -> dict[str, np.ndarray]:
     """Slider position, acceleration and the pin force on the rod (x, y) of the ideal
     slider-crank (rigid joints) with the same bodies, in closed form."""
-    r, l, ls, m2, m3, J2, g, d, w = (
-        float(values[k]) for k in ("r", "l", "ls", "m2", "m3", "J2", "g", "d", "omega")
-    )
-    th1 = float(values["theta1_0"]) + w * np.asarray(t, dtype=float)
-    s1, c1 = np.sin(th1), np.cos(th1)
-    s2 = -(d + r * s1) / l
-    c2 = np.sqrt(1 - s2**2)
-    w2 = -r * w * c1 / (l * c2)
-    a2 = (r * w**2 * s1 / l + s2 * w2**2) / c2
-    x = r * c1 + l * c2
-    a = -r * w**2 * c1 - l * (c2 * w2**2 + s2 * a2)
-    fx = -m3 * a  # on the rod from the slider pin: minus what the pin gives the slider
-    aax, aay = -r * w**2 * c1, -r * w**2 * s1
-    # moments about the crank pin: (J2 + m2 ls^2) a2 = -m2 ls (c2 aAy - s2 aAx)
-    #   + l (c2 Fy - s2 Fx) - m2 g ls c2
-    fy = ((J2 + m2 * ls**2) * a2 + m2 * ls * (c2 * aay - s2 * aax) + m2 * g * ls * c2
-          + l * s2 * fx) / (l * c2)  # fmt: skip
-    return {"x": x, "a": a, "force_x": fx, "force_y": fy, "force": np.hypot(fx, fy)}
+    th1 = float(values["theta1_0"]) + float(values["omega"]) * np.asarray(t, dtype=float)
+    m = ideal_mechanism(values, th1)  # no gas: the pin force on the rod is -m3 a along x
+    fx, fy = m["force_x"], m["force_y"]
+    return {"x": m["x"], "a": m["a"], "force_x": fx, "force_y": fy, "force": np.hypot(fx, fy)}
 
 
 def run(revolutions: float = 5.0, transient: float = 0.0, fs: float | None = None,
