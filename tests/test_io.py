@@ -17,10 +17,13 @@ from recipdyn.io import lazy_duck_arrays, write_dataset
 
 lazy_duck_arrays()
 bare = xr.Dataset({"b": ("n", np.arange(4.0))})  # no index: xarray has not imported dask yet
+indexed = xr.Dataset({"a": ("time", np.arange(5.0))}, coords={"time": np.arange(5.0)})
+dask_after_build = "dask" in sys.modules  # an index asks whether its data are a dask collection
 write_dataset(bare, sys.argv[1] + "/bare.nc")
 bare_equal = bool(xr.open_dataset(sys.argv[1] + "/bare.nc").b.equals(bare.b))
 ds = xr.Dataset({"a": ("time", np.arange(50.0))}, coords={"time": np.arange(50.0) / 10})
 out = {"dask_array_after_build": "dask.array" in sys.modules,
+       "dask_after_build": dask_after_build,
        "pint_after_build": "pint" in sys.modules}
 write_dataset(ds, sys.argv[1] + "/plain.nc")
 out["distributed_after_write"] = "distributed" in sys.modules
@@ -57,7 +60,8 @@ def test_records_are_built_and_written_without_dask_until_it_is_used(tmp_path):
                           capture_output=True, text=True, timeout=300)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
     res = json.loads(done.stdout.strip().splitlines()[-1])
-    assert res == {"dask_array_after_build": False, "pint_after_build": False,
+    assert res == {"dask_array_after_build": False, "dask_after_build": False,
+                   "pint_after_build": False,
                    "distributed_after_write": False, "bare_equal": True, "hidden_left": [],
                    "plain_equal": True,
                    "recognised": True, "chunks": [10] * 5, "chunked_equal": True,

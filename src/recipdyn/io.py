@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import sys
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -173,6 +174,29 @@ def lazy_duck_arrays() -> None:
     for mod, marker in (("dask", "dask.array"), ("pint", "pint")):
         if mod not in cache:
             cache[mod] = _OnDemand(mod, marker)
+    _lazy_dask_collection()
+
+
+def _lazy_dask_collection() -> None:
+    """xarray's index building asks ``dask.base.is_dask_collection`` of every coordinate,
+    importing dask (0.07 s with its jinja2). An object is a dask collection only through
+    ``__dask_graph__``; without that method (every numpy array) the answer is no without the
+    import; with it, xarray's own answer."""
+    try:
+        from xarray.namedarray import utils
+    except ImportError:  # pragma: no cover - another xarray
+        return
+    real = getattr(utils, "is_dask_collection", None)
+    if real is None or getattr(real, "_recipdyn_lazy", False):
+        return
+
+    def is_dask_collection(x: object) -> bool:
+        if "dask" not in sys.modules and not hasattr(type(x), "__dask_graph__"):
+            return False
+        return real(x)
+
+    is_dask_collection._recipdyn_lazy = True
+    utils.is_dask_collection = is_dask_collection
 
 
 @contextlib.contextmanager
