@@ -33,6 +33,8 @@ PRESETS = {
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
+    "compressor-contact[guide=clearance,guide_clearance=2e-4]": {
+        "guide": "clearance", "guide_clearance": 2e-4},
 }  # fmt: skip
 # Not in the list yet: the dynamic valves with a lubricated pin fail the Jacobian check in a
 # rate column (their central-difference Jacobian). An ideal crank pin's sweep is checked in

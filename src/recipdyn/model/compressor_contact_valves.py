@@ -148,7 +148,7 @@ class CompressorContactValves(cc.CompressorContact):
         """The contact model's scales for its states; the gas states at their own size."""
         y0 = self.initial_state(values)
         g0, a0, _ = _layout(values)
-        return va.gas_scale(values, y0, g0, a0, np.maximum(1.0, np.abs(y0)))
+        return va.gas_scale(values, y0, g0, a0, super().state_scale(values))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
