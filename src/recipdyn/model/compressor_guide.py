@@ -231,7 +231,9 @@ def pack(v: Mapping[str, Any]) -> np.ndarray:
     part = load_component(v)
     if part.name not in GUIDE_LOADS:
         raise ParameterError(f"load = {part.name!r}: compressor-guide takes the "
-                             f"{', '.join(GUIDE_LOADS)} loads")  # fmt: skip
+                             f"{', '.join(GUIDE_LOADS)} loads; any load: --model "
+                             "compressor-contact --set guide=clearance --set crank_joint=ideal "
+                             "--set crosshead_joint=ideal")  # fmt: skip
     data = np.asarray(part.pack(v), dtype=np.float64)
     head += [v["omega"], v["theta1_0"], v["load_amplitude"],
              -1.0 if v["load_sign"] == "physical" else 1.0,
