@@ -25,6 +25,7 @@ CASES = {
                                             {**_IDEAL, "guide_clearance": 2e-4,
                                              "load": "cycle"}),
     "crank pin worn, rigid guide": ("compressor-contact", {}),
+    "crank pin worn, healthy guide (c = 0)": ("compressor-contact", {"guide": "clearance"}),
     "crank pin worn, guide c = 0.2 mm": ("compressor-contact",
                                          {"guide": "clearance", "guide_clearance": 2e-4}),
     "crank pin worn, valves, rigid guide": ("compressor-contact-valves", {}),
@@ -68,6 +69,8 @@ def main(argv: list[str] | None = None) -> dict:
         / best["compressor-guide, c = 0.2 mm, cycle"],
         "worn guide / rigid guide (crank pin worn)": best["crank pin worn, guide c = 0.2 mm"]
         / best["crank pin worn, rigid guide"],
+        "worn guide / healthy guide (crank pin worn)": best["crank pin worn, guide c = 0.2 mm"]
+        / best["crank pin worn, healthy guide (c = 0)"],
         "worn guide / rigid guide (crank pin worn, valves)": best[
             "crank pin worn, valves, guide c = 0.2 mm"]
         / best["crank pin worn, valves, rigid guide"],

@@ -27,6 +27,11 @@ energy of rod and crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic ene
 work of the gas force and of the crank through the journal, ``W_loss`` the work lost in the joint:
 contact damping, friction and the oil film's share).
 
+With ``guide = clearance`` the crosshead is a body of its own between the guide's shoes
+(`recipdyn.model.components.guide`): its pin's lateral position and its tilt are degrees of
+freedom (eight states after the twelve above: position, tilt, their rates, the four corners'
+approach velocities), the rod's small end follows it, and both pins may then be ideal.
+
 The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
 `recipdyn.model.components.contact`): the compiled kernels take complex states, and
 ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no difference is taken), on the
