@@ -1246,7 +1246,7 @@ def _guide_outputs(y: np.ndarray, j: np.ndarray) -> dict[str, Signal]:
         "shoe_force_upper": Signal(j[:, 25], "N", "normal force of the upper shoe"),
         "shoe_force_lower": Signal(j[:, 26], "N", "normal force of the lower shoe"),
         "side_force": Signal(j[:, 23], "N", "net side force of the guide on the crosshead "
-                             "(+ up; with its friction)"),
+                             "(+ up)"),
         "guide_friction_force": Signal(j[:, 22], "N", "friction force of the shoes on the "
                                        "crosshead along +x"),
         "guide_contact": Signal((j[:, 27] > 0).astype(float), "", "1 while a corner touches "
