@@ -33,6 +33,8 @@ PRESETS = {
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
+    "compressor-contact[guide=clearance,guide_clearance=2e-4]": {
+        "guide": "clearance", "guide_clearance": 2e-4},
 }  # fmt: skip
 # Not in the list yet: the dynamic valves with a lubricated pin fail the Jacobian check in a
 # rate column (their central-difference Jacobian). An ideal crank pin's sweep is checked in
@@ -232,11 +234,12 @@ def test_sweep_any_model(model, tmp_path):
     settings = dict(revolutions=2.0, transient=2.0, points=8, lyap_revolutions=5.0, fs=200.0,
                     rtol=1e-9, atol=1e-11)  # fmt: skip
     refused = not model.lyapunov_supported(model.parameters())
+    base = model.parameters() if hasattr(model, "preset") else None
     if refused:  # said up front, with the model's reason, before any work
         with pytest.raises(ParameterError, match="not available"):
-            SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name)
+            SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name,
+                      **({} if base is None else {"base": base}))  # fmt: skip
         measures = ("poincare", "peak")
-    base = model.parameters() if hasattr(model, "preset") else None
     spec = SweepSpec(axes=(axis,), measures=measures, settings=settings, model=spec_name,
                      **({} if base is None else {"base": base}))  # fmt: skip
     ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False)).load()

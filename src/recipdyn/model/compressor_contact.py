@@ -27,6 +27,11 @@ energy of rod and crosshead, ``U = K delta^2.5 / 2.5`` the contact's elastic ene
 work of the gas force and of the crank through the journal, ``W_loss`` the work lost in the joint:
 contact damping, friction and the oil film's share).
 
+With ``guide = clearance`` the crosshead is a body of its own between the guide's shoes
+(`recipdyn.model.components.guide`): its pin's lateral position and its tilt are degrees of
+freedom (eight states after the twelve above: position, tilt, their rates, the four corners'
+approach velocities), the rod's small end follows it, and both pins may then be ideal.
+
 The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
 `recipdyn.model.components.contact`): the compiled kernels take complex states, and
 ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no difference is taken), on the
@@ -49,7 +54,15 @@ import numba as nb
 import numpy as np
 
 from . import valves as va
-from ._compressor_contact import both_accelerations, crank_accelerations, crosshead_accelerations
+from ._compressor_contact import (
+    both_accelerations,
+    both_guide_accelerations,
+    crank_accelerations,
+    crank_guide_accelerations,
+    crosshead_accelerations,
+    crosshead_guide_accelerations,
+    ideal_guide_accelerations,
+)
 from .base import (
     EVENT_SIGNATURE,
     RHS_SIGNATURE,
@@ -58,6 +71,7 @@ from .base import (
     Signal,
     compiled,
 )
+from .components.guide import CLEARANCE, GUIDE_PARAMS, GUIDES
 from .components.load import cycle_outputs, cycle_summary
 from .joints.contact import (
     FRICTION_LAWS,
@@ -101,16 +115,33 @@ STATE_NAMES = ("ex", "ey", "ex_crosshead", "ey_crosshead", "ex_dot", "ey_dot",
                "W_loss")  # fmt: skip
 STATE_UNITS = ("m",) * 4 + ("m/s",) * 6 + ("J", "J")
 I_WIN, I_WLOSS = 10, 11
-#: A rigid joint's states (eccentricity, rate, approach velocity): constant 0.
-RIGID = {"crank": (2, 3, 6, 7, 9), "crosshead": (0, 1, 4, 5, 8), "both": ()}
-#: The same by configuration code (0 crank, 1 crosshead, 2 both), for the compiled kernels.
-_RIGID_MASK = np.array([[i in RIGID[j] for i in range(len(STATE_NAMES))] for j in JOINTS])
+#: A rigid joint's states (eccentricity, rate, approach velocity): constant 0 (``ideal``: both
+#: pins ideal, with the guide's clearance only).
+RIGID = {"crank": (2, 3, 6, 7, 9), "crosshead": (0, 1, 4, 5, 8), "both": (),
+         "ideal": tuple(range(10))}  # fmt: skip
+#: The same by configuration code (0 crank, 1 crosshead, 2 both, 3 ideal), for the compiled
+#: kernels.
+_RIGID_MASK = np.array([[i in RIGID[j] for i in range(len(STATE_NAMES))]
+                        for j in (*JOINTS, "ideal")])  # fmt: skip
 
 
-@lru_cache(maxsize=3)
-def lagrangian(joints: str = "crank"):
+#: The joint configurations with the guide's clearance: the three above, and both pins ideal.
+GUIDE_JOINTS = (*JOINTS, "ideal")
+#: The guide's force input of the generated kernels with the guide's clearance: the lateral
+#: force on the crosshead at its pin (its friction along the guide adds to ``F_gas``).
+GUIDE_INPUTS = ("F3_y",)
+
+
+@lru_cache(maxsize=8)
+def lagrangian(joints: str = "crank", guide: bool = False):
     """The derived [`Lagrangian`][recipdyn.model.derive.Lagrangian] of the mechanism with clearance
-    at ``joints`` (module docstring)."""
+    at ``joints`` (module docstring); with ``guide``, the crosshead pin's lateral position
+    ``yg`` from the guide's centreline is one more coordinate (the guide with clearance,
+    `recipdyn.model.components.guide`; ``joints`` may then be ``ideal``: both pins ideal). The
+    crosshead's tilt about its pin is not in it: with the crosshead's centre of mass at the pin
+    its kinetic energy ``J3 phi'^2 / 2`` couples with nothing, so ``phi'' = M / J3`` (the
+    moment of the shoes and of the crosshead pin's friction about the pin), written in the
+    glue."""
     import sympy as sp
 
     from .derive import derive
@@ -119,30 +150,39 @@ def lagrangian(joints: str = "crank"):
     e = dict(zip(("e1x", "e1y", "e2x", "e2y"), sp.symbols("e1x e1y e2x e2y", real=True),
                  strict=True))  # fmt: skip
     names = {"crank": ("e1x", "e1y"), "crosshead": ("e2x", "e2y"),
-             "both": ("e1x", "e1y", "e2x", "e2y")}[joints]  # fmt: skip
+             "both": ("e1x", "e1y", "e2x", "e2y"), "ideal": ()}[joints]  # fmt: skip
     q = tuple(e[k] for k in names)
     qd = tuple(sp.Symbol(f"{k}_dot", real=True) for k in names)
     e = {k: (v if k in names else sp.S.Zero) for k, v in e.items()}
+    yg = sp.S.Zero
+    if guide:
+        yg = sp.Symbol("yg", real=True)
+        q, qd = (*q, yg), (*qd, sp.Symbol("yg_dot", real=True))
     r, l, ls, m2, m3, J2, g, d, w, th10 = sp.symbols(" ".join(MECH), real=True)
     Fg, F1x, F1y, F2x, F2y, Tr = sp.symbols(" ".join(INPUTS), real=True)
+    F3y = sp.Symbol(GUIDE_INPUTS[0], real=True)
     th1 = th10 + w * t
     Bx, By = r * sp.cos(th1) + e["e1x"], r * sp.sin(th1) + e["e1y"]  # big end (bearing 1)
-    th2 = sp.asin((e["e2y"] - d - By) / l)  # small end at y = -d + e2y
+    th2 = sp.asin((yg + e["e2y"] - d - By) / l)  # small end at y = -d + yg + e2y
     x3 = Bx + l * sp.cos(th2) - e["e2x"]  # crosshead pin (journal 2) = small end - e2
-    xg, yg = Bx + ls * sp.cos(th2), By + ls * sp.sin(th2)
+    xg, yg_rod = Bx + ls * sp.cos(th2), By + ls * sp.sin(th2)
 
     def dt(x):  # total time derivative along q' = qd
         return sp.diff(x, t) + sum(sp.diff(x, a) * b for a, b in zip(q, qd, strict=True))
 
-    T = (m2 * (dt(xg) ** 2 + dt(yg) ** 2) + J2 * dt(th2) ** 2 + m3 * dt(x3) ** 2) / 2
-    V = m2 * g * yg
+    T = (m2 * (dt(xg) ** 2 + dt(yg_rod) ** 2) + J2 * dt(th2) ** 2 + m3 * dt(x3) ** 2) / 2
+    V = m2 * g * yg_rod
+    if guide:  # the crosshead's lateral motion, and its weight
+        T = T + m3 * dt(yg) ** 2 / 2
+        V = V + m3 * g * yg
     # virtual work: F1 on the big end, F2 on the small end and -F2 on the crosshead pin
-    # (together F2 . d e2), the joints' torque on the rod, the gas force on the crosshead
+    # (together F2 . d e2), the joints' torque on the rod, the gas force (with the guide's
+    # friction) on the crosshead along x, the guide's lateral force on it
     Q = [F1x * sp.diff(Bx, k) + F1y * sp.diff(By, k) + F2x * sp.diff(e["e2x"], k)
          + F2y * sp.diff(e["e2y"], k) + Tr * sp.diff(th2, k) + Fg * sp.diff(x3, k)
-         for k in q]  # fmt: skip
-    return derive(T, V, q, qd, t, (r, l, ls, m2, m3, J2, g, d, w, th10, Fg, F1x, F1y, F2x, F2y,
-                                   Tr), Q=Q)  # fmt: skip
+         + F3y * sp.diff(yg, k) for k in q]  # fmt: skip
+    params = (r, l, ls, m2, m3, J2, g, d, w, th10, Fg, F1x, F1y, F2x, F2y, Tr)
+    return derive(T, V, q, qd, t, (*params, F3y) if guide else params, Q=Q)
 
 
 def generate() -> str:
@@ -153,17 +193,21 @@ def generate() -> str:
     head = ['"""Generated by recipdyn.model.derive -- do not edit by hand.', "",
             "Mechanism of the compressor with contact-impact clearance joints "
             "(recipdyn.model.compressor_contact):", "the accelerations qdd of M qdd = b for "
-            "clearance at the crank pin, the crosshead pin, or both.", '"""', "",
-            "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
+            "clearance at the crank pin, the crosshead pin, or both;", "with the guide's "
+            "clearance (``*_guide``), the crosshead's lateral position is the last coordinate.",
+            '"""', "", "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
     # numpy's scalar functions instead of math's: the same machine code for real arguments,
     # and the kernels also take complex ones (the complex-step Jacobian, the glue's ``cs_jac``)
     # sin and cos of the crank angle come from the caller (computed once per call)
     bodies = []
-    for j in JOINTS:
-        lag = lagrangian(j)
-        th1 = lag.params[MECH.index("theta1_0")] + lag.params[MECH.index("omega")] * lag.t
-        src = accelerations_source(lag, j, len(INPUTS), given=(sp.sin(th1), sp.cos(th1)))
-        bodies.append(src.replace("math.", "np."))
+    for guide in (False, True):
+        for j in GUIDE_JOINTS if guide else JOINTS:
+            lag = lagrangian(j, guide)
+            th1 = lag.params[MECH.index("theta1_0")] + lag.params[MECH.index("omega")] * lag.t
+            n_in = len(INPUTS) + (len(GUIDE_INPUTS) if guide else 0)
+            name = f"{j}_guide" if guide else j
+            src = accelerations_source(lag, name, n_in, given=(sp.sin(th1), sp.cos(th1)))
+            bodies.append(src.replace("math.", "np."))
     return "\n".join(head) + "\n\n".join(bodies)
 
 
@@ -316,6 +360,105 @@ def _accelerate(t, y, p, out, cfg, j, fg):
     return v3, c2
 
 
+# ---- the guide's clearance (`recipdyn.model.components.guide`): the crosshead pin's lateral
+# position ``y[gy]``, the tilt ``y[gy + 1]``, their rates, the corners' phases ``y[gy + 4:]``
+
+
+@nb.njit(cache=True, inline="always")
+def _joints_guide(t, y, p, cfg, gy):
+    """`_joints` with the guide's clearance (``cfg`` 3: both pins ideal): the rod's small end
+    follows the crosshead pin's lateral position, and the crosshead pin's journal turns with
+    the crosshead's tilt."""
+    _, c2, th2d, v3, s1, c1 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3] + y[gy],
+                                          y[6], y[7] + y[gy + 2])  # fmt: skip
+    w = p[P_OMEGA]
+    z = 0.0 * y[0]
+    p_crank = z
+    f1 = (z, z, z, z, z, z, z)
+    f2 = (z, z, z, z, z, z, z)
+    if cfg == 0 or cfg == 2:  # crank pin: journal on the crank (w), bearing on the rod
+        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
+                   p[P_OIL], p)  # fmt: skip
+        vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
+        p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
+    if cfg == 1 or cfg == 2:  # crosshead pin: journal on the crosshead (turning with its tilt)
+        f2 = _pair(y[2], y[3], y[6], y[7], y[gy + 3], th2d, p[P_C2], p[P_K2], p[P_RJ2],
+                   _abs(y[9]), p[P_OIL2], p)  # fmt: skip
+    return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
+
+
+@nb.njit(cache=True)
+def _guide_crank_power(t, y, p, yd, f2, cfg, gy, fgx, fgy):
+    """Power of the crank through an ideal crank pin with the guide's clearance, from Newton's
+    law for the rod (independent of the Lagrangian): the pin's reaction is
+    ``F_A = m2 a_G - F_s + (0, m2 g)``, ``F_s`` the force on the rod at its small end: the
+    crosshead joint's (``cfg`` 1), or, with both pins ideal (``cfg`` 3), what the crosshead's
+    own Newton's law leaves, ``F_s = (F_gas + F_guide,x, F_guide,y - m3 g) - m3 a_3``
+    (``fgx``: the gas force and the guide's friction along x; ``fgy`` the guide's lateral
+    force)."""
+    r, l, ls, m2, m3, g, w = p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3], p[P_G], p[P_OMEGA]
+    th1 = p[P_TH10] + w * t
+    s1, c1 = math.sin(th1), math.cos(th1)
+    s2, c2, th2d, _, _, _ = _kinematics(t, p, 0.0, 0.0, 0.0, 0.0, y[2], y[3] + y[gy], y[6],
+                                        y[7] + y[gy + 2])  # fmt: skip
+    s2dd = (yd[7] + yd[gy + 2] + r * w * w * s1) / l
+    th2dd = (s2dd + s2 * th2d * th2d) / c2
+    agx = -r * w * w * c1 + ls * (-s2 * th2dd - c2 * th2d * th2d)
+    agy = -r * w * w * s1 + ls * (c2 * th2dd - s2 * th2d * th2d)
+    if cfg == 1:
+        fsx, fsy = f2[0], f2[1]
+    else:
+        a3x = -r * w * w * c1 - l * (c2 * th2d * th2d + s2 * th2dd)
+        fsx = fgx - m3 * a3x
+        fsy = fgy - m3 * g - m3 * yd[gy + 2]
+    fax = m2 * agx - fsx
+    fay = m2 * agy - fsy + m2 * g
+    return r * w * (-fax * s1 + fay * c1)
+
+
+@nb.njit(cache=True, inline="always")
+def _accelerate_guide(t, y, p, out, cfg, gy, j3, j, fg, gf):
+    """`_accelerate` with the guide's clearance: the derivatives of the joints' twelve states
+    and of the guide's eight (``y[gy:gy + 8]``) from the joints' forces ``j``
+    (`_joints_guide`), the gas force ``fg`` and the guide's ``gf`` (`slice_forces`: the
+    resultant on the crosshead at its pin, its moment about the pin, the power lost);
+    ``j3`` the crosshead's tilt inertia. Returns (crosshead velocity, cos theta2)."""
+    f1, f2, p_crank, p_loss, _, v3, c2, s1, c1 = j
+    fx, fy, mz, lost, _ = gf
+    fgx = fg + fx
+    u = (fgx, f1[0], f1[1], f2[0], f2[1], f1[2] + f2[2], fy, s1, c1)
+    for i in range(4):
+        out[i] = y[4 + i]
+        out[4 + i] = 0.0 * y[0]
+    out[gy] = y[gy + 2]
+    out[gy + 1] = y[gy + 3]
+    if cfg == 0:
+        a = crank_guide_accelerations(t, (y[0], y[1], y[gy], y[4], y[5], y[gy + 2]), p, u)
+        out[4], out[5], out[gy + 2] = a[0], a[1], a[2]
+    elif cfg == 1:
+        a = crosshead_guide_accelerations(t, (y[2], y[3], y[gy], y[6], y[7], y[gy + 2]), p, u)
+        out[6], out[7], out[gy + 2] = a[0], a[1], a[2]
+    elif cfg == 2:
+        a5 = both_guide_accelerations(t, (y[0], y[1], y[2], y[3], y[gy], y[4], y[5], y[6],
+                                          y[7], y[gy + 2]), p, u)  # fmt: skip
+        out[4], out[5], out[6], out[7], out[gy + 2] = a5[0], a5[1], a5[2], a5[3], a5[4]
+    else:
+        a1 = ideal_guide_accelerations(t, (y[gy], y[gy + 2]), p, u)
+        out[gy + 2] = a1[0]
+    # the tilt: the shoes' moment and the crosshead pin's friction torque on its journal
+    out[gy + 3] = (mz + f2[3]) / j3
+    for k in range(4):
+        out[gy + 4 + k] = 0.0
+    p_in = fg * v3 + p_crank
+    if cfg == 1 or cfg == 3:
+        p_in += _guide_crank_power(t, y, p, out, f2, cfg, gy, fgx, fy)
+    out[8] = 0.0
+    out[9] = 0.0
+    out[I_WIN] = p_in
+    out[I_WLOSS] = p_loss + lost
+    return v3, c2
+
+
 #: Imaginary step of the complex-step Jacobian: any size far below the states' works (the
 #: derivative's error is O(h^2) relative, and no difference is taken).
 CS_STEP = 1e-60
@@ -416,7 +559,7 @@ def record_both(t, y, p, out):
 
 
 #: Joint configuration codes of the compiled kernels (literals in the generated glue).
-CFG = {"crank": 0, "crosshead": 1, "both": 2}
+CFG = {"crank": 0, "crosshead": 1, "both": 2, "ideal": 3}
 #: The joint family at each pin: its parameter and the joints it may be (the massless link
 #: exists at the crank pin only, and only in the massless-link model).
 PIN_CHOICES = {"crank_joint": ("link", "ideal", "contact", "lubricated"),
@@ -429,8 +572,8 @@ def joint_types(values: Mapping[str, Any]) -> tuple[str, str]:
     ``clearance_joints`` (where the clearance is) and ``joint`` (dry or lubricated)."""
     where = values.get("clearance_joints", "crank")
     kind = "lubricated" if values.get("joint", "dry") == "lubricated" else "contact"
-    crank = values.get("crank_joint") or ("ideal" if where == "crosshead" else kind)
-    cross = values.get("crosshead_joint") or ("ideal" if where == "crank" else kind)
+    crank = values.get("crank_joint") or ("ideal" if where in ("crosshead", "ideal") else kind)
+    cross = values.get("crosshead_joint") or ("ideal" if where in ("crank", "ideal") else kind)
     return crank, cross
 
 
@@ -445,14 +588,16 @@ def _resolve_joints(values: dict[str, Any]) -> None:
             "crank_joint = 'link' is out of range for this model; allowed: 'ideal', 'contact', "
             "'lubricated' (the massless link is the compressor model's: --model compressor)"
         )
-    if crank == "ideal" and cross == "ideal":
+    guide = values.get("guide", "rigid") == "clearance"
+    if crank == "ideal" and cross == "ideal" and not guide:
         raise ParameterError(
             "crank_joint = crosshead_joint = 'ideal': no clearance joint left; allowed: "
-            "'contact' or 'lubricated' at one pin at least (the ideal mechanism: --model "
-            "compressor with rc = 0)"
+            "'contact' or 'lubricated' at one pin at least, or guide = 'clearance' (the ideal "
+            "mechanism: --model compressor with rc = 0)"
         )
     values["crank_joint"], values["crosshead_joint"] = crank, cross
-    values["clearance_joints"] = ("both" if "ideal" not in (crank, cross) else
+    values["clearance_joints"] = ("ideal" if crank == cross == "ideal" else
+                                  "both" if "ideal" not in (crank, cross) else
                                   "crank" if cross == "ideal" else "crosshead")  # fmt: skip
 
 
@@ -465,23 +610,60 @@ def load_part(values: Mapping[str, Any]):
     return load_component(values)
 
 
+#: The guide's slice, with its clearance: after the joints' part, before the load's.
+N_GUIDE = len(CLEARANCE.pack({"d": 0.0, "crosshead_half_length": 1.0,
+                              "crosshead_half_height": 1.0, "guide_clearance": 0.0,
+                              "guide_stiffness": 1.0, "guide_contact_law": "hertz",
+                              "guide_restitution": 1.0, "guide_friction": 0.0,
+                              "guide_v0": 1.0, "guide_v1": 2.0, "guide_friction_law": "tanh",
+                              "v_impact_min": 1.0, "crosshead_tilt_inertia": 1.0}))  # fmt: skip
+#: The guide's first state, with its clearance: after the joints' twelve (a load's follow).
+G_GUIDE = len(STATE_NAMES)
+N_GUIDE_STATES = len(CLEARANCE.states) + len(CLEARANCE.aux_states)
+
+
+GUIDE_REFUSAL = (
+    "Benettin's method is not offered with guide = 'clearance': the tangent "
+    "integration across the shoe impacts (the saltation matrices of the four "
+    "corners' event) has not been checked against differences of the flow, as the "
+    "pins' has; set guide = 'rigid' for exponents of worn pins"
+)
+
+
+def has_guide(values: Mapping[str, Any]) -> bool:
+    """Whether the crosshead's guide has clearance (``guide = clearance``)."""
+    return values.get("guide", "rigid") == "clearance"
+
+
+def first_load_state(values: Mapping[str, Any]) -> int:
+    """The index of a load's first state: after the joints' twelve and the guide's eight."""
+    return G_GAS + (N_GUIDE_STATES if has_guide(values) else 0)
+
+
 @lru_cache(maxsize=32)
-def _glue(joints: str, load: str):
+def _glue(joints: str, load: str, guide: bool = False):
     from .components.contact import glue_source
     from .components.contract import glue_module
     from .components.load import LOADS, VALVES
 
     part = VALVES if load == VALVES.name else LOADS[load]
-    src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED,
-                      first_state=G_GAS)  # fmt: skip
-    return glue_module(src, f"contact_{joints}_{load}")
+    if not guide:
+        src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED,
+                          first_state=G_GAS)  # fmt: skip
+        return glue_module(src, f"contact_{joints}_{load}")
+    src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + N_GUIDE,
+                      first_state=G_GAS + N_GUIDE_STATES, guide=N_PACKED,
+                      guide_state=G_GUIDE)  # fmt: skip
+    return glue_module(src, f"contact_{joints}_{load}_guide")
 
 
 def kernels(values: Mapping[str, Any], load=None):
-    """The generated glue of the joints and the load ``values`` choose (or ``load``): a
-    module with ``rhs``, ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe`` and
-    ``fd_jac`` (`recipdyn.model.components.contact`)."""
+    """The generated glue of the joints, the guide and the load ``values`` choose (or
+    ``load``): a module with ``rhs``, ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe``
+    and ``fd_jac`` (`recipdyn.model.components.contact`)."""
     part = load_part(values) if load is None else load
+    if has_guide(values):
+        return _glue(values["clearance_joints"], part.name, True)
     return _glue(values["clearance_joints"], part.name)
 
 
@@ -494,7 +676,8 @@ def _link(name: str, **changes) -> Param:
 SCHEMA = Schema((
     *(_link(k) for k in ("r", "l", "ls", "m2", "m3", "J2", "g")),
     Param("clearance_joints", "", "crank", "where the clearance is: the crank pin, the crosshead "
-          "pin, or both (the other joints are ideal)", choices=JOINTS, group="joint"),
+          "pin, or both (the other joints are ideal); 'ideal': neither (with guide = "
+          "'clearance')", choices=GUIDE_JOINTS, group="joint"),
     _link("rc", description="radial clearance of the crank-pin joint, c = R_b - R_j",
           low=0.0, low_open=True),
     Param("rc_crosshead", "m", 1e-4, "radial clearance of the crosshead-pin joint "
@@ -550,6 +733,10 @@ SCHEMA = Schema((
           "(lubricated)", 0.5, 1.0, high_open=True, group="joint"),
     Param("v_impact_min", "m/s", 1e-3, "floor of the recorded approach velocity (grazing "
           "contacts)", 0.0, _INF, low_open=True, group="joint"),
+    Param("guide", "", "rigid", "the crosshead guide: 'rigid' (the crosshead on y = -d) or "
+          "'clearance' (the crosshead moves sideways and tilts between the shoes and knocks on "
+          "them: guide_clearance and the guide_* parameters)", choices=GUIDES, group="guide"),
+    *GUIDE_PARAMS,
     _link("omega"), _link("theta1_0"),
     _link("load_amplitude"), _link("load_sign"), _link("load"),
     *(_link(k) for k in (*CYCLE_PARAMS, "gas", "suction_temperature")),
@@ -617,6 +804,11 @@ def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
              v["eps_dry"], v["v_impact_min"],
              v["oil_viscosity"] if pins[1] == "lubricated" else 0.0]  # fmt: skip
     part = load_part(v) if load is None else load
+    if has_guide(v):
+        vec, offsets = Assembly(N_PACKED, (CLEARANCE, part)).pack(
+            np.asarray(head, dtype=np.float64), v)  # fmt: skip
+        assert offsets["guide"] == N_PACKED and offsets["load"] == N_PACKED + N_GUIDE
+        return vec
     vec, offsets = Assembly(N_PACKED, (part,)).pack(np.asarray(head, dtype=np.float64), v)
     assert offsets["load"] == N_PACKED  # a literal in the glue
     return vec
@@ -628,10 +820,13 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     th1 = th10 + w * t
     y = np.atleast_2d(y)
     e1x, e1y, e2x, e2y, u1, v1, u2, v2 = (y[:, i] for i in range(8))
-    s2 = (e2y - d - r * np.sin(th1) - e1y) / l
+    ys, vs = e2y, v2  # the small end's lateral position and velocity, from y = -d
+    if has_guide(values):  # it follows the crosshead pin's lateral position
+        ys, vs = e2y + y[:, G_GUIDE], v2 + y[:, G_GUIDE + 2]
+    s2 = (ys - d - r * np.sin(th1) - e1y) / l
     c2 = np.sqrt(1.0 - s2**2)
     vbx, vby = -r * w * np.sin(th1) + u1, r * w * np.cos(th1) + v1
-    th2d = (v2 - vby) / (l * c2)
+    th2d = (vs - vby) / (l * c2)
     vgx, vgy = vbx - ls * s2 * th2d, vby + ls * c2 * th2d
     v3 = vbx - l * s2 * th2d - u2
     kin = 0.5 * (m2 * (vgx**2 + vgy**2) + J2 * th2d**2 + m3 * v3**2)
@@ -640,6 +835,12 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     d2 = np.maximum(np.hypot(e2x, e2y) - float(values["rc_crosshead"]), 0.0)
     elastic = stiffness(values, "crank") * d1**2.5 / 2.5
     elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
+    if has_guide(values):  # the crosshead's lateral motion, tilt and weight
+        from .components.guide import tilt_inertia
+
+        yg, ygd, phid = y[:, G_GUIDE], y[:, G_GUIDE + 2], y[:, G_GUIDE + 3]
+        kin = kin + 0.5 * (m3 * ygd**2 + tilt_inertia(values) * phid**2)
+        pot = pot + m3 * g * yg
     return {"mechanical": kin + pot, "elastic": elastic}
 
 
@@ -753,6 +954,12 @@ class CompressorContact(Model):
         joints = values["clearance_joints"]
         k = self.kernels(values)
         onset, record = k.event, k.reset
+        if has_guide(values):
+            return (Event("impact", onset, direction=-1, action="reset", reset=record,
+                          description="contact onset or separation of a crosshead corner on "
+                          "a guide shoe or at a worn pin (the smallest phased factor falls "
+                          "through 0): at an onset the approach velocity is recorded for the "
+                          "damping law"),)  # fmt: skip
         if joints == "both":
             return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
@@ -763,8 +970,43 @@ class CompressorContact(Model):
                       description=f"contact onset ({where}, approaching): the approach "
                       "velocity is recorded for the damping law"),)  # fmt: skip
 
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """The joints' twelve states; with the guide's clearance, its eight after them."""
+        own = tuple(zip(STATE_NAMES, STATE_UNITS, strict=True))
+        if has_guide(values):
+            return own + CLEARANCE.states + CLEARANCE.aux_states
+        return own
+
+    #: Why Benettin's method is refused with the guide's clearance (a subclass that refuses it
+    #: always says its own reason).
+    lyapunov_refusal = GUIDE_REFUSAL
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The default (``max(1, |y0|)``); with the guide's clearance, its lateral position
+        0.02 m and tilt 0.01 rad (perturbations of a few percent put the crosshead ~1 mm into
+        a shoe, as `compressor-guide`'s), the corners' approach velocities 1 mm/s."""
+        s = np.maximum(1.0, np.abs(self.initial_state(values)))
+        if has_guide(values):
+            g = G_GUIDE
+            s[g], s[g + 1] = 0.02, 0.01
+            s[g + 4 : g + 8] = 1e-3
+        return s
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        """Not with the guide's clearance: its corners' saltation matrices have not been
+        checked against differences of the flow (as the pins' have)."""
+        return self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
+
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         k = self.kernels(values)
+        if has_guide(values):
+            names, units = zip(*self.states(values), strict=True)
+            return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
+                             params=pack(values, self.load_part(values)), state_names=names,
+                             state_units=units, period=self.period(values), name=self.name,
+                             events=self.events(values), aux_states=4,
+                             passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN,
+                                      I_WLOSS))  # fmt: skip
         return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
                          params=pack(values, self.load_part(values)),
                          state_names=self.state_names,
@@ -798,24 +1040,31 @@ class CompressorContact(Model):
         ang2 = ang + math.pi if ang2 is None else ang2
         y = np.zeros(len(STATE_NAMES))
         joints = values["clearance_joints"]
-        if joints != "crosshead":
+        if joints not in ("crosshead", "ideal"):
             e = values["e0_ratio"] * values["rc"]
             y[[0, 1, 4, 5]] = (e * math.cos(ang), e * math.sin(ang), values["edot0_x"],
                                values["edot0_y"])  # fmt: skip
-        if joints != "crank":
+        if joints not in ("crank", "ideal"):
             e = values["e0_ratio"] * values["rc_crosshead"]
             y[[2, 3]] = e * math.cos(ang2), e * math.sin(ang2)
         y[8] = y[9] = values["v_impact_min"]
         if self.tracks_separations(values):  # the phase: + in contact, - in free flight
             sign = 1.0 if values["e0_ratio"] >= 1.0 else -1.0
             y[8] = y[9] = sign * values["v_impact_min"]
+        if has_guide(values):
+            # the crosshead centred in its guide, level, moving along it; with no clearance
+            # its corners touch the shoes already (in contact)
+            sign = 1.0 if values["guide_clearance"] == 0 else -1.0
+            g = np.zeros(N_GUIDE_STATES)
+            g[4:] = sign * values["v_impact_min"]
+            y = np.concatenate([y, g])
         return y
 
     def tracks_separations(self, values: Mapping[str, Any]) -> bool:
         """Whether the event also locates separations (the phase is then the sign of
         ``v_impact``; [`phased_factor`][recipdyn.model.compressor_contact.phased_factor]): with
-        clearance at both pins."""
-        return values["clearance_joints"] == "both"
+        clearance at both pins, or with the guide's clearance."""
+        return values["clearance_joints"] == "both" or has_guide(values)
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["omega"])
@@ -829,11 +1078,15 @@ class CompressorContact(Model):
         r, l, d, w = (float(values[k]) for k in ("r", "l", "d", "omega"))
         th1 = float(values["theta1_0"]) + w * t
         e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))
+        guide = has_guide(values)
+        e2ydd = j[:, 17]
+        if guide:  # the small end follows the crosshead pin's lateral position
+            e2y, e2ydd = e2y + y[:, G_GUIDE], e2ydd + j[:, 21]
         s2 = (e2y - d - r * np.sin(th1) - e1y) / l
         c2 = np.sqrt(1.0 - s2**2)
         th2d = j[:, 18]
         # theta2'' from sin(theta2)'' = (e2y'' - By'') / l, By'' = -r w^2 sin(theta1) + e1y''
-        s2dd = (j[:, 17] + r * w**2 * np.sin(th1) - j[:, 15]) / l
+        s2dd = (e2ydd + r * w**2 * np.sin(th1) - j[:, 15]) / l
         th2dd = (s2dd + s2 * th2d**2) / c2
         x3 = r * np.cos(th1) + e1x + l * c2 - e2x
         a3 = -r * w**2 * np.cos(th1) + j[:, 14] - l * (c2 * th2d**2 + s2 * th2dd) - j[:, 16]
@@ -849,12 +1102,18 @@ class CompressorContact(Model):
                              "kinetic + gravity energy of rod and crosshead + contact elastic"),
             **cycle_outputs(values, th1),
         }  # fmt: skip
+        if guide:
+            en_g = j[:, 28]
+            sig["energy"] = Signal(en["mechanical"] + en["elastic"] + en_g, "J",
+                                   "kinetic + gravity energy of rod and crosshead + contact "
+                                   "elastic (pins and guide shoes)")  # fmt: skip
+            sig.update(_guide_outputs(y, j))
         joints = values["clearance_joints"]
         for key, where, row, (ix, iy), rc in (
             ("", "crank-pin", 0, (0, 1), "rc"),
             ("_crosshead", "crosshead-pin", 1, (2, 3), "rc_crosshead"),
         ):  # fmt: skip
-            if joints != "both" and joints != where.split("-")[0]:
+            if joints not in ("both", where.split("-")[0]):
                 continue
             ex, ey = y[:, ix], y[:, iy]
             rho = np.hypot(ex, ey)
@@ -923,9 +1182,12 @@ class CompressorContact(Model):
         out: dict[str, float] = {}
         t = ds["time"].values
         revs = (t[-1] - t[0]) / self.period(values) if t.size > 1 else float("nan")
+        if has_guide(values):
+            ds, guide_summary = _guide_summary(values, ds, revs)
+            out.update(guide_summary)
         joints = values["clearance_joints"]
-        active = [("", 0, 1, 4, 5, "rc")] if joints != "crosshead" else []
-        if joints != "crank":
+        active = [("", 0, 1, 4, 5, "rc")] if joints not in ("crosshead", "ideal") else []
+        if joints not in ("crank", "ideal"):
             active.append(("_crosshead", 2, 3, 6, 7, "rc_crosshead"))
         has_ev = "impact_time" in ds
         if has_ev:
@@ -969,6 +1231,56 @@ class CompressorContact(Model):
         })  # fmt: skip
         out.update(cycle_summary(values, ds))
         return out
+
+
+def _guide_outputs(y: np.ndarray, j: np.ndarray) -> dict[str, Signal]:
+    """The guide's outputs from its states and the observer's columns (21-29)."""
+    g = G_GUIDE
+    return {
+        "guide_y": Signal(y[:, g], "m", "crosshead lateral position from the guide's "
+                          "centreline (+ up)"),
+        "guide_v": Signal(y[:, g + 2], "m/s", "crosshead lateral velocity"),
+        "guide_acc": Signal(j[:, 21], "m/s**2", "crosshead lateral acceleration (what an "
+                            "accelerometer on the guide sees of the knock)"),
+        "tilt": Signal(y[:, g + 1], "rad", "crosshead tilt in the guide"),
+        "shoe_force_upper": Signal(j[:, 25], "N", "normal force of the upper shoe"),
+        "shoe_force_lower": Signal(j[:, 26], "N", "normal force of the lower shoe"),
+        "side_force": Signal(j[:, 23], "N", "net side force of the guide on the crosshead "
+                             "(+ up)"),
+        "guide_friction_force": Signal(j[:, 22], "N", "friction force of the shoes on the "
+                                       "crosshead along +x"),
+        "guide_contact": Signal((j[:, 27] > 0).astype(float), "", "1 while a corner touches "
+                                "a shoe"),
+    }  # fmt: skip
+
+
+def _guide_summary(values: Mapping[str, Any], ds: Any, revs: float) -> tuple[Any, dict]:
+    """The record without the guide's events (an event whose corners changed phase), and
+    the guide's figures: shoe impacts (count, per revolution, largest approach velocity),
+    the peak lateral acceleration, the largest lateral excursion, the contact fraction."""
+    out: dict[str, float] = {}
+    if "impact_time" in ds:
+        names = [f"v_impact_guide_{k}" for k in range(1, 5)]
+        before = np.column_stack([ds[f"impact_{k}"].values for k in names])
+        after = np.column_stack([ds[f"impact_{k}_after"].values for k in names])
+        mine = (before != after).any(axis=1)
+        onset = (after > 0) & (before <= 0)
+        vel = after[onset]
+        out.update({
+            "impacts_guide": float(onset.sum()),
+            "impacts_per_revolution_guide": onset.sum() / revs if revs > 0 else float("nan"),
+            "impact_velocity_max_guide_m_s": float(vel.max()) if vel.size else 0.0,
+        })  # fmt: skip
+        ds = ds.isel(impact_event=np.flatnonzero(~mine))
+    c = float(values["guide_clearance"])
+    excursion = float(np.abs(ds["guide_y"].values).max())
+    out.update({
+        "peak_abs_guide_acc_m_s2": float(np.abs(ds["guide_acc"].values).max()),
+        "max_lateral_excursion_m": excursion,
+        "max_lateral_excursion_ratio": excursion / c if c > 0 else float("nan"),
+        "guide_contact_fraction": float(ds["guide_contact"].values.mean()),
+    })  # fmt: skip
+    return ds, out
 
 
 COMPRESSOR_CONTACT = CompressorContact()

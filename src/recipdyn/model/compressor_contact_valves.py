@@ -44,10 +44,20 @@ __all__ = ["CompressorContactValves", "COMPRESSOR_CONTACT_VALVES"]
 
 G0, A0 = cc.G_GAS, cc.G_AUX
 STATE_NAMES = (*cc.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
+#: The gas states' and the counters' names and units (after the guide's, with its clearance).
+_GAS = tuple(zip((*va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES),
+                 (*va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS), strict=True))  # fmt: skip
 STATE_UNITS = (*cc.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
 N_STATE = len(STATE_NAMES)
 #: The valve data in the parameter vector: after the joints' and the cycle's.
 P_VALVE = cc.N_PACKED + cy.N_CYCLE
+
+
+def _layout(values: Mapping[str, Any]) -> tuple[int, int, int]:
+    """The first gas state, the first mass counter, and the load's offset in the parameter
+    vector (after the guide's states and slice, with its clearance)."""
+    g = cc.first_load_state(values)
+    return g, g + va.N_GAS, cc.N_PACKED + (cc.N_GUIDE if cc.has_guide(values) else 0)
 
 
 _DROP = {"load", "load_amplitude", "load_sign", "gas"}
@@ -103,8 +113,18 @@ class CompressorContactValves(cc.CompressorContact):
                       "an onset records the approach velocity, a plate rebounds or "
                       "rests"),)  # fmt: skip
 
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """The contact model's states (the joints', the guide's with its clearance), then the
+        gas states and the four mass counters."""
+        return super().states(values) + _GAS
+
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         k = self.kernels(values)
+        if cc.has_guide(values):
+            names, units = zip(*self.states(values), strict=True)
+            return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=names,
+                             state_units=units, period=self.period(values), name=self.name,
+                             events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
         return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=STATE_NAMES,
                          state_units=STATE_UNITS, period=self.period(values), name=self.name,
                          events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
@@ -118,15 +138,17 @@ class CompressorContactValves(cc.CompressorContact):
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         """The contact model's initial state (journal along the ideal cycle's rod load), the
         ideal cycle's gas states at the initial crank angle, plates closed, counters 0."""
-        y = np.zeros(N_STATE)
-        y[:G0] = super().initial_state(self._values(values))
-        y[G0:A0] = va.gas_initial(values, cy.cycle_data(values), float(values["theta1_0"]))
+        g0, a0, _ = _layout(values)
+        y = np.zeros(a0 + va.N_AUX)
+        y[:g0] = super().initial_state(self._values(values))
+        y[g0:a0] = va.gas_initial(values, cy.cycle_data(values), float(values["theta1_0"]))
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """The contact model's scales for its states; the gas states at their own size."""
         y0 = self.initial_state(values)
-        return va.gas_scale(values, y0, G0, A0, np.maximum(1.0, np.abs(y0)))
+        g0, a0, _ = _layout(values)
+        return va.gas_scale(values, y0, g0, a0, super().state_scale(values))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
@@ -137,8 +159,9 @@ class CompressorContactValves(cc.CompressorContact):
         sig = super().outputs(values, t, y)
         s = self.system(values)
         dy = rhs_series(s.rhs, s.params, t, y)
-        sig.update(va.gas_outputs(values, sig["x"].values, y, dy, G0, A0,
-                                  s.params[cc.N_PACKED:P_VALVE]))  # fmt: skip
+        g0, a0, lo = _layout(values)
+        sig.update(va.gas_outputs(values, sig["x"].values, y, dy, g0, a0,
+                                  s.params[lo:lo + cy.N_CYCLE]))  # fmt: skip
         return sig
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
@@ -146,12 +169,21 @@ class CompressorContactValves(cc.CompressorContact):
         events (each event is assigned to the factor of the event function on its surface)."""
         if "impact_time" in ds:
             p = self.system(values).params
+            names = [k for k, _ in self.states(values)]
             ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
-                                                       for k in STATE_NAMES]))  # fmt: skip
+                                                       for k in names]))  # fmt: skip
             cfg = cc.CFG[values["clearance_joints"]]
-            contact = np.array([abs(cc.contact_factor(e, p, cfg)[0]) for e in ev])
-            valve = np.array([abs(va.valve_event(e, G0, p[P_VALVE:])) for e in ev])
+            g0, _, lo = _layout(values)
+            contact = np.array([abs(cc.contact_factor(e, p, cfg)[0]) if cfg < 3 else np.inf
+                                for e in ev])  # fmt: skip
+            valve = np.array([abs(va.valve_event(e, g0, p[lo + cy.N_CYCLE :])) for e in ev])
             is_valve = valve < contact
+            if cc.has_guide(values):  # a guide's event: its corners changed phase
+                after = np.column_stack([ds[f"impact_v_impact_guide_{k}_after"].values
+                                         for k in range(1, 5)])  # fmt: skip
+                before = np.column_stack([ds[f"impact_v_impact_guide_{k}"].values
+                                          for k in range(1, 5)])  # fmt: skip
+                is_valve &= ~(before != after).any(axis=1)
             ds_contact = ds.isel(impact_event=np.flatnonzero(~is_valve))
             ds_valve = ds.isel(impact_event=np.flatnonzero(is_valve))
         else:

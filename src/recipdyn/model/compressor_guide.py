@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from .components.guide import GUIDE_PARAMS, tilt_inertia
 from .components.load import (
     cycle_force,
     cycle_outputs,
@@ -46,7 +47,7 @@ from .components.load import (
     table_force,
 )
 from .joints._guide import guide_energy, guide_system
-from .joints.contact import FRICTION_LAWS, LAWS, delivered_restitution, hysteresis_factor
+from .joints.contact import FRICTION_LAWS, delivered_restitution, hysteresis_factor
 from .joints.guide import (
     N_HEAD,
     P_A,
@@ -218,15 +219,9 @@ def _series(t, y, p):
     return out
 
 
-def _j3(v: Mapping[str, Any]) -> float:
-    if v.get("crosshead_tilt_inertia") is not None:
-        return float(v["crosshead_tilt_inertia"])
-    a, b = v["crosshead_half_length"], v["crosshead_half_height"]
-    return float(v["m3"]) * (a * a + b * b) / 3.0
-
-
 def pack(v: Mapping[str, Any]) -> np.ndarray:
-    mech = (v["r"], 0.0, v["l"], v["ls"], 0.0, v["m2"], v["m3"], 0.0, v["J2"], _j3(v), v["g"])
+    mech = (v["r"], 0.0, v["l"], v["ls"], 0.0, v["m2"], v["m3"], 0.0, v["J2"], tilt_inertia(v),
+            v["g"])  # fmt: skip
     c = float(v["guide_clearance"])
     head = [*mech, v["d"], v["crosshead_half_length"], v["crosshead_half_height"], c,
             v["guide_stiffness"], hysteresis_factor(v["guide_contact_law"],
@@ -237,7 +232,9 @@ def pack(v: Mapping[str, Any]) -> np.ndarray:
     part = load_component(v)
     if part.name not in GUIDE_LOADS:
         raise ParameterError(f"load = {part.name!r}: compressor-guide takes the "
-                             f"{', '.join(GUIDE_LOADS)} loads")  # fmt: skip
+                             f"{', '.join(GUIDE_LOADS)} loads; any load: --model "
+                             "compressor-contact --set guide=clearance --set crank_joint=ideal "
+                             "--set crosshead_joint=ideal")  # fmt: skip
     data = np.asarray(part.pack(v), dtype=np.float64)
     head += [v["omega"], v["theta1_0"], v["load_amplitude"],
              -1.0 if v["load_sign"] == "physical" else 1.0,
@@ -253,34 +250,7 @@ def _link(name: str, **changes) -> Param:
 
 SCHEMA = Schema((
     *(_link(k) for k in ("r", "l", "ls", "m2", "m3", "J2", "g", "d")),
-    Param("guide_clearance", "m", 0.0, "radial clearance of the crosshead in its guide (shoe "
-          "to guide: the crosshead's lateral play is twice it); 0 = the ideal guide", 0.0,
-          0.01, assumed="assumed: a new guide; API 618 machines run 0.1-0.3 mm and more worn",
-          group="guide"),
-    Param("crosshead_half_length", "m", 0.15, "half the crosshead shoe's length along the "
-          "guide, about the pin", 0.0, 2.0, low_open=True,
-          assumed="assumed: not given in the paper", group="guide"),
-    Param("crosshead_half_height", "m", 0.1, "half the crosshead's height, pin to shoe face",
-          0.0, 2.0, low_open=True, assumed="assumed: not given in the paper", group="guide"),
-    Param("crosshead_tilt_inertia", "kg*m**2", None, "crosshead's moment of inertia about the "
-          "pin (default: a uniform block, m3 (a^2 + b^2) / 3)", 0.0, _INF, low_open=True,
-          optional=True, group="guide"),
-    Param("guide_stiffness", "N/m**1.5", 1e12, "contact stiffness K of a crosshead corner on a "
-          "shoe (F = K delta^1.5 ...)", 0.0, _INF, low_open=True,
-          assumed="assumed: stiff shoes; 40 kN of side force on one corner: 12 um",
-          group="guide"),
-    Param("guide_contact_law", "", "gonthier", "normal force law at the shoes", choices=LAWS,
-          group="guide"),
-    Param("guide_restitution", "", 0.5, "nominal restitution of a shoe impact", 0.0, 1.0,
-          low_open=True, assumed="assumed: a lubricated shoe", group="guide"),
-    Param("guide_friction", "", 0.05, "Coulomb friction coefficient at the shoes", 0.0, 2.0,
-          assumed="assumed: boundary-lubricated shoe", group="guide"),
-    Param("guide_friction_law", "", "ambrosio", "'ambrosio' (dynamic correction, v0/v1) or "
-          "'tanh'", choices=FRICTION_LAWS, group="guide"),
-    Param("guide_v0", "m/s", 1e-4, "friction: sliding velocity below which there is none", 0.0,
-          _INF, low_open=True, group="guide"),
-    Param("guide_v1", "m/s", 1e-3, "friction: sliding velocity above which it is full Coulomb",
-          0.0, _INF, low_open=True, group="guide"),
+    *GUIDE_PARAMS,
     Param("v_impact_min", "m/s", 1e-3, "floor of the recorded approach velocity (grazing "
           "contacts)", 0.0, _INF, low_open=True, group="guide"),
     _link("omega"), _link("theta1_0"),

@@ -240,13 +240,188 @@ def reset(t, y, p, out):
 '''
 
 
-def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int) -> str:
-    """The glue module's source for the joints ``cfg`` (0 crank, 1 crosshead, 2 both) and
-    the load component ``load`` whose slice starts at ``offset`` (its states, if any, at
-    ``first_state``: module docstring)."""
+_GUIDE_HEADER = """
+from recipdyn.model.compressor_contact import (
+    _accelerate_guide,
+    _joints_guide,
+)
+from recipdyn.model.joints.guide import S_A, S_B, S_C, S_CHI, S_FLAW, S_J3, S_K, S_MU, S_V0
+from recipdyn.model.joints.guide import S_V1, S_VMIN, corner_force
+from recipdyn.model.joints.guide import slice_flip_phases as guide_reset
+from recipdyn.model.joints.guide import slice_forces as guide_forces
+from recipdyn.model.joints.guide import slice_smallest_factor as guide_factor
+"""
+
+_GUIDE_BODY = '''
+
+@nb.njit(cache=True, inline="always")
+def _guide(y, p, v3):
+    # the corners' contact: resultant on the crosshead at its pin, moment, power lost, elastic
+    return guide_forces(p, {GO}, y[{GY}], v3, y[{GY} + 2], y[{GY} + 1], y[{GY} + 3],
+                        y[{GY} + 4], y[{GY} + 5], y[{GY} + 6], y[{GY} + 7])
+
+
+@nb.njit(cache=True, inline="always")
+def _mechanism(t, y, p, out):
+    j = _joints_guide(t, y, p, {CFG}, {GY})
+    return _accelerate_guide(t, y, p, out, {CFG}, {GY}, p[{GO} + S_J3], j,
+                             _force(t, y, p, j[7], j[8]), _guide(y, p, j[5]))
+
+
+@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out):
+    v3, c2 = _mechanism(t, y, p, out)
+{STATE_RHS}
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def fd_jac(t, y, p, J):
+    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
+    (positions), c omega (rates)."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    c = min(p[P_C1], p[P_C2])
+    for k in range(n):
+        # positions by the clearance, rates by c omega, work integrals 1 J; the guide's and
+        # the gas states (dynamic valves) at least 1e-3 of their unit
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
+        h = 1e-5 * max(abs(y[k]), scale)
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in range(n):
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+
+
+@nb.njit(cache=True)
+def _cs_columns(t, y, p, f, J, skip_rigid):
+    n = y.shape[0]
+    yc = np.empty(n, np.complex128)
+    fc = np.empty(n, np.complex128)
+    for i in range(n):
+        yc[i] = y[i]
+    J[:, :] = 0.0
+    first = True
+    for m in range(I_WIN + 8):
+        k = m if m < I_WIN else m - I_WIN + {GY}  # then the guide's states
+        if m < I_WIN and skip_rigid and _RIGID_MASK[{CFG}, k]:
+            continue
+        yc[k] = complex(y[k], CS_STEP)
+        _mechanism(t, yc, p, fc)
+        yc[k] = y[k]
+        for i in range(n):
+            J[i, k] = fc[i].imag / CS_STEP
+        if first:
+            for i in range(n):
+                f[i] = fc[i].real
+            first = False
+
+
+@nb.njit(cache=True)
+def cs_jac(t, y, p, J):
+    f = np.empty(y.shape[0])
+    _cs_columns(t, y, p, f, J, False)
+{JAC}
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    """Per sample: both joints' rows of `_pair` (14), the accelerations e1'', e2'' (4),
+    theta2', x3', gas force; then the guide's: the crosshead pin's lateral acceleration, the
+    shoes' resultant (x, y) and moment, the upper and lower shoes' normal forces, the
+    corners in contact, the shoes' elastic energy, the tilt's acceleration."""
+    n = t.shape[0]
+    out = np.zeros((n, 30))
+    d = np.empty(y.shape[1])
+    for i in range(n):
+        yi = y[i].copy()
+        _rhs(t[i], yi, p, d)
+        f1, f2, _, _, th2d, v3, _, s1, c1 = _joints_guide(t[i], yi, p, {CFG}, {GY})
+        for k in range(7):
+            out[i, k] = f1[k]
+            out[i, 7 + k] = f2[k]
+        out[i, 14:18] = d[4:8]
+        out[i, 18] = th2d
+        out[i, 19] = v3
+        out[i, 20] = _force(t[i], yi, p, s1, c1)
+        fx, fy, mz, _, elastic = _guide(yi, p, v3)
+        out[i, 21] = d[{GY} + 2]
+        out[i, 22] = fx
+        out[i, 23] = fy
+        out[i, 24] = mz
+        for k in range(4):
+            fk = corner_force(k, yi[{GY}], v3, yi[{GY} + 2], yi[{GY} + 1], yi[{GY} + 3],
+                              p[{GO} + S_A], p[{GO} + S_B], p[{GO} + S_C], p[{GO} + S_K],
+                              p[{GO} + S_CHI], p[{GO} + S_MU], p[{GO} + S_V0],
+                              p[{GO} + S_V1], int(p[{GO} + S_FLAW]), p[{GO} + S_VMIN],
+                              yi[{GY} + 4 + k])
+            out[i, 25 if k < 2 else 26] += fk[5]
+            if fk[5] > 0.0:
+                out[i, 27] += 1.0
+        out[i, 28] = elastic
+        out[i, 29] = d[{GY} + 3]
+    return out
+
+
+@nb.njit(cache=True, inline="always")
+def _guide_factor(y, p):
+    # the corners' phased factors do not depend on the axial velocity
+    return guide_factor(p, {GO}, y[{GY}], 0.0, y[{GY} + 2], y[{GY} + 1], y[{GY} + 3], y,
+                        {GY} + 4)[0]
+
+
+@nb.njit(cache=True, inline="always")
+def _joint_factor(y, p):
+    return {JOINT_FACTOR}
+
+
+@nb.njit(cache=True, inline="always")
+def _load_factor(y, p):
+    return {LOAD_FACTOR}
+
+
+@compiled(EVENT_SIGNATURE)
+def event(t, y, p):
+    """The smallest factor of the guide's corners, the joints and the load (each positive
+    between its events)."""
+    return min(_guide_factor(y, p), _joint_factor(y, p), _load_factor(y, p))
+
+
+@compiled(RHS_SIGNATURE)
+def reset(t, y, p, out):
+    """The factor at zero acts: a corner's (it changes phase), a joint's (it changes phase)
+    or the load's (a valve plate rebounds or rests)."""
+    fg = abs(_guide_factor(y, p))
+    fj = abs(_joint_factor(y, p))
+    fl = abs(_load_factor(y, p))
+    for i in range(y.shape[0]):
+        out[i] = y[i]
+    if fg <= fj and fg <= fl:
+        guide_reset(p, {GO}, y[{GY}], 0.0, y[{GY} + 2], y[{GY} + 1], y[{GY} + 3], y, {GY} + 4,
+                    out)
+    elif fj <= fl:
+{JOINT_RESET}
+    else:
+{LOAD_RESET}
+'''
+
+
+def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
+                guide: int | None = None, guide_state: int | None = None) -> str:  # fmt: skip
+    """The glue module's source for the joints ``cfg`` (0 crank, 1 crosshead, 2 both; 3 both
+    ideal, with the guide's clearance only) and the load component ``load`` whose slice starts
+    at ``offset`` (its states, if any, at ``first_state``: module docstring); with the guide's
+    clearance, ``guide`` is the offset of its slice and ``guide_state`` its first state."""
     stateful = bool(load.states)
     fill = dict(combo=f"clearance_joints={joints}, load={load.name}", CFG=cfg, LO=offset,
                 G=first_state, A=first_state + len(load.states), module=load.module)  # fmt: skip
+    if guide is not None:
+        fill["combo"] += ", guide=clearance"
     src = _HEADER.format(**fill)
     if stateful:
         kinds = ("state_force", "state_rhs", "event", "reset")
@@ -255,6 +430,19 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int) -
         src += _FORCE["sc"].format(force_sc=load.kernel("force_sc"), **fill)
     else:
         src += _FORCE["angle"].format(force=load.kernel("force"), **fill)
+    if guide is not None:
+        fill.update(GO=guide, GY=guide_state)
+        src += _GUIDE_HEADER
+        src += _GUIDE_BODY.format(
+            STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
+            JAC=_JAC_FD if stateful else _JAC_CS,
+            JOINT_FACTOR="math.inf" if cfg == 3 else f"contact_factor(y, p, {cfg})[0]",
+            JOINT_RESET=("        pass" if cfg == 3 else
+                         f"        _flip(y, contact_factor(y, p, {cfg})[1], p, out)"),
+            LOAD_FACTOR=f"load_event(y, {first_state}, p, {offset})" if stateful else "math.inf",
+            LOAD_RESET=(f"        load_reset(y, {first_state}, p, {offset}, out)" if stateful
+                        else "        pass"), **fill)  # fmt: skip
+        return src
     src += _BODY.format(STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
                         JAC=_JAC_FD if stateful else _JAC_CS, **fill)  # fmt: skip
     src += _STATE_EVENTS.format(**fill) if stateful else "\n\n" + _EVENTS[cfg]

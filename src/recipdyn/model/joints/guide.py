@@ -52,7 +52,8 @@ import numpy as np
 from .contact import friction_factor, normal_force
 
 __all__ = ["MECH", "INPUTS", "CORNERS", "N_HEAD", "lagrangian", "generate", "corner_forces",
-           "pin_kinematics", "guide_forces", "smallest_factor", "flip_phases",
+           "pin_kinematics", "guide_forces", "smallest_factor", "flip_phases", "slice_forces",
+           "slice_smallest_factor", "slice_flip_phases",
            "solve_free", "solve_prescribed", "phased_gap_factor", "corner_kinematics",
            "corner_force"]  # fmt: skip
 
@@ -256,9 +257,15 @@ def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, v
 
 
 # ---- packed parameters shared by every model built on this joint ------------------------------
-#: After the `MECH` head: the guide's offset below the crank axis, the slider's half-length and
-#: half-height, the radial clearance, the contact stiffness and hysteresis factor, friction
-#: (coefficient, v0, v1, law code), the floor of the approach velocity, the event's length scale.
+#: The guide's slice of the parameter vector, from its first value (its offset ``o``): the
+#: guide's offset below the crank axis, the slider's half-length and half-height, the radial
+#: clearance, the contact stiffness and hysteresis factor, friction (coefficient, v0, v1, law
+#: code), the floor of the approach velocity, the event's length scale, the slider's tilt
+#: inertia (read by the glue of the contact joints only; the benchmark and `compressor-guide`
+#: have it in the `MECH` head).
+(S_D, S_A, S_B, S_C, S_K, S_CHI, S_MU, S_V0, S_V1, S_FLAW, S_VMIN, S_SCALE,
+ S_J3) = range(13)  # fmt: skip
+#: The same after the `MECH` head (the benchmark's and `compressor-guide`'s layout).
 (P_D, P_A, P_B, P_C, P_K, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_VMIN,
  P_SCALE) = range(len(MECH), len(MECH) + 12)  # fmt: skip
 N_HEAD = len(MECH) + 12
@@ -275,43 +282,64 @@ def pin_kinematics(p, th1, th1d, th2, th2d):
 
 
 @nb.njit(cache=True, inline="always")
-def guide_forces(p, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
-    """`corner_forces` with the guide's packed parameters."""
-    return corner_forces(y_rel, vx, vy, phi, phid, p[P_A], p[P_B], p[P_C], p[P_K], p[P_CHI],
-                         p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]), p[P_VMIN], v1i, v2i, v3i,
-                         v4i)  # fmt: skip
+def slice_forces(p, o, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
+    """`corner_forces` with the guide's slice at ``o`` (layout ``S_*``)."""
+    return corner_forces(y_rel, vx, vy, phi, phid, p[o + S_A], p[o + S_B], p[o + S_C],
+                         p[o + S_K], p[o + S_CHI], p[o + S_MU], p[o + S_V0], p[o + S_V1],
+                         int(p[o + S_FLAW]), p[o + S_VMIN], v1i, v2i, v3i, v4i)  # fmt: skip
 
 
 @nb.njit(cache=True, inline="always")
-def smallest_factor(p, y_rel, vx, vy, phi, phid, y, k0):
+def guide_forces(p, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
+    """`corner_forces` with the guide's packed parameters."""
+    return slice_forces(p, P_D, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i)
+
+
+@nb.njit(cache=True, inline="always")
+def slice_smallest_factor(p, o, y_rel, vx, vy, phi, phid, y, k0):
     """The smallest phased factor of the four corners (their phases in ``y[k0:k0 + 4]``) and
-    its corner: one event function for every onset and separation."""
+    its corner, with the guide's slice at ``o``: one event function for every onset and
+    separation."""
     best, which = math.inf, 0
     for k in range(4):
-        _, _, pen, _, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[P_A], p[P_B])
-        f = phased_gap_factor(pen - p[P_C], y[k0 + k], p[P_SCALE])
+        _, _, pen, _, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[o + S_A],
+                                               p[o + S_B])  # fmt: skip
+        f = phased_gap_factor(pen - p[o + S_C], y[k0 + k], p[o + S_SCALE])
         if f < best:
             best, which = f, k
     return best, which
 
 
 @nb.njit(cache=True, inline="always")
-def flip_phases(p, y_rel, vx, vy, phi, phid, y, k0, out):
-    """The reset at a zero of `smallest_factor`: every corner whose factor has reached the
-    crossing changes phase, the event's own and any other at or below zero (a flat impact
+def smallest_factor(p, y_rel, vx, vy, phi, phid, y, k0):
+    """`slice_smallest_factor` with the guide's packed parameters."""
+    return slice_smallest_factor(p, P_D, y_rel, vx, vy, phi, phid, y, k0)
+
+
+@nb.njit(cache=True, inline="always")
+def slice_flip_phases(p, o, y_rel, vx, vy, phi, phid, y, k0, out):
+    """The reset at a zero of `slice_smallest_factor`: every corner whose factor has reached
+    the crossing changes phase, the event's own and any other at or below zero (a flat impact
     puts two corners on their surface at the same instant: both must be reset, or the second
     would stay in its free-flight phase while it penetrates). At an onset the approach
     velocity (the penetration rate, floored at the packed ``v_impact_min``) is recorded; at a
     separation the recorded value turns negative (free flight)."""
-    best = smallest_factor(p, y_rel, vx, vy, phi, phid, y, k0)[0]
+    best = slice_smallest_factor(p, o, y_rel, vx, vy, phi, phid, y, k0)[0]
     for k in range(4):
-        _, _, pen, dpen, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[P_A], p[P_B])
-        if phased_gap_factor(pen - p[P_C], y[k0 + k], p[P_SCALE]) > max(best, 0.0):
+        _, _, pen, dpen, _, _ = corner_kinematics(k, y_rel, vx, vy, phi, phid, p[o + S_A],
+                                                  p[o + S_B])  # fmt: skip
+        if phased_gap_factor(pen - p[o + S_C], y[k0 + k], p[o + S_SCALE]) > max(best, 0.0):
             continue
         if y[k0 + k] > 0.0:
             out[k0 + k] = -y[k0 + k]
         else:
-            out[k0 + k] = max(dpen, p[P_VMIN])
+            out[k0 + k] = max(dpen, p[o + S_VMIN])
+
+
+@nb.njit(cache=True, inline="always")
+def flip_phases(p, y_rel, vx, vy, phi, phid, y, k0, out):
+    """`slice_flip_phases` with the guide's packed parameters."""
+    slice_flip_phases(p, P_D, y_rel, vx, vy, phi, phid, y, k0, out)
 
 
 if __name__ == "__main__":  # pragma: no cover - developer tool
