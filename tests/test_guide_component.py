@@ -24,7 +24,7 @@ IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "
 
 
 def test_a_rigid_guide_leaves_the_contact_model_as_it_was():
-    """With ``guide = rigid`` (the default) the guide's parameters are inert: the parameter
+    """With ``guide = ideal`` (the default) the guide's parameters are inert: the parameter
     vector is the joints' and the load's only, the generated glue holds no guide code, and a
     run with every guide parameter changed is the default run to the bit (same trajectory,
     same steps). A guide parameter leaking into the rigid kernel would change one of them."""

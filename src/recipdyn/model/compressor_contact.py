@@ -588,7 +588,7 @@ def _resolve_joints(values: dict[str, Any]) -> None:
             "crank_joint = 'link' is out of range for this model; allowed: 'ideal', 'contact', "
             "'lubricated' (the massless link is the compressor model's: --model compressor)"
         )
-    guide = values.get("guide", "rigid") == "clearance"
+    guide = values.get("guide", "ideal") == "clearance"
     if crank == "ideal" and cross == "ideal" and not guide:
         raise ParameterError(
             "crank_joint = crosshead_joint = 'ideal': no clearance joint left; allowed: "
@@ -626,13 +626,13 @@ GUIDE_REFUSAL = (
     "Benettin's method is not offered with guide = 'clearance': the tangent "
     "integration across the shoe impacts (the saltation matrices of the four "
     "corners' event) has not been checked against differences of the flow, as the "
-    "pins' has; set guide = 'rigid' for exponents of worn pins"
+    "pins' has; set guide = 'ideal' for exponents of worn pins"
 )
 
 
 def has_guide(values: Mapping[str, Any]) -> bool:
     """Whether the crosshead's guide has clearance (``guide = clearance``)."""
-    return values.get("guide", "rigid") == "clearance"
+    return values.get("guide", "ideal") == "clearance"
 
 
 def first_load_state(values: Mapping[str, Any]) -> int:
@@ -733,8 +733,8 @@ SCHEMA = Schema((
           "(lubricated)", 0.5, 1.0, high_open=True, group="joint"),
     Param("v_impact_min", "m/s", 1e-3, "floor of the recorded approach velocity (grazing "
           "contacts)", 0.0, _INF, low_open=True, group="joint"),
-    Param("guide", "", "rigid", "the crosshead guide: 'rigid' (the crosshead on y = -d) or "
-          "'clearance' (the crosshead moves sideways and tilts between the shoes and knocks on "
+    Param("guide", "", "ideal", "the crosshead guide: 'ideal' (rigid: the crosshead on y = -d) "
+          "or 'clearance' (the crosshead moves sideways and tilts between the shoes and knocks on "
           "them: guide_clearance and the guide_* parameters)", choices=GUIDES, group="guide"),
     *GUIDE_PARAMS,
     _link("omega"), _link("theta1_0"),

@@ -31,7 +31,7 @@ __all__ = ["GUIDES", "GUIDE_PARAMS", "CLEARANCE", "guide_slice", "tilt_inertia"]
 
 _INF = math.inf
 #: The choices of the ``guide`` parameter.
-GUIDES = ("rigid", "clearance")
+GUIDES = ("ideal", "clearance")
 
 #: The clearance guide's schema fragment (shared with `compressor-guide`).
 GUIDE_PARAMS = (
