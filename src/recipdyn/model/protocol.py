@@ -387,6 +387,19 @@ class Model(ABC):
         adds their fragments here (the compressor, `recipdyn.model.components`)."""
         return self.schema
 
+    def configured(self, values: Mapping[str, Any]) -> Model:
+        """The model that describes runs at validated ``values``: itself (the default), or,
+        for a model whose parameters choose its implementation (the compressor,
+        `recipdyn.model.family`), this model with that implementation's declarations
+        (section and vibration signals, validity bounds, refusals, state names). The layers
+        above read those declarations from it."""
+        return self
+
+    def parameter_table(self) -> list[tuple[Param, str]]:
+        """Every parameter with the configuration it belongs to (``""``: the default one),
+        for ``recipdyn models``. Default: the schema's."""
+        return [(p, "") for p in self.schema]
+
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise
         [`ParameterError`][recipdyn.errors.ParameterError]."""
