@@ -236,6 +236,13 @@ class Compressor(Model):
             if hasattr(impl, k):
                 setattr(self, k, getattr(impl, k))
 
+    def __getattr__(self, name: str) -> Any:
+        # what an implementation offers beyond the protocol (the contact joints' kernels):
+        # the default configuration's
+        if name.startswith("_"):
+            raise AttributeError(name)
+        return getattr(implementation(route(self._selectors)), name)
+
     def with_defaults(self, **defaults: Any) -> Compressor:
         """This model with other defaults (selectors or any parameter), under its name."""
         return Compressor(self.name, {**self.defaults, **defaults}, self.description)
@@ -339,7 +346,10 @@ class Compressor(Model):
         except UnknownParameterError as exc:
             where = owner(exc.name, s)
             if where:
-                raise ParameterError(f"{exc.name} belongs to {where}") from None
+                raise ParameterError(
+                    f"{exc.name} is not a parameter of this configuration "
+                    f"of {self.name!r}; it belongs to {where}"
+                ) from None
             raise
         for k in SELECTORS.names:
             if k not in out and s[k] != self._selectors[k]:

@@ -1,0 +1,288 @@
+"""The one compressor model (`recipdyn.model.family`): selectors choose the implementation.
+
+* every route gives, to the bit, what its implementation (the model class each old name
+  reached) gives, with the same step count: the model only delegates;
+* the old names are presets: their values, records and sweep digests are the
+  implementations';
+* a record of ``--model compressor --set crank_joint=contact`` reruns and is analysed;
+* the matrix of joints x loads x drives x guide (issue 30, item 3): every allowed combination
+  builds, integrates a short stretch, and its recorded crosshead velocity and acceleration are
+  the derivatives of its recorded position and velocity; every refused one is refused in one
+  line that says why.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import recipdyn
+from recipdyn.cli import main
+from recipdyn.errors import ModelValidityWarning, ParameterError
+from recipdyn.model import family
+from recipdyn.model.registry import get_model, register
+
+#: One configuration per route: the compressor's selectors, the route, and the values the
+#: implementation (the model class the old name reached) takes for the same run.
+ROUTES = [
+    ({}, "link", {}),
+    ({"crank_joint": "contact"}, "contact", {}),
+    ({"load": "valves"}, "link-valves", {}),
+    ({"crank_joint": "contact", "load": "valves"}, "contact-valves", {}),
+    ({"guide": "clearance", "crank_joint": "ideal", "guide_clearance": 2e-4}, "guide",
+     {"guide_clearance": 2e-4}),
+]  # fmt: skip
+
+
+def _simulate(**kw):
+    with warnings.catch_warnings():  # (the massless link under the valves' reversing load)
+        warnings.simplefilter("ignore", ModelValidityWarning)
+        return recipdyn.simulate(**kw)
+
+
+@pytest.mark.parametrize("selectors,route,own", ROUTES, ids=[r[1] for r in ROUTES])
+def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
+    """The model delegates: the same compiled kernels on the same parameter vector, so every
+    recorded variable and the number of right-hand-side calls equal the implementation's
+    exactly (no tolerance: the arithmetic is the same)."""
+    m = get_model("compressor")
+    values = m.parameters(selectors)
+    assert m.route(values)[0] == route
+    impl = family.implementation(route)
+    assert np.array_equal(m.system(values).params, impl.system(impl.parameters(own)).params)
+    kw = dict(revolutions=0.25, fs=2000.0)
+    a = _simulate(model=m, params=selectors, **kw)
+    b = _simulate(model=impl, params=own, **kw)
+    assert set(a.data_vars) == set(b.data_vars)
+    for k in b.data_vars:
+        assert np.array_equal(a[k].values, b[k].values, equal_nan=True), k
+    assert a.attrs["solver_nfev"] == b.attrs["solver_nfev"]
+    assert a.attrs["model"] == "compressor"
+    assert a.attrs["vibration_signal"] == impl.vibration()[0]
+
+
+@pytest.mark.parametrize("name", sorted(family.PRESETS))
+def test_presets_keep_the_values_and_sweep_digests_of_the_old_names(name):
+    """A preset at its defaults validates to exactly the values its implementation gives
+    (no selector added), so a sweep store made before the presets keeps its digest: the
+    spec's digest with the preset equals the one with the implementation registered under
+    the name (the code that made the old stores)."""
+    from recipdyn.model import registry
+    from recipdyn.sweep import SweepSpec, parse_axis
+
+    preset = get_model(name)
+    impl = preset.route(family.PRESETS[name])[1]
+    assert preset.parameters() == impl.parameters()
+    assert preset.schema is impl.schema and preset.state_names == impl.state_names
+    axis = parse_axis("omega=19:21:2", name)
+    digest = SweepSpec(axes=(axis,), measures=("peak",), model=name).digest
+    register(impl)
+    try:
+        assert SweepSpec(axes=(axis,), measures=("peak",), model=name).digest == digest
+    finally:
+        registry._REGISTERED.pop(impl.name)
+    assert digest == PINNED_DIGESTS[name]
+
+
+#: The digests of ``sweep --model NAME -p omega=19:21:2 -m peak`` computed by the code before
+#: the presets (each name its own model class then).
+PINNED_DIGESTS = {
+    "compressor": "7ea050575d92065b",
+    "compressor-contact": "91a4fb581c4b9ea1",
+    "compressor-valves": "0a1cb736b638e9ce",
+    "compressor-contact-valves": "452894a907246e77",
+    "compressor-guide": "ca4e62f122ef6f28",
+}
+
+
+def test_the_default_models_sweep_digest_is_unchanged():
+    from recipdyn.sweep import SweepSpec, parse_axis
+
+    axis = parse_axis("omega=19:21:2")
+    assert SweepSpec(axes=(axis,), measures=("peak",)).digest == PINNED_DIGESTS["compressor"]
+
+
+def test_a_record_of_the_model_with_a_selector_reruns_and_is_analysed(tmp_path, capsys):
+    """``--model compressor --set crank_joint=contact``: the record stores the model's name
+    and the selector (``param_crank_joint``); ``simulate -c`` reruns it to the bit and
+    ``analyze`` reads it; its values equal the preset's (``--model compressor-contact``)."""
+    rec = tmp_path / "r.nc"
+    args = ["-n", "0.5", "--fs", "2 kHz", "--no-progress", "--no-figure"]
+    assert main(["simulate", "--set", "crank_joint=contact", "-o", str(rec), *args]) == 0
+    import xarray as xr
+
+    ds = xr.open_dataset(rec).load()
+    assert ds.attrs["model"] == "compressor" and ds.attrs["param_crank_joint"] == "contact"
+    m = get_model("compressor")
+    values = m.values_from_record(ds.attrs)
+    assert values == get_model("compressor-contact").parameters()
+    assert m.configured(values).sections()[0][0] == "ex"
+    again = tmp_path / "again.nc"
+    assert main(["simulate", "-c", str(rec), "-o", str(again), *args]) == 0
+    ds2 = xr.open_dataset(again).load()
+    for k in ("ex", "ey", "a", "gas_force"):
+        assert np.array_equal(ds[k].values, ds2[k].values), k
+    capsys.readouterr()
+    out = tmp_path / "an"
+    assert main(["analyze", str(rec), "-o", str(out), "--section-points", "3",
+                 "--lyap-revolutions", "1", "--no-progress"]) == 0  # fmt: skip
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary  # the equation-based part ran on the contact model's sections
+
+
+@pytest.mark.parametrize("preset,kw,route", [
+    ("compressor-contact", {"crank_joint": "link"}, "link"),
+    ("compressor-contact", {"clearance_joints": "both", "joint": "lubricated"}, "contact"),
+    ("compressor-valves", {"crank_joint": "lubricated"}, "contact-valves"),
+    ("compressor-guide", {"guide": "ideal"}, "link"),
+])  # fmt: skip
+def test_a_preset_is_the_model_with_other_defaults(preset, kw, route):
+    """A preset's selectors can be set like the model's: ``--model compressor-contact --set
+    crank_joint=link`` is the massless link."""
+    m = get_model(preset)
+    assert m.route(m.parameters(kw))[0] == route
+
+
+# ---------------------------------------------------------------------------------------------
+# The matrix (issue 30, item 3)
+
+TABLE = ((0.0, -1.0e4), (90.0, -5.0e4), (180.0, 2.0e4), (270.0, -3.0e4))
+#: Allowed combinations run by default: every selector value at least once, with and without
+#: another family's non-default, on configurations the other test files compile too (the
+#: contact glue compiles per configuration, 30-60 s on a loaded machine, then is cached).
+ALLOWED = [
+    ({}, "link"),
+    ({"crank_joint": "ideal"}, "link"),
+    ({"load": "cycle"}, "link"),
+    ({"load": "table", "load_table": TABLE}, "link"),
+    ({"drive": "motor"}, "link"),
+    ({"crank_joint": "ideal", "drive": "motor"}, "link"),
+    ({"load": "valves"}, "link-valves"),
+    ({"crank_joint": "contact"}, "contact"),
+    ({"crank_joint": "contact", "load": "cycle"}, "contact"),
+    ({"crank_joint": "contact", "load": "table", "load_table": TABLE}, "contact"),
+    ({"crank_joint": "lubricated", "crosshead_joint": "contact"}, "contact"),
+    ({"crank_joint": "ideal", "crosshead_joint": "contact"}, "contact"),
+    ({"crank_joint": "lubricated", "crosshead_joint": "lubricated"}, "contact"),
+    ({"crank_joint": "contact", "load": "valves"}, "contact-valves"),
+    ({"guide": "clearance", "crank_joint": "ideal"}, "guide"),
+    ({"guide": "clearance", "crank_joint": "ideal", "load": "cycle"}, "guide"),
+]
+#: Refused combinations and a phrase of the one line that says why.
+REFUSED = [
+    ({"crosshead_joint": "contact"}, "the massless link exists at the crank pin"),
+    ({"crank_joint": "contact", "drive": "motor"}, "drive = 'motor' with a contact"),
+    ({"crank_joint": "ideal", "crosshead_joint": "lubricated", "drive": "motor"},
+     "drive = 'motor' with a contact"),
+    ({"load": "valves", "drive": "motor"}, "drive = 'motor' with load = 'valves'"),
+    ({"guide": "clearance"}, "guide = 'clearance' with crank_joint = 'link'"),
+    ({"guide": "clearance", "crank_joint": "contact"}, "not available yet"),
+    ({"guide": "clearance", "crank_joint": "ideal", "drive": "motor"},
+     "drive = 'motor' with guide"),
+    ({"guide": "clearance", "crank_joint": "ideal", "load": "valves"},
+     "load = 'valves' with guide"),
+    ({"load": "valves", "load_table": TABLE}, "not with load = 'valves'"),
+    ({"crank_joint": "contact", "load": "valves", "load_table": TABLE},
+     "not with load = 'valves'"),
+    ({"load": "table"}, "load = 'table' needs load_table"),
+    ({"crank_joint": "contact", "load": "my_loads.py:HARMONIC"}, "a component of your own"),
+    ({"crank_joint": "ideal", "rc": 1e-3}, "the crank pin is ideal"),
+    ({"rc_crosshead": 3e-4}, "belongs to crosshead_joint = 'contact' | 'lubricated'"),
+    ({"oil_viscosity": 0.05}, "crosshead_joint = 'lubricated'"),
+    ({"contact_law": "hertz"}, "crank_joint or crosshead_joint = 'contact' | 'lubricated'"),
+    ({"guide_clearance": 1e-4}, "belongs to guide = 'clearance'"),
+    ({"crank_joint": "contact", "equations": "exact"}, "belongs to crank_joint = 'link'"),
+    ({"load": "valves", "load_amplitude": 1e5}, "belongs to load = 'paper'"),
+    ({"crank_joint": "nope"}, "crank_joint = 'nope'"),
+]  # fmt: skip
+
+
+def _derivative_check(ds, x: str, v: str) -> None:
+    """``v`` is the time derivative of ``x``: the central difference of ``x`` at step h equals
+    ``v`` within the difference's own error, estimated from its change at step 2h (the error
+    of a central difference falls as h^2, so |D_h - D_2h| ~ 3 |D_h - x'|), plus rounding.
+    Where a contact impact or a valve stop makes ``x`` unsmooth between samples the estimate
+    is large: such samples are not set aside, they are only compared more loosely."""
+    t = ds["time"].values
+    h = t[2] - t[1]
+    X, V = ds[x].values, ds[v].values
+    d1 = (X[3:-1] - X[1:-3]) / (2 * h)
+    d2 = (X[4:] - X[:-4]) / (4 * h)
+    rounding = 10 * np.finfo(float).eps * np.abs(X).max() / h
+    err = np.abs(d1 - V[2:-2])
+    tol = np.abs(d2 - d1) + rounding + 1e-9 * np.abs(V).max()
+    assert np.all(err <= tol), (x, v, float((err / tol).max()))
+
+
+def _run_and_check(kw, route):
+    m = get_model("compressor")
+    values = m.parameters(kw)
+    assert m.route(values)[0] == route
+    ds = _simulate(model=m, params=kw, revolutions=0.1, fs=20000.0)
+    for k in ds.data_vars:
+        assert np.all(np.isfinite(ds[k].values)), k
+    _derivative_check(ds, "x", "v")
+    _derivative_check(ds, "v", "a")
+    cfg = m.configured(values)
+    assert all(name in ds for name, _ in cfg.sections())  # its sections are recorded
+    assert cfg.vibration()[0] in ds
+
+
+@pytest.mark.parametrize("kw,route", ALLOWED,
+                         ids=[",".join(f"{k}={v}" for k, v in kw.items() if k != "load_table")
+                              or "default" for kw, _ in ALLOWED])  # fmt: skip
+def test_every_allowed_combination_runs(kw, route):
+    _run_and_check(kw, route)
+
+
+@pytest.mark.parametrize("kw,words", REFUSED,
+                         ids=[",".join(f"{k}={v}" for k, v in kw.items() if k != "load_table")
+                              for kw, _ in REFUSED])  # fmt: skip
+def test_every_refused_combination_says_why_in_one_line(kw, words):
+    with pytest.raises(ParameterError) as exc:
+        get_model("compressor").parameters(kw)
+    msg = str(exc.value)
+    assert words in msg and "\n" not in msg, msg
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--set", "crosshead_joint=contact"], "the massless link exists at the crank pin"),
+    (["--set", "rc_crosshead=0.3mm"], "rc_crosshead"),
+    (["--set", "contact_law=hertz"], "crank_joint or crosshead_joint"),
+    (["--set", "crank_joint=contact", "--set", "drive=motor"], "not available yet"),
+])  # fmt: skip
+def test_the_command_line_refuses_in_one_line(args, words, tmp_path, capsys):
+    assert main(["simulate", *args, "-o", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert words in err and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def _cross_product():
+    names = family.SELECTORS.names
+    choices = [family.SELECTORS[n].choices for n in names]
+    for combo in itertools.product(*choices):
+        kw = dict(zip(names, combo, strict=True))
+        if kw["load"] == "table":
+            kw["load_table"] = TABLE
+        yield kw
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kw", list(_cross_product()),
+                         ids=lambda kw: ",".join(f"{k}={v}" for k, v in kw.items()
+                                                 if k != "load_table"))  # fmt: skip
+def test_the_whole_matrix(kw):
+    """Every combination of the selectors' values: it runs (as above), or it is refused in
+    one line."""
+    m = get_model("compressor")
+    try:
+        values = m.parameters(kw)
+    except ParameterError as exc:
+        assert "\n" not in str(exc)
+        return
+    _run_and_check(kw, m.route(values)[0])
