@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .parameters import SELECTORS
+from .parameters import PIN_SPELLINGS, SELECTORS
 from .protocol import Model, Param, Schema, UnknownParameterError
 from .registry import is_spec
 
@@ -282,6 +282,11 @@ class Compressor(Model):
         schema = impl.schema_for({k: v for k, v in values.items() if k in impl.schema.names})
         if schema is impl.schema and route(self._selectors) == route(s):
             schema = self._schema0  # (a preset's defaults)
+        known = {*schema.names, *schema.aliases, *schema.extras, *SELECTORS.names,
+                 *PIN_SPELLINGS, "load_table", "pressure_table"}  # fmt: skip
+        for k in values:
+            if k not in known and (where := owner(k, s)):
+                raise ParameterError(self._elsewhere(k, where))
         extra = [p for p in SELECTORS if p.name not in schema.names and p.name in values
                  and values[p.name] != self._selectors[p.name]]  # fmt: skip
         if not extra:
@@ -346,15 +351,16 @@ class Compressor(Model):
         except UnknownParameterError as exc:
             where = owner(exc.name, s)
             if where:
-                raise ParameterError(
-                    f"{exc.name} is not a parameter of this configuration "
-                    f"of {self.name!r}; it belongs to {where}"
-                ) from None
+                raise ParameterError(self._elsewhere(exc.name, where)) from None
             raise
         for k in SELECTORS.names:
             if k not in out and s[k] != self._selectors[k]:
                 out[k] = s[k]
         return out
+
+    def _elsewhere(self, name: str, where: str) -> str:
+        return (f"{name} is not a parameter of this configuration of {self.name!r}; it "
+                f"belongs to {where}")  # fmt: skip
 
     def check(self, values: Mapping[str, Any]) -> None:
         impl, own = self._split(values)
@@ -424,8 +430,11 @@ class Compressor(Model):
     def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
         """The values of a record of any configuration (its selectors as ``param_*``, this
         preset's defaults for the ones it lacks)."""
-        given = {k[len("param_") :]: attrs[k] for k in attrs if k.startswith("param_")}
-        given = {k: (None if v == "default" else v.item() if isinstance(v, np.generic) else v)
+        names = {*SELECTORS.names, *PIN_SPELLINGS}
+        given = {k[len("param_") :]: attrs[k] for k in attrs
+                 if k.startswith("param_") and k[len("param_") :] in names}  # fmt: skip
+        given = {k: (None if isinstance(v, str) and v == "default" else
+                     v.item() if isinstance(v, np.generic) else v)
                  for k, v in given.items()}  # fmt: skip
         _, impl, s = self.route(given)
         out = impl.values_from_record(attrs)
