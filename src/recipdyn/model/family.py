@@ -108,9 +108,9 @@ def route(s: Mapping[str, Any]) -> str:
                 "drive = 'motor' with guide = 'clearance' is not available "
                 "yet; allowed with the guide clearance: drive = 'prescribed'"
             )
-        if load == "valves" or is_spec(load):
+        if load in ("valves", "table") or is_spec(load):
             raise ParameterError(f"load = {load!r} with guide = 'clearance' is not available "
-                                 "yet; allowed: 'paper', 'table', 'cycle'")  # fmt: skip
+                                 "yet; allowed: 'paper', 'cycle'")  # fmt: skip
         return "guide"
     if crank == "link" and cross != "ideal":
         raise ParameterError(
@@ -160,6 +160,8 @@ def _chosen(raw: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, An
     return s
 
 
+#: The load tables (beside the schemas).
+_TABLES = ("load_table", "pressure_table")
 #: The oil film's parameters (a lubricated joint's).
 _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
 
@@ -324,11 +326,16 @@ class Compressor(Model):
                 "and force in N, or their CSV file) or pressure_table"
             )
         if s["load"] == "valves":
-            for k in ("load_table", "pressure_table"):
+            for k in _TABLES:
                 if raw.get(k) is not None:
                     raise ParameterError(f"{k}: not with load = 'valves', whose gas force "
                                          "follows the chamber pressures; allowed: load = "
                                          "'table'")  # fmt: skip
+        if name == "guide" and any(raw.get(k) is not None for k in _TABLES):
+            raise ParameterError(
+                "a load table with guide = 'clearance' is not available yet; "
+                "allowed with the guide clearance: load = 'paper', 'cycle'"
+            )
         if s["crank_joint"] == "ideal" and "rc" in own and name.startswith("link"):
             if raw.get("rc", 0.0) not in (0.0, 0, None):
                 raise ParameterError(f"rc = {raw['rc']!r}: the crank pin is ideal (crank_joint "
