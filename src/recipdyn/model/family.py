@@ -171,11 +171,11 @@ def owner(name: str, s: Mapping[str, Any]) -> str:
     (``"crosshead_joint = 'contact' | 'lubricated'"``), or ``""`` if none does; ``s``: the
     current selector values (one selector is changed at a time; a crosshead-pin parameter is
     the crosshead joint's)."""
-    if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
-        return "crosshead_joint = 'contact' | 'lubricated'"
-    if name in _OIL:
-        return "crank_joint or crosshead_joint = 'lubricated'"
     if name in implementation("contact").schema and name not in implementation("link").schema:
+        if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
+            return "crosshead_joint = 'contact' | 'lubricated'"
+        if name in _OIL:
+            return "crank_joint or crosshead_joint = 'lubricated'"
         return "crank_joint or crosshead_joint = 'contact' | 'lubricated'"
     found = []
     for sel in SELECTORS:
