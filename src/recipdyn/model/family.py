@@ -160,10 +160,23 @@ def _chosen(raw: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, An
     return s
 
 
+#: The values that choose the route.
+_KEYS = (*SELECTORS.names, *PIN_SPELLINGS)
 #: The load tables (beside the schemas).
 _TABLES = ("load_table", "pressure_table")
 #: The oil film's parameters (a lubricated joint's).
 _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
+
+
+_NOT_OWN: dict[int, frozenset[str]] = {}
+
+
+def _not_own(impl: Model) -> frozenset[str]:
+    """The selectors that ``impl`` does not have (left out of its values)."""
+    key = id(impl)
+    if key not in _NOT_OWN:
+        _NOT_OWN[key] = frozenset(SELECTORS.names) - set(impl.schema.names)
+    return _NOT_OWN[key]
 
 
 def owner(name: str, s: Mapping[str, Any]) -> str:
@@ -208,6 +221,7 @@ class Compressor(Model):
         self.name = name
         self.defaults = dict(defaults or {})
         self._selectors = _chosen(self.defaults, _DEFAULTS)
+        self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
         impl = implementation(route(self._selectors))
         self.description = description or impl.description
         self._adopt(impl)
@@ -256,16 +270,26 @@ class Compressor(Model):
         return _chosen(values, self._selectors)
 
     def route(self, values: Mapping[str, Any]) -> tuple[str, Model, dict[str, Any]]:
-        """(route, implementation, selector values) at ``values``."""
-        s = self.selectors(values)
-        name = route(s)
-        return name, implementation(name), s
+        """(route, implementation, selector values) at ``values`` (remembered per value of
+        the selectors: every call of the protocol asks)."""
+        key = tuple(values.get(k) for k in _KEYS)
+        try:
+            name, s = self._routes[key]
+        except KeyError:
+            s = self.selectors(values)
+            name = route(s)
+            if len(self._routes) < 256:
+                self._routes[key] = name, s
+        except TypeError:  # an unhashable value
+            s = self.selectors(values)
+            name = route(s)
+        return name, implementation(name), dict(s)
 
     def _split(self, values: Mapping[str, Any]) -> tuple[Model, dict[str, Any]]:
         """The implementation at validated ``values`` and its own values."""
         _, impl, _ = self.route(values)
-        return impl, {k: v for k, v in values.items()
-                      if k not in SELECTORS.names or k in impl.schema.names}  # fmt: skip
+        drop = _not_own(impl)
+        return impl, {k: v for k, v in values.items() if k not in drop}
 
     def configured(self, values: Mapping[str, Any]) -> Model:
         """This model with the declarations of the implementation ``values`` choose (its
