@@ -162,6 +162,8 @@ def _chosen(raw: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, An
 
 #: The values that choose the route.
 _KEYS = (*SELECTORS.names, *PIN_SPELLINGS)
+#: Names every configuration takes (the selectors, the pins' older spelling, the tables).
+_ALWAYS = frozenset({*_KEYS, "load_table", "pressure_table"})
 #: The load tables (beside the schemas).
 _TABLES = ("load_table", "pressure_table")
 #: The oil film's parameters (a lubricated joint's).
@@ -169,6 +171,16 @@ _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
 
 
 _NOT_OWN: dict[int, frozenset[str]] = {}
+_NAMES: dict[int, tuple[Schema, frozenset[str]]] = {}
+
+
+def _known(schema: Schema) -> frozenset[str]:
+    """The names, aliases and extras of ``schema`` (remembered: the protocol asks often)."""
+    hit = _NAMES.get(id(schema))
+    if hit is None or hit[0] is not schema:
+        hit = _NAMES[id(schema)] = schema, frozenset({*schema.names, *schema.aliases,
+                                                      *schema.extras})  # fmt: skip
+    return hit[1]
 
 
 def _not_own(impl: Model) -> frozenset[str]:
@@ -305,11 +317,11 @@ class Compressor(Model):
         """The implementation's schema at ``values``, with the selectors that it does not
         have and ``values`` holds (set away from this preset's defaults)."""
         _, impl, s = self.route(values)
-        schema = impl.schema_for({k: v for k, v in values.items() if k in impl.schema.names})
+        mine = _known(impl.schema)
+        schema = impl.schema_for({k: v for k, v in values.items() if k in mine})
         if schema is impl.schema and route(self._selectors) == route(s):
             schema = self._schema0  # (a preset's defaults)
-        known = {*schema.names, *schema.aliases, *schema.extras, *SELECTORS.names,
-                 *PIN_SPELLINGS, "load_table", "pressure_table"}  # fmt: skip
+        known = _known(schema) | _ALWAYS
         for k in values:
             if k not in known and (where := owner(k, s)):
                 raise ParameterError(self._elsewhere(k, where))
@@ -336,7 +348,7 @@ class Compressor(Model):
         raw.update(values or {})
         raw.update(kw)
         name, impl, s = self.route(raw)
-        own = set(impl.schema.names) | set(impl.schema.aliases) | set(impl.schema.extras)
+        own = _known(impl.schema)
         mine = {k: v for k, v in raw.items() if k not in SELECTORS.names or k in own}
         for k in ("crank_joint", "crosshead_joint"):  # the pins, named for the contact joints
             if k in own:
