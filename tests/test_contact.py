@@ -640,9 +640,10 @@ def test_the_old_joint_parameters_are_aliases_of_the_joint_family(old, new):
 
 
 @pytest.mark.parametrize("kw,words", [
-    (dict(crank_joint="link"), ["crank_joint", "--model compressor"]),
-    (dict(crank_joint="ideal", crosshead_joint="ideal"), ["no clearance joint", "rc = 0"]),
+    (dict(crank_joint="link", crosshead_joint="contact"), ["crank_joint = 'link'",
+                                                           "ideal crosshead pin only"]),
     (dict(crosshead_joint="link"), ["crosshead_joint", "allowed"]),
+    (dict(drive="motor"), ["drive = 'motor' with a contact", "not available yet"]),
 ])  # fmt: skip
 def test_a_joint_combination_that_does_not_exist_is_refused_in_one_line(kw, words, capsys):
     from recipdyn.cli import main

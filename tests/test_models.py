@@ -47,17 +47,10 @@ def _ids(x):
 
 
 def _preset(name, over):
-    """The compressor with other defaults: the same model class, its schema's defaults
-    replaced, so every test below runs the combination as it runs a registered model."""
-    from dataclasses import replace
-
-    from recipdyn.model.protocol import Schema
-
-    base = get_model(name.split("[")[0])
-    schema = Schema(tuple(replace(p, default=over.get(p.name, p.default)) for p in base.schema),
-                    base.schema.aliases)  # fmt: skip
-    model = type(base)()
-    model.schema = schema
+    """The compressor with other defaults (`recipdyn.model.family.Compressor.with_defaults`:
+    its selectors and parameters), so every test below runs the combination as it runs a
+    registered model."""
+    model = get_model(name.split("[")[0]).with_defaults(**over)
     model.preset = over
     return model
 

@@ -390,7 +390,7 @@ def _record_model(ds, path):
     """The model a record was made with (its spec: a plug-in model's file too). A record
     with parameters but no model named was written when recipdyn had one model, the
     default."""
-    from .model.registry import DEFAULT_MODEL, get_model
+    from .model.registry import DEFAULT_MODEL, configured_for_record, get_model
 
     spec = ds.attrs.get("model_spec") or ds.attrs.get("model_name")
     if spec is None:
@@ -399,7 +399,7 @@ def _record_model(ds, path):
                                  "a recipdyn run (NetCDF from 'recipdyn simulate')")  # fmt: skip
         spec = DEFAULT_MODEL
     try:
-        return get_model(str(spec))
+        return configured_for_record(get_model(str(spec)), ds.attrs)
     except ParameterError as exc:
         raise ParameterError(f"{path}: made with model {spec!r}, which is not available here "
                              f"({exc})") from None  # fmt: skip

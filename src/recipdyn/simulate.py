@@ -284,6 +284,7 @@ def simulate(
     """
     m = get_model(model)
     values = model_values(m, params, overrides)
+    m = m.configured(values)  # the declarations of the configuration the values choose
     _check_run_settings(revolutions, transient, fs, method, rtol, atol)
     spec = model_spec(m)
     settings = dict(revolutions=revolutions, transient=transient, fs=fs, method=method,

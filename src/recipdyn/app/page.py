@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError
-from ..model.registry import DEFAULT_MODEL, get_model, model_names
+from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model, model_names
 from .figures import images, simulate_form, status_lines, views
 from .form import RUN, Field, config_text, fields, format_value, from_query, read_form, to_query
 
@@ -118,8 +118,9 @@ def run_page(model: str, texts: dict[str, Any]) -> PageResult:
         blank.status = [f"not run: {exc}"]
         return blank
     m = form.model
-    status = status_lines(ds, m) + [f"warning: {n}" for n in notes]
-    return PageResult(views(ds, m), images(ds), status, query=to_query(m, texts))
+    run = configured_for_record(m, ds.attrs)  # the declarations of the run's configuration
+    status = status_lines(ds, run) + [f"warning: {n}" for n in notes]
+    return PageResult(views(ds, run), images(ds), status, query=to_query(m, texts))
 
 
 def click_query(store: str, click: dict, texts: dict[str, Any]) -> str:

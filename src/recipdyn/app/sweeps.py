@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.registry import DEFAULT_MODEL, get_model
+from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model
 from .form import _display_unit, _factor
 
 __all__ = ["sweep_figure", "point_from_click", "log_ticks"]
@@ -28,7 +28,8 @@ def _open(store: str | Path):
 
 
 def _model(ds):
-    return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or DEFAULT_MODEL))
+    m = get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model") or DEFAULT_MODEL))
+    return configured_for_record(m, ds.attrs)
 
 
 def _axis_unit(ds, dim: str) -> tuple[str, float]:

@@ -30,6 +30,7 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
 
     from ..config import CHOICES, build_params, model_values, read_config
     from ..errors import ParameterError
+    from ..model.parameters import configures
     from ..model.protocol import UnknownParameterError
     from ..model.registry import DEFAULT_MODEL, get_model, is_spec
     from ..units import parse_assignment
@@ -49,13 +50,21 @@ def _collect_model(model, rc, d, omega, sets, config, *, load: bool = True):
     for item in sets or []:
         k, v = parse_assignment(item)
         values[k] = v
-    if m is None and any(is_spec(values.get(k)) for k in CHOICES):
-        m = get_model(DEFAULT_MODEL)  # a component from a user's file: its schema is the model's
+    if m is None and (any(is_spec(values.get(k)) for k in CHOICES) or configures(values)):
+        # a component from a user's file, or a selector choosing another configuration
+        # (crank_joint = contact ...): the model's schema at these values validates them
+        m = get_model(DEFAULT_MODEL)
     try:
         params = (dataclasses.asdict(build_params(values)) if m is None
                   else model_values(m, values))  # fmt: skip
     except UnknownParameterError as exc:
-        raise _unknown_parameter(exc, name) from None
+        if m is not None or exc.suggestions:
+            raise _unknown_parameter(exc, name) from None
+        m = get_model(DEFAULT_MODEL)  # a parameter of another configuration: the model says
+        try:  # which selector value enables it
+            params = model_values(m, values)
+        except UnknownParameterError as exc2:
+            raise _unknown_parameter(exc2, name) from None
     if m is None and load:
         m = get_model(DEFAULT_MODEL)
     return m, params, settings
@@ -399,6 +408,7 @@ def _run(m, params, kw: dict, out: Path, stream: bool, extra: dict, max_memory, 
         typer.echo(f"figure and summary: the last {FIGURE_SAMPLES} samples")
     ds = ds.load()
     values = m.values_from_record(ds.attrs)
+    m = m.configured(values)
     if figure:
         from ..plotting import _mpl, mark_invalid, model_figure
 

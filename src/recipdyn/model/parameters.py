@@ -44,6 +44,8 @@ __all__ = [
     "paper_2d12",
     "resolve_name",
     "SCHEMA",
+    "SELECTORS",
+    "configures",
 ]
 
 
@@ -162,6 +164,43 @@ SCHEMA = Schema((
 })  # fmt: skip
 
 PARAM_UNITS: dict[str, str] = {p.name: p.unit for p in SCHEMA if p.unit}
+
+JOINTS = ("link", "ideal", "contact", "lubricated")
+#: The selectors of the compressor (`recipdyn.model.family`): each a parameter whose value
+#: chooses a part, and so the implementation that runs.
+SELECTORS = Schema((
+    Param("crank_joint", "", "link", "the crank-pin joint: 'link' (the paper's massless link "
+          "of length rc), 'ideal', 'contact' (dry contact-impact) or 'lubricated' (oil film + "
+          "contact)", choices=JOINTS, group="joint"),
+    Param("crosshead_joint", "", "ideal", "the crosshead-pin joint: 'ideal', 'contact' or "
+          "'lubricated'", choices=JOINTS[1:], group="joint"),
+    Param("load", "", "paper", "cylinder load: 'paper' (Eq. 1-2), 'table' (load_table or "
+          "pressure_table), 'cycle' (ideal valves), 'valves' (dynamic plate valves, the gas as "
+          "states) or file.py:OBJ", choices=("paper", "table", "cycle", "valves"),
+          group="load"),
+    Param("drive", "", "prescribed", "what turns the crank: 'prescribed' (constant omega) or "
+          "'motor'", choices=("prescribed", "motor"), group="drive"),
+    Param("guide", "", "ideal", "the crosshead guide: 'ideal' (the crosshead runs at y = -d) "
+          "or 'clearance' (it moves and tilts between the shoes: crosshead knock)",
+          choices=("ideal", "clearance"), group="guide"),
+))  # fmt: skip
+
+#: The contact joints' older way to name the pins (``clearance_joints``: where, ``joint``: dry
+#: or lubricated), which the selectors read too.
+PIN_SPELLINGS = ("clearance_joints", "joint")
+
+
+def configures(values: Mapping[str, Any]) -> bool:
+    """Whether ``values`` (names, raw) choose a configuration of the compressor other than
+    the massless link's by a selector it does not have (``crank_joint = contact``, ``load =
+    valves``...): then the model, not this module's `SCHEMA`, validates them."""
+    for k, v in values.items():
+        if k in PIN_SPELLINGS or (k in SELECTORS.names and k not in SCHEMA.names):
+            return True
+        if k in SELECTORS.names and v not in SCHEMA[k].choices and not is_spec(v):
+            return True
+    return False
+
 
 #: The parameters that choose a component and may name one from a user's module or file
 #: (``module:object``, ``file.py:OBJ``; `recipdyn.model.components.contract.resolve_component`).

@@ -333,6 +333,13 @@ class Model(ABC):
         by saltation matrices). A model refuses it by setting ``lyapunov_refusal``."""
         return not self.lyapunov_refusal
 
+    def identity_values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """The values that identify a run (a sweep store's digest): ``values`` without the
+        parameters that have no effect at them. Default: all of them. A model that gains a
+        component keeps the digests of the stores made before by leaving the component's
+        parameters out while it is not chosen."""
+        return dict(values)
+
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """Typical size of each state component (used to perturb states in the interface
         tests). Default: ``max(1, |initial state|)``; a model whose states are far smaller
@@ -386,6 +393,19 @@ class Model(ABC):
         ``schema``; an assembled model whose parameters choose components from a user's file
         adds their fragments here (the compressor, `recipdyn.model.components`)."""
         return self.schema
+
+    def configured(self, values: Mapping[str, Any]) -> Model:
+        """The model that describes runs at validated ``values``: itself (the default), or,
+        for a model whose parameters choose its implementation (the compressor,
+        `recipdyn.model.family`), this model with that implementation's declarations
+        (section and vibration signals, validity bounds, refusals, state names). The layers
+        above read those declarations from it."""
+        return self
+
+    def parameter_table(self) -> list[tuple[Param, str]]:
+        """Every parameter with the configuration it belongs to (``""``: the default one),
+        for ``recipdyn models``. Default: the schema's."""
+        return [(p, "") for p in self.schema]
 
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise

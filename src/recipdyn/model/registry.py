@@ -23,23 +23,23 @@ from ..errors import ParameterError
 from .protocol import Model, close_matches
 
 __all__ = ["get_model", "model_names", "register", "models_with_parameter", "model_spec",
-           "load_object", "is_spec", "absolute_spec", "DEFAULT_MODEL",
+           "load_object", "is_spec", "absolute_spec", "configured_for_record", "DEFAULT_MODEL",
            "ENTRY_POINT_GROUP"]  # fmt: skip
 
 DEFAULT_MODEL = "compressor"
 ENTRY_POINT_GROUP = "recipdyn.models"
 
 _BUILTIN = {
-    "compressor": "recipdyn.model.compressor:COMPRESSOR",
+    "compressor": "recipdyn.model.family:COMPRESSOR",
     "duffing": "recipdyn.model.reference:DUFFING",
     "lorenz": "recipdyn.model.reference:LORENZ",
     "henon": "recipdyn.model.reference:HENON",
     "double-pendulum": "recipdyn.model.reference.double_pendulum:DOUBLE_PENDULUM",
     "impact-oscillator": "recipdyn.model.reference.impact_oscillator:IMPACT_OSCILLATOR",
-    "compressor-contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
-    "compressor-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
-    "compressor-contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",  # noqa: E501
-    "compressor-guide": "recipdyn.model.compressor_guide:COMPRESSOR_GUIDE",
+    "compressor-contact": "recipdyn.model.family:COMPRESSOR_CONTACT",
+    "compressor-valves": "recipdyn.model.family:COMPRESSOR_VALVES",
+    "compressor-contact-valves": "recipdyn.model.family:COMPRESSOR_CONTACT_VALVES",
+    "compressor-guide": "recipdyn.model.family:COMPRESSOR_GUIDE",
 }
 _REGISTERED: dict[str, Model] = {}
 
@@ -174,3 +174,12 @@ def models_with_parameter(name: str) -> list[str]:
         if name in schema or name in schema.aliases:
             found.append(model_name)
     return found
+
+
+def configured_for_record(model: Model, attrs) -> Model:
+    """``model`` configured (`Model.configured`) by the values a record's or a sweep store's
+    attributes hold; ``model`` itself when they hold none it can read (a measured signal)."""
+    try:
+        return model.configured(model.values_from_record(attrs))
+    except (ParameterError, KeyError, TypeError, ValueError):
+        return model

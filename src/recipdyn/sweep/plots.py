@@ -59,11 +59,12 @@ def wrap_around_mean(angle) -> tuple[np.ndarray, float]:
 def _store_model(ds):
     """The model a sweep store was made with (its spec: a plug-in model's file too), or None
     for one that is not available here."""
-    from ..model.registry import DEFAULT_MODEL, get_model
+    from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model
 
     try:
-        return get_model(str(ds.attrs.get("model_spec") or ds.attrs.get("model")
-                             or DEFAULT_MODEL))  # fmt: skip
+        return configured_for_record(get_model(str(ds.attrs.get("model_spec")
+                                                   or ds.attrs.get("model") or DEFAULT_MODEL)),
+                                     ds.attrs)  # fmt: skip
     except Exception:  # a store from a model that is not installed here
         return None
 

@@ -57,7 +57,7 @@ BACKENDS = ("serial", "processes", "dask")
 def _variables(spec: SweepSpec) -> dict[str, tuple[str, tuple[str, ...], int | None, str]]:
     """name -> (dtype, extra dims, extra size, units) for the requested measures."""
     v: dict[str, tuple[str, tuple[str, ...], int | None, str]] = {}
-    m = spec.get_model()
+    m = spec.get_model().configured(spec.base)
     n = int(spec.settings["points"])
     per_time = "Hz" if m.time_unit == "s" else f"1/{m.time_unit}"
     if "poincare" in spec.measures or "verdict" in spec.measures:

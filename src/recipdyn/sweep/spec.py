@@ -195,7 +195,8 @@ class SweepSpec:
     def to_json(self) -> str:
         return json.dumps(
             dict(axes=[dataclasses.asdict(a) for a in self.axes], measures=list(self.measures),
-                 base=dict(self.base), settings=self.settings, continuation=self.continuation,
+                 base=self.get_model().identity_values(self.base), settings=self.settings,
+                 continuation=self.continuation,
                  # (the default model is not named: the digests of stores made before
                  # sweeps took other models stay the same)
                  **({} if self.model == DEFAULT_MODEL else {"model": self.model})),

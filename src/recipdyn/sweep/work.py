@@ -60,7 +60,7 @@ class _Point:
     (through its protocol only)."""
 
     def __init__(self, model_spec: str, p: Any):
-        m = get_model(model_spec)
+        m = get_model(model_spec).configured(p)
         self.model = m
         self.system = m.system(p)
         period = m.period(p)

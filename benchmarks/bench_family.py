@@ -1,0 +1,59 @@
+"""Benchmark: the one ``compressor`` model (its selectors choose the implementation) against
+the implementation it delegates to (the model class the old name reached), per revolution.
+
+Each route runs ``recipdyn.simulate`` for one revolution (fs 2 kHz, default tolerances) with
+``--model compressor --set SELECTORS`` and with the implementation directly, in alternating
+rounds in one process (so both see the same load of the machine); the best time of each side
+and their ratio are printed. The model adds only the routing of each call (a few dict
+operations): the ratio should be 1 within the machine's noise.
+
+    python benchmarks/bench_family.py [--rounds 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import warnings
+
+ROUTES = {
+    "massless link (default)": ({}, "link"),
+    "contact crank pin": ({"crank_joint": "contact"}, "contact"),
+    "link + dynamic valves": ({"load": "valves"}, "link-valves"),
+}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--revolutions", type=float, default=1.0)
+    args = ap.parse_args()
+
+    import recipdyn
+    from recipdyn.errors import ModelValidityWarning
+    from recipdyn.model import family
+    from recipdyn.model.registry import get_model
+
+    warnings.simplefilter("ignore", ModelValidityWarning)
+    model = get_model("compressor")
+    kw = dict(revolutions=args.revolutions, fs=2000.0)
+    print(f"{'route':28s} {'model (s/rev)':>14s} {'implementation':>15s} {'ratio':>7s}")
+    for label, (selectors, route) in ROUTES.items():
+        impl = family.implementation(route)
+        sides = {"model": (model, selectors), "impl": (impl, {})}
+        for m, p in sides.values():  # compile or load the cache
+            recipdyn.simulate(model=m, params=p, revolutions=0.05, fs=2000.0)
+        best = {k: float("inf") for k in sides}
+        for r in range(args.rounds):
+            order = list(sides) if r % 2 == 0 else list(sides)[::-1]
+            for k in order:
+                m, p = sides[k]
+                t0 = time.perf_counter()
+                recipdyn.simulate(model=m, params=p, **kw)
+                best[k] = min(best[k], (time.perf_counter() - t0) / args.revolutions)
+        print(f"{label:28s} {best['model']:14.4f} {best['impl']:15.4f} "
+              f"{best['model'] / best['impl']:7.3f}")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

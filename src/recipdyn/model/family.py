@@ -1,0 +1,530 @@
+r"""The compressor: one model whose parameters choose the implementation.
+
+``--model compressor`` takes five *selectors*, each a parameter:
+
+========================  ==================================================================
+``crank_joint``           ``link`` (the paper's massless link of length ``rc``), ``ideal``,
+                          ``contact`` (dry contact–impact), ``lubricated``
+``crosshead_joint``       ``ideal``, ``contact``, ``lubricated``
+``load``                  ``paper``, ``table`` (``load_table`` or ``pressure_table``),
+                          ``cycle``, ``valves`` (the cylinder gas with dynamic plate valves),
+                          or a component of your own, ``file.py:OBJ``
+``drive``                 ``prescribed`` (constant ``omega``), ``motor``
+``guide``                 ``ideal`` (the crosshead runs at ``y = -d``), ``clearance`` (the
+                          crosshead moves and tilts between the guide's shoes)
+========================  ==================================================================
+
+The selectors choose one of the implementations (`ROUTES`) and the model delegates every call
+to it: the same compiled kernels run on the same parameter vector, so a configuration gives
+the numbers its implementation gives, to the bit, at the same cost. A combination that no
+implementation covers is refused in one line that says why (`route`), and a parameter that
+belongs to another configuration is refused in one line naming the selector value that
+enables it (`owner`).
+
+The old model names are *presets*: ``compressor-contact`` is this model with
+``crank_joint = contact`` as its default, ``compressor-valves`` with ``load = valves``,
+``compressor-contact-valves`` with both, ``compressor-guide`` with ``guide = clearance`` and
+ideal pins (`PRESETS`).
+
+**Values and records.** A configuration's validated values are its implementation's values
+plus each selector the implementation does not itself have whose value differs from the
+preset's default. So the values of every preset at its defaults, and of every configuration
+its old model name reached, are the ones that name gave before: sweep stores keep their
+digests, records and configs rerun. A record stores the model it was made with (a preset's
+name, or ``compressor``) and the selectors as ``param_*`` like any parameter;
+`Compressor.values_from_record` reads them back, so ``--model compressor --set
+crank_joint=contact`` and ``--model compressor-contact`` give records that rerun and analyse
+alike (and hold the same values).
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+from collections.abc import Mapping
+from dataclasses import fields, is_dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .parameters import PIN_SPELLINGS, SELECTORS
+from .protocol import Model, Param, Schema, UnknownParameterError
+from .registry import is_spec
+
+__all__ = [
+    "Compressor", "SELECTORS", "ROUTES", "PRESETS", "route", "owner", "implementation",
+    "COMPRESSOR",
+    "COMPRESSOR_CONTACT", "COMPRESSOR_VALVES",  # noqa: F822 (built on first use, __getattr__)
+    "COMPRESSOR_CONTACT_VALVES", "COMPRESSOR_GUIDE",  # noqa: F822
+]  # fmt: skip
+
+_DEFAULTS = SELECTORS.defaults()
+
+#: The implementations, by route: where each lives (imported when first asked for).
+ROUTES = {
+    "link": "recipdyn.model.compressor:COMPRESSOR",
+    "link-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
+    "contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
+    "contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",
+    "guide": "recipdyn.model.compressor_guide:COMPRESSOR_GUIDE",
+}
+_LOADED: dict[str, Model] = {}
+
+
+def implementation(name: str) -> Model:
+    """The implementation of route ``name`` (`ROUTES`)."""
+    if name not in _LOADED:
+        module, _, attr = ROUTES[name].partition(":")
+        _LOADED[name] = getattr(importlib.import_module(module), attr)
+    return _LOADED[name]
+
+
+_MOTOR_CONTACT = (
+    "drive = 'motor' with a contact or lubricated joint is not available yet "
+    "(the contact joints' equations take a prescribed crank); allowed with drive "
+    "= 'motor': crank_joint = 'link' or 'ideal' and crosshead_joint = 'ideal'"
+)
+
+
+def route(s: Mapping[str, Any], table: bool = False) -> str:
+    """The implementation (a key of `ROUTES`) for the selector values ``s`` (``table``: a
+    load or pressure table is given); a combination that none covers raises
+    [`ParameterError`][recipdyn.errors.ParameterError] in one line that says why and what is
+    allowed."""
+    crank, cross, load, drive, guide = (s[k] for k in SELECTORS.names)
+    rigid_pins = crank in ("link", "ideal") and cross == "ideal"
+    if guide == "clearance":
+        if crank == "link":
+            raise ParameterError(
+                "guide = 'clearance' with crank_joint = 'link' is not available: the massless "
+                "link's equations hold the crosshead on its line; allowed with the guide "
+                "clearance: crank_joint = 'ideal', 'contact' or 'lubricated'"
+            )
+        if drive == "motor":
+            raise ParameterError(
+                "drive = 'motor' with guide = 'clearance' is not available "
+                "yet; allowed with the guide clearance: drive = 'prescribed'"
+            )
+        if is_spec(load):
+            raise ParameterError(f"load = {load!r} (a component of your own) with guide = "
+                                 "'clearance' is not available yet; allowed: 'paper', "
+                                 "'table', 'cycle', 'valves'")  # fmt: skip
+        if rigid_pins and load in ("paper", "cycle") and not table:
+            return "guide"  # compressor-guide: its own kernel, the Flores benchmark's
+        # the contact joints' glue with its own guide (any pin joint, ideal pins included)
+        return "contact-valves" if load == "valves" else "contact"
+    if crank == "link" and cross != "ideal":
+        raise ParameterError(
+            f"crank_joint = 'link' with crosshead_joint = {cross!r}: the massless link exists "
+            "at the crank pin with an ideal crosshead pin only; for clearance at both pins: "
+            "crank_joint = 'contact' or 'lubricated'"
+        )
+    if rigid_pins:
+        if load == "valves":
+            if drive == "motor":
+                raise ParameterError("drive = 'motor' with load = 'valves' is not available "
+                                     "yet; allowed with drive = 'motor': load = 'paper', "
+                                     "'table', 'cycle' or file.py:OBJ")  # fmt: skip
+            return "link-valves"
+        return "link"
+    if drive == "motor":
+        raise ParameterError(_MOTOR_CONTACT)
+    if is_spec(load):
+        raise ParameterError(
+            f"load = {load!r} (a component of your own) with a contact or lubricated joint is "
+            "not available yet; allowed: crank_joint = 'link' or 'ideal' and crosshead_joint = "
+            "'ideal', or load = 'paper', 'table', 'cycle', 'valves'"
+        )
+    return "contact-valves" if load == "valves" else "contact"
+
+
+def _chosen(raw: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, Any]:
+    """The selector values in ``raw`` (names, raw or validated; a record's ``None``, unset)
+    over ``defaults``, checked against their choices. The contact joints' older spelling
+    (``clearance_joints`` where, ``joint`` dry or lubricated) gives the two pins when neither
+    is named."""
+    s = dict(defaults)
+    for k in SELECTORS.names:
+        v = raw.get(k)
+        if v is not None:
+            s[k] = v
+    if any(raw.get(k) is not None for k in ("clearance_joints", "joint")):
+        where = raw.get("clearance_joints") or "crank"
+        kind = "lubricated" if raw.get("joint") == "lubricated" else "contact"
+        if raw.get("crank_joint") is None:
+            s["crank_joint"] = "ideal" if where == "crosshead" else kind
+        if raw.get("crosshead_joint") is None:
+            s["crosshead_joint"] = "ideal" if where == "crank" else kind
+    for k, v in s.items():
+        if not (k == "load" and is_spec(v)):
+            SELECTORS[k].check(v)
+    return s
+
+
+#: The values that choose the route.
+_KEYS = (*SELECTORS.names, *PIN_SPELLINGS)
+#: Names every configuration takes (the selectors, the pins' older spelling, the tables).
+_ALWAYS = frozenset({*_KEYS, "load_table", "pressure_table"})
+#: The load tables (beside the schemas).
+_TABLES = ("load_table", "pressure_table")
+#: The oil film's parameters (a lubricated joint's).
+_OIL = ("oil_viscosity", "eps_dry", "bearing_length")
+
+
+_NOT_OWN: dict[int, frozenset[str]] = {}
+_NAMES: dict[int, tuple[Schema, frozenset[str]]] = {}
+
+
+def _known(schema: Schema) -> frozenset[str]:
+    """The names, aliases and extras of ``schema`` (remembered: the protocol asks often)."""
+    hit = _NAMES.get(id(schema))
+    if hit is None or hit[0] is not schema:
+        hit = _NAMES[id(schema)] = schema, frozenset({*schema.names, *schema.aliases,
+                                                      *schema.extras})  # fmt: skip
+    return hit[1]
+
+
+def _not_own(impl: Model) -> frozenset[str]:
+    """The selectors that ``impl`` does not have (left out of its values)."""
+    key = id(impl)
+    if key not in _NOT_OWN:
+        _NOT_OWN[key] = frozenset(SELECTORS.names) - set(impl.schema.names)
+    return _NOT_OWN[key]
+
+
+def owner(name: str, s: Mapping[str, Any]) -> str:
+    """The selector values under which parameter ``name`` exists, as text
+    (``"crosshead_joint = 'contact' | 'lubricated'"``), or ``""`` if none does; ``s``: the
+    current selector values (one selector is changed at a time; a crosshead-pin parameter is
+    the crosshead joint's)."""
+    if name in implementation("contact").schema and name not in implementation("link").schema:
+        if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
+            return "crosshead_joint = 'contact' | 'lubricated'"
+        if name in _OIL:
+            return "crank_joint or crosshead_joint = 'lubricated'"
+        return "crank_joint or crosshead_joint = 'contact' | 'lubricated'"
+    found = []
+    for sel in SELECTORS:
+        ok = []
+        for v in sel.choices:
+            if v == s[sel.name]:
+                continue
+            trial = {**s, sel.name: v}
+            if sel.name == "crank_joint" and v != "link":  # (contact at the crank pin alone)
+                trial["crosshead_joint"] = "ideal"
+            if sel.name == "guide":  # the guide's clearance runs with ideal pins
+                trial.update(crank_joint="ideal", crosshead_joint="ideal")
+            try:
+                impl = implementation(route(trial))
+            except ParameterError:
+                continue
+            if name in impl.schema or name in impl.schema.aliases:
+                ok.append(v)
+        if ok:
+            found.append(f"{sel.name} = {' | '.join(repr(v) for v in ok)}")
+    return " or ".join(found)
+
+
+class Compressor(Model):
+    """The compressor whose selectors (module docstring) choose the implementation; a
+    preset is an instance with other defaults (`with_defaults`)."""
+
+    def __init__(self, name: str = "compressor", defaults: Mapping[str, Any] | None = None,
+                 description: str = "") -> None:  # fmt: skip
+        self.name = name
+        self.defaults = dict(defaults or {})
+        self._selectors = _chosen(self.defaults, _DEFAULTS)
+        self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
+        impl = implementation(route(self._selectors))
+        self.description = description or impl.description
+        self._adopt(impl)
+        others = {k: v for k, v in self.defaults.items() if k not in SELECTORS.names}
+        if others:  # (a preset of other parameter defaults: shown in its schema)
+            self.schema = Schema(tuple(replace(p, default=others.get(p.name, p.default))
+                                       for p in impl.schema), impl.schema.aliases,
+                                 impl.schema.extras)  # fmt: skip
+        self._schema0 = self.schema
+
+    def _adopt(self, impl: Model) -> None:
+        """Take the implementation's declarations that do not depend on values."""
+        for k in (
+            "state_names",
+            "state_units",
+            "schema",
+            "section_signals",
+            "vibration_signal",
+            "section_pair",
+            "validity_bounds",
+            "summary_verdicts",
+            "mean_signals",
+            "max_signals",
+            "event_example",
+            "lyapunov_refusal",
+            "time_unit",
+        ):
+            if hasattr(impl, k):
+                setattr(self, k, getattr(impl, k))
+
+    def __getattr__(self, name: str) -> Any:
+        # what an implementation offers beyond the protocol (the contact joints' kernels):
+        # the default configuration's
+        if name.startswith("_"):
+            raise AttributeError(name)
+        return getattr(implementation(route(self._selectors)), name)
+
+    def with_defaults(self, **defaults: Any) -> Compressor:
+        """This model with other defaults (selectors or any parameter), under its name."""
+        return Compressor(self.name, {**self.defaults, **defaults}, self.description)
+
+    # -- routing ------------------------------------------------------------------------
+    def selectors(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """The selector values at ``values`` (raw or validated), this preset's defaults for
+        the ones not given."""
+        return _chosen(values, self._selectors)
+
+    def route(self, values: Mapping[str, Any]) -> tuple[str, Model, dict[str, Any]]:
+        """(route, implementation, selector values) at ``values`` (remembered per value of
+        the selectors: every call of the protocol asks)."""
+        table = any(values.get(k) is not None for k in _TABLES)
+        key = (*(values.get(k) for k in _KEYS), table)
+        try:
+            name, s = self._routes[key]
+        except KeyError:
+            s = self.selectors(values)
+            name = route(s, table)
+            if len(self._routes) < 256:
+                self._routes[key] = name, s
+        except TypeError:  # an unhashable value
+            s = self.selectors(values)
+            name = route(s, table)
+        return name, implementation(name), dict(s)
+
+    def _split(self, values: Mapping[str, Any]) -> tuple[Model, dict[str, Any]]:
+        """The implementation at validated ``values`` and its own values."""
+        _, impl, _ = self.route(values)
+        drop = _not_own(impl)
+        return impl, {k: v for k, v in values.items() if k not in drop}
+
+    def configured(self, values: Mapping[str, Any]) -> Model:
+        """This model with the declarations of the implementation ``values`` choose (its
+        section signals, vibration signal, validity bounds, refusals, state names)."""
+        _, impl, _ = self.route(values)
+        out = copy.copy(self)
+        out._adopt(impl)
+        out.schema = self.schema_for(values)
+        return out
+
+    # -- parameters ---------------------------------------------------------------------
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """The implementation's schema at ``values``, with the selectors that it does not
+        have and ``values`` holds (set away from this preset's defaults)."""
+        _, impl, s = self.route(values)
+        mine = _known(impl.schema)
+        schema = impl.schema_for({k: v for k, v in values.items() if k in mine})
+        if schema is impl.schema and route(self._selectors) == route(s):
+            schema = self._schema0  # (a preset's defaults)
+        known = _known(schema) | _ALWAYS
+        for k in values:
+            if k not in known and (where := owner(k, s)):
+                raise ParameterError(self._elsewhere(k, where))
+        extra = [p for p in SELECTORS if p.name not in schema.names and p.name in values
+                 and values[p.name] != self._selectors[p.name]]  # fmt: skip
+        if not extra:
+            return schema
+        extra = [replace(p, choices=(*p.choices, values[p.name])) if is_spec(values[p.name])
+                 else p for p in extra]  # fmt: skip
+        return Schema((*schema.params, *extra), schema.aliases, schema.extras)
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        """Validated values: the implementation the selectors choose validates its own, the
+        selectors it does not have are added where they differ from this preset's defaults
+        (module docstring). A parameter of another configuration is refused in one line
+        naming the selector value that enables it."""
+        if is_dataclass(values) and not isinstance(values, type):
+            values = {f.name: getattr(values, f.name) for f in fields(values)}
+        elif values is not None and not isinstance(values, Mapping):
+            raise ParameterError(f"parameters of model {self.name!r}: expected a mapping of "
+                                 f"names to values, got {type(values).__name__}")  # fmt: skip
+        raw = {k: v for k, v in self.defaults.items() if k not in SELECTORS.names}
+        raw.update(values or {})
+        raw.update(kw)
+        name, impl, s = self.route(raw)
+        own = _known(impl.schema)
+        mine = {k: v for k, v in raw.items() if k not in SELECTORS.names or k in own}
+        for k in ("crank_joint", "crosshead_joint"):  # the pins, named for the contact joints
+            if k in own:
+                mine[k] = s[k]
+        if s["load"] in ("table", "valves") and "load" in own:
+            mine["load"] = "paper"
+        if s["load"] == "table" and raw.get("load_table") is None and raw.get(
+                "pressure_table") is None:  # fmt: skip
+            raise ParameterError(
+                "load = 'table' needs load_table (rows of crank angle in deg "
+                "and force in N, or their CSV file) or pressure_table"
+            )
+        if s["load"] == "valves":
+            for k in _TABLES:
+                if raw.get(k) is not None:
+                    raise ParameterError(f"{k}: not with load = 'valves', whose gas force "
+                                         "follows the chamber pressures; allowed: load = "
+                                         "'table'")  # fmt: skip
+        if s["crank_joint"] == "ideal" and "rc" in own and name.startswith("link"):
+            if raw.get("rc", 0.0) not in (0.0, 0, None):
+                raise ParameterError(f"rc = {raw['rc']!r}: the crank pin is ideal (crank_joint "
+                                     "= 'ideal'); rc belongs to crank_joint = 'link' | "
+                                     "'contact' | 'lubricated'")  # fmt: skip
+            mine["rc"] = 0.0
+        if s["guide"] == "ideal" and raw.get("guide_clearance") not in (None, 0, 0.0):
+            raise ParameterError("guide_clearance belongs to guide = 'clearance'")
+        ptab = mine.pop("pressure_table", None) if "pressure_table" not in impl.schema else None
+        try:
+            out = impl.parameters(mine)
+            if ptab is not None:
+                from .load import read_pressure_table
+
+                if mine.get("load_table") is not None:
+                    raise ParameterError("pressure_table and load_table: give one of them")
+                out = impl.parameters({**out, "load_table": read_pressure_table(
+                    ptab, bore=out["bore"], rod_diameter=out["rod_diameter"],
+                    frame_pressure=out["frame_pressure"])})  # fmt: skip
+        except UnknownParameterError as exc:
+            where = owner(exc.name, s)
+            if where:
+                raise ParameterError(self._elsewhere(exc.name, where)) from None
+            raise
+        for k in SELECTORS.names:
+            if k not in out and s[k] != self._selectors[k]:
+                out[k] = s[k]
+        return out
+
+    def _elsewhere(self, name: str, where: str) -> str:
+        return (f"{name} is not a parameter of this configuration of {self.name!r}; it "
+                f"belongs to {where}")  # fmt: skip
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        impl, own = self._split(values)
+        impl.check(own)
+
+    # -- the rest: delegated -------------------------------------------------------------
+    def system(self, values: Mapping[str, Any]):
+        impl, own = self._split(values)
+        return impl.system(own)
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        impl, own = self._split(values)
+        return impl.initial_state(own)
+
+    def period(self, values: Mapping[str, Any]) -> float | None:
+        impl, own = self._split(values)
+        return impl.period(own)
+
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        impl, own = self._split(values)
+        return impl.states(own)
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray):
+        impl, own = self._split(values)
+        return impl.outputs(own, t, y)
+
+    def events(self, values: Mapping[str, Any]):
+        impl, own = self._split(values)
+        return impl.events(own)
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        impl, own = self._split(values)
+        return impl.lyapunov_supported(own)
+
+    def identity_values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        impl, own = self._split(values)
+        kept = impl.identity_values(own)
+        return {k: v for k, v in values.items() if k in kept or k not in own}
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        impl, own = self._split(values)
+        return impl.state_scale(own)
+
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        impl, own = self._split(values)
+        return impl.validity_applies(own)
+
+    def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
+        impl, own = self._split(values)
+        return impl.law_range(own, ds)
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        impl, own = self._split(values)
+        return impl.has_dynamics(own)
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        impl, own = self._split(values)
+        return impl.run_summary(own, ds)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """The implementation's record attributes under this model's name, with the
+        selectors ``values`` holds beside the implementation's parameters."""
+        impl, own = self._split(values)
+        out = impl.record_attrs(own, y0)
+        out.update({"title": f"recipdyn simulation: {self.name}", "model": self.name,
+                    "model_description": self.description})  # fmt: skip
+        extra = [p for p in self.schema_for(values) if p.name not in own]
+        out.update(Schema(tuple(extra)).to_attrs(values))
+        return out
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """The values of a record of any configuration (its selectors as ``param_*``, this
+        preset's defaults for the ones it lacks)."""
+        names = {*SELECTORS.names, *PIN_SPELLINGS}
+        given = {k[len("param_") :]: attrs[k] for k in attrs
+                 if k.startswith("param_") and k[len("param_") :] in names}  # fmt: skip
+        given = {k: (None if isinstance(v, str) and v == "default" else
+                     v.item() if isinstance(v, np.generic) else v)
+                 for k, v in given.items()}  # fmt: skip
+        _, impl, s = self.route(given)
+        out = impl.values_from_record(attrs)
+        for k in SELECTORS.names:
+            if k not in out and s[k] != self._selectors[k]:
+                out[k] = s[k]
+        return out
+
+    def parameter_table(self) -> list[tuple[Param, str]]:
+        """Every parameter of every configuration with the selector values it belongs to
+        (``""``: this preset's default configuration), for ``recipdyn models``."""
+        rows: list[tuple[Param, str]] = [(p, "") for p in self.schema]
+        seen = set(self.schema.names)
+        for p in SELECTORS:
+            if p.name not in seen:
+                rows.append((replace(p, default=self._selectors[p.name]), "selector"))
+                seen.add(p.name)
+        for name in ROUTES:
+            for p in implementation(name).schema:
+                if p.name not in seen:
+                    rows.append((p, owner(p.name, self._selectors)))
+                    seen.add(p.name)
+        return rows
+
+
+#: The presets: the old model names, this model with other defaults.
+PRESETS = {
+    "compressor-contact": {"crank_joint": "contact"},
+    "compressor-valves": {"load": "valves"},
+    "compressor-contact-valves": {"crank_joint": "contact", "load": "valves"},
+    "compressor-guide": {"guide": "clearance", "crank_joint": "ideal"},
+}
+
+#: The registered instance (``--model compressor``, the default); the presets are
+#: ``COMPRESSOR_CONTACT``, ``COMPRESSOR_VALVES``, ``COMPRESSOR_CONTACT_VALVES`` and
+#: ``COMPRESSOR_GUIDE``, built when first asked for (each loads its implementation).
+COMPRESSOR = Compressor()
+_PRESET_NAMES = {f"COMPRESSOR_{k[len('compressor-'):].upper().replace('-', '_')}": k
+                 for k in PRESETS}  # fmt: skip
+
+
+def __getattr__(name: str) -> Compressor:
+    if name in _PRESET_NAMES:
+        key = _PRESET_NAMES[name]
+        globals()[name] = Compressor(key, PRESETS[key])
+        return globals()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
