@@ -14,7 +14,7 @@ Three groups, by what the record must hold:
     (0 at its minimum, 1 at its maximum) in 10-degree bins, and its max/min ratio.
 ``cycle`` (the angle and both pressure channels)
     The indicator-diagram diagnosis (Bloch, *A Practical Guide to Compressor Technology*,
-    2nd ed., Wiley 2006, ch. 11; Bloch & Hoefner, *Reciprocating Compressors: Operation and
+    2nd ed., Wiley 2006; Bloch & Hoefner, *Reciprocating Compressors: Operation and
     Maintenance*, 1996), made independent of the operating condition by comparing each
     chamber with its own ideal cycle at its own measured suction and discharge levels: the
     crank angles of the four valve events (discharge closing, suction opening, suction

@@ -357,7 +357,11 @@ def _train(folder: Path, seed: int) -> tuple[Diagnoser, dict]:
         "train_severity": train_df.severity.to_numpy(float),
         "train_records": train_df.record.to_numpy(int),
         "library_accel": acc_curves,
-        "library_p_head": p_curves,
+        # the head-end pressure of the healthy records only: the evidence compares a record's
+        # with its closest healthy one (zeros elsewhere, which compress away)
+        "library_p_head": np.where(
+            (train_df.label == "healthy").to_numpy()[:, None], p_curves, 0
+        ).astype(np.float16),
     }
     for k in ("center", "scale"):
         state[k] = np.asarray(state[k], float)
@@ -535,8 +539,86 @@ def _importance(diag, X, y, seed) -> list[tuple[str, float]]:
 TRUSTED_PREFIXES = ("sklearn.", "numpy.", "builtins.", "collections.")
 
 
+def _estimators(state: dict):
+    """``(key, estimator)`` of every gradient-boosting model in a diagnoser's state."""
+    for k, est in state["classifiers"].items():
+        yield f"classifiers/{k}", est
+    for c, regs in state["regressors"].items():
+        for k, est in regs.items():
+            yield f"regressors/{c}/{k}", est
+
+
+def _pack(state: dict) -> dict:
+    """A copy of ``state`` whose boosting models hold their trees as one byte array each
+    (`PACKED`) instead of one object a tree: skops writes and reads each object with its own
+    schema entry, which made a file of 4 500 trees 7 MB and 15 s to load. The nodes' split
+    gains and sample counts (not used to predict) are zeroed, so they compress away."""
+    import copy
+
+    state = dict(state)
+    state["classifiers"] = dict(state["classifiers"])
+    state["regressors"] = {c: dict(r) for c, r in state["regressors"].items()}
+    packed = {}
+    for key, est in _estimators(state):
+        preds = est._predictors
+        trees = [p for row in preds for p in row]
+        if any(p.binned_left_cat_bitsets.size or p.raw_left_cat_bitsets.size for p in trees):
+            continue  # categorical splits: kept as objects
+        nodes = np.concatenate([p.nodes for p in trees])
+        nodes["gain"] = 0.0
+        nodes["count"] = 0
+        packed[key] = {
+            "nodes": np.frombuffer(nodes.tobytes(), np.uint8).copy(),
+            "sizes": np.array([p.nodes.size for p in trees], np.int32),
+            "shape": [len(preds), len(preds[0])],
+            "bitset_dtype": str(trees[0].binned_left_cat_bitsets.dtype),
+        }
+        slim = copy.copy(est)
+        slim._predictors = []
+        # the bin edges serve the fit and the categorical features only (prediction compares
+        # raw values with each node's threshold): 180 features x 255 edges a model, dropped
+        bm = copy.copy(est._bin_mapper)
+        bm.bin_thresholds_ = [
+            t if cat else np.zeros(0)
+            for t, cat in zip(bm.bin_thresholds_, bm.is_categorical_, strict=True)
+        ]
+        slim._bin_mapper = bm
+        parts = key.split("/")
+        if parts[0] == "classifiers":
+            state["classifiers"][parts[1]] = slim
+        else:
+            state["regressors"][parts[1]][parts[2]] = slim
+    state[PACKED] = packed
+    return state
+
+
+def _unpack(state: dict) -> dict:
+    """Inverse of `_pack` (the trees rebuilt as scikit-learn's own predictor objects)."""
+    from sklearn.ensemble._hist_gradient_boosting.common import PREDICTOR_RECORD_DTYPE
+    from sklearn.ensemble._hist_gradient_boosting.predictor import TreePredictor
+
+    packed = state.pop(PACKED, {})
+    ests = dict(_estimators(state))
+    for key, p in packed.items():
+        nodes = np.asarray(p["nodes"], np.uint8).view(PREDICTOR_RECORD_DTYPE)
+        bounds = np.concatenate([[0], np.cumsum(p["sizes"])])
+        empty = np.zeros((0, 8), dtype=p["bitset_dtype"])
+        trees = [
+            TreePredictor(nodes[a:b].copy(), empty, empty)
+            for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+        ]
+        n, k = p["shape"]
+        ests[key]._predictors = [trees[i * k : (i + 1) * k] for i in range(n)]
+    return state
+
+
+#: Key of the packed trees in a diagnoser file.
+PACKED = "packed_trees"
+
+
 def save(diag: Diagnoser, path: str | Path) -> Path:
-    """Write ``diag`` to a skops file (written to a temporary file, then renamed)."""
+    """Write ``diag`` to a skops file (written to a temporary file, then renamed), its trees
+    packed (`_pack`)."""
     import zipfile
 
     import skops.io as sio
@@ -545,7 +627,7 @@ def save(diag: Diagnoser, path: str | Path) -> Path:
 
     path = Path(path)
     with atomic_path(path) as tmp:
-        sio.dump(diag.state, tmp, compression=zipfile.ZIP_DEFLATED, compresslevel=9)
+        sio.dump(_pack(diag.state), tmp, compression=zipfile.ZIP_DEFLATED, compresslevel=9)
     return path
 
 
@@ -571,6 +653,7 @@ def load(path: str | Path, *, check_version: bool = True) -> Diagnoser:
     state = sio.load(path, trusted=untrusted)
     if not isinstance(state, dict) or state.get("format") != FORMAT:
         raise ParameterError(f"diagnoser {path}: not a recipdyn diagnoser")
+    state = _unpack(state)
     if check_version:
         for what, have, want in (
             ("recipdyn", state["recipdyn_version"], __version__),
