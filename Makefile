@@ -54,8 +54,8 @@ format: $(STAMP)
 clean:
 	rm -rf $(VENV) $(OUT) site .pytest_cache
 
-# the diagnoser shipped with recipdyn (docs/diagnosis.md): the default data set (12 operating
-# conditions x 8 classes x 4 severities, 384 records, ~12 min on 2 cores), trained, evaluated
+# the diagnoser shipped with recipdyn (docs/diagnosis.md): the default data set (40 operating
+# conditions x 8 classes x 4 severities, 1280 records, ~35 min on 2 loaded cores), trained, evaluated
 diagnoser: warmup
-	$(VENV)/bin/recipdyn dataset -o $(OUT)/diagnoser-data --conditions 12 --resume
+	$(VENV)/bin/recipdyn dataset -o $(OUT)/diagnoser-data --conditions 40 --resume
 	$(VENV)/bin/recipdyn train $(OUT)/diagnoser-data -o src/recipdyn/diagnosis/data/default.skops --report $(OUT)/diagnoser-report

@@ -295,8 +295,44 @@ def test_the_app_builds_with_every_callback(store):
     app = build_app(store)
     outputs = " ".join(app.callback_map)
     for part in ("panel.children", "g-signal.figure", "download.data", "sweep.figure",
-                 "nav.search"):  # fmt: skip
+                 "nav.search", "dx-result.children"):  # fmt: skip
         assert part in outputs
+
+
+# --- the diagnosis section ----------------------------------------------------------------
+
+
+def test_the_diagnosis_page_answers_a_dropped_record_and_shows_a_refusal(tmp_path):
+    """A record of the shipped diagnoser's domain, dropped as a CSV (the page receives it
+    base64-encoded), is diagnosed: probabilities summing to 1, the evidence lines and the
+    overlay image; the same record read at another speed is refused with its reason; a
+    file of an unreadable type is told, not raised."""
+    import pandas as pd
+
+    from recipdyn.app import diagnose_upload
+    from recipdyn.app.diagnosis import example_record, result_children
+
+    nc = example_record(tmp_path, revolutions=4.0)
+    import xarray as xr
+
+    rec = xr.open_dataset(nc)
+    fs = 1.0 / float(rec.time[1] - rec.time[0])
+    csv = tmp_path / "record.csv"
+    names = ("accel_guide", "tacho", "p_head_sensor", "p_crank_sensor")
+    pd.DataFrame({k: rec[k].values for k in names}).to_csv(csv, index=False)
+    upload = "data:text/csv;base64," + base64.b64encode(csv.read_bytes()).decode()
+    view = diagnose_upload(upload, "record.csv", tacho="tacho", p_head="p_head_sensor",
+                           p_crank="p_crank_sensor", fs=f"{fs} Hz")  # fmt: skip
+    assert not view.error and not view.refused, view.error or view.lines
+    assert sum(view.probabilities.values()) == pytest.approx(1.0)
+    assert view.lines[0].startswith("diagnosis:") and any("impacts" in x for x in view.lines)
+    assert min(_png_size(view.image)) > 100
+    assert len(result_children(view)) == 2  # the text and the overlay
+    fast = diagnose_upload(upload, "record.csv", tacho=None, speed="600 rpm", fs=f"{fs} Hz")
+    assert fast.refused and "crank speed" in fast.lines[0] and fast.image is None
+    bad = diagnose_upload(upload, "record.xyz")
+    assert "allowed" in bad.error and ".csv" in bad.error
+    assert "drop a file" in diagnose_upload(None, None).error
 
 
 # --- a real browser -----------------------------------------------------------------------

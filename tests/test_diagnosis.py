@@ -197,6 +197,23 @@ def test_expected_calibration_error_of_known_cases():
     assert expected_calibration_error(p, y)[0] == pytest.approx(0.0, abs=1e-12)
 
 
+def test_a_saved_diagnoser_predicts_exactly_as_the_trained_one(trained, small, tmp_path):
+    """The file packs every boosting model's trees into one array (small, fast to load);
+    read back, the classifiers and the severity regressors give the same numbers to the bit,
+    for every channel subset."""
+    from recipdyn.diagnosis.train import AVAILABILITY, _augment, load, save
+
+    diag, _ = trained
+    df, _ = read_features(small[0])
+    X, _ = _augment(df[[f"f_{n}" for n in diag.names]].to_numpy(float), diag.names)
+    back = load(save(diag, tmp_path / "d.skops"))
+    assert len(AVAILABILITY) == 3 and X.shape[0] == 3 * len(df)
+    assert np.array_equal(back.predict_proba(X), diag.predict_proba(X))
+    for c in diag.classes[1:]:
+        for a, b in zip(back.severity(X, c), diag.severity(X, c), strict=True):
+            assert np.array_equal(a, b)
+
+
 def test_a_diagnoser_of_another_version_is_refused(trained, tmp_path):
     from recipdyn.diagnosis.train import Diagnoser, load, save
 
@@ -304,6 +321,8 @@ def test_shipped_diagnoser_matches_todays_physics():
             "pc_ratio",
             "ph_rise_50",
             "ph_fall_50",
+            "cy_head_n_exp",
+            "cy_crank_work",
         ):
             assert res["features"][k] == pytest.approx(pin["features"][k], rel=0.02), k
         x = np.array([[res["features"][n] for n in diag.names]])

@@ -66,10 +66,10 @@ def test_the_output_comparison_tolerates_rounding_and_catches_changes():
     assert differences("1 2 3\n", "1 2\n", 1.0)
 
 
-def test_there_are_six_tutorials():
-    assert [p.name[:2] for p in NOTEBOOKS] == ["01", "02", "03", "04", "05", "06"]
+def test_there_are_seven_tutorials():
+    assert [p.name[:2] for p in NOTEBOOKS] == ["01", "02", "03", "04", "05", "06", "07"]
     names = " ".join(p.stem for p in NOTEBOOKS)
-    assert "contact_joint" in names and "valves" in names
+    assert "contact_joint" in names and "valves" in names and "diagnosis" in names
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)

@@ -18,7 +18,9 @@ carries the model and every changed field (``?model=compressor-contact&rc=0.5+mm
 link reopens the same run; "Download config" writes the run's TOML config, which
 ``recipdyn simulate -c FILE`` runs. The sweep browser opens a sweep store and shows its
 fault map (2-D) or bifurcation diagram (1-D); clicking a point opens it in the panel and
-runs it.
+runs it. The diagnosis section takes a dropped record (or a simulated example) and its
+channel names and shows `recipdyn.diagnose`'s answer: the probabilities, the severity, the
+evidence and the overlay, or the refusal and its reason (`recipdyn.app.diagnosis`).
 
 Why Dash: a plain Flask server with React components, so the app is one Python process and
 its callbacks are plain functions (tested without a browser, and in a real headless
@@ -27,6 +29,7 @@ Chromium); Plotly figures report clicks on map cells, which the sweep browser ne
 
 from __future__ import annotations
 
+from .diagnosis import DiagnosisView, diagnose_upload
 from .figures import images, simulate_form, status_lines, views
 from .form import (
     MAX_SAMPLES,
@@ -45,5 +48,5 @@ __all__ = [
     "build_app", "run_page", "PageResult", "panel_for", "click_query", "GRAPHS", "fields",
     "Field", "read_form", "format_value", "to_query", "from_query", "config_text",
     "MAX_SAMPLES", "simulate_form", "views", "images", "status_lines", "sweep_figure",
-    "point_from_click", "log_ticks",
+    "point_from_click", "log_ticks", "DiagnosisView", "diagnose_upload",
 ]  # fmt: skip

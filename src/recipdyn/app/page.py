@@ -15,6 +15,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model, model_names
+from .diagnosis import diagnosis_section
 from .figures import images, simulate_form, status_lines, views
 from .form import RUN, Field, config_text, fields, format_value, from_query, read_form, to_query
 
@@ -176,6 +177,7 @@ def build_app(store: str | Path | None = None):
                               placeholder="folder of a sweep", style={"width": "20em"}),
                     html.Button("Open", id="open", n_clicks=0),
                     dcc.Dropdown(id="sweep-var", options=[], value=None),
+                    diagnosis_section(),
                 ], id="panel-scroll", style={"maxHeight": "calc(100vh - 230px)",
                                              "overflowY": "auto", "marginTop": "6px",
                                              "borderTop": "1px solid #ccc"}),
@@ -294,5 +296,33 @@ def build_app(store: str | Path | None = None):
             return click_query(store_path, click, form_texts(*state)), ""
         except ParameterError as exc:
             return no_update, str(exc)
+
+    @app.callback(Output("dx-file", "children"), Input("dx-upload", "filename"))
+    def _dx_file(filename):
+        return f"record: {filename}" if filename else ""
+
+    @app.callback(
+        Output("dx-result", "children"),
+        Input("dx-run", "n_clicks"), Input("dx-example", "n_clicks"),
+        State("dx-upload", "contents"), State("dx-upload", "filename"),
+        State("dx-channel", "value"), State("dx-tacho", "value"), State("dx-speed", "value"),
+        State("dx-phead", "value"), State("dx-pcrank", "value"), State("dx-fs", "value"),
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _diagnose(_n, _example, contents, filename, channel, tacho, speed, ph, pc, fs):
+        import tempfile
+
+        from .diagnosis import diagnose_upload, example_record, result_children
+
+        kw = dict(channel=channel, tacho=None if speed else tacho, speed=speed, p_head=ph,
+                  p_crank=pc, fs=fs)  # fmt: skip
+        if ctx.triggered_id == "dx-example":
+            with tempfile.TemporaryDirectory() as tmp:
+                kw.update(channel="accel_guide", tacho="tacho", speed=None,
+                          p_head="p_head_sensor", p_crank="p_crank_sensor", fs=None)  # fmt: skip
+                view = diagnose_upload(None, None, path=example_record(Path(tmp)), **kw)
+        else:
+            view = diagnose_upload(contents, filename, **kw)
+        return result_children(view)
 
     return app

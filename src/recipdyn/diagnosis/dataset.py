@@ -54,6 +54,7 @@ __all__ = [
     "read_features",
     "CHANNELS",
     "split_of",
+    "dataset_record",
 ]
 
 #: The sensed channels stored per record.
@@ -624,6 +625,26 @@ def read_features(folder: str | Path):
             "build one with 'recipdyn dataset'"
         )
     return pd.read_parquet(table), json.loads(card.read_text(encoding="utf-8"))
+
+
+def dataset_record(folder: str | Path, index: int) -> dict[str, Any]:
+    """One stored record of a data set: its sensed channels (``CHANNELS``, float arrays),
+    ``fs`` and its row of the feature table (labels, condition, split)."""
+    import zarr
+
+    df, _ = read_features(folder)
+    rows = df[df.record == index]
+    if rows.empty:
+        raise ParameterError(
+            f"index = {index!r}; allowed: a finished record of {folder} "
+            f"({', '.join(str(i) for i in df.record.head(5))}, ...)"
+        )
+    g = zarr.open_group(str(Path(folder) / "signals.zarr"), mode="r")
+    n = int(g["n_samples"][index])
+    out: dict[str, Any] = {c: np.asarray(g[c][index, :n], float) for c in CHANNELS}
+    out["fs"] = float(rows.fs.iloc[0])
+    out["row"] = rows.iloc[0].to_dict()
+    return out
 
 
 def records_done(folder: str | Path) -> np.ndarray:

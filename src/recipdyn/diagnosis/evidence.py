@@ -12,6 +12,24 @@ Three groups, by what the record must hold:
 ``pressure`` (the angle, and the head- and crank-end pressure channels)
     The shape of each chamber's pressure over the revolution, normalised to its own range
     (0 at its minimum, 1 at its maximum) in 10-degree bins, and its max/min ratio.
+``cycle`` (the angle and both pressure channels)
+    The indicator-diagram diagnosis (Bloch, *A Practical Guide to Compressor Technology*,
+    2nd ed., Wiley 2006; Bloch & Hoefner, *Reciprocating Compressors: Operation and
+    Maintenance*, 1996), made independent of the operating condition by comparing each
+    chamber with its own ideal cycle at its own measured suction and discharge levels: the
+    crank angles of the four valve events (discharge closing, suction opening, suction
+    closing, discharge opening: where the pressure crosses 10 % of the way between the two
+    levels) minus the ideal cycle's closed-form angles (polytropic re-expansion from the
+    clearance volume, compression from the bottom dead centre: `CLEARANCE`, `N_POLY`); the
+    depth and angle of the dip below the suction level before the suction valve opens and of
+    the peak above the discharge level (a plate held by stiction needs a larger pressure
+    difference); the re-expansion and compression exponents fitted on ``log p - log V`` (a
+    leak bends them); the indicated work over the ideal's; each also head end minus crank
+    end (a head-end valve fault moves the head end only: the crank end is the record's own
+    reference). For the joints: the crosshead-pin load (the gas force of the two pressures
+    plus the nominal crosshead-and-piston mass times the kinematic acceleration), the share
+    of the impact energy in the `REVERSAL_WINDOW_DEG` after its reversals, and how far after
+    a reversal the largest burst lies.
 
 A missing group is NaN; the classifiers are trained with the groups removed as a record
 would lack them, so a record with fewer channels is still diagnosed (less sharply).
@@ -23,7 +41,14 @@ import math
 
 import numpy as np
 
-__all__ = ["record_features", "feature_groups", "impacts", "BINS", "HIGHPASS_HZ"]
+__all__ = [
+    "record_features",
+    "feature_groups",
+    "impacts",
+    "cycle_features",
+    "BINS",
+    "HIGHPASS_HZ",
+]
 
 #: Crank-angle bins per revolution of the angle and pressure features (10 degrees).
 BINS = 36
@@ -120,11 +145,177 @@ def _pressure_events(p360) -> dict[str, float]:
     return {k: out[k] for k in EVENTS}
 
 
+#: Nominal clearance fraction and polytropic exponent of the ideal cycle the measured one is
+#: compared with (the model's defaults: `recipdyn.model.parameters`).
+CLEARANCE = 0.1
+N_POLY = 1.3
+#: Fraction of the way between the suction and discharge levels at which a valve event is read.
+EVENT_LEVEL = 0.1
+#: Window after a crosshead-pin load reversal in which its knock is looked for, degrees.
+REVERSAL_WINDOW_DEG = 30
+CHAMBER_FEATURES = (
+    "dc",
+    "so",
+    "sc",
+    "do",
+    "so_dip",
+    "so_dip_deg",
+    "do_peak",
+    "do_peak_deg",
+    "n_exp",
+    "n_comp",
+    "work",
+)
+
+
+def _geometry():
+    """The machine's chamber volumes (m**3) and crosshead acceleration per omega**2 (m) at
+    each whole degree of crank after outer dead centre (the tacho's mark), from the one
+    model's mechanism and cylinder."""
+    from ..model.cycle import cycle_geometry
+    from ..model.registry import get_model
+    from .classes import MODEL
+
+    v = get_model(MODEL).parameters({})
+    r, length, d = float(v["r"]), float(v["l"]), float(v["d"])
+    g = cycle_geometry(r, length, d, float(v["bore"]), float(v["rod_diameter"]))
+    th = g.theta_odc + np.radians(np.arange(360.0))
+
+    def x(t):
+        return r * np.cos(t) + np.sqrt(length**2 - (d + r * np.sin(t)) ** 2)
+
+    h = 1e-4
+    acc = (x(th + h) - 2 * x(th) + x(th - h)) / h**2  # d2x/dtheta2
+    vs_he, vs_ce = g.area_head * g.stroke, g.area_crank * g.stroke
+    return {
+        "V_head": CLEARANCE * vs_he + g.area_head * (g.x_max - x(th)),
+        "V_crank": CLEARANCE * vs_ce + g.area_crank * (x(th) - g.x_min),
+        "Vs_head": vs_he,
+        "Vs_crank": vs_ce,
+        "acc_per_omega2": acc,
+        "area_head": g.area_head,
+        "area_crank": g.area_crank,
+        "area_rod": g.area_rod,
+        "m_rec": float(v["m3"]),  # the crosshead pin carries the crosshead and piston
+        "frame_pressure": float(v["frame_pressure"]),
+    }
+
+
+_GEOMETRY: dict | None = None
+
+
+def _first_crossing(y, level, lo, hi, rising) -> float:
+    """Fractional index in [lo, hi) where ``y`` first crosses ``level`` (NaN: never)."""
+    seg = y[lo:hi]
+    hit = np.flatnonzero(seg >= level if rising else seg <= level)
+    if not hit.size:
+        return math.nan
+    k = lo + int(hit[0])
+    if k == 0 or y[k] == y[k - 1]:
+        return float(k)
+    return float(k - 1 + (level - y[k - 1]) / (y[k] - y[k - 1]))
+
+
+def _chamber_cycle(p, V, vs) -> dict[str, float]:
+    """Valve-event deviations from the ideal cycle, fitted exponents and work ratio of one
+    chamber (``p``, ``V``: 360 one-degree samples from outer dead centre)."""
+    from ..model.cycle import ideal_indicated_work, indicated_work
+
+    out = dict.fromkeys(CHAMBER_FEATURES, math.nan)
+    if not (np.isfinite(p).all() and np.isfinite(V).all()):
+        return out
+    k0 = int(np.argmin(V))  # this chamber's top dead centre
+    p, V = np.roll(p, -k0), np.roll(V, -k0)
+    bdc = int(np.argmax(V))
+    p_lo = float(np.median(p[int(0.5 * bdc) : int(0.85 * bdc)]))  # suction plateau
+    p_hi = float(np.median(p[-40:-5]))  # discharge plateau, just before top dead centre
+    span = p_hi - p_lo
+    if not (p_lo > 0 and span > 0):
+        return out
+    lev_lo, lev_hi = p_lo + EVENT_LEVEL * span, p_hi - EVENT_LEVEL * span
+    v0, vmax = V[0], V[bdc]
+    ideal_v = {  # ideal cycle's volume at each event (polytropic through the two levels)
+        "dc": v0 * (p_hi / lev_hi) ** (1 / N_POLY),
+        "so": v0 * (p_hi / lev_lo) ** (1 / N_POLY),
+        "sc": vmax * (p_lo / lev_lo) ** (1 / N_POLY),
+        "do": vmax * (p_lo / lev_hi) ** (1 / N_POLY),
+    }
+    meas = {
+        "dc": _first_crossing(p, lev_hi, 0, bdc, rising=False),
+        "so": _first_crossing(p, lev_lo, 0, bdc, rising=False),
+        "sc": _first_crossing(p, lev_lo, bdc, 360, rising=True),
+        "do": _first_crossing(p, lev_hi, bdc, 360, rising=True),
+    }
+    for ev, vi in ideal_v.items():
+        grow = ev in ("dc", "so")
+        seg = np.arange(0, bdc + 1) if grow else np.arange(bdc, 360)
+        vv = V[seg] if grow else -V[seg]
+        ideal = float(np.interp(vi if grow else -vi, vv, seg))
+        out[ev] = meas[ev] - ideal
+    # a valve opens once the pressure difference overcomes its spring preload and any
+    # stiction: the dip below the suction plateau (and the peak above the discharge plateau),
+    # its depth relative to the span, and its angle after the ideal cycle reaches the level
+    k_dip = int(np.argmin(p[:bdc]))
+    k_peak = bdc + int(np.argmax(p[bdc:]))
+    a_lo = float(np.interp(v0 * (p_hi / p_lo) ** (1 / N_POLY), V[: bdc + 1], np.arange(bdc + 1)))
+    a_hi = float(np.interp(-vmax * (p_lo / p_hi) ** (1 / N_POLY), -V[bdc:], np.arange(bdc, 360)))
+    out["so_dip"] = (p_lo - p[k_dip]) / span
+    out["so_dip_deg"] = k_dip - a_lo
+    out["do_peak"] = (p[k_peak] - p_hi) / span
+    out["do_peak_deg"] = k_peak - a_hi
+    for name, a, b in (("n_exp", meas["dc"], meas["so"]), ("n_comp", meas["sc"], meas["do"])):
+        if np.isfinite(a) and np.isfinite(b) and b - a >= 4:
+            k = np.arange(math.ceil(a), math.floor(b) + 1)
+            slope = np.polyfit(np.log(V[k]), np.log(p[k]), 1)[0]
+            out[name] = float(-slope)
+    ideal_w = ideal_indicated_work(p_lo, p_hi / p_lo, CLEARANCE, N_POLY, vs)
+    out["work"] = indicated_work(p, V) / ideal_w if ideal_w > 0 else math.nan
+    return out
+
+
+def cycle_features(p_head360, p_crank360, energy360, speed_hz: float) -> dict[str, float]:
+    """The ``cycle`` group (module docstring) from the two chamber pressures (Pa) and the
+    high-passed acceleration energy, each at the 360 whole degrees after outer dead centre."""
+    global _GEOMETRY
+    if _GEOMETRY is None:
+        _GEOMETRY = _geometry()
+    g = _GEOMETRY
+    row = {}
+    ph, pc = np.asarray(p_head360, float), np.asarray(p_crank360, float)
+    head = _chamber_cycle(ph, g["V_head"], g["Vs_head"])
+    crank = _chamber_cycle(pc, g["V_crank"], g["Vs_crank"])
+    for k in CHAMBER_FEATURES:
+        row[f"cy_head_{k}"] = head[k]
+        row[f"cy_crank_{k}"] = crank[k]
+        row[f"cy_diff_{k}"] = head[k] - crank[k]
+    # crosshead-pin load (> 0: compression) and where the impact energy sits after reversals
+    omega = 2 * math.pi * speed_hz
+    f_gas = -ph * g["area_head"] + pc * g["area_crank"] + g["frame_pressure"] * g["area_rod"]
+    load = g["m_rec"] * omega**2 * g["acc_per_omega2"] - f_gas
+    e = np.asarray(energy360, float)
+    flips = np.flatnonzero(np.sign(load) != np.sign(np.roll(load, 1)))
+    row["cy_reversals"] = float(flips.size)
+    ok = flips.size > 0 and np.isfinite(e).all() and e.sum() > 0
+    if ok:
+        w = np.zeros(360, bool)
+        for f in flips:
+            w[(f + np.arange(REVERSAL_WINDOW_DEG)) % 360] = True
+        peak = int(np.argmax(e))
+        row["cy_energy_after_reversal"] = float(e[w].sum() / e.sum())
+        row["cy_peak_after_reversal_deg"] = float(np.min((peak - flips) % 360))
+    else:
+        row["cy_energy_after_reversal"] = math.nan
+        row["cy_peak_after_reversal_deg"] = math.nan
+    return row
+
+
 def feature_groups(names) -> dict[str, list[str]]:
-    """Feature names by group (``base``, ``angle``, ``pressure``)."""
-    groups: dict[str, list[str]] = {"base": [], "angle": [], "pressure": []}
+    """Feature names by group (``base``, ``angle``, ``pressure``, ``cycle``)."""
+    groups: dict[str, list[str]] = {"base": [], "angle": [], "pressure": [], "cycle": []}
     for n in names:
-        if n.startswith("ang_"):
+        if n.startswith("cy_"):
+            groups["cycle"].append(n)
+        elif n.startswith("ang_"):
             groups["angle"].append(n)
         elif n.startswith(("ph_", "pc_")):
             groups["pressure"].append(n)
@@ -184,4 +375,13 @@ def record_features(
         row[f"{tag}_ratio"] = float(ratio)
         for k, v in events.items():
             row[f"{tag}_{k}"] = float(v)
+    if p_head is not None and p_crank is not None and ok_angle:
+        e360 = _angle_bins(e, r, mask, n_revs, start, 360)
+        ph360 = _angle_bins(np.asarray(p_head, float), r, mask, n_revs, start, 360)
+        pc360 = _angle_bins(np.asarray(p_crank, float), r, mask, n_revs, start, 360)
+        row.update(cycle_features(ph360, pc360, e360, speed))
+    else:
+        row.update(
+            cycle_features(np.full(360, np.nan), np.full(360, np.nan), np.full(360, np.nan), speed)
+        )
     return row

@@ -1,0 +1,51 @@
+"""How far each fault at each severity level moves each feature group away from the healthy
+machine, relative to the healthy records' own spread (docs/diagnosis.md, detection limits).
+
+    python benchmarks/bench_diagnosis_separability.py DATASET
+
+For every feature: the fault record minus the median of the healthy records of the same
+operating condition (same machine, same condition, other noise draws), divided by the
+spread of the healthy records over all conditions (interquartile range / 1.349, a robust
+standard deviation). A group's score is its largest feature's median over the conditions:
+below ~1 the fault hides inside the healthy machine's variation across conditions.
+"""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+
+import numpy as np
+
+
+def main() -> None:
+    from recipdyn.diagnosis.dataset import read_features
+    from recipdyn.diagnosis.evidence import feature_groups
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dataset")
+    args = ap.parse_args()
+    df, card = read_features(args.dataset)
+    names = [c[2:] for c in df.columns if c.startswith("f_")]
+    groups = {g: [f"f_{n}" for n in m] for g, m in feature_groups(names).items() if m}
+    cols = [c for m in groups.values() for c in m]
+    healthy = df[df.label == "healthy"]
+    q1, q3 = np.nanpercentile(healthy[cols].to_numpy(float), [25, 75], axis=0)
+    spread = np.where(q3 > q1, (q3 - q1) / 1.349, np.nan)
+    base = healthy.groupby("condition")[cols].median()
+    print("| class | severity | " + " | ".join(groups) + " |")
+    print("|---|---|" + "---|" * len(groups))
+    for c in card["spec"]["classes"][1:]:
+        for s in card["spec"]["levels"]:
+            sub = df[(df.label == c) & (df.severity == s)]
+            d = (sub[cols].to_numpy(float) - base.loc[sub.condition].to_numpy(float)) / spread
+            with warnings.catch_warnings():  # a feature NaN on every record (no event)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                med = np.nanmedian(np.abs(d), axis=0)
+            k = {col: i for i, col in enumerate(cols)}
+            score = [np.nanmax(med[[k[x] for x in m]]) for m in groups.values()]
+            print(f"| {c} | {s:g} | " + " | ".join(f"{v:.1f}" for v in score) + " |")
+
+
+if __name__ == "__main__":
+    main()
