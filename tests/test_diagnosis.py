@@ -345,3 +345,28 @@ def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
     a = build_dataset(tmp_path / "d", spec, backend="dask", dask_local=1, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
     assert read_features(a)[0].equals(read_features(b)[0])
+
+
+def test_boosting_runs_on_one_thread_even_when_scikit_learn_is_not_yet_loaded():
+    """scikit-learn's boosting spins its OpenMP threads at every barrier: on busy cores a
+    small model's fit or prediction waits for a descheduled thread (a notebook's training
+    took over 20 CPU-minutes instead of seconds beside another busy process). threadpoolctl
+    limits only the runtimes already loaded, so `one_thread` must load scikit-learn's first:
+    checked in a fresh interpreter, where nothing has loaded it yet."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    probe = ("import json\nfrom threadpoolctl import threadpool_info\n"
+             "from recipdyn.diagnosis.train import one_thread\n"
+             "with one_thread():\n"
+             "    omp = [i['num_threads'] for i in threadpool_info()\n"
+             "           if i['user_api'] == 'openmp']\n"
+             "print(json.dumps(omp))\n")  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "OMP_NUM_THREADS": "2"}
+    done = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                          text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    omp = json.loads(done.stdout.strip().splitlines()[-1])
+    assert omp and all(n == 1 for n in omp), omp

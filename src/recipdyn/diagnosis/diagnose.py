@@ -181,6 +181,14 @@ def diagnose_arrays(
     out=None,
 ) -> Diagnosis:
     """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed)."""
+    from .train import one_thread
+
+    with one_thread():
+        return _diagnose_arrays(x, fs, tacho=tacho, speed_hz=speed_hz, p_head=p_head,
+                                p_crank=p_crank, model=model, out=out)  # fmt: skip
+
+
+def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> Diagnosis:
     from ..analysis.vibration import crank_angle, tacho_times
     from .evidence import impacts, record_features
 

@@ -28,8 +28,10 @@ alone (it must be at chance).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -278,13 +280,25 @@ def curve(x, tacho, fs, f_rev, points: int = CURVE_POINTS) -> np.ndarray:
     return np.interp(tq, t, x)
 
 
+@contextlib.contextmanager
+def one_thread() -> Iterator[None]:
+    """Run scikit-learn's boosting on one OpenMP thread. Its threads wait for each other by
+    spinning, so on a machine whose cores are busy (a sweep, a test worker) every fit and
+    every prediction of these small models waits for a descheduled thread: 10x slower or
+    worse, never faster. threadpoolctl limits only the runtimes already loaded, so the
+    OpenMP runtime scikit-learn brings is loaded first."""
+    import sklearn.ensemble  # noqa: F401 - loads the OpenMP runtime threadpoolctl must see
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(1):
+        yield
+
+
 def train(folder: str | Path, *, seed: int = 0, progress: bool = True) -> tuple[Diagnoser, dict]:
     """Train a diagnoser on the training conditions of the data set in ``folder`` and
     evaluate it on the test conditions; returns ``(diagnoser, evaluation)``."""
-    from threadpoolctl import threadpool_limits
-
     folder = Path(folder)
-    with threadpool_limits(1):  # OpenMP threads on a loaded machine cost 10x, not save
+    with one_thread():
         return _train(folder, seed)
 
 
