@@ -33,8 +33,9 @@ ROUTES = [
     ({"crank_joint": "contact"}, "contact", {}),
     ({"load": "valves"}, "link-valves", {}),
     ({"crank_joint": "contact", "load": "valves"}, "contact-valves", {}),
-    ({"guide": "clearance", "crank_joint": "ideal", "guide_clearance": 2e-4}, "guide",
-     {"guide_clearance": 2e-4}),
+    ({"guide": "clearance", "crank_joint": "ideal", "guide_clearance": 2e-4}, "contact",
+     {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal",
+      "guide_clearance": 2e-4}),
 ]  # fmt: skip
 
 
@@ -171,8 +172,8 @@ ALLOWED = [
     ({"crank_joint": "ideal", "crosshead_joint": "contact"}, "contact"),
     ({"crank_joint": "lubricated", "crosshead_joint": "lubricated"}, "contact"),
     ({"crank_joint": "contact", "load": "valves"}, "contact-valves"),
-    ({"guide": "clearance", "crank_joint": "ideal"}, "guide"),
-    ({"guide": "clearance", "crank_joint": "ideal", "load": "cycle"}, "guide"),
+    ({"guide": "clearance", "crank_joint": "ideal"}, "contact"),
+    ({"guide": "clearance", "crank_joint": "ideal", "load": "cycle"}, "contact"),
     ({"guide": "clearance", "crank_joint": "contact", "guide_clearance": 2e-4}, "contact"),
 ]
 #: Refused combinations and a phrase of the one line that says why.

@@ -36,8 +36,8 @@ def test_a_rigid_guide_leaves_the_contact_model_as_it_was():
     np.testing.assert_array_equal(pack(v), pack(w))
     src = glue_source(cfg=0, joints="crank", load=PAPER, offset=N_PACKED, first_state=12)
     assert "guide" not in src.replace("guide=", "")
-    a = recipdyn.simulate(model="compressor-contact", params=v, revolutions=0.25, fs=2000.0)
-    b = recipdyn.simulate(model="compressor-contact", params=w, revolutions=0.25, fs=2000.0)
+    a = recipdyn.simulate(model=CC, params=v, revolutions=0.25, fs=2000.0)
+    b = recipdyn.simulate(model=CC, params=w, revolutions=0.25, fs=2000.0)
     for k in ("ex", "ey", "a", "joint_force", "W_in", "W_loss"):
         np.testing.assert_array_equal(a[k].values, b[k].values)
     assert a.attrs["solver_nsteps"] == b.attrs["solver_nsteps"]
@@ -118,7 +118,7 @@ def test_no_clearance_and_stiff_shoes_give_the_rigid_guide():
     assert np.abs(worn.guide_y.values).max() < 1e-5
     v = CC.parameters({**IDEAL_PINS, "guide_clearance": 0.0})
     # after half a revolution: the crosshead starts centred, its shoes unloaded, and settles
-    ideal = recipdyn.simulate(model="compressor-contact", params=v, **{**kw, "transient": 0.5})
+    ideal = recipdyn.simulate(model=CC, params=v, **{**kw, "transient": 0.5})
     side = ideal_crosshead(v, ideal.theta1.values)["side_force"]
     assert np.abs(ideal.side_force.values - side).max() < 0.03 * np.abs(side).max()
 

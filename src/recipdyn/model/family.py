@@ -87,9 +87,11 @@ _MOTOR_CONTACT = (
 )
 
 
-def route(s: Mapping[str, Any], table: bool = False) -> str:
+def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False) -> str:
     """The implementation (a key of `ROUTES`) for the selector values ``s`` (``table``: a
-    load or pressure table is given); a combination that none covers raises
+    load or pressure table is given; ``guide_kernel``: ideal pins in a worn guide with the
+    paper's load or the cycle run `compressor-guide`'s own kernel, as the preset of that name
+    does, instead of the contact joints' glue); a combination that none covers raises
     [`ParameterError`][recipdyn.errors.ParameterError] in one line that says why and what is
     allowed."""
     crank, cross, load, drive, guide = (s[k] for k in SELECTORS.names)
@@ -110,7 +112,7 @@ def route(s: Mapping[str, Any], table: bool = False) -> str:
             raise ParameterError(f"load = {load!r} (a component of your own) with guide = "
                                  "'clearance' is not available yet; allowed: 'paper', "
                                  "'table', 'cycle', 'valves'")  # fmt: skip
-        if rigid_pins and load in ("paper", "cycle") and not table:
+        if guide_kernel and rigid_pins and load in ("paper", "cycle") and not table:
             return "guide"  # compressor-guide: its own kernel, the Flores benchmark's
         # the contact joints' glue with its own guide (any pin joint, ideal pins included)
         return "contact-valves" if load == "valves" else "contact"
@@ -236,7 +238,10 @@ class Compressor(Model):
         self.defaults = dict(defaults or {})
         self._selectors = _chosen(self.defaults, _DEFAULTS)
         self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
-        impl = implementation(route(self._selectors))
+        #: A preset whose defaults choose the guide clearance (compressor-guide) runs its own
+        #: kernel where it applies; the model otherwise runs the contact joints' glue.
+        self._guide_kernel = self._selectors["guide"] == "clearance"
+        impl = implementation(route(self._selectors, guide_kernel=self._guide_kernel))
         self.description = description or impl.description
         self._adopt(impl)
         others = {k: v for k, v in self.defaults.items() if k not in SELECTORS.names}
@@ -271,7 +276,11 @@ class Compressor(Model):
         # the default configuration's
         if name.startswith("_"):
             raise AttributeError(name)
-        return getattr(implementation(route(self._selectors)), name)
+        return getattr(implementation(self._route0()), name)
+
+    def _route0(self, s: Mapping[str, Any] | None = None) -> str:
+        """The route at the selector values ``s`` (default: this preset's)."""
+        return route(self._selectors if s is None else s, guide_kernel=self._guide_kernel)
 
     def with_defaults(self, **defaults: Any) -> Compressor:
         """This model with other defaults (selectors or any parameter), under its name."""
@@ -292,12 +301,12 @@ class Compressor(Model):
             name, s = self._routes[key]
         except KeyError:
             s = self.selectors(values)
-            name = route(s, table)
+            name = route(s, table, self._guide_kernel)
             if len(self._routes) < 256:
                 self._routes[key] = name, s
         except TypeError:  # an unhashable value
             s = self.selectors(values)
-            name = route(s, table)
+            name = route(s, table, self._guide_kernel)
         return name, implementation(name), dict(s)
 
     def _split(self, values: Mapping[str, Any]) -> tuple[Model, dict[str, Any]]:
@@ -322,7 +331,7 @@ class Compressor(Model):
         _, impl, s = self.route(values)
         mine = _known(impl.schema)
         schema = impl.schema_for({k: v for k, v in values.items() if k in mine})
-        if schema is impl.schema and route(self._selectors) == route(s):
+        if schema is impl.schema and self._route0() == self._route0(s):
             schema = self._schema0  # (a preset's defaults)
         known = _known(schema) | _ALWAYS
         for k in values:
@@ -353,7 +362,7 @@ class Compressor(Model):
         name, impl, s = self.route(raw)
         own = _known(impl.schema)
         mine = {k: v for k, v in raw.items() if k not in SELECTORS.names or k in own}
-        for k in ("crank_joint", "crosshead_joint"):  # the pins, named for the contact joints
+        for k in SELECTORS.names:  # a selector the implementation has (the pins, the guide)
             if k in own:
                 mine[k] = s[k]
         if s["load"] in ("table", "valves") and "load" in own:
