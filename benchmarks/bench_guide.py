@@ -12,11 +12,8 @@ resolving the shoe contact.
 from __future__ import annotations
 
 import argparse
-import math
-import time
 
-from recipdyn.integrate import integrate
-from recipdyn.model.registry import get_model
+from _timing import best_per_revolution, setup
 
 CASES = {
     "healthy guide (c = 0)": ("compressor-guide", {}),
@@ -29,30 +26,13 @@ CASES = {
 }  # fmt: skip
 
 
-def _setup(name: str, over: dict):
-    model = get_model(name)
-    vals = model.parameters(over)
-    system = model.system(vals)
-    kw = dict(rtol=1e-10, atol=1e-12, max_events=10**7)
-    y0 = model.initial_state(vals)
-    integrate(system, y0, (0.0, 0.01), **kw)  # compiled, before the timing
-    return system, y0, 2.0 * math.pi / float(vals["omega"]), kw
-
-
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="1 revolution, 2 repeats")
     args = ap.parse_args(argv)
     revs, repeat = (1.0, 2) if args.quick else (2.0, 3)
-    setups = {k: _setup(*c) for k, c in CASES.items()}
-    best = dict.fromkeys(CASES, math.inf)
-    steps = {}
-    for _ in range(repeat):
-        for k, (system, y0, period, kw) in setups.items():
-            t0 = time.perf_counter()
-            run = integrate(system, y0, (0.0, revs * period), **kw)
-            best[k] = min(best[k], (time.perf_counter() - t0) / revs)
-            steps[k] = run.nsteps / revs
+    setups = {k: setup(*c) for k, c in CASES.items()}
+    best, steps = best_per_revolution(setups, revs, repeat)
     t0 = best["healthy guide (c = 0)"]
     print(f"per revolution (best of {repeat}, {revs:g} revolutions):")
     for k, t in best.items():

@@ -9,11 +9,8 @@ compilation); the cases alternate within each round and the best of the rounds i
 from __future__ import annotations
 
 import argparse
-import math
-import time
 
-from recipdyn.integrate import integrate
-from recipdyn.model.registry import get_model
+from _timing import best_per_revolution, setup
 
 _IDEAL = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}
 CASES = {
@@ -35,30 +32,13 @@ CASES = {
 }  # fmt: skip
 
 
-def _setup(name: str, over: dict):
-    model = get_model(name)
-    vals = model.parameters(over)
-    system = model.system(vals)
-    kw = dict(rtol=1e-10, atol=1e-12, max_events=10**7)
-    y0 = model.initial_state(vals)
-    integrate(system, y0, (0.0, 0.01), **kw)  # compiled, before the timing
-    return system, y0, 2.0 * math.pi / float(vals["omega"]), kw
-
-
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="half a revolution, 2 rounds")
     args = ap.parse_args(argv)
     revs, repeat = (0.5, 2) if args.quick else (1.0, 3)
-    setups = {k: _setup(*c) for k, c in CASES.items()}
-    best = dict.fromkeys(CASES, math.inf)
-    steps = {}
-    for _ in range(repeat):
-        for k, (system, y0, period, kw) in setups.items():
-            t0 = time.perf_counter()
-            run = integrate(system, y0, (0.0, revs * period), **kw)
-            best[k] = min(best[k], (time.perf_counter() - t0) / revs)
-            steps[k] = run.nsteps / revs
+    setups = {k: setup(*c) for k, c in CASES.items()}
+    best, steps = best_per_revolution(setups, revs, repeat)
     print(f"per revolution (best of {repeat}, {revs:g} revolutions):")
     for k, t in best.items():
         print(f"  {k:42s} {1e3 * t:9.2f} ms  {steps[k]:8.0f} steps")

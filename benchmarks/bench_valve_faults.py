@@ -12,11 +12,8 @@ kept.
 from __future__ import annotations
 
 import argparse
-import math
-import time
 
-from recipdyn.integrate import integrate
-from recipdyn.model.registry import get_model
+from _timing import best_per_revolution, setup
 
 FAULTS = {
     "healthy": {},
@@ -30,17 +27,6 @@ FAULTS = {
 MODELS = (("compressor-valves", {"rc": 0.0}), ("compressor-contact-valves", {"rc": 1e-3}))
 
 
-def _setup(name: str, over: dict):
-    model = get_model(name)
-    vals = model.parameters(over)
-    system, ev = model.system(vals), model.events(vals)[0]
-    kw = dict(rtol=1e-10, atol=1e-12, event=ev.function, event_direction=ev.direction,
-              event_action=ev.action, reset=ev.reset, max_events=10**7)  # fmt: skip
-    y0 = model.initial_state(vals)
-    integrate(system, y0, (0.0, 0.01), **kw)  # compiled, before the timing
-    return system, y0, 2.0 * math.pi / float(vals["omega"]), kw
-
-
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="2 revolutions, 3 repeats")
@@ -48,17 +34,9 @@ def main(argv: list[str] | None = None) -> dict:
     revs, repeat = (2.0, 3) if args.quick else (4.0, 5)
     summary, cases = [], {}
     for name, base in MODELS:
-        setups = {k: _setup(name, base | f) for k, f in FAULTS.items()}
-        best = dict.fromkeys(FAULTS, math.inf)
-        steps = {}
-        # interleaved: every repeat runs every case, so a change of the machine's load during
-        # the benchmark (shared cores) affects all cases alike; the best of the repeats is kept
-        for _ in range(repeat):
-            for k, (system, y0, period, kw) in setups.items():
-                t0 = time.perf_counter()
-                run = integrate(system, y0, (0.0, revs * period), **kw)
-                best[k] = min(best[k], (time.perf_counter() - t0) / revs)
-                steps[k] = run.nsteps / revs
+        # interleaved (benchmarks/_timing.py): the ratios to the healthy case stay meaningful
+        setups = {k: setup(name, base | f, with_event=True) for k, f in FAULTS.items()}
+        best, steps = best_per_revolution(setups, revs, repeat)
         t0, n0 = best["healthy"], steps["healthy"]
         print(f"{name} {base}, per revolution (best of {repeat}, {revs:g} revolutions):")
         for k, t in best.items():
