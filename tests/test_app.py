@@ -7,17 +7,13 @@ click a fault-map cell; download the config and run it with the CLI)."""
 import base64
 import json
 import math
-import shutil
-import socket
 import struct
-import subprocess
-import threading
 import time
-import urllib.request
 
 import numpy as np
 import pytest
 
+from _cdp import chromium, served_page
 from recipdyn.app import (
     GRAPHS,
     build_app,
@@ -338,66 +334,6 @@ def test_the_diagnosis_page_answers_a_dropped_record_and_shows_a_refusal(tmp_pat
 # --- a real browser -----------------------------------------------------------------------
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class _Page:
-    """A minimal Chrome DevTools Protocol client: evaluate JavaScript, type, click."""
-
-    def __init__(self, ws_url):
-        import websocket
-
-        self.ws = websocket.create_connection(ws_url, timeout=120)
-        self.n = 0
-
-    def call(self, method, **params):
-        self.n += 1
-        self.ws.send(json.dumps({"id": self.n, "method": method, "params": params}))
-        while True:
-            msg = json.loads(self.ws.recv())
-            if msg.get("id") == self.n:
-                return msg.get("result", {})
-
-    def js(self, expr):
-        res = self.call("Runtime.evaluate", expression=expr, returnByValue=True,
-                        awaitPromise=True)  # fmt: skip
-        return res.get("result", {}).get("value")
-
-    def wait(self, expr, timeout=120.0):
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            value = self.js(expr)
-            if value:
-                return value
-            time.sleep(0.3)
-        raise AssertionError(
-            f"timed out waiting for {expr}: {self.js('document.body.innerText')[:800]}"
-        )
-
-    def click(self, element_js):
-        """A real mouse click (pointer events) at the centre of an element."""
-        x, y = self.js(f"(() => {{ const e = {element_js}; e.scrollIntoView({{block: 'center'}});"
-                       " const b = e.getBoundingClientRect();"
-                       " return [b.x + b.width / 2, b.y + b.height / 2]; })()")  # fmt: skip
-        for kind in ("mouseMoved", "mousePressed", "mouseReleased"):
-            self.call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left",
-                      clickCount=1)  # fmt: skip
-
-    def type_into(self, field_key, text, enter=False):
-        """Select a field's text and type ``text`` (real key events)."""
-        el = f'document.getElementById(\'{{"key":"{field_key}","type":"field"}}\')'
-        self.js(f"(() => {{ const el = {el}; el.scrollIntoView(); el.focus(); el.select(); }})()")
-        self.call("Input.insertText", text=text)
-        if enter:
-            for kind, text in (("keyDown", "\r"), ("keyUp", "")):  # keyDown + text: keypress
-                self.call("Input.dispatchKeyEvent", type=kind, key="Enter", code="Enter",
-                          text=text, windowsVirtualKeyCode=13, nativeVirtualKeyCode=13)  # fmt: skip
-        return self.js(f"{el}.value")
-
-
 _STATUS = "(document.getElementById('status') || {innerText: ''}).innerText"
 _POINTS = ("(() => { const g = document.querySelector('#g-signal .js-plotly-plot');"
            " return g && g._fullData ? g._fullData.length && g._fullData[0].y.length : -1; })()")  # fmt: skip  # noqa: E501
@@ -407,11 +343,7 @@ _IMAGE = ("(() => { const i = document.querySelector('#images img');"
 
 @pytest.mark.browser
 def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    if exe is None:
-        pytest.skip("chromium is not installed (CI installs it in .ci/run)")
-    from werkzeug.serving import make_server
-
+    chromium()
     import recipdyn.app.page as page
 
     runs = []  # every simulation the page asks for (no loops, no double runs)
@@ -419,28 +351,7 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
     monkeypatch.setattr(page, "run_page", lambda m, t: runs.append(m) or real(m, t))
     # compile (or load) the two models first, so the page waits for runs, not compilers
     assert run_page("compressor-contact", SHORT).query is not None
-    port = _free_port()
-    server = make_server("127.0.0.1", port, build_app(store).server, threaded=True)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    profile, downloads = tmp_path / "profile", tmp_path / "downloads"
-    proc = subprocess.Popen(
-        [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         f"--user-data-dir={profile}", "--remote-debugging-port=0", "--window-size=1400,1000",
-         "about:blank"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    try:
-        for _ in range(300):
-            f = profile / "DevToolsActivePort"
-            if f.exists() and f.read_text().strip():
-                break
-            time.sleep(0.1)
-        cdp_port = int((profile / "DevToolsActivePort").read_text().split()[0])
-        targets = json.load(urllib.request.urlopen(f"http://127.0.0.1:{cdp_port}/json/list"))
-        page_ = _Page(next(t for t in targets if t["type"] == "page")["webSocketDebuggerUrl"])
-        page_.call("Browser.setDownloadBehavior", behavior="allow",
-                   downloadPath=str(downloads))  # fmt: skip
+    with served_page(build_app(store), tmp_path) as (page_, port, downloads):
         # 1. the address opens the compressor with short run settings and runs it once
         page_.call("Page.navigate", url=f"http://127.0.0.1:{port}/?run.revolutions=1"
                    "&run.fs=2+kHz")  # fmt: skip
@@ -503,9 +414,5 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         # 7. the address reopens the same run in a fresh page
         search = page_.js("location.search")
         assert "rc=2+mm" in search and "d=2+mm" in search
-    finally:
-        proc.terminate()
-        proc.wait(timeout=30)
-        server.shutdown()
     params = read_form(*from_query(search)[:2]).params  # the model's values, as every model's
     assert params["rc"] == pytest.approx(2e-3) and params["d"] == pytest.approx(2e-3)

@@ -370,3 +370,47 @@ def test_boosting_runs_on_one_thread_even_when_scikit_learn_is_not_yet_loaded():
     assert done.returncode == 0, done.stderr[-2000:]
     omp = json.loads(done.stdout.strip().splitlines()[-1])
     assert omp and all(n == 1 for n in omp), omp
+
+
+def test_a_missing_pressure_channel_gives_no_pin_load_reversals():
+    """Without a chamber pressure the crosshead-pin load is unknown: the reversal features are
+    NaN (they counted every degree as a reversal, 360, and looked like evidence). With both
+    pressures of an ideal cycle the load reverses an even number of times a revolution."""
+    from recipdyn.diagnosis.evidence import cycle_features
+
+    th = np.radians(np.arange(360.0))
+    ph = 2e5 + 1e5 * np.cos(th)
+    pc = 2e5 - 1e5 * np.cos(th)
+    e = np.ones(360)
+    full = cycle_features(ph, pc, e, 3.0)
+    assert full["cy_reversals"] >= 2 and full["cy_reversals"] % 2 == 0
+    for missing in ((np.full(360, np.nan), pc), (ph, np.full(360, np.nan))):
+        row = cycle_features(*missing, e, 3.0)
+        for k in ("cy_reversals", "cy_energy_after_reversal", "cy_peak_after_reversal_deg"):
+            assert math.isnan(row[k]), k
+
+
+def test_deciding_features_are_the_subsets_and_their_z_is_bounded():
+    """The shipped diagnoser's deciding features: a record at the healthy training median but
+    one pin-load reversal more (a feature the healthy records hold constant) gets a finite z
+    of 1 / HEALTHY_SPREAD_FLOOR training scales (it was 1e12 with a zero spread); with the
+    pressure channels missing, no pressure or cycle feature is among them (the classifier
+    of that subset does not read them)."""
+    from recipdyn.diagnosis.diagnose import HEALTHY_SPREAD_FLOOR, _deciding, default_model_path
+    from recipdyn.diagnosis.train import load
+
+    diag = load(default_model_path())
+    st = diag.state
+    healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
+    Z = st["Z_train"].astype(float)[healthy]
+    row = st["center"] + np.nanmedian(Z, axis=0) * st["scale"]
+    i = diag.names.index("cy_reversals")
+    assert np.ptp(Z[:, i]) == 0  # constant in the healthy records: the case of the floor
+    row[i] += st["scale"][i]
+    top = dict(_deciding(diag, row))
+    assert top["cy_reversals"] == pytest.approx(1.0 / HEALTHY_SPREAD_FLOOR)
+    no_p = row.copy()
+    no_p[[k for k, n in enumerate(diag.names) if n.startswith(("cy_", "ph_", "pc_"))]] = np.nan
+    no_p[diag.names.index("acc_skewness")] += 3 * st["scale"][diag.names.index("acc_skewness")]
+    names = [n for n, _ in _deciding(diag, no_p)]
+    assert names and not any(n.startswith(("cy_", "ph_", "pc_")) for n in names)

@@ -30,6 +30,9 @@ RANGE_SLACK = 0.02
 #: Slack on the training range of the impacts' ringing frequency (relative; the Welch
 #: spectrum's resolution is fs/1024, ~10 Hz, and the resonance's peak is broad: Q = 10).
 RING_SLACK = 0.1
+#: The smallest spread of the healthy training records a deciding feature's z is measured in,
+#: as a share of the whole training set's interquartile range (`_deciding`).
+HEALTHY_SPREAD_FLOOR = 0.05
 
 
 def default_model_path() -> Path:
@@ -319,18 +322,24 @@ def _top_angles(imp, n: int = 6) -> list[float]:
 
 
 def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
-    """The features farthest (robust z) from the healthy training records."""
+    """The features farthest (robust z) from the healthy training records, among those the
+    classifier of the record's channel subset reads. The healthy records' spread (their
+    interquartile range) is floored at `HEALTHY_SPREAD_FLOOR` of the whole training set's: a
+    feature the healthy records hold nearly constant (a count of pin-load reversals) would
+    otherwise give a z of 1e14 for an ordinary departure."""
+    from .train import _cols, available
+
     st = diag.state
+    cols = _cols(diag.names, available(row, diag.names))
     healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
-    Z = st["Z_train"].astype(float)[healthy]
-    z = (row - st["center"]) / st["scale"]
+    Z = st["Z_train"].astype(float)[healthy][:, cols]
+    z = ((row - st["center"]) / st["scale"])[cols]
     med = np.nanmedian(Z, axis=0)
     spread = np.nanpercentile(Z, 75, axis=0) - np.nanpercentile(Z, 25, axis=0)
-    spread = np.where(spread > 0, spread, np.nanstd(Z, axis=0) + 1e-12)
-    dz = (z - med) / spread
+    dz = (z - med) / np.maximum(np.nan_to_num(spread), HEALTHY_SPREAD_FLOOR)
     ok = np.isfinite(dz)
     order = np.argsort(-np.abs(np.where(ok, dz, 0)))[:n]
-    return [(diag.names[i], float(dz[i])) for i in order if ok[i]]
+    return [(diag.names[cols[i]], float(dz[i])) for i in order if ok[i]]
 
 
 def _closest(diag, row, label: str) -> int:

@@ -293,6 +293,11 @@ def cycle_features(p_head360, p_crank360, energy360, speed_hz: float) -> dict[st
     f_gas = -ph * g["area_head"] + pc * g["area_crank"] + g["frame_pressure"] * g["area_rod"]
     load = g["m_rec"] * omega**2 * g["acc_per_omega2"] - f_gas
     e = np.asarray(energy360, float)
+    if not np.isfinite(load).all():  # a pressure channel missing: no pin load, no reversals
+        row["cy_reversals"] = math.nan
+        row["cy_energy_after_reversal"] = math.nan
+        row["cy_peak_after_reversal_deg"] = math.nan
+        return row
     flips = np.flatnonzero(np.sign(load) != np.sign(np.roll(load, 1)))
     row["cy_reversals"] = float(flips.size)
     ok = flips.size > 0 and np.isfinite(e).all() and e.sum() > 0
