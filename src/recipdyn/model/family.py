@@ -172,6 +172,9 @@ _ALWAYS = frozenset({*_KEYS, "load_table", "pressure_table"})
 _TABLES = ("load_table", "pressure_table")
 #: The oil film's parameters (a lubricated joint's).
 _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
+#: The parameters of the crank pin's joint alone, and of the crosshead pin's.
+_CRANK_PIN = ("rc", "K", "journal_radius", "e0_angle")
+_CROSSHEAD_PIN = ("rc_crosshead", "K_crosshead", "crosshead_pin_radius", "e0_angle_crosshead")
 
 
 _NOT_OWN: dict[int, frozenset[str]] = {}
@@ -200,7 +203,10 @@ def owner(name: str, s: Mapping[str, Any]) -> str:
     (``"crosshead_joint = 'contact' | 'lubricated'"``), or ``""`` if none does; ``s``: the
     current selector values (one selector is changed at a time; a crosshead-pin parameter is
     the crosshead joint's)."""
-    if name in implementation("contact").schema and name not in implementation("link").schema:
+    contact = implementation("contact").schema
+    if name in contact and name not in implementation("link").schema:
+        if contact[name].group == "guide":
+            return "guide = 'clearance'"
         if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
             return "crosshead_joint = 'contact' | 'lubricated'"
         if name in _OIL:
@@ -233,9 +239,12 @@ class Compressor(Model):
     preset is an instance with other defaults (`with_defaults`)."""
 
     def __init__(self, name: str = "compressor", defaults: Mapping[str, Any] | None = None,
-                 description: str = "") -> None:  # fmt: skip
+                 description: str = "", choosable: bool = True) -> None:  # fmt: skip
         self.name = name
         self.defaults = dict(defaults or {})
+        #: Whether a form offers the selectors (`selector_schema`): the one model does; a
+        #: preset is a fixed starting point whose form is its implementation's.
+        self.choosable = choosable
         self._selectors = _chosen(self.defaults, _DEFAULTS)
         self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
         #: A preset whose defaults choose the guide clearance (compressor-guide) runs its own
@@ -284,7 +293,9 @@ class Compressor(Model):
 
     def with_defaults(self, **defaults: Any) -> Compressor:
         """This model with other defaults (selectors or any parameter), under its name."""
-        return Compressor(self.name, {**self.defaults, **defaults}, self.description)
+        return Compressor(
+            self.name, {**self.defaults, **defaults}, self.description, self.choosable
+        )
 
     # -- routing ------------------------------------------------------------------------
     def selectors(self, values: Mapping[str, Any]) -> dict[str, Any]:
@@ -498,6 +509,32 @@ class Compressor(Model):
                 out[k] = s[k]
         return out
 
+    def selector_schema(self) -> Schema:
+        """The five selectors with every value they take (a load of your own, ``file.py:OBJ``,
+        is given on the command line or in a config file) and this model's defaults; empty for
+        a preset (``choosable = False``)."""
+        if not self.choosable:
+            return Schema(())
+        return Schema(tuple(replace(p, default=self._selectors[p.name]) for p in SELECTORS))
+
+    def inactive(self, values: Mapping[str, Any]) -> frozenset[str]:
+        """The parameters of ``configured(values)`` that do not act at the selector values
+        of ``values``: a pin's own parameters where that pin is ideal, the oil film's where
+        no pin is lubricated, the guide's (but ``guide``) where the guide is ideal; and the
+        pins' older spelling (``clearance_joints``, ``joint``), which the selectors replace."""
+        s = self.selectors(values)
+        schema = self.configured(values).schema
+        out = set(PIN_SPELLINGS)
+        if s["crank_joint"] == "ideal":
+            out.update(_CRANK_PIN)
+        if s["crosshead_joint"] == "ideal":
+            out.update(_CROSSHEAD_PIN)
+        if "lubricated" not in (s["crank_joint"], s["crosshead_joint"]):
+            out.update(_OIL)
+        if s["guide"] == "ideal":
+            out.update(p.name for p in schema if p.group == "guide" and p.name != "guide")
+        return frozenset(out & set(schema.names))
+
     def parameter_table(self) -> list[tuple[Param, str]]:
         """Every parameter of every configuration with the selector values it belongs to
         (``""``: this preset's default configuration), for ``recipdyn models``."""
@@ -534,6 +571,6 @@ _PRESET_NAMES = {f"COMPRESSOR_{k[len('compressor-'):].upper().replace('-', '_')}
 def __getattr__(name: str) -> Compressor:
     if name in _PRESET_NAMES:
         key = _PRESET_NAMES[name]
-        globals()[name] = Compressor(key, PRESETS[key])
+        globals()[name] = Compressor(key, PRESETS[key], choosable=False)
         return globals()[name]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
