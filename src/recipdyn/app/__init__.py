@@ -26,12 +26,13 @@ A bad value is shown next to its field, and the previous figures are cleared. Th
 carries the model, the selectors and every changed field
 (``?model=compressor&crank_joint=contact&rc=0.5+mm``), so a link reopens the same run (a
 field of another configuration is named with the selector value that enables it; a selector
-value that is a file, ``file.py:OBJ``, is never taken from a link); "Download config" writes the run's TOML config, which
-``recipdyn simulate -c FILE`` runs. The sweep browser opens a sweep store and shows its
-fault map (2-D) or bifurcation diagram (1-D); clicking a point opens it in the panel and
-runs it. The diagnosis section takes a dropped record (or a simulated example) and its
-channel names and shows `recipdyn.diagnose`'s answer: the probabilities, the severity, the
-evidence and the overlay, or the refusal and its reason (`recipdyn.app.diagnosis`).
+value that is a file, ``file.py:OBJ``, is never taken from a link); "Download config" writes
+the run's TOML config, which ``recipdyn simulate -c FILE`` runs. The sweep browser opens a
+sweep store and shows its fault map (2-D) or bifurcation diagram (1-D); clicking a point
+opens it in the panel and runs it. The diagnosis section takes a dropped record (or a
+simulated example) and its channel names and shows `recipdyn.diagnose`'s answer: the
+probabilities, the severity, the evidence and the overlay, or the refusal and its reason
+(`recipdyn.app.diagnosis`).
 
 Why Dash: a plain Flask server with React components, so the app is one Python process and
 its callbacks are plain functions (tested without a browser, and in a real headless

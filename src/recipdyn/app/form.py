@@ -373,8 +373,7 @@ def _elsewhere(m: Any, texts: dict[str, str], key: str, text: str) -> str | None
     except ParameterError as exc:
         if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", str(exc)):
             return str(exc)
-    now = ", ".join(f"{k} = {v!r}" for k, v in sel.items())
-    return (f"{key} is not a parameter of this configuration ({now})"
+    return (f"{key} is not a parameter of this configuration of {m.name!r}"
             + (f"; it belongs to {where}" if where not in ("", "selector") else ""))  # fmt: skip
 
 

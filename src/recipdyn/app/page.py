@@ -274,6 +274,8 @@ def build_app(store: str | Path | None = None):
         prevent_initial_call=True,
     )  # fmt: skip
     def _simulate(_n, _go, _submit, name, search, *state):
+        if all(t["prop_id"].endswith(".n_submit") and not t["value"] for t in ctx.triggered):
+            raise PreventUpdate  # fields just drawn (a selector changed), no Enter pressed
         texts = form_texts(*state)
         res = run_page(name, texts)
         errs = [res.errors.get(o["id"]["key"], "") for o in ctx.outputs_list[6]]
