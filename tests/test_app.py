@@ -431,7 +431,20 @@ def test_a_link_never_chooses_a_component_from_a_file():
 
 
 def test_a_combination_the_model_refuses_is_told_at_its_selector():
-    form = read_form("compressor", {"crank_joint": "link", "crosshead_joint": "contact"})
+    """A combination that does not exist is told under the selector as soon as the panel is
+    drawn (its other fields are the default configuration's), and again when read."""
+    refused = {"crank_joint": "link", "crosshead_joint": "contact"}
+
+    def told(texts):
+        return {c.id["key"]: c.children for c in _components(panel_for("compressor", texts))
+                if isinstance(getattr(c, "id", None), dict) and c.id.get("type") == "ferr"
+                and c.children}  # fmt: skip
+
+    assert list(told(refused)) == ["crank_joint"]
+    assert "massless link exists" in told(refused)["crank_joint"]
+    assert {f.key for f in fields("compressor", refused)} == {f.key for f in fields("compressor")}
+    assert told({"crank_joint": "contact"}) == {}
+    form = read_form("compressor", refused)
     assert list(form.errors) == ["crank_joint"]
     assert "the massless link exists at the crank pin" in form.errors["crank_joint"]
     form = read_form("compressor", {"load": "table"})

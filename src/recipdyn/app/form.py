@@ -31,8 +31,8 @@ from ..model.protocol import Param
 from ..model.registry import DEFAULT_MODEL, get_model, is_spec, model_names
 from ..units import to_si
 
-__all__ = ["Field", "fields", "selected", "read_form", "format_value", "to_query", "from_query",
-           "config_text", "MAX_SAMPLES", "RUN"]  # fmt: skip
+__all__ = ["Field", "fields", "selected", "selector_errors", "read_form", "format_value",
+           "to_query", "from_query", "config_text", "MAX_SAMPLES", "RUN"]  # fmt: skip
 
 #: The longest run the app draws (samples, or iterations of a map); longer runs belong to
 #: ``recipdyn simulate``, which streams them to a file.
@@ -179,6 +179,20 @@ def selected(model: Any, texts: dict[str, Any] | None = None) -> dict[str, str]:
     texts = texts or {}
     return {p.name: texts[p.name] if texts.get(p.name) in p.choices else p.default
             for p in get_model(model).selector_schema()}  # fmt: skip
+
+
+def selector_errors(model: Any, texts: dict[str, Any] | None = None) -> dict[str, str]:
+    """The model's refusal of the selector values in ``texts`` (a combination that does not
+    exist), at the selector it names first; empty when they make a configuration."""
+    m = get_model(model)
+    sel = selected(m, texts)
+    if not sel:
+        return {}
+    try:
+        m.configured(sel)
+    except ParameterError as exc:
+        return {_owner(str(exc), list(sel)) or next(iter(sel)): str(exc)}
+    return {}
 
 
 def _configuration(m: Any, sel: dict[str, str]) -> tuple[Any, frozenset[str]]:

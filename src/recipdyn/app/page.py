@@ -29,6 +29,7 @@ from .form import (
     from_query,
     read_form,
     selected,
+    selector_errors,
     to_query,
 )
 
@@ -40,7 +41,7 @@ _RED = "#B00020"
 _INPUT = {"width": "12em"}
 
 
-def _field_row(f: Field, text: Any) -> Any:
+def _field_row(f: Field, text: Any, error: str = "") -> Any:
     from dash import dcc, html
 
     tip = f.description + (f" [assumed: {f.assumed}]" if f.assumed else "")
@@ -66,7 +67,7 @@ def _field_row(f: Field, text: Any) -> Any:
         ]),
         html.Div(f"allowed {f.range_text()}" + ("; empty: derived" if f.optional else ""),
                  style={"color": "#666", "fontSize": "11px", "marginLeft": "10.5em"}),
-        html.Div(id={"type": "ferr", "key": f.key},
+        html.Div(error, id={"type": "ferr", "key": f.key},
                  style={"color": _RED, "fontSize": "12px", "marginLeft": "10.5em"}),
     ], style={"marginBottom": "4px"})  # fmt: skip
 
@@ -78,10 +79,11 @@ def panel_for(model: str, texts: dict[str, str]) -> list[Any]:
     from dash import html
 
     groups: dict[str, list[Any]] = {}
+    refused = selector_errors(model, texts)  # a combination that does not exist: told at once
     for f in fields(model, texts):
         text = texts.get(f.key, f.default if f.choices is not None else f.default_text)
         groups.setdefault("run" if f.key.startswith(RUN) else f.group, []).append(
-            _field_row(f, text)
+            _field_row(f, text, refused.get(f.key, ""))
         )
     return [html.Details([html.Summary(g, style={"fontWeight": "bold", "cursor": "pointer"}),
                           *rows], open=True, style={"marginBottom": "6px"})
