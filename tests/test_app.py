@@ -471,11 +471,15 @@ def test_the_config_of_a_configuration_reads_back_to_its_values(name, tmp_path):
     assert {k: values[k] for k in chosen} == chosen
 
 
-def test_a_selected_contact_configuration_runs_what_its_preset_runs():
+def test_a_selected_contact_configuration_runs_what_its_preset_runs(tmp_path):
     """The compressor with crank_joint = contact, chosen in the form, runs the kernel the
     compressor-contact preset runs: the same record, sample for sample, its address carries
-    the selector and its figure is the contact figure (0.1 revolution)."""
+    the selector and its figure is the contact figure (0.1 revolution); its downloaded
+    config, run by ``recipdyn simulate -c``, gives that record again."""
+    import xarray as xr
+
     from recipdyn.app import simulate_form
+    from recipdyn.cli import main
 
     short = {"rc": "0.5 mm", "run.revolutions": "0.1", "run.fs": "2 kHz"}
     res = run_page("compressor", {"crank_joint": "contact", **short})
@@ -488,6 +492,13 @@ def test_a_selected_contact_configuration_runs_what_its_preset_runs():
     for k in ("a", "ex", "ey"):
         assert np.array_equal(ds[k].values, ref[k].values), k
     assert _png_size(res.images[0][1]) == _sizes(ds, [contact_figure])
+    cfg, out = tmp_path / "contact.toml", tmp_path / "contact.nc"
+    cfg.write_text(config_text(read_form("compressor", {"crank_joint": "contact", **short})),
+                   encoding="utf-8")  # fmt: skip
+    assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
+    with xr.open_dataset(out) as cli:
+        assert cli.attrs["model"] == "compressor" and cli.attrs["param_crank_joint"] == "contact"
+        assert np.array_equal(cli["a"].values, ds["a"].values)
 
 
 @pytest.mark.parametrize("name", [n for n in model_names() if n != "compressor"])
