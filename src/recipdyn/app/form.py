@@ -384,7 +384,7 @@ def _elsewhere(m: Any, texts: dict[str, str], key: str, text: str) -> str | None
     f = Field(p.name, p.name, p.unit, _display_unit(p), p.default, param=p, choices=p.choices)
     try:
         m.parameters({**sel, key: f.parse(text)})
-    except ParameterError as exc:
+    except (ParameterError, TypeError, ValueError) as exc:
         if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", str(exc)):
             return str(exc)
     return (f"{key} is not a parameter of this configuration of {m.name!r}"

@@ -5,9 +5,9 @@ State lives in the address: ``?model=compressor-contact&rc=0.5+mm&run.revolution
 that model with those fields and runs it; ``?model=compressor&crank_joint=contact&rc=0.5+mm``
 opens the compressor's contact configuration. Changing a selector (crank_joint, load, ...)
 redraws the panel with that configuration's fields, keeping the texts of the fields that
-remain; the run that follows writes the address. Choosing a model, clicking a sweep point or a run
-that succeeds writes the address (one history entry each), so the browser's back button and a
-copied link give the same page.
+remain, and runs nothing (a new configuration may compile first): Simulate runs it. Choosing a
+model, clicking a sweep point or a run that succeeds writes the address (one history entry
+each), so the browser's back button and a copied link give the same page.
 """
 
 from __future__ import annotations
