@@ -73,7 +73,8 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
     keys = {f.key for f in flds}
     tables = {p.name for p in m.schema if p.choices is None and not p.optional
               and not isinstance(p.default, (int, float))}  # fmt: skip
-    assert keys >= set(m.schema.names) - tables
+    idle = set(m.inactive(m.parameters())) if len(m.selector_schema()) else set()
+    assert keys >= set(m.schema.names) - tables - idle  # (idle: another configuration's)
     assert {"run.revolutions", "run.fs", "run.method"} <= keys
     form = read_form(m, {f.key: f.default_text if f.choices is None else f.default
                          for f in flds})  # fmt: skip
@@ -83,7 +84,7 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
 
 
 def test_fields_read_the_units_engineers_type():
-    by = {f.key: f for f in fields("compressor")}
+    by = {f.key: f for f in fields("compressor", {"load": "cycle"})}
     assert by["rc"].unit == "mm" and by["suction_pressure"].unit == "bar"
     assert by["omega"].unit == "rpm" and by["theta_c_offset"].unit == "deg"
     assert by["rc"].parse("0.5 mm") == pytest.approx(0.5e-3, rel=1e-15)
@@ -117,7 +118,7 @@ def test_run_settings_are_the_command_lines():
         ({"run.fs": "-1 kHz"}, "run.fs", "fs = -1 kHz is out of range"),
         ({"run.revolutions": "1e6"}, "run.revolutions", "more than the app draws"),
         # a check across parameters goes to the field it names
-        ({"suction_pressure": "5 bar"}, "discharge_pressure", "suction_pressure"),
+        ({"load": "cycle", "suction_pressure": "5 bar"}, "discharge_pressure", "suction_pressure"),
         ({"m2": "0", "m3": "0", "J2": "0"}, "m2", "at least one must be > 0"),
     ],
 )
@@ -265,10 +266,24 @@ def test_downloaded_config_runs_on_the_command_line(tmp_path):
 #: Configurations of the one model: the selector values, parameters that must have a field
 #: there, and parameters of other configurations that must not.
 CONFIGURATIONS = {
+    "the default: massless link, paper load": (
+        {},
+        {"rc", "d", "equations", "load_amplitude", "m1", "omega"},
+        {"restitution", "valve_lift", "guide_clearance", "bore", "motor", "J_drive"},
+    ),
     "contact crank pin": (
         {"crank_joint": "contact"},
         {"rc", "restitution", "contact_law", "journal_radius", "K", "e0_angle"},
-        {"rc_crosshead", "oil_viscosity", "valve_lift", "guide_clearance", "equations", "m1"},
+        {
+            "rc_crosshead",
+            "oil_viscosity",
+            "valve_lift",
+            "guide_clearance",
+            "equations",
+            "m1",
+            "bore",
+            "motor",
+        },
     ),
     "lubricated crosshead pin": (
         {"crank_joint": "ideal", "crosshead_joint": "lubricated"},
@@ -288,7 +303,7 @@ CONFIGURATIONS = {
     "motor drive": (
         {"drive": "motor", "load": "cycle"},
         {"motor", "J_drive", "motor_torque", "bore", "equations"},
-        {"restitution", "valve_lift", "guide_clearance"},
+        {"restitution", "valve_lift", "guide_clearance", "load_amplitude"},
     ),
 }
 
@@ -355,14 +370,17 @@ def test_each_configuration_shows_its_own_fields(name):
 def test_changing_a_selector_keeps_the_texts_of_the_fields_that_remain():
     """The panel of another selector value holds that configuration's fields, with the texts
     already typed in the fields that it has too."""
-    typed = {"rc": "0.5 mm", "omega": "300 rpm", "equations": "exact", "bore": "0.4 m"}
+    typed = {"rc": "0.5 mm", "omega": "300 rpm", "equations": "exact", "load": "cycle",
+             "bore": "0.4 m"}  # fmt: skip
     before = _widgets(panel_for("compressor", typed))
     assert before["crank_joint"] == "link" and before["equations"] == "exact"
     after = _widgets(panel_for("compressor", {**typed, "crank_joint": "contact"}))
     assert after["crank_joint"] == "contact"
     assert (after["rc"], after["omega"], after["bore"]) == ("0.5 mm", "300 rpm", "0.4 m")
     assert "equations" not in after and after["restitution"] == "0.9"
-    assert set(after) == {f.key for f in fields("compressor", {"crank_joint": "contact"})}
+    assert after["load"] == "cycle"
+    assert set(after) == {f.key for f in fields("compressor", {"crank_joint": "contact",
+                                                               "load": "cycle"})}  # fmt: skip
 
 
 def test_the_address_carries_the_selectors():
@@ -401,6 +419,10 @@ def test_the_address_carries_the_selectors():
         ("crank_joint=contact&oil_viscosity=0.1", "it belongs to crank_joint or "
          "crosshead_joint = 'lubricated'"),
         ("guide_clearance=0.1+mm", "guide_clearance belongs to guide = 'clearance'"),
+        ("J_drive=2", "J_drive is not a parameter of this configuration of 'compressor'; it "
+         "belongs to drive = 'motor'"),
+        ("bore=0.4+m", "it belongs to load = 'cycle'"),
+        ("load=cycle&load_amplitude=1e5", "it belongs to load = 'paper'"),
         # the model's own message
         ("crank_joint=ideal&rc=0.5+mm", "rc = 0.0005: the crank pin is ideal (crank_joint = "
          "'ideal'); rc belongs to crank_joint = 'link' | 'contact' | 'lubricated'"),

@@ -18,8 +18,9 @@ The compressor (``compressor``) opens with its selectors as choice fields, ``cra
 (`Model.selector_schema`); below them come the fields of the configuration they choose
 (`Model.configured`), less those that do not act in it (`Model.inactive`: a pin's own
 parameters where it is ideal, the oil film's where no pin is lubricated, the guide's where it
-is ideal). Changing a selector redraws the panel, keeping the texts of the fields that remain;
-a combination the model refuses is told at the selector. A model without selectors (the
+is ideal, the motor's with the prescribed speed, the cycle's with the paper's load).
+Changing a selector redraws the panel, keeping the texts of the fields that remain; a
+combination the model refuses is told at the selector. A model without selectors (the
 presets, the reference systems) shows its schema's fields.
 
 A bad value is shown next to its field, and the previous figures are cleared. The address

@@ -195,7 +195,7 @@ def selector_errors(model: Any, texts: dict[str, Any] | None = None) -> dict[str
     return {}
 
 
-def _configuration(m: Any, sel: dict[str, str]) -> tuple[Any, frozenset[str]]:
+def _configuration(m: Any, sel: dict[str, str]) -> tuple[Any, dict[str, str]]:
     """The configured model at the selector values ``sel`` and the names its form leaves out;
     a combination the model refuses shows its default configuration's fields (the refusal is
     told when the form is read)."""
@@ -216,10 +216,10 @@ def fields(model: Any = None, texts: dict[str, Any] | None = None) -> list[Field
     sel = m.selector_schema()
     out = [Field(p.name, p.name, p.unit, "", p.default, p.description, CONFIGURATION,
                  p.choices, False, p.assumed, p) for p in sel]  # fmt: skip
-    schema, skip = m.schema, frozenset()
+    schema, skip = m.schema, set()
     if len(sel):
-        configured, skip = _configuration(m, selected(m, texts))
-        schema, skip = configured.schema, skip | set(sel.names)
+        configured, idle = _configuration(m, selected(m, texts))
+        schema, skip = configured.schema, {*idle, *sel.names}
     for p in schema:
         if p.name in skip:
             continue
@@ -381,6 +381,7 @@ def _elsewhere(m: Any, texts: dict[str, str], key: str, text: str) -> str | None
         return None
     p, where = rows[key]
     sel = selected(m, texts)
+    where = _configuration(m, sel)[1].get(key) or where
     f = Field(p.name, p.name, p.unit, _display_unit(p), p.default, param=p, choices=p.choices)
     try:
         m.parameters({**sel, key: f.parse(text)})

@@ -517,23 +517,37 @@ class Compressor(Model):
             return Schema(())
         return Schema(tuple(replace(p, default=self._selectors[p.name]) for p in SELECTORS))
 
-    def inactive(self, values: Mapping[str, Any]) -> frozenset[str]:
+    def inactive(self, values: Mapping[str, Any]) -> dict[str, str]:
         """The parameters of ``configured(values)`` that do not act at the selector values
-        of ``values``: a pin's own parameters where that pin is ideal, the oil film's where
-        no pin is lubricated, the guide's (but ``guide``) where the guide is ideal; and the
-        pins' older spelling (``clearance_joints``, ``joint``), which the selectors replace."""
+        of ``values``, each with the selector values under which it does: a pin's own
+        parameters where that pin is ideal, the oil film's where no pin is lubricated, the
+        guide's (but ``guide``) where the guide is ideal, the motor's where the drive is
+        prescribed, the compression cycle's with the paper's load and the paper's amplitude
+        with the cycle; and the pins' older spelling (``clearance_joints``, ``joint``), which
+        the selectors replace."""
         s = self.selectors(values)
         schema = self.configured(values).schema
-        out = set(PIN_SPELLINGS)
+        out = dict.fromkeys(PIN_SPELLINGS, "")
+        pins = (s["crank_joint"], s["crosshead_joint"])
         if s["crank_joint"] == "ideal":
-            out.update(_CRANK_PIN)
+            out.update(dict.fromkeys(_CRANK_PIN, "crank_joint = 'contact' | 'lubricated'"))
+            out["rc"] = "crank_joint = 'link' | 'contact' | 'lubricated'"
         if s["crosshead_joint"] == "ideal":
-            out.update(_CROSSHEAD_PIN)
-        if "lubricated" not in (s["crank_joint"], s["crosshead_joint"]):
-            out.update(_OIL)
-        if s["guide"] == "ideal":
-            out.update(p.name for p in schema if p.group == "guide" and p.name != "guide")
-        return frozenset(out & set(schema.names))
+            out.update(dict.fromkeys(_CROSSHEAD_PIN, "crosshead_joint = 'contact' | "
+                                                     "'lubricated'"))  # fmt: skip
+        if "lubricated" not in pins:
+            out.update(dict.fromkeys(_OIL, "crank_joint or crosshead_joint = 'lubricated'"))
+        by_group = {
+            "guide": "guide = 'clearance'" if s["guide"] == "ideal" else None,
+            "drive": "drive = 'motor'" if s["drive"] == "prescribed" else None,
+            "cycle": "load = 'cycle'" if s["load"] == "paper" else None,
+        }
+        for p in schema:
+            if by_group.get(p.group) and p.name not in SELECTORS.names:
+                out[p.name] = by_group[p.group]
+        if s["load"] in ("cycle", "valves"):
+            out["load_amplitude"] = "load = 'paper'"
+        return {k: v for k, v in out.items() if k in schema.names}
 
     def parameter_table(self) -> list[tuple[Param, str]]:
         """Every parameter of every configuration with the selector values it belongs to

@@ -414,11 +414,12 @@ class Model(ABC):
         fields of ``configured(their values)``."""
         return Schema(())
 
-    def inactive(self, values: Mapping[str, Any]) -> frozenset[str]:
-        """Names in ``configured(values).schema`` that a form leaves out at the selector
-        values in ``values``: parameters that do not act in that configuration (a pin's
+    def inactive(self, values: Mapping[str, Any]) -> dict[str, str]:
+        """The parameters of ``configured(values).schema`` that a form leaves out at the
+        selector values in ``values``, each with the selector values under which it acts
+        (``""``: none to tell): parameters that do not act in that configuration (a pin's
         clearance where the pin is ideal) and older spellings of a selector. Default: none."""
-        return frozenset()
+        return {}
 
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise
