@@ -298,7 +298,16 @@ CONFIGURATIONS = {
     "guide clearance": (
         {"crank_joint": "ideal", "guide": "clearance"},
         {"guide_clearance", "guide_stiffness", "crosshead_half_length", "guide_friction"},
-        {"rc", "rc_crosshead", "oil_viscosity", "valve_lift", "equations"},
+        {
+            "rc",
+            "rc_crosshead",
+            "oil_viscosity",
+            "valve_lift",
+            "equations",
+            "restitution",
+            "contact_law",
+            "friction",
+        },
     ),
     "motor drive": (
         {"drive": "motor", "load": "cycle"},

@@ -175,6 +175,9 @@ _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
 #: The parameters of the crank pin's joint alone, and of the crosshead pin's.
 _CRANK_PIN = ("rc", "K", "journal_radius", "e0_angle")
 _CROSSHEAD_PIN = ("rc_crosshead", "K_crosshead", "crosshead_pin_radius", "e0_angle_crosshead")
+#: The contact law, materials and friction of the pins' joints (not the guide's).
+_PIN_CONTACT = ("contact_law", "restitution", "E_journal", "nu_journal", "E_bearing",
+                "nu_bearing", "friction", "friction_law", "v0", "v1", "e0_ratio")  # fmt: skip
 
 
 _NOT_OWN: dict[int, frozenset[str]] = {}
@@ -520,11 +523,12 @@ class Compressor(Model):
     def inactive(self, values: Mapping[str, Any]) -> dict[str, str]:
         """The parameters of ``configured(values)`` that do not act at the selector values
         of ``values``, each with the selector values under which it does: a pin's own
-        parameters where that pin is ideal, the oil film's where no pin is lubricated, the
-        guide's (but ``guide``) where the guide is ideal, the motor's where the drive is
-        prescribed, the compression cycle's with the paper's load and the paper's amplitude
-        with the cycle; and the pins' older spelling (``clearance_joints``, ``joint``), which
-        the selectors replace."""
+        parameters where that pin is ideal, the pins' contact law, materials and friction
+        where both are rigid (a worn guide has its own), the oil film's where no pin is
+        lubricated, the guide's (but ``guide``) where the guide is ideal, the motor's where
+        the drive is prescribed, the compression cycle's with the paper's load and the
+        paper's amplitude with the cycle; and the pins' older spelling
+        (``clearance_joints``, ``joint``), which the selectors replace."""
         s = self.selectors(values)
         schema = self.configured(values).schema
         out = dict.fromkeys(PIN_SPELLINGS, "")
@@ -537,6 +541,9 @@ class Compressor(Model):
                                                      "'lubricated'"))  # fmt: skip
         if "lubricated" not in pins:
             out.update(dict.fromkeys(_OIL, "crank_joint or crosshead_joint = 'lubricated'"))
+        if set(pins) <= {"link", "ideal"}:  # (the worn guide has its own law and friction)
+            out.update(dict.fromkeys(_PIN_CONTACT, "crank_joint or crosshead_joint = "
+                                                   "'contact' | 'lubricated'"))  # fmt: skip
         by_group = {
             "guide": "guide = 'clearance'" if s["guide"] == "ideal" else None,
             "drive": "drive = 'motor'" if s["drive"] == "prescribed" else None,
