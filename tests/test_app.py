@@ -69,7 +69,8 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
     keys = {f.key for f in flds}
     tables = {p.name for p in m.schema if p.choices is None and not p.optional
               and not isinstance(p.default, (int, float))}  # fmt: skip
-    assert keys >= set(m.schema.names) - tables
+    idle = set(m.inactive(m.parameters())) if len(m.selector_schema()) else set()
+    assert keys >= set(m.schema.names) - tables - idle  # (idle: another configuration's)
     assert {"run.revolutions", "run.fs", "run.method"} <= keys
     form = read_form(m, {f.key: f.default_text if f.choices is None else f.default
                          for f in flds})  # fmt: skip
@@ -79,7 +80,7 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
 
 
 def test_fields_read_the_units_engineers_type():
-    by = {f.key: f for f in fields("compressor")}
+    by = {f.key: f for f in fields("compressor", {"load": "cycle"})}
     assert by["rc"].unit == "mm" and by["suction_pressure"].unit == "bar"
     assert by["omega"].unit == "rpm" and by["theta_c_offset"].unit == "deg"
     assert by["rc"].parse("0.5 mm") == pytest.approx(0.5e-3, rel=1e-15)
@@ -113,7 +114,7 @@ def test_run_settings_are_the_command_lines():
         ({"run.fs": "-1 kHz"}, "run.fs", "fs = -1 kHz is out of range"),
         ({"run.revolutions": "1e6"}, "run.revolutions", "more than the app draws"),
         # a check across parameters goes to the field it names
-        ({"suction_pressure": "5 bar"}, "discharge_pressure", "suction_pressure"),
+        ({"load": "cycle", "suction_pressure": "5 bar"}, "discharge_pressure", "suction_pressure"),
         ({"m2": "0", "m3": "0", "J2": "0"}, "m2", "at least one must be > 0"),
     ],
 )
@@ -256,6 +257,292 @@ def test_downloaded_config_runs_on_the_command_line(tmp_path):
         assert ds.attrs["sampling_rate_hz"] == 2000.0 and ds.attrs["revolutions"] == 1.0
 
 
+# --- the compressor's configurations ------------------------------------------------------
+
+#: Configurations of the one model: the selector values, parameters that must have a field
+#: there, and parameters of other configurations that must not.
+CONFIGURATIONS = {
+    "the default: massless link, paper load": (
+        {},
+        {"rc", "d", "equations", "load_amplitude", "m1", "omega"},
+        {"restitution", "valve_lift", "guide_clearance", "bore", "motor", "J_drive"},
+    ),
+    "contact crank pin": (
+        {"crank_joint": "contact"},
+        {"rc", "restitution", "contact_law", "journal_radius", "K", "e0_angle"},
+        {
+            "rc_crosshead",
+            "oil_viscosity",
+            "valve_lift",
+            "guide_clearance",
+            "equations",
+            "m1",
+            "bore",
+            "motor",
+        },
+    ),
+    "lubricated crosshead pin": (
+        {"crank_joint": "ideal", "crosshead_joint": "lubricated"},
+        {"rc_crosshead", "crosshead_pin_radius", "oil_viscosity", "eps_dry", "bearing_length"},
+        {"rc", "journal_radius", "K", "valve_lift", "guide_clearance", "equations"},
+    ),
+    "valves load": (
+        {"load": "valves"},
+        {"valve_lift", "valve_mass", "discharge_coefficient", "ring_leak_area", "rc", "m1"},
+        {"load_amplitude", "restitution", "rc_crosshead", "guide_clearance"},
+    ),
+    "guide clearance": (
+        {"crank_joint": "ideal", "guide": "clearance"},
+        {"guide_clearance", "guide_stiffness", "crosshead_half_length", "guide_friction"},
+        {
+            "rc",
+            "rc_crosshead",
+            "oil_viscosity",
+            "valve_lift",
+            "equations",
+            "restitution",
+            "contact_law",
+            "friction",
+        },
+    ),
+    "motor drive": (
+        {"drive": "motor", "load": "cycle"},
+        {"motor", "J_drive", "motor_torque", "bore", "equations"},
+        {"restitution", "valve_lift", "guide_clearance", "load_amplitude"},
+    ),
+}
+
+
+def _components(tree):
+    """Every Dash component in ``tree`` (depth first)."""
+    items = tree if isinstance(tree, (list, tuple)) else [tree]
+    for c in items:
+        if c is None or isinstance(c, (str, int, float)):
+            continue
+        yield c
+        yield from _components(getattr(c, "children", None))
+
+
+def _widgets(panel) -> dict[str, object]:
+    """The panel's field and choice values by key."""
+    return {c.id["key"]: c.value for c in _components(panel)
+            if isinstance(getattr(c, "id", None), dict) and c.id.get("type") in
+            ("field", "choice")}  # fmt: skip
+
+
+def test_the_compressor_shows_its_selectors_first_with_the_models_values():
+    """The one model's form opens with its five selectors as choice fields, their values the
+    model's own (`selector_schema`, the values `recipdyn models` lists), their defaults the
+    massless link with the paper's load."""
+    m = get_model("compressor")
+    sel = m.selector_schema()
+    flds = fields("compressor")
+    head = flds[: len(sel)]
+    assert [f.key for f in head] == ["crank_joint", "crosshead_joint", "load", "drive", "guide"]
+    assert [f.choices for f in head] == [p.choices for p in sel]
+    table = {p.name: p for p, where in m.parameter_table() if where == "selector"}
+    for f in head:  # the selectors recipdyn models tags as such have the same values
+        assert f.name not in table or table[f.name].choices == f.choices
+    assert {"contact", "lubricated"} <= set(head[0].choices) and "valves" in head[2].choices
+    assert "motor" in head[3].choices and "clearance" in head[4].choices
+    assert [f.default for f in head] == ["link", "ideal", "paper", "prescribed", "ideal"]
+    assert {f.group for f in head} == {"configuration"}
+    assert sum(f.key in sel for f in flds) == len(sel)  # each once: not again in its group
+
+
+@pytest.mark.parametrize("name", list(CONFIGURATIONS))
+def test_each_configuration_shows_its_own_fields(name):
+    """A configuration's form has the fields of the parameters that act in it and none of
+    another's; its default texts read back to the model's values at those selectors, to
+    the bit; the form is read with the configured model (its states)."""
+    chosen, own, others = CONFIGURATIONS[name]
+    m = get_model("compressor")
+    flds = fields("compressor", chosen)
+    keys = {f.key for f in flds}
+    assert own <= keys, own - keys
+    assert not others & keys, others & keys
+    configured = m.configured(chosen)
+    assert keys - set(m.selector_schema().names) - {k for k in keys if k.startswith("run.")} <= \
+        set(configured.schema.names)  # fmt: skip
+    texts = {f.key: f.default_text if f.choices is None else f.default for f in flds}
+    form = read_form("compressor", {**texts, **chosen})
+    assert form.ok, (form.errors, form.general)
+    assert form.params == m.parameters(chosen)
+    assert form.model.states(form.params) == configured.states(form.params)
+    assert {k: form.params.get(k) for k in chosen} == chosen
+
+
+def test_changing_a_selector_keeps_the_texts_of_the_fields_that_remain():
+    """The panel of another selector value holds that configuration's fields, with the texts
+    already typed in the fields that it has too."""
+    typed = {"rc": "0.5 mm", "omega": "300 rpm", "equations": "exact", "load": "cycle",
+             "bore": "0.4 m"}  # fmt: skip
+    before = _widgets(panel_for("compressor", typed))
+    assert before["crank_joint"] == "link" and before["equations"] == "exact"
+    after = _widgets(panel_for("compressor", {**typed, "crank_joint": "contact"}))
+    assert after["crank_joint"] == "contact"
+    assert (after["rc"], after["omega"], after["bore"]) == ("0.5 mm", "300 rpm", "0.4 m")
+    assert "equations" not in after and after["restitution"] == "0.9"
+    assert after["load"] == "cycle"
+    assert set(after) == {f.key for f in fields("compressor", {"crank_joint": "contact",
+                                                               "load": "cycle"})}  # fmt: skip
+
+
+def test_the_address_carries_the_selectors():
+    texts = {"crank_joint": "ideal", "crosshead_joint": "lubricated", "rc_crosshead": "0.2 mm",
+             "oil_viscosity": "0.04 Pa*s", "run.revolutions": "2"}  # fmt: skip
+    q = to_query("compressor", texts)
+    assert q == (
+        "?model=compressor&crank_joint=ideal&crosshead_joint=lubricated"
+        "&rc_crosshead=0.2+mm&run.revolutions=2"
+    )  # oil_viscosity: its default
+    name, back, err = from_query(q)
+    assert (name, err) == ("compressor", "")
+    assert back == {k: v for k, v in texts.items() if k != "oil_viscosity"}
+    assert to_query(name, back) == q
+    form = read_form(name, back)
+    assert form.ok and form.params["rc_crosshead"] == pytest.approx(2e-4, rel=1e-15)
+    assert (form.params["crank_joint"], form.params["crosshead_joint"]) == ("ideal", "lubricated")
+    # the brief's example: the selector, then the configuration's field
+    assert from_query("?model=compressor&crank_joint=contact&rc=0.5+mm") == (
+        "compressor",
+        {"crank_joint": "contact", "rc": "0.5 mm"},
+        "",
+    )
+
+
+@pytest.mark.parametrize(
+    ("query", "message"),
+    [
+        ("crank_joint=contact&equations=exact",
+         "address: equations is not a parameter of this configuration of 'compressor'; it "
+         "belongs to crank_joint = 'link' | 'ideal'"),
+        ("valve_lift=2+mm", "valve_lift is not a parameter of this configuration of "
+         "'compressor'; it belongs to load = 'valves'"),
+        ("crank_joint=contact&rc_crosshead=0.2+mm",
+         "it belongs to crosshead_joint = 'contact' | 'lubricated'"),
+        ("crank_joint=contact&oil_viscosity=0.1", "it belongs to crank_joint or "
+         "crosshead_joint = 'lubricated'"),
+        ("guide_clearance=0.1+mm", "guide_clearance belongs to guide = 'clearance'"),
+        ("J_drive=2", "J_drive is not a parameter of this configuration of 'compressor'; it "
+         "belongs to drive = 'motor'"),
+        ("bore=0.4+m", "it belongs to load = 'cycle'"),
+        ("load=cycle&load_amplitude=1e5", "it belongs to load = 'paper'"),
+        # the model's own message
+        ("crank_joint=ideal&rc=0.5+mm", "rc = 0.0005: the crank pin is ideal (crank_joint = "
+         "'ideal'); rc belongs to crank_joint = 'link' | 'contact' | 'lubricated'"),
+    ],
+)  # fmt: skip
+def test_a_field_of_another_configuration_is_told(query, message):
+    """A parameter of another configuration in an address is not read; the error names the
+    selector values that enable it, like an unknown field's."""
+    name, texts, err = from_query(f"?model=compressor&{query}")
+    foreign = query.rsplit("&", 1)[-1].split("=")[0]
+    assert foreign not in texts and message in err, err
+    assert "unknown field" not in err  # it is known: it belongs elsewhere
+
+
+def test_a_link_never_chooses_a_component_from_a_file():
+    """A selector's value from an address is one of the model's listed values: a load of
+    your own (``file.py:OBJ``) is refused without importing it, as a model path is."""
+    plugin = "tests/plugin_components.py:LOAD"
+    name, texts, err = from_query(f"?model=compressor&load={plugin}&rc=0.5+mm")
+    assert texts == {"rc": "0.5 mm"} and "load" not in texts
+    assert "a link does not import a file" in err and "allowed: paper, table" in err
+    form = read_form("compressor", {"load": plugin})
+    assert list(form.errors) == ["load"] and "allowed: one of paper" in form.errors["load"]
+    assert from_query("?model=compressor&crank_joint=welded")[2] == (
+        "address: crank_joint = 'welded' is not offered here; allowed: link, ideal, contact, "
+        "lubricated"
+    )
+
+
+def test_a_combination_the_model_refuses_is_told_at_its_selector():
+    """A combination that does not exist is told under the selector as soon as the panel is
+    drawn (its other fields are the default configuration's), and again when read."""
+    refused = {"crank_joint": "link", "crosshead_joint": "contact"}
+
+    def told(texts):
+        return {c.id["key"]: c.children for c in _components(panel_for("compressor", texts))
+                if isinstance(getattr(c, "id", None), dict) and c.id.get("type") == "ferr"
+                and c.children}  # fmt: skip
+
+    assert list(told(refused)) == ["crank_joint"]
+    assert "massless link exists" in told(refused)["crank_joint"]
+    assert {f.key for f in fields("compressor", refused)} == {f.key for f in fields("compressor")}
+    assert told({"crank_joint": "contact"}) == {}
+    form = read_form("compressor", refused)
+    assert list(form.errors) == ["crank_joint"]
+    assert "the massless link exists at the crank pin" in form.errors["crank_joint"]
+    form = read_form("compressor", {"load": "table"})
+    assert list(form.errors) == ["load"] and "needs load_table" in form.errors["load"]
+
+
+@pytest.mark.parametrize("name", ["contact crank pin", "lubricated crosshead pin",
+                                  "valves load", "guide clearance"])  # fmt: skip
+def test_the_config_of_a_configuration_reads_back_to_its_values(name, tmp_path):
+    """The TOML config the app writes for a configuration is read by ``recipdyn simulate
+    -c`` (`read_config`, `model_values`) to the same model and values, to the bit."""
+    from recipdyn.config import model_values, read_config
+
+    chosen = CONFIGURATIONS[name][0]
+    typed = {"omega": "300 rpm", "d": "0.5 mm", **chosen}
+    form = read_form("compressor", {**typed, **SHORT})
+    assert form.ok, (form.errors, form.general)
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(config_text(form), encoding="utf-8")
+    back = read_config(cfg)
+    assert back.model == "compressor"
+    values = model_values(get_model(back.model), back.params)
+    assert values == form.params
+    assert {k: values[k] for k in chosen} == chosen
+
+
+def test_a_selected_contact_configuration_runs_what_its_preset_runs(tmp_path):
+    """The compressor with crank_joint = contact, chosen in the form, runs the kernel the
+    compressor-contact preset runs: the same record, sample for sample, its address carries
+    the selector and its figure is the contact figure (0.1 revolution); its downloaded
+    config, run by ``recipdyn simulate -c``, gives that record again."""
+    import xarray as xr
+
+    from recipdyn.app import simulate_form
+    from recipdyn.cli import main
+
+    short = {"rc": "0.5 mm", "run.revolutions": "0.1", "run.fs": "2 kHz"}
+    res = run_page("compressor", {"crank_joint": "contact", **short})
+    assert res.query == ("?model=compressor&crank_joint=contact&rc=0.5+mm"
+                         "&run.revolutions=0.1&run.fs=2+kHz"), res.status  # fmt: skip
+    assert any(line.startswith("contact_fraction = ") for line in res.status)
+    ds, _ = simulate_form(read_form("compressor", {"crank_joint": "contact", **short}))
+    ref, _ = simulate_form(read_form("compressor-contact", short))
+    assert ds.attrs["model"] == "compressor" and ds.attrs["param_crank_joint"] == "contact"
+    for k in ("a", "ex", "ey"):
+        assert np.array_equal(ds[k].values, ref[k].values), k
+    assert _png_size(res.images[0][1]) == _sizes(ds, [contact_figure])
+    cfg, out = tmp_path / "contact.toml", tmp_path / "contact.nc"
+    cfg.write_text(config_text(read_form("compressor", {"crank_joint": "contact", **short})),
+                   encoding="utf-8")  # fmt: skip
+    assert main(["simulate", "-c", str(cfg), "-o", str(out), "--no-figure", "--no-progress"]) == 0
+    with xr.open_dataset(out) as cli:
+        assert cli.attrs["model"] == "compressor" and cli.attrs["param_crank_joint"] == "contact"
+        assert np.array_equal(cli["a"].values, ds["a"].values)
+
+
+@pytest.mark.parametrize("name", [n for n in model_names() if n != "compressor"])
+def test_the_presets_and_other_models_keep_their_forms(name):
+    """A model without selectors (the presets, fixed starting configurations; the reference
+    systems) has the form of its schema, as before: every parameter a field can hold, in
+    the schema's order, then the run settings; its fields do not depend on the texts."""
+    m = get_model(name)
+    assert len(m.selector_schema()) == 0
+    flds = fields(name)
+    expect = [p.name for p in m.schema if p.choices is not None or p.optional
+              or isinstance(p.default, (int, float))]  # fmt: skip
+    assert [f.key for f in flds if not f.key.startswith("run.")] == expect
+    assert [f.key for f in fields(name, {"crank_joint": "contact", "load": "valves"})] == [
+        f.key for f in flds]  # fmt: skip
+
+
 # --- the sweep browser --------------------------------------------------------------------
 
 
@@ -359,6 +646,20 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
                                                         f"&& {_STATUS}")  # fmt: skip
         assert page_.wait(f"{_POINTS} > 100 && {_POINTS}") == 629  # decoded by plotly.js
         assert page_.wait(_IMAGE) > 500  # simulate's figure, decoded
+        assert runs == ["compressor"]
+
+        # 1b. a selector, chosen with the mouse: the contact configuration's fields (its
+        # contact law's restitution, not the massless link's equations), no run yet
+        def exists(key, kind):
+            return page_.js(f"!!document.getElementById('{{\"key\":\"{key}\",\"type\":"
+                            f"\"{kind}\"}}')")  # fmt: skip
+
+        assert exists("equations", "choice") and not exists("restitution", "field")
+        page_.click('document.getElementById(\'{"key":"crank_joint","type":"choice"}\')')
+        page_.click("[...document.querySelectorAll('[role=option]')]"
+                    ".find(e => e.innerText.trim() === 'contact')")  # fmt: skip
+        page_.wait('!!document.getElementById(\'{"key":"restitution","type":"field"}\')')
+        assert not exists("equations", "choice") and exists("rc", "field")
         assert runs == ["compressor"]
         # 2. choose the contact model with the mouse: its panel, its run, its figure
         page_.click("document.getElementById('model')")

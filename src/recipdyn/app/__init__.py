@@ -13,14 +13,27 @@ command line's defaults (`recipdyn.defaults`). "Simulate" runs the model and sho
   pressures, rod load and valve lifts), drawn by the same plotting functions;
 * the run's summary and, when it left the model's validity, why.
 
+The compressor (``compressor``) opens with its selectors as choice fields, ``crank_joint``,
+``crosshead_joint``, ``load``, ``drive`` and ``guide``, with the values the model lists
+(`Model.selector_schema`); below them come the fields of the configuration they choose
+(`Model.configured`), less those that do not act in it (`Model.inactive`: a pin's own
+parameters where it is ideal, the oil film's where no pin is lubricated, the guide's where it
+is ideal, the motor's with the prescribed speed, the cycle's with the paper's load).
+Changing a selector redraws the panel, keeping the texts of the fields that remain; a
+combination the model refuses is told at the selector. A model without selectors (the
+presets, the reference systems) shows its schema's fields.
+
 A bad value is shown next to its field, and the previous figures are cleared. The address
-carries the model and every changed field (``?model=compressor-contact&rc=0.5+mm``), so a
-link reopens the same run; "Download config" writes the run's TOML config, which
-``recipdyn simulate -c FILE`` runs. The sweep browser opens a sweep store and shows its
-fault map (2-D) or bifurcation diagram (1-D); clicking a point opens it in the panel and
-runs it. The diagnosis section takes a dropped record (or a simulated example) and its
-channel names and shows `recipdyn.diagnose`'s answer: the probabilities, the severity, the
-evidence and the overlay, or the refusal and its reason (`recipdyn.app.diagnosis`).
+carries the model, the selectors and every changed field
+(``?model=compressor&crank_joint=contact&rc=0.5+mm``), so a link reopens the same run (a
+field of another configuration is named with the selector value that enables it; a selector
+value that is a file, ``file.py:OBJ``, is never taken from a link); "Download config" writes
+the run's TOML config, which ``recipdyn simulate -c FILE`` runs. The sweep browser opens a
+sweep store and shows its fault map (2-D) or bifurcation diagram (1-D); clicking a point
+opens it in the panel and runs it. The diagnosis section takes a dropped record (or a
+simulated example) and its channel names and shows `recipdyn.diagnose`'s answer: the
+probabilities, the severity, the evidence and the overlay, or the refusal and its reason
+(`recipdyn.app.diagnosis`).
 
 Why Dash: a plain Flask server with React components, so the app is one Python process and
 its callbacks are plain functions (tested without a browser, and in a real headless

@@ -8,6 +8,12 @@ exactly to six digits (``0.001 m`` -> ``"1 mm"``), else in SI (``20 rad/s`` stay
 ``"20 rad/s"`` rather than an inexact ``"190.986 rpm"``), so the defaults of the form are the
 model's defaults to the bit. The same texts make the page's address (`to_query`) and the
 run's config file (`config_text`, read back by ``recipdyn simulate -c``).
+
+A model whose parameters choose its configuration (the compressor's joints, load, drive and
+guide: `Model.selector_schema`) gets those selectors first, as choice fields, then the fields
+of the configuration they choose (`Model.configured`), less the parameters that do not act
+in it (`Model.inactive`). The form reads the selectors from the texts themselves, so the
+texts alone (a page's fields, an address) say which fields there are.
 """
 
 from __future__ import annotations
@@ -22,17 +28,19 @@ from urllib.parse import parse_qsl, urlencode
 from ..defaults import ATOL_RANGE, RTOL_RANGE, SIMULATION
 from ..errors import ParameterError
 from ..model.protocol import Param
-from ..model.registry import DEFAULT_MODEL, get_model, model_names
+from ..model.registry import DEFAULT_MODEL, get_model, is_spec, model_names
 from ..units import to_si
 
-__all__ = ["Field", "fields", "read_form", "format_value", "to_query", "from_query",
-           "config_text", "MAX_SAMPLES", "RUN"]  # fmt: skip
+__all__ = ["Field", "fields", "selected", "selector_errors", "read_form", "format_value",
+           "to_query", "from_query", "config_text", "MAX_SAMPLES", "RUN"]  # fmt: skip
 
 #: The longest run the app draws (samples, or iterations of a map); longer runs belong to
 #: ``recipdyn simulate``, which streams them to a file.
 MAX_SAMPLES = 2_000_000
 #: Prefix of the run settings' field keys (they share the form with a model's parameters).
 RUN = "run."
+#: The group of the selector fields (shown first).
+CONFIGURATION = "configuration"
 
 
 @dataclass(frozen=True)
@@ -164,13 +172,57 @@ def _run_fields() -> list[Field]:
     ]  # fmt: skip
 
 
-def fields(model: Any = None) -> list[Field]:
-    """The form of ``model`` (a name or a model; default the compressor): every parameter of
-    its schema that a field can hold (numbers, choices, optional numbers; a table such as the
-    compressor's ``load_table`` is set in a config file), then the run settings."""
+def selected(model: Any, texts: dict[str, Any] | None = None) -> dict[str, str]:
+    """The selector values in ``texts`` (`Model.selector_schema`; a value that is not one of
+    a selector's choices counts as its default here, and its field reports it); empty for a
+    model of one configuration."""
+    texts = texts or {}
+    return {p.name: texts[p.name] if texts.get(p.name) in p.choices else p.default
+            for p in get_model(model).selector_schema()}  # fmt: skip
+
+
+def selector_errors(model: Any, texts: dict[str, Any] | None = None) -> dict[str, str]:
+    """The model's refusal of the selector values in ``texts`` (a combination that does not
+    exist), at the selector it names first; empty when they make a configuration."""
     m = get_model(model)
-    out = []
-    for p in m.schema:
+    sel = selected(m, texts)
+    if not sel:
+        return {}
+    try:
+        m.configured(sel)
+    except ParameterError as exc:
+        return {_owner(str(exc), list(sel)) or next(iter(sel)): str(exc)}
+    return {}
+
+
+def _configuration(m: Any, sel: dict[str, str]) -> tuple[Any, dict[str, str]]:
+    """The configured model at the selector values ``sel`` and the names its form leaves out;
+    a combination the model refuses shows its default configuration's fields (the refusal is
+    told when the form is read)."""
+    try:
+        return m.configured(sel), m.inactive(sel)
+    except ParameterError:
+        dflt = {k: p.default for k, p in zip(sel, m.selector_schema(), strict=True)}
+        return m.configured(dflt), m.inactive(dflt)
+
+
+def fields(model: Any = None, texts: dict[str, Any] | None = None) -> list[Field]:
+    """The form of ``model`` (a name or a model; default the compressor): its selectors, if
+    it has any, then every parameter of the configuration the selector values in ``texts``
+    choose (default: the model's defaults) that a field can hold (numbers, choices, optional
+    numbers; a table such as the compressor's ``load_table`` is set in a config file), then
+    the run settings."""
+    m = get_model(model)
+    sel = m.selector_schema()
+    out = [Field(p.name, p.name, p.unit, "", p.default, p.description, CONFIGURATION,
+                 p.choices, False, p.assumed, p) for p in sel]  # fmt: skip
+    schema, skip = m.schema, set()
+    if len(sel):
+        configured, idle = _configuration(m, selected(m, texts))
+        schema, skip = configured.schema, {*idle, *sel.names}
+    for p in schema:
+        if p.name in skip:
+            continue
         if p.choices is None and not isinstance(p.default, (int, float)) and not p.optional:
             continue
         out.append(Field(p.name, p.name, p.unit, _display_unit(p), p.default, p.description,
@@ -218,7 +270,7 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
     """
     m = get_model(model)
     form = Form(m)
-    flds = fields(m)
+    flds = fields(m, texts)
     raw: dict[str, Any] = {}
     for f in flds:
         text = texts.get(f.key)
@@ -234,6 +286,7 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
         # the schema's ranges, then the model's checks across parameters; an empty optional
         # field (None) is derived by the model
         form.params = m.parameters(values)
+        form.model = m.configured(form.params)  # the configuration's declarations
     except (ParameterError, TypeError, ValueError) as exc:
         key = _owner(str(exc), [f.key for f in flds])
         if key is None:
@@ -262,11 +315,11 @@ def _check_length(form: Form) -> None:
 
 
 def to_query(model: Any, texts: dict[str, Any]) -> str:
-    """The address query of a form: the model and every field that differs from its default
-    (``?model=compressor-contact&rc=0.5+mm``)."""
+    """The address query of a form: the model and every field that differs from its default,
+    the selectors first (``?model=compressor&crank_joint=contact&rc=0.5+mm``)."""
     m = get_model(model)
     items = [("model", m.name)]
-    for f in fields(m):
+    for f in fields(m, texts):
         text = texts.get(f.key)
         if text is not None and str(text).strip() != f.default_text:
             items.append((f.key, str(text).strip()))
@@ -275,32 +328,68 @@ def to_query(model: Any, texts: dict[str, Any]) -> str:
 
 def from_query(search: str | None) -> tuple[str, dict[str, str], str]:
     """``(model name, field texts, error)`` from an address query; parameter aliases are
-    accepted and unknown names reported in ``error`` (the known ones are still read). Only
-    registered model names are accepted, never a ``module:object`` path (opening a link must
-    not import a file)."""
+    accepted and unknown names reported in ``error`` (the known ones are still read), a
+    parameter of another configuration with the selector values that enable it. Only
+    registered model names and the selectors' listed values are accepted, never a
+    ``module:object`` path (opening a link must not import a file)."""
     pairs = parse_qsl((search or "").lstrip("?"), keep_blank_values=True)
     spec = dict(pairs).get("model") or DEFAULT_MODEL
     if spec not in model_names():  # never a module:object path: a link must not import code
         return DEFAULT_MODEL, {}, (f"address: unknown model {spec!r}; known: "
                                    f"{', '.join(model_names())}")  # fmt: skip
     m = get_model(spec)
-    keys = {f.key for f in fields(m)}
-    texts, unknown = {}, []
+    texts, problems = {}, []
+    for p in m.selector_schema():
+        v = dict(pairs).get(p.name)
+        if v is None:
+            continue
+        if v in p.choices:
+            texts[p.name] = v
+        else:
+            own = (" (a component of your own is given in a config file or on the command "
+                   "line: a link does not import a file)") if is_spec(v) else ""  # fmt: skip
+            problems.append(f"{p.name} = {v!r} is not offered here; allowed: "
+                            f"{', '.join(p.choices)}{own}")  # fmt: skip
+    keys = {f.key for f in fields(m, texts)}
+    schema = _configuration(m, selected(m, texts))[0].schema if texts else m.schema
+    unknown = []
     for k, v in pairs:
-        if k == "model":
+        if k == "model" or k in m.selector_schema():
             continue
         if k not in keys and not k.startswith(RUN):
             try:
-                k = m.schema.resolve(k)
+                k = schema.resolve(k)
             except ParameterError:
                 pass
         if k in keys:
             texts[k] = v
+        elif (why := _elsewhere(m, texts, k, v)) is not None:
+            problems.append(why)
         else:
             unknown.append(k)
-    err = f"address: unknown field(s) {', '.join(unknown)} for model {m.name!r}" if unknown \
-        else ""  # fmt: skip
-    return m.name, texts, err
+    if unknown:
+        problems.insert(0, f"unknown field(s) {', '.join(unknown)} for model {m.name!r}")
+    return m.name, texts, "; ".join(f"address: {p}" for p in problems)
+
+
+def _elsewhere(m: Any, texts: dict[str, str], key: str, text: str) -> str | None:
+    """Why ``key``, a parameter of another configuration of ``m`` (`Model.parameter_table`),
+    has no field here: the model's own message when it refuses the value at these selector
+    values, else the selector values it belongs to; None for a name no configuration has."""
+    rows = {p.name: (p, where) for p, where in m.parameter_table()}
+    if key not in rows:
+        return None
+    p, where = rows[key]
+    sel = selected(m, texts)
+    where = _configuration(m, sel)[1].get(key) or where
+    f = Field(p.name, p.name, p.unit, _display_unit(p), p.default, param=p, choices=p.choices)
+    try:
+        m.parameters({**sel, key: f.parse(text)})
+    except (ParameterError, TypeError, ValueError) as exc:
+        if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", str(exc)):
+            return str(exc)
+    return (f"{key} is not a parameter of this configuration of {m.name!r}"
+            + (f"; it belongs to {where}" if where not in ("", "selector") else ""))  # fmt: skip
 
 
 def config_text(form: Form) -> str:

@@ -2,9 +2,12 @@
 of this module (``panel_for``, ``run_page``, ...), which the tests call without a browser.
 
 State lives in the address: ``?model=compressor-contact&rc=0.5+mm&run.revolutions=2`` opens
-that model with those fields and runs it. Choosing a model, clicking a sweep point or a run
-that succeeds writes the address (one history entry each), so the browser's back button and a
-copied link give the same page.
+that model with those fields and runs it; ``?model=compressor&crank_joint=contact&rc=0.5+mm``
+opens the compressor's contact configuration. Changing a selector (crank_joint, load, ...)
+redraws the panel with that configuration's fields, keeping the texts of the fields that
+remain, and runs nothing (a new configuration may compile first): Simulate runs it. Choosing a
+model, clicking a sweep point or a run that succeeds writes the address (one history entry
+each), so the browser's back button and a copied link give the same page.
 """
 
 from __future__ import annotations
@@ -17,7 +20,18 @@ from ..errors import ParameterError
 from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model, model_names
 from .diagnosis import diagnosis_section
 from .figures import images, simulate_form, status_lines, views
-from .form import RUN, Field, config_text, fields, format_value, from_query, read_form, to_query
+from .form import (
+    RUN,
+    Field,
+    config_text,
+    fields,
+    format_value,
+    from_query,
+    read_form,
+    selected,
+    selector_errors,
+    to_query,
+)
 
 __all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "GRAPHS"]
 
@@ -27,7 +41,7 @@ _RED = "#B00020"
 _INPUT = {"width": "12em"}
 
 
-def _field_row(f: Field, text: Any) -> Any:
+def _field_row(f: Field, text: Any, error: str = "") -> Any:
     from dash import dcc, html
 
     tip = f.description + (f" [assumed: {f.assumed}]" if f.assumed else "")
@@ -53,21 +67,23 @@ def _field_row(f: Field, text: Any) -> Any:
         ]),
         html.Div(f"allowed {f.range_text()}" + ("; empty: derived" if f.optional else ""),
                  style={"color": "#666", "fontSize": "11px", "marginLeft": "10.5em"}),
-        html.Div(id={"type": "ferr", "key": f.key},
+        html.Div(error, id={"type": "ferr", "key": f.key},
                  style={"color": _RED, "fontSize": "12px", "marginLeft": "10.5em"}),
     ], style={"marginBottom": "4px"})  # fmt: skip
 
 
 def panel_for(model: str, texts: dict[str, str]) -> list[Any]:
-    """The parameter panel of ``model``: one group per schema group (the run settings last),
-    each field holding ``texts[key]`` or its default."""
+    """The parameter panel of ``model``: its selectors first (if it has any), then one group
+    per schema group of the configuration they choose (the run settings last), each field
+    holding ``texts[key]`` or its default."""
     from dash import html
 
     groups: dict[str, list[Any]] = {}
-    for f in fields(model):
+    refused = selector_errors(model, texts)  # a combination that does not exist: told at once
+    for f in fields(model, texts):
         text = texts.get(f.key, f.default if f.choices is not None else f.default_text)
         groups.setdefault("run" if f.key.startswith(RUN) else f.group, []).append(
-            _field_row(f, text)
+            _field_row(f, text, refused.get(f.key, ""))
         )
     return [html.Details([html.Summary(g, style={"fontWeight": "bold", "cursor": "pointer"}),
                           *rows], open=True, style={"marginBottom": "6px"})
@@ -130,7 +146,7 @@ def click_query(store: str, click: dict, texts: dict[str, Any]) -> str:
     from .sweeps import point_from_click
 
     name, values = point_from_click(store, click)
-    by_key = {f.key: f for f in fields(name)}
+    by_key = {f.key: f for f in fields(name, values)}
     out = {k: format_value(v, by_key[k]) for k, v in values.items() if k in by_key}
     out.update({k: v for k, v in texts.items() if k.startswith(RUN)})
     return to_query(name, out)
@@ -153,6 +169,7 @@ def build_app(store: str | Path | None = None):
         dcc.Location(id="url", refresh=False),
         dcc.Location(id="nav", refresh="callback-nav"),
         dcc.Store(id="shown"), dcc.Store(id="go", data=0), dcc.Download(id="download"),
+        dcc.Store(id="configuration"),
         html.H2("recipdyn: reciprocating compressor dynamics", style={"margin": "4px 0"}),
         html.Div([
             html.Div([
@@ -207,7 +224,7 @@ def build_app(store: str | Path | None = None):
 
     @app.callback(
         Output("model", "value"), Output("panel", "children"), Output("model-help", "children"),
-        Output("form-error", "children"), Output("go", "data"),
+        Output("form-error", "children"), Output("go", "data"), Output("configuration", "data"),
         Input("url", "search"), State("shown", "data"), State("go", "data"),
     )  # fmt: skip
     def _panel(search, shown, go):
@@ -215,7 +232,25 @@ def build_app(store: str | Path | None = None):
         if shown is not None and to_query(name, texts) == shown:
             raise PreventUpdate  # the run on the page is this address's run
         return (name, panel_for(name, texts), get_model(name).description, err,
-                (go or 0) + 1)  # fmt: skip
+                (go or 0) + 1, [name, selected(name, texts)])  # fmt: skip
+
+    @app.callback(
+        Output("panel", "children", allow_duplicate=True),
+        Output("configuration", "data", allow_duplicate=True),
+        Input({"type": "choice", "key": ALL}, "value"), State("model", "value"),
+        State("configuration", "data"), *fields_state,
+        prevent_initial_call=True,
+    )  # fmt: skip
+    def _reconfigure(_choices, name, shown, *state):
+        # a selector changed: the panel of the configuration it chooses (no run: the next
+        # Simulate runs it and writes the address)
+        if name not in model_names():
+            raise PreventUpdate
+        texts = form_texts(*state)
+        now = [name, selected(name, texts)]
+        if shown == now:
+            raise PreventUpdate  # (a choice that is no selector, or the panel just drawn)
+        return panel_for(name, texts), now
 
     @app.callback(
         Output("nav", "search", allow_duplicate=True),
@@ -241,6 +276,8 @@ def build_app(store: str | Path | None = None):
         prevent_initial_call=True,
     )  # fmt: skip
     def _simulate(_n, _go, _submit, name, search, *state):
+        if all(t["prop_id"].endswith(".n_submit") and not t["value"] for t in ctx.triggered):
+            raise PreventUpdate  # fields just drawn (a selector changed), no Enter pressed
         texts = form_texts(*state)
         res = run_page(name, texts)
         errs = [res.errors.get(o["id"]["key"], "") for o in ctx.outputs_list[6]]

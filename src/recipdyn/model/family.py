@@ -172,6 +172,12 @@ _ALWAYS = frozenset({*_KEYS, "load_table", "pressure_table"})
 _TABLES = ("load_table", "pressure_table")
 #: The oil film's parameters (a lubricated joint's).
 _OIL = ("oil_viscosity", "eps_dry", "bearing_length")
+#: The parameters of the crank pin's joint alone, and of the crosshead pin's.
+_CRANK_PIN = ("rc", "K", "journal_radius", "e0_angle")
+_CROSSHEAD_PIN = ("rc_crosshead", "K_crosshead", "crosshead_pin_radius", "e0_angle_crosshead")
+#: The contact law, materials and friction of the pins' joints (not the guide's).
+_PIN_CONTACT = ("contact_law", "restitution", "E_journal", "nu_journal", "E_bearing",
+                "nu_bearing", "friction", "friction_law", "v0", "v1", "e0_ratio")  # fmt: skip
 
 
 _NOT_OWN: dict[int, frozenset[str]] = {}
@@ -200,7 +206,10 @@ def owner(name: str, s: Mapping[str, Any]) -> str:
     (``"crosshead_joint = 'contact' | 'lubricated'"``), or ``""`` if none does; ``s``: the
     current selector values (one selector is changed at a time; a crosshead-pin parameter is
     the crosshead joint's)."""
-    if name in implementation("contact").schema and name not in implementation("link").schema:
+    contact = implementation("contact").schema
+    if name in contact and name not in implementation("link").schema:
+        if contact[name].group == "guide":
+            return "guide = 'clearance'"
         if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
             return "crosshead_joint = 'contact' | 'lubricated'"
         if name in _OIL:
@@ -233,9 +242,12 @@ class Compressor(Model):
     preset is an instance with other defaults (`with_defaults`)."""
 
     def __init__(self, name: str = "compressor", defaults: Mapping[str, Any] | None = None,
-                 description: str = "") -> None:  # fmt: skip
+                 description: str = "", choosable: bool = True) -> None:  # fmt: skip
         self.name = name
         self.defaults = dict(defaults or {})
+        #: Whether a form offers the selectors (`selector_schema`): the one model does; a
+        #: preset is a fixed starting point whose form is its implementation's.
+        self.choosable = choosable
         self._selectors = _chosen(self.defaults, _DEFAULTS)
         self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
         #: A preset whose defaults choose the guide clearance (compressor-guide) runs its own
@@ -284,7 +296,9 @@ class Compressor(Model):
 
     def with_defaults(self, **defaults: Any) -> Compressor:
         """This model with other defaults (selectors or any parameter), under its name."""
-        return Compressor(self.name, {**self.defaults, **defaults}, self.description)
+        return Compressor(
+            self.name, {**self.defaults, **defaults}, self.description, self.choosable
+        )
 
     # -- routing ------------------------------------------------------------------------
     def selectors(self, values: Mapping[str, Any]) -> dict[str, Any]:
@@ -498,6 +512,50 @@ class Compressor(Model):
                 out[k] = s[k]
         return out
 
+    def selector_schema(self) -> Schema:
+        """The five selectors with every value they take (a load of your own, ``file.py:OBJ``,
+        is given on the command line or in a config file) and this model's defaults; empty for
+        a preset (``choosable = False``)."""
+        if not self.choosable:
+            return Schema(())
+        return Schema(tuple(replace(p, default=self._selectors[p.name]) for p in SELECTORS))
+
+    def inactive(self, values: Mapping[str, Any]) -> dict[str, str]:
+        """The parameters of ``configured(values)`` that do not act at the selector values
+        of ``values``, each with the selector values under which it does: a pin's own
+        parameters where that pin is ideal, the pins' contact law, materials and friction
+        where both are rigid (a worn guide has its own), the oil film's where no pin is
+        lubricated, the guide's (but ``guide``) where the guide is ideal, the motor's where
+        the drive is prescribed, the compression cycle's with the paper's load and the
+        paper's amplitude with the cycle; and the pins' older spelling
+        (``clearance_joints``, ``joint``), which the selectors replace."""
+        s = self.selectors(values)
+        schema = self.configured(values).schema
+        out = dict.fromkeys(PIN_SPELLINGS, "")
+        pins = (s["crank_joint"], s["crosshead_joint"])
+        if s["crank_joint"] == "ideal":
+            out.update(dict.fromkeys(_CRANK_PIN, "crank_joint = 'contact' | 'lubricated'"))
+            out["rc"] = "crank_joint = 'link' | 'contact' | 'lubricated'"
+        if s["crosshead_joint"] == "ideal":
+            out.update(dict.fromkeys(_CROSSHEAD_PIN, "crosshead_joint = 'contact' | "
+                                                     "'lubricated'"))  # fmt: skip
+        if "lubricated" not in pins:
+            out.update(dict.fromkeys(_OIL, "crank_joint or crosshead_joint = 'lubricated'"))
+        if set(pins) <= {"link", "ideal"}:  # (the worn guide has its own law and friction)
+            out.update(dict.fromkeys(_PIN_CONTACT, "crank_joint or crosshead_joint = "
+                                                   "'contact' | 'lubricated'"))  # fmt: skip
+        by_group = {
+            "guide": "guide = 'clearance'" if s["guide"] == "ideal" else None,
+            "drive": "drive = 'motor'" if s["drive"] == "prescribed" else None,
+            "cycle": "load = 'cycle'" if s["load"] == "paper" else None,
+        }
+        for p in schema:
+            if by_group.get(p.group) and p.name not in SELECTORS.names:
+                out[p.name] = by_group[p.group]
+        if s["load"] in ("cycle", "valves"):
+            out["load_amplitude"] = "load = 'paper'"
+        return {k: v for k, v in out.items() if k in schema.names}
+
     def parameter_table(self) -> list[tuple[Param, str]]:
         """Every parameter of every configuration with the selector values it belongs to
         (``""``: this preset's default configuration), for ``recipdyn models``."""
@@ -534,6 +592,6 @@ _PRESET_NAMES = {f"COMPRESSOR_{k[len('compressor-'):].upper().replace('-', '_')}
 def __getattr__(name: str) -> Compressor:
     if name in _PRESET_NAMES:
         key = _PRESET_NAMES[name]
-        globals()[name] = Compressor(key, PRESETS[key])
+        globals()[name] = Compressor(key, PRESETS[key], choosable=False)
         return globals()[name]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

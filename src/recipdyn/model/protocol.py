@@ -407,6 +407,20 @@ class Model(ABC):
         for ``recipdyn models``. Default: the schema's."""
         return [(p, "") for p in self.schema]
 
+    def selector_schema(self) -> Schema:
+        """The parameters whose values choose the configuration (`configured`), each with
+        every value it takes and this model's default, in the order a form shows them; empty
+        (the default) for a model of one configuration. The app shows them first, then the
+        fields of ``configured(their values)``."""
+        return Schema(())
+
+    def inactive(self, values: Mapping[str, Any]) -> dict[str, str]:
+        """The parameters of ``configured(values).schema`` that a form leaves out at the
+        selector values in ``values``, each with the selector values under which it acts
+        (``""``: none to tell): parameters that do not act in that configuration (a pin's
+        clearance where the pin is ideal) and older spellings of a selector. Default: none."""
+        return {}
+
     def check(self, values: Mapping[str, Any]) -> None:  # noqa: B027 - optional hook
         """Validity checks across parameters; raise
         [`ParameterError`][recipdyn.errors.ParameterError]."""
