@@ -37,8 +37,9 @@ def test_every_class_is_one_entry_with_a_meaning_and_a_valid_range():
     for c in CLASSES[1:]:
         assert c.parameter in schema and c.meaning
         lo, hi = sorted((c.mild, c.severe))
-        get_model(MODEL).parameters({c.parameter: lo})
-        get_model(MODEL).parameters({c.parameter: hi})
+        for v in (lo, hi):  # with the settings the class requires (the guide's clearance)
+            p = get_model(MODEL).parameters({**dict(c.requires), c.parameter: v})
+            assert p[c.parameter] == v
         for s in (0.0, 0.3, 1.0):  # value and severity are inverse
             assert c.severity(c.value(s)) == pytest.approx(s, abs=1e-12)
 
@@ -148,6 +149,34 @@ def test_process_pool_gives_the_serial_records_to_the_bit(small, tmp_path):
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
     fa, fb = read_features(a)[0], read_features(b)[0]
     assert fa.drop(columns=[]).equals(fb)
+
+
+# ---- the crosshead guide's class ------------------------------------------------------------
+
+
+def test_only_the_guide_class_records_run_the_clearance_guide():
+    """The worn guide's records set ``guide = clearance`` and the guide's clearance at their
+    severity; every other record is the one a data set without that class holds (same
+    condition, class, severity and parameters: the rigid guide), so the healthy baseline and
+    the other classes are unchanged by the new class."""
+    with_guide = DatasetSpec(n_conditions=3, seed=2)
+    without = DatasetSpec(n_conditions=3, seed=2, classes=SHIPPED_CLASSES)
+    assert "crosshead_guide_clearance" in with_guide.classes
+    a = design(with_guide)
+    guide = [t for t in a if t["label"] == "crosshead_guide_clearance"]
+    fc = CLASSES[[c.name for c in CLASSES].index("crosshead_guide_clearance")]
+    assert len(guide) == 3 * len(with_guide.levels)
+    for t in guide:
+        assert t["params"]["guide"] == "clearance"
+        assert t["params"]["guide_clearance"] == fc.value(t["severity"])
+    assert {round(fc.value(s), 12) for s in (0.0, 1.0)} == {2e-4, 8e-4}
+
+    def key(t):
+        return {k: v for k, v in t.items() if k not in ("index", "noise_seed")}
+
+    rest = [key(t) for t in a if t["label"] != "crosshead_guide_clearance"]
+    assert rest == [key(t) for t in design(without)]
+    assert all("guide" not in t["params"] for t in design(without))
 
 
 # ---- continuous severities -------------------------------------------------------------------
