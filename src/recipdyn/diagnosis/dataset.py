@@ -251,8 +251,10 @@ def n_samples_max(tasks) -> int:
     )
 
 
-def simulate_record(task: dict[str, Any]):
-    """The sensed record (an xarray Dataset) of one task."""
+def simulate_record(task: dict[str, Any], *, summary: bool = False):
+    """The sensed record (an xarray Dataset) of one task. ``summary``: also compute the
+    simulation's run summary into the attrs (the data set reads the signals only; the
+    summary is a tenth of a record's time)."""
     from .. import sensors
     from ..simulate import simulate
 
@@ -263,6 +265,7 @@ def simulate_record(task: dict[str, Any]):
             revolutions=task["revolutions"],
             transient=task["transient"],
             fs=task["fs"],
+            summary=summary,
             **task["params"],
         )
     return sensors.record(
