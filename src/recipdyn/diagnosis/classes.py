@@ -101,7 +101,8 @@ HEALTHY = FaultClass(
     "healthy",
     None,
     meaning="the baseline machine: new pin bearings "
-    "(0.1 mm radial clearance), tight valves and rings, nominal springs",
+    "(0.1 mm radial clearance), the rigid crosshead guide, tight valves and rings, nominal "
+    "springs",
 )
 
 #: The fault classes after the healthy one; one entry each (docs/diagnosis.md, data card).
