@@ -389,6 +389,25 @@ def test_evaluation_bookkeeping(trained):
             assert d["recall_by_severity"][d["limit_severity"]] >= 0.9
 
 
+def test_training_on_a_subset_of_the_classes(small):
+    """``train(classes=...)`` (to measure what a class adds) leaves the other classes'
+    records out of the training and the evaluation; a subset without the healthy machine or
+    with a class the data set lacks is refused, naming the setting."""
+    from recipdyn.diagnosis.train import train
+
+    out, *_ = small
+    df, _ = read_features(out)
+    diag, ev = train(out, seed=0, classes=("healthy", "ring_leak"))
+    assert diag.classes == ["healthy", "ring_leak"]
+    keep = df.label.isin(["healthy", "ring_leak"])
+    assert ev["n_test"] == (keep & (df.split == "test")).sum()
+    assert ev["n_train"] == (keep & (df.split == "train")).sum()
+    assert np.asarray(ev["full"]["confusion"]).shape == (2, 2)
+    for bad in (("ring_leak",), ("healthy", "crosshead_guide_clearance")):
+        with pytest.raises(ParameterError, match="classes"):
+            train(out, classes=bad)
+
+
 def test_expected_calibration_error_of_known_cases():
     """Perfectly calibrated bins give 0; always 90 % sure and always right gives 0.1."""
     from recipdyn.diagnosis.train import expected_calibration_error
