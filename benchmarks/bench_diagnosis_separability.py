@@ -7,7 +7,8 @@ For every feature: the fault record minus the median of the healthy records of t
 operating condition (same machine, same condition, other noise draws), divided by the
 spread of the healthy records over all conditions (interquartile range / 1.349, a robust
 standard deviation). A group's score is its largest feature's median over the conditions:
-below ~1 the fault hides inside the healthy machine's variation across conditions.
+below ~1 the fault hides inside the healthy machine's variation across conditions. On a data
+set of continuous severities, by the evaluation's severity bins.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 def main() -> None:
     from recipdyn.diagnosis.dataset import read_features
     from recipdyn.diagnosis.evidence import feature_groups
+    from recipdyn.diagnosis.train import severity_bins
 
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
@@ -35,16 +37,26 @@ def main() -> None:
     base = healthy.groupby("condition")[cols].median()
     print("| class | severity | " + " | ".join(groups) + " |")
     print("|---|---|" + "---|" * len(groups))
+    edges = severity_bins(card)  # continuous severities: the evaluation's bins
+    if edges is None:
+        groups_of = [(f"{s:g}", df.severity == s) for s in card["spec"]["levels"]]
+    else:
+        groups_of = [
+            (f"{a:.3g}–{b:.3g}", (df.severity >= a) & ((df.severity < b) | (b == edges[-1])))
+            for a, b in zip(edges[:-1], edges[1:], strict=True)
+        ]
     for c in card["spec"]["classes"][1:]:
-        for s in card["spec"]["levels"]:
-            sub = df[(df.label == c) & (df.severity == s)]
+        for s, in_bin in groups_of:
+            sub = df[(df.label == c) & in_bin]
+            if sub.empty:
+                continue
             d = (sub[cols].to_numpy(float) - base.loc[sub.condition].to_numpy(float)) / spread
             with warnings.catch_warnings():  # a feature NaN on every record (no event)
                 warnings.simplefilter("ignore", RuntimeWarning)
                 med = np.nanmedian(np.abs(d), axis=0)
             k = {col: i for i, col in enumerate(cols)}
             score = [np.nanmax(med[[k[x] for x in m]]) for m in groups.values()]
-            print(f"| {c} | {s:g} | " + " | ".join(f"{v:.1f}" for v in score) + " |")
+            print(f"| {c} | {s} | " + " | ".join(f"{v:.1f}" for v in score) + " |")
 
 
 if __name__ == "__main__":

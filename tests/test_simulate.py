@@ -276,3 +276,17 @@ def test_a_record_alone_loads_no_plotting_or_distributed_stack(tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     assert json.loads(done.stdout.strip().splitlines()[-1]) == {"code": 0, "loaded": []}
     assert out.exists()
+
+
+def test_simulate_without_the_run_summary_records_the_same_signals():
+    """``summary=False`` (a data set's records) leaves the run summary out of the attrs and
+    nothing else: the signals and the event records, with their units, are those of the
+    default run (the summary is computed after the integration, from the recorded
+    samples). On a model with reset events, so that the event records are compared too."""
+    from recipdyn.simulate import simulate
+
+    a = simulate(model="impact-oscillator", revolutions=3, fs=2000.0)
+    b = simulate(model="impact-oscillator", revolutions=3, fs=2000.0, summary=False)
+    assert "impact_time" in a and a.sizes["impact_event"] > 0
+    assert "summary_interval" in a.attrs and "summary_interval" not in b.attrs
+    assert a.drop_attrs(deep=False).identical(b.drop_attrs(deep=False))

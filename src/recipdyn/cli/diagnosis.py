@@ -10,15 +10,14 @@ import typer
 from . import app, refused_leaves_nothing, report, with_json
 
 
-def _levels(text: str) -> tuple[float, ...]:
+def _levels(text: str, name: str = "levels", example: str = "0.25,0.5,0.75,1"):
     from ..errors import ParameterError
 
     try:
         return tuple(float(v) for v in text.split(",") if v.strip())
     except ValueError:
         raise ParameterError(
-            f"levels = {text!r}; allowed: a comma list of severities in "
-            "(0, 1], e.g. 0.25,0.5,0.75,1"
+            f"{name} = {text!r}; allowed: a comma list of severities in [0, 1], e.g. {example}"
         ) from None
 
 
@@ -27,6 +26,17 @@ def dataset(
     out: Path = typer.Option(Path("out/dataset"), "--out", "-o", help="Data set folder."),
     conditions: int = typer.Option(16, "--conditions", "-n", help="Operating conditions drawn."),
     levels: str = typer.Option("0.25,0.5,0.75,1", help="Severity levels in (0, 1]."),
+    severity_range: str = typer.Option(
+        None,
+        "--severity-range",
+        help="LO,HI: draw each fault record's severity uniformly in [LO, HI] (seeded) "
+        "instead of the fixed --levels.",
+    ),
+    draws: int = typer.Option(
+        None,
+        help="With --severity-range: records of each class per condition (default: "
+        "as many as --levels).",
+    ),
     snr: float = typer.Option(20.0, "--snr", help="Accelerometer SNR, dB."),
     revolutions: float = typer.Option(2.0, help="Revolutions recorded per record."),
     transient: float = typer.Option(1.0, help="Revolutions discarded first."),
@@ -49,6 +59,9 @@ def dataset(
     from ..diagnosis.dataset import DatasetSpec, build_dataset
 
     kw = {} if classes is None else {"classes": tuple(c.strip() for c in classes.split(","))}
+    if severity_range is not None:
+        kw["severity_range"] = _levels(severity_range, "severity_range", "0.1,1")
+        kw["severity_draws"] = draws
     spec = DatasetSpec(
         n_conditions=conditions,
         levels=_levels(levels),

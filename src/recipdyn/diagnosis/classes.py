@@ -3,7 +3,9 @@ operating conditions and sensor settings a data set spans.
 
 Adding a class is one entry of `CLASSES`: its name, the model parameter that carries the
 fault, the parameter's values at the mildest and the most severe level, the scale between
-them and what the fault is physically. Every class is a parameter of one model,
+them, what the fault is physically and, if the fault needs it, the model's selectors its
+records set (the worn crosshead guide is simulated with ``guide = clearance``; every other
+record keeps the rigid guide). Every class is a parameter of one model,
 `MODEL` (the contact–impact joints at both pins with the gas and dynamic valves), so the
 healthy baseline is the same machine for every class.
 """
@@ -29,7 +31,9 @@ __all__ = [
 MODEL = "compressor-contact-valves"
 
 #: The healthy machine: the model's defaults with both pins in clearance joints whose radial
-#: clearance (0.1 mm) is that of a new bearing of this size (about 1e-3 of the pin diameter).
+#: clearance (0.1 mm) is that of a new bearing of this size (about 1e-3 of the pin diameter),
+#: and the rigid crosshead guide (``guide = ideal``, the model's default): a new guide's
+#: oil-filled play is not modelled (docs/diagnosis.md).
 BASELINE: dict[str, object] = {
     "clearance_joints": "both",
     "rc": 1.0e-4,
@@ -57,6 +61,10 @@ class FaultClass:
         clearances, forces that span a decade) or linearly.
     meaning : str
         What the fault is on a real machine.
+    requires : tuple of (str, object)
+        Model settings every record of this class needs besides the fault parameter (e.g.
+        ``(("guide", "clearance"),)``: the guide's clearance is a parameter of the model only
+        with the clearance guide); the other classes' records keep the `BASELINE`.
     """
 
     name: str
@@ -66,6 +74,7 @@ class FaultClass:
     unit: str = ""
     scale: str = "log"
     meaning: str = ""
+    requires: tuple[tuple[str, object], ...] = ()
 
     def value(self, severity: float) -> float:
         """The parameter's value at ``severity`` in [0, 1]."""
@@ -81,15 +90,19 @@ class FaultClass:
         return (value - self.mild) / (self.severe - self.mild)
 
     def overrides(self, severity: float) -> dict[str, float]:
-        """Model parameters of this fault at ``severity`` (empty for the healthy machine)."""
-        return {} if self.parameter is None else {self.parameter: self.value(severity)}
+        """Model parameters of this fault at ``severity`` (empty for the healthy machine): the
+        settings it `requires` and the fault parameter's value."""
+        if self.parameter is None:
+            return {}
+        return {**dict(self.requires), self.parameter: self.value(severity)}
 
 
 HEALTHY = FaultClass(
     "healthy",
     None,
     meaning="the baseline machine: new pin bearings "
-    "(0.1 mm radial clearance), tight valves and rings, nominal springs",
+    "(0.1 mm radial clearance), the rigid crosshead guide, tight valves and rings, nominal "
+    "springs",
 )
 
 #: The fault classes after the healthy one; one entry each (docs/diagnosis.md, data card).
@@ -110,6 +123,20 @@ CLASSES: tuple[FaultClass, ...] = (
         8e-4,
         "m",
         meaning="worn crosshead-pin (small-end) bushing: radial clearance 0.2 to 0.8 mm",
+    ),
+    FaultClass(
+        "crosshead_guide_clearance",
+        "guide_clearance",
+        2e-4,
+        8e-4,
+        "m",
+        meaning="worn crosshead guide (shoes or guide bore): radial clearance 0.2 to 0.8 mm "
+        "shoe to guide, a lateral play of 0.4 to 1.6 mm on the 200 mm crosshead (assumed: "
+        "a new guide ~0.1-0.15 mm of diametral play per 100 mm of crosshead, 0.2-0.3 mm "
+        "here; the mildest level is about twice that, a usual wear limit, the most severe "
+        "five to eight times it); the crosshead knocks on the shoes where the side force "
+        "reverses",
+        requires=(("guide", "clearance"),),
     ),
     FaultClass(
         "suction_valve_leak",

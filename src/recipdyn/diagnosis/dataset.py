@@ -4,8 +4,9 @@ Design: ``n_conditions`` operating conditions (speed, suction and discharge pres
 crosshead masses, the accelerometer's mounting resonance and the sampling rate), drawn
 uniformly from `CONDITIONS` with a seeded generator; at each condition
 every fault class at every severity level (the healthy machine as often as each fault, so the
-classes are balanced); each record sensed at the data set's SNR (`recipdyn.sensors`) with its
-own noise seed. The conditions are split whole into train and test sets, so no condition is
+classes are balanced), or, with ``severity_range``, at severities drawn uniformly (seeded) in
+that range; each record sensed at the data set's SNR (`recipdyn.sensors`) with its own noise
+seed. The conditions are split whole into train and test sets, so no condition is
 shared between them.
 
 Layout of ``OUT``:
@@ -36,6 +37,7 @@ import sys
 import time
 import traceback
 import warnings
+import zlib
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -55,6 +57,7 @@ __all__ = [
     "CHANNELS",
     "split_of",
     "dataset_record",
+    "severities",
 ]
 
 #: The sensed channels stored per record.
@@ -82,6 +85,19 @@ class DatasetSpec:
         Seed of the conditions, the split and every record's sensor noise.
     classes : tuple of str
         Class names (default: all of `CLASSES`).
+    severity_range : (float, float) or None
+        Continuous severities: each fault record's severity drawn uniformly in ``[lo, hi]``
+        (``0 <= lo < hi <= 1``) instead of the fixed ``levels``, seeded per condition and
+        class (`severity_draws`). None: the fixed levels.
+    severity_draws : int or None
+        With ``severity_range``: records of each class at each condition (default: as many
+        as ``levels``). Ignored without it.
+
+    Notes
+    -----
+    A data set's store is identified by `to_json`, which leaves out the two continuous-
+    severity settings while they are None, so a store built with fixed levels keeps its
+    identity (and resumes) whatever settings are added here later.
     """
 
     n_conditions: int = 16
@@ -92,6 +108,8 @@ class DatasetSpec:
     test_fraction: float = 0.25
     seed: int = 0
     classes: tuple[str, ...] = field(default_factory=lambda: tuple(class_names()))
+    severity_range: tuple[float, float] | None = None
+    severity_draws: int | None = None
 
     def __post_init__(self):
         if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
@@ -115,9 +133,46 @@ class DatasetSpec:
             get_class(c)
         if "healthy" not in self.classes:
             raise ParameterError("classes: must include 'healthy' (the baseline)")
+        r = self.severity_range
+        if r is not None:
+            try:
+                lo, hi = (float(v) for v in r)
+            except (TypeError, ValueError):
+                lo = hi = math.nan
+            if not 0 <= lo < hi <= 1:
+                raise ParameterError(
+                    f"severity_range = {r!r}; allowed: two severities 0 <= lo < hi <= 1"
+                )
+            object.__setattr__(self, "severity_range", (lo, hi))
+        d = self.severity_draws
+        if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
+            raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
+
+    @property
+    def continuous(self) -> bool:
+        """Whether the severities are drawn in `severity_range` (not the fixed levels)."""
+        return self.severity_range is not None
+
+    @property
+    def per_class(self) -> int:
+        """Records of each class at each condition."""
+        if self.continuous and self.severity_draws is not None:
+            return self.severity_draws
+        return len(self.levels)
 
     def to_json(self) -> str:
-        return json.dumps(asdict(self), sort_keys=True)
+        """The spec's identity (a store holds the data set of exactly this string); the
+        continuous-severity settings are left out while None (fixed levels)."""
+        d = asdict(self)
+        for k in ("severity_range", "severity_draws"):
+            if d[k] is None:
+                del d[k]
+        return json.dumps(d, sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
+        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
 
 
 def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
@@ -138,14 +193,27 @@ def split_of(spec: DatasetSpec) -> list[str]:
     return ["test" if i in test else "train" for i in range(spec.n_conditions)]
 
 
+def severities(spec: DatasetSpec, condition: int, name: str) -> list[float]:
+    """The severities of class ``name``'s records at ``condition``: the fixed levels, or
+    ``spec.per_class`` draws, uniform in ``spec.severity_range``, from a generator seeded by
+    the data set's seed, the condition and the class name (so adding a class or a condition
+    leaves the others' draws as they were)."""
+    if not spec.continuous:
+        return [float(s) for s in spec.levels]
+    lo, hi = spec.severity_range
+    rng = np.random.default_rng([spec.seed, 3, condition, zlib.crc32(name.encode())])
+    return rng.uniform(lo, hi, spec.per_class).tolist()
+
+
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
-    """The records of ``spec``: one task per (condition, class, level), in a fixed order."""
+    """The records of ``spec``: one task per (condition, class, severity), in a fixed order
+    (``level`` numbers a class's records at a condition)."""
     tasks = []
     splits = split_of(spec)
     for ci, cond in enumerate(_conditions(spec)):
         for name in spec.classes:
             fc = get_class(name)
-            for li, s in enumerate(spec.levels):
+            for li, s in enumerate(severities(spec, ci, name)):
                 idx = len(tasks)
                 params = dict(BASELINE)
                 params.update(
@@ -183,8 +251,10 @@ def n_samples_max(tasks) -> int:
     )
 
 
-def simulate_record(task: dict[str, Any]):
-    """The sensed record (an xarray Dataset) of one task."""
+def simulate_record(task: dict[str, Any], *, summary: bool = False):
+    """The sensed record (an xarray Dataset) of one task. ``summary``: also compute the
+    simulation's run summary into the attrs (the data set reads the signals only; the
+    summary is a tenth of a record's time)."""
     from .. import sensors
     from ..simulate import simulate
 
@@ -195,6 +265,7 @@ def simulate_record(task: dict[str, Any]):
             revolutions=task["revolutions"],
             transient=task["transient"],
             fs=task["fs"],
+            summary=summary,
             **task["params"],
         )
     return sensors.record(
@@ -415,12 +486,7 @@ def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
 
     folder = Path(folder)
     g = zarr.open_group(str(folder / "signals.zarr"), mode="r+")
-    spec = DatasetSpec(
-        **{
-            k: tuple(v) if isinstance(v, list) else v
-            for k, v in json.loads(g.attrs["spec_json"]).items()
-        }
-    )
+    spec = DatasetSpec.from_dict(json.loads(g.attrs["spec_json"]))
     tasks = design(spec)
     names = feature_names()
     if g["features"].shape[1] != len(names):
@@ -547,7 +613,12 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
                 "meaning": fc.meaning,
                 "unit": fc.unit,
                 "scale": fc.scale,
-                "values": [fc.value(s) for s in spec.levels] if fc.parameter else [],
+                "values": [fc.value(s) for s in spec.levels]
+                if fc.parameter and not spec.continuous
+                else [],
+                "value_range": [fc.value(s) for s in spec.severity_range]
+                if fc.parameter and spec.continuous
+                else [],
             }
         )
     balance = {}
@@ -576,6 +647,14 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
             "split": [spec.seed, 1],
             "noise": f"{spec.seed} * 1000003 + record index",
         },
+        "severities": {
+            "kind": "uniform",
+            "range": list(spec.severity_range),
+            "per_class": spec.per_class,
+            "seed": f"[{spec.seed}, 3, condition, crc32(class name)]",
+        }
+        if spec.continuous
+        else {"kind": "levels", "levels": list(spec.levels), "per_class": spec.per_class},
         "split": "by operating condition: no condition has records in both train and test",
         "records": int(len(df)),
         "balance": balance,
@@ -585,20 +664,33 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
 
 def datacard_markdown(card: dict[str, Any]) -> str:
     s = card["spec"]
+    sev = card.get("severities", {"kind": "levels"})
+    if sev["kind"] == "uniform":
+        lo, hi = sev["range"]
+        how = (
+            f"{sev['per_class']} records of each class with severities drawn uniformly in "
+            f"[{lo:g}, {hi:g}]"
+        )
+        head = "values over the severity range"
+    else:
+        how = f"{len(s['levels'])} severity levels {s['levels']}"
+        head = "values at the levels"
     lines = [
         f"# Data card (recipdyn {card['recipdyn_version']})",
         "",
         f"Model `{card['model']}`, healthy baseline {card['baseline']}; "
         f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
-        f"{len(s['levels'])} severity levels {s['levels']}; {s['revolutions']} "
+        f"{how}; {s['revolutions']} "
         f"revolutions after {s['transient']}; accelerometer SNR {s['snr_db']} dB; "
         f"seed {s['seed']}. {card['split']}.",
         "",
-        "| class | parameter | values at the levels | meaning |",
+        f"| class | parameter | {head} | meaning |",
         "|---|---|---|---|",
     ]
     for c in card["classes"]:
-        vals = ", ".join(f"{v:.3g}" for v in c["values"]) + f" {c['unit']}" if c["values"] else ""
+        v = c.get("value_range") or c["values"]
+        sep = " .. " if c.get("value_range") else ", "
+        vals = sep.join(f"{x:.3g}" for x in v) + f" {c['unit']}" if v else ""
         lines.append(f"| {c['name']} | {c['parameter'] or ''} | {vals} | {c['meaning']} |")
     lines += ["", "| condition | range | meaning |", "|---|---|---|"]
     for k, r in card["conditions"].items():

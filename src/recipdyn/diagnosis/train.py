@@ -21,9 +21,10 @@
 Evaluation (on the held-out test conditions): accuracy, confusion matrix, per-class recall,
 the reliability diagram and expected calibration error of the top-class probability, the
 detection limit of each fault (the smallest severity level from which every level's recall is
-at least 90 %), the severity's median relative error and the intervals' coverage, the
-permutation importance of the features, and a classifier trained on the operating condition
-alone (it must be at chance).
+at least 90 %; on continuous severities, the lower edge of the lowest of `SEVERITY_BINS` equal
+severity bins from which every bin's recall is), the severity's median relative error and the
+intervals' coverage, the permutation importance of the features, and a classifier trained on
+the operating condition alone (it must be at chance).
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ __all__ = [
     "OOD_MARGIN",
     "expected_calibration_error",
     "detection_limits",
+    "severity_bins",
 ]
 
 #: Neighbours of the out-of-distribution distance.
@@ -179,33 +181,67 @@ def expected_calibration_error(proba: np.ndarray, y: np.ndarray, bins: int = 10)
     return float(ece), diagram
 
 
-def detection_limits(labels, levels, severities, predicted, classes, threshold=0.9):
+def detection_limits(labels, levels, severities, predicted, classes, threshold=0.9, bins=None):
     """Per fault class: the recall at each severity level and the detection limit, the
     smallest level from which every level's recall is at least ``threshold`` (None: not
-    reached)."""
+    reached).
+
+    ``bins`` (edges, increasing): for continuous severities, the recall in each bin
+    ``[edges[i], edges[i + 1])`` (the last bin closed), keyed by the bin's centre, and the
+    limit is the lower edge of the lowest bin from which every bin's recall reaches
+    ``threshold``; ``recall_bins`` gives the edges and ``n_by_severity`` the records of each
+    bin or level."""
     out = {}
+    edges = None if bins is None else np.asarray(bins, float)
     for c in classes:
         if c == "healthy":
             continue
         m = labels == c
-        recall = {}
-        for lv in sorted(set(severities[m].tolist())):
-            mm = m & (severities == lv)
-            recall[float(lv)] = float((predicted[mm] == c).mean())
+        recall, count, lower = {}, {}, {}
+        if edges is None:
+            for lv in sorted(set(severities[m].tolist())):
+                mm = m & (severities == lv)
+                recall[float(lv)] = float((predicted[mm] == c).mean())
+                count[float(lv)] = int(mm.sum())
+                lower[float(lv)] = float(lv)
+        else:
+            idx = np.clip(np.searchsorted(edges, severities, side="right") - 1, 0, edges.size - 2)
+            for b in range(edges.size - 1):
+                mm = m & (idx == b)
+                if not mm.any():
+                    continue
+                key = float(0.5 * (edges[b] + edges[b + 1]))
+                recall[key] = float((predicted[mm] == c).mean())
+                count[key] = int(mm.sum())
+                lower[key] = float(edges[b])
         limit = None
         for lv in sorted(recall, reverse=True):
             if recall[lv] >= threshold:
-                limit = lv
+                limit = lower[lv]
             else:
                 break
         fc = get_class(c)
         out[c] = {
             "recall_by_severity": recall,
+            "n_by_severity": count,
+            "recall_bins": None if edges is None else edges.tolist(),
             "limit_severity": limit,
             "limit_value": fc.value(limit) if limit is not None else None,
             "unit": fc.unit,
         }
     return out
+
+
+#: Equal bins over a data set's severity range in which the detection limit reads the recall
+#: on continuous severities.
+SEVERITY_BINS = 4
+
+
+def severity_bins(card: dict) -> np.ndarray | None:
+    """Edges of the detection limit's severity bins for a data set of continuous
+    severities (`SEVERITY_BINS` equal bins over its range); None for fixed levels."""
+    r = card["spec"].get("severity_range")
+    return None if r is None else np.linspace(r[0], r[1], SEVERITY_BINS + 1)
 
 
 class Diagnoser:
@@ -294,20 +330,38 @@ def one_thread() -> Iterator[None]:
         yield
 
 
-def train(folder: str | Path, *, seed: int = 0, progress: bool = True) -> tuple[Diagnoser, dict]:
+def train(
+    folder: str | Path,
+    *,
+    seed: int = 0,
+    progress: bool = True,
+    classes: list[str] | tuple[str, ...] | None = None,
+) -> tuple[Diagnoser, dict]:
     """Train a diagnoser on the training conditions of the data set in ``folder`` and
-    evaluate it on the test conditions; returns ``(diagnoser, evaluation)``."""
+    evaluate it on the test conditions; returns ``(diagnoser, evaluation)``.
+
+    ``classes``: train and evaluate on these classes of the data set only (its records of
+    the other classes left out; default all), e.g. to measure what a class adds."""
     folder = Path(folder)
     with one_thread():
-        return _train(folder, seed)
+        return _train(folder, seed, classes)
 
 
-def _train(folder: Path, seed: int) -> tuple[Diagnoser, dict]:
+def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     from .. import __version__
 
     df, card = read_features(folder)
     names = [c[2:] for c in df.columns if c.startswith("f_")]
     classes = list(card["spec"]["classes"])
+    if only is not None:
+        bad = [c for c in only if c not in classes] + ([] if "healthy" in only else ["healthy"])
+        if bad:
+            raise ParameterError(
+                f"classes = {list(only)!r}; allowed: 'healthy' and any of the data set's "
+                f"{', '.join(classes)}"
+            )
+        classes = [c for c in classes if c in only]
+        df = df[df.label.isin(classes)].reset_index(drop=True)
     train_df = df[df.split == "train"].reset_index(drop=True)
     test_df = df[df.split == "test"].reset_index(drop=True)
     if train_df.label.nunique() < len(classes) or test_df.empty:
@@ -415,10 +469,7 @@ def _fingerprints(train_df, card, names, diag) -> list[dict[str, Any]]:
     training condition)."""
     from .dataset import DatasetSpec, design
 
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in card["spec"].items()}
-    )
-    tasks = {t["index"]: t for t in design(spec)}
+    tasks = {t["index"]: t for t in design(DatasetSpec.from_dict(card["spec"]))}
     first = train_df.condition.min()
     out = []
     for c in ("healthy", "ring_leak", "suction_valve_leak"):
@@ -475,6 +526,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
                 test_df.severity.to_numpy(),
                 np.array(classes)[pred],
                 classes,
+                bins=severity_bins(diag.card),
             ),
         }
         if subset == "full":
