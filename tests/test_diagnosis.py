@@ -636,3 +636,35 @@ def test_deciding_features_are_the_subsets_and_their_z_is_bounded():
     no_p[diag.names.index("acc_skewness")] += 3 * st["scale"][diag.names.index("acc_skewness")]
     names = [n for n, _ in _deciding(diag, no_p)]
     assert names and not any(n.startswith(("cy_", "ph_", "pc_")) for n in names)
+
+
+def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
+    """The shipped diagnoser was trained on four severity levels (0.25 apart): its conformal
+    half-width for a leak with every channel is ~1e-5 (the regressor learns the levels
+    exactly), which printed "0.88 (90 % interval 1.00..1.00)"-like claims for a machine between
+    two levels. The interval's half-width is at least half the levels' spacing; a diagnoser
+    trained on drawn severities keeps its conformal half-width."""
+    import copy
+    import json
+
+    from recipdyn.diagnosis.diagnose import default_model_path
+    from recipdyn.diagnosis.train import Diagnoser, load
+
+    diag = load(default_model_path())
+    card = json.loads(diag.state["datacard_json"])
+    levels = sorted(card["spec"]["levels"])
+    assert diag.severity_resolution == pytest.approx(0.5 * min(np.diff(levels)))
+    assert min(diag.state["conformal"]["ring_leak"].values()) < 1e-3  # the degenerate case
+    row = diag.state["center"][None, :].copy()  # a full-channel row (every group finite)
+    for label in diag.state["regressors"]:
+        s, lo, hi = diag.severity(row, label)
+        r = diag.severity_resolution  # the interval is [s - q, s + q] clipped to [0, 1]
+        assert hi[0] - lo[0] >= min(s[0] + r, 1.0) - max(s[0] - r, 0.0) - 1e-12, label
+    state = copy.copy(diag.state)
+    card["spec"]["severity_range"] = [0.25, 1.0]
+    state["datacard_json"] = json.dumps(card)
+    drawn = Diagnoser(state)
+    assert drawn.severity_resolution == 0.0
+    s, lo, hi = drawn.severity(row, "ring_leak")
+    q = diag.state["conformal"]["ring_leak"]["full"]
+    assert hi[0] - lo[0] <= 2 * q + 1e-12

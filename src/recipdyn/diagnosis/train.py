@@ -278,7 +278,21 @@ class Diagnoser:
         s = np.clip(_predict_subsets(reg, X, self.names, proba=False), 0.0, 1.0)
         subs = [available(row, self.names) for row in X]
         q = np.array([self.state["conformal"][label][k] for k in subs])
+        q = np.maximum(q, self.severity_resolution)
         return s, np.clip(s - q, 0, 1), np.clip(s + q, 0, 1)
+
+    @property
+    def severity_resolution(self) -> float:
+        """The narrowest half-width a severity interval may have: half the spacing of the
+        fixed levels the diagnoser was trained on (0 for drawn severities). A regressor
+        trained on four levels learns them exactly, and its conformal residuals on records of
+        those same levels are ~0, but a machine between two levels is not one of them: an
+        interval narrower than the levels' spacing claims what the data set cannot show."""
+        spec = json.loads(self.state["datacard_json"]).get("spec", {})
+        levels = sorted(spec.get("levels") or ())
+        if spec.get("severity_range") is not None or len(levels) < 2:
+            return 0.0
+        return 0.5 * float(np.min(np.diff(levels)))
 
     def ood(self, row: np.ndarray) -> tuple[float, float, str]:
         """(distance, threshold, subset) of one feature row."""
