@@ -565,7 +565,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
         sev[c] = {
             "median_relative_error": float(np.median(rel)),
             "coverage": float(cover.mean()),
-            "half_width": float(diag.state["conformal"][c]["full"]),
+            "half_width": max(float(diag.state["conformal"][c]["full"]), diag.severity_resolution),
             "n": int(m.sum()),
         }
         rel_all += rel.tolist()
