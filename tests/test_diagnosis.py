@@ -639,32 +639,34 @@ def test_deciding_features_are_the_subsets_and_their_z_is_bounded():
 
 
 def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
-    """The shipped diagnoser was trained on four severity levels (0.25 apart): its conformal
-    half-width for a leak with every channel is ~1e-5 (the regressor learns the levels
-    exactly), which printed "0.88 (90 % interval 1.00..1.00)"-like claims for a machine between
-    two levels. The interval's half-width is at least half the levels' spacing; a diagnoser
-    trained on drawn severities keeps its conformal half-width."""
+    """A diagnoser trained on fixed severity levels: its regressors learn the levels exactly
+    and the conformal half-width on records of those levels collapses (the leaks' was 1e-5
+    with every channel, which printed intervals such as 1.00..1.00 for any machine). Its
+    interval's half-width is at least half the levels' spacing. A diagnoser trained on drawn
+    severities (the shipped one) keeps its conformal half-width."""
     import copy
     import json
 
     from recipdyn.diagnosis.diagnose import default_model_path
     from recipdyn.diagnosis.train import Diagnoser, load
 
-    diag = load(default_model_path())
-    card = json.loads(diag.state["datacard_json"])
-    levels = sorted(card["spec"]["levels"])
-    assert diag.severity_resolution == pytest.approx(0.5 * min(np.diff(levels)))
-    assert min(diag.state["conformal"]["ring_leak"].values()) < 1e-3  # the degenerate case
-    row = diag.state["center"][None, :].copy()  # a full-channel row (every group finite)
-    for label in diag.state["regressors"]:
-        s, lo, hi = diag.severity(row, label)
-        r = diag.severity_resolution  # the interval is [s - q, s + q] clipped to [0, 1]
-        assert hi[0] - lo[0] >= min(s[0] + r, 1.0) - max(s[0] - r, 0.0) - 1e-12, label
-    state = copy.copy(diag.state)
-    card["spec"]["severity_range"] = [0.25, 1.0]
+    shipped = load(default_model_path())
+    card = json.loads(shipped.state["datacard_json"])
+    assert card["spec"]["severity_range"] is not None  # the shipped one: drawn severities
+    assert shipped.severity_resolution == 0.0
+    row = shipped.state["center"][None, :].copy()  # a full-channel row (every group finite)
+    label = "ring_leak"
+    q = shipped.state["conformal"][label]["full"]
+    s, lo, hi = shipped.severity(row, label)
+    assert (lo[0], hi[0]) == (max(s[0] - q, 0.0), min(s[0] + q, 1.0))
+    # the same diagnoser as if trained on four levels, with a collapsed conformal half-width
+    levels = [0.25, 0.5, 0.75, 1.0]
+    card["spec"].update(severity_range=None, levels=levels)
+    state = copy.deepcopy({k: shipped.state[k] for k in ("datacard_json", "conformal")})
     state["datacard_json"] = json.dumps(card)
-    drawn = Diagnoser(state)
-    assert drawn.severity_resolution == 0.0
-    s, lo, hi = drawn.severity(row, "ring_leak")
-    q = diag.state["conformal"]["ring_leak"]["full"]
-    assert hi[0] - lo[0] <= 2 * q + 1e-12
+    state["conformal"][label] = dict.fromkeys(state["conformal"][label], 1e-5)
+    fixed = Diagnoser({**shipped.state, **state})
+    r = fixed.severity_resolution
+    assert r == pytest.approx(0.125)
+    s, lo, hi = fixed.severity(row, label)
+    assert (lo[0], hi[0]) == pytest.approx((max(s[0] - r, 0.0), min(s[0] + r, 1.0)), abs=1e-15)
