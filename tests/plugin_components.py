@@ -107,9 +107,9 @@ KELVIN_VOIGT = Component(
     kernels={"normal": "kv_normal", "elastic": "kv_elastic"},
     pack=lambda v: np.array([v["kv_stiffness"], v["kv_damping"]]),
     params=(
-        Param("kv_stiffness", "N/m", 1.0e10, "contact stiffness k", 0.0, 1e13, low_open=True,
+        Param("kv_stiffness", "N/m", 1.0e9, "contact stiffness k", 0.0, 1e13, low_open=True,
               group="joint"),
-        Param("kv_damping", "N*s/m", 3.0e5, "contact damping c", 0.0, 1e9, group="joint"),
+        Param("kv_damping", "N*s/m", 1.0e5, "contact damping c", 0.0, 1e9, group="joint"),
     ),
 )  # fmt: skip
 
