@@ -676,8 +676,10 @@ def law_source(law, offset: int) -> str:
     head = [f"from {law.module} import {law.kernel(r)} as law_{r}" for r in LAW_ROLES]
     if "friction" in law.kernels:
         head.append(f"from {law.module} import {law.kernel('friction')} as law_friction")
-    head.append("from recipdyn.model.compressor_contact import (_abs, _kinematics, "
-                "friction_factor, short_bearing_forces, " + ", ".join(names) + ")")
+    head.append(
+        "from recipdyn.model.compressor_contact import (_abs, _kinematics, "
+        "friction_factor, short_bearing_forces, " + ", ".join(names) + ")"
+    )
     body = [pair] + [inspect.getsource(f.py_func) for f in (_joints, _joints_guide)]
     return "\n".join(head) + "\n\n\n" + "\n\n".join(body)
 

@@ -43,8 +43,14 @@ import numpy as np
 
 from ..protocol import Param
 
-__all__ = ["Component", "Assembly", "check_fragments", "glue_module", "resolve_component",
-           "source_digest"]
+__all__ = [
+    "Component",
+    "Assembly",
+    "check_fragments",
+    "glue_module",
+    "resolve_component",
+    "source_digest",
+]
 
 
 def _no_params(values: Mapping[str, Any]) -> np.ndarray:
