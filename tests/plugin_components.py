@@ -1,7 +1,10 @@
-"""Two components added to the compressor from this one file, recipdyn untouched (issue 30,
-item 6; docs/components.md): a load and a motor torque law. Used by
-``tests/test_plugin_components.py`` as ``--set load=tests/plugin_components.py:HARMONIC`` and
-``--set drive=motor --set motor=tests/plugin_components.py:LINEAR``."""
+"""Components added to the compressor from this one file, recipdyn untouched (issue 30,
+item 6; docs/components.md): a load, a motor torque law and two contact laws of the pin joints.
+Used by ``tests/test_plugin_components.py`` as
+``--set load=tests/plugin_components.py:HARMONIC``,
+``--set drive=motor --set motor=tests/plugin_components.py:LINEAR`` and
+``--set crank_joint=contact --set contact_law=tests/plugin_components.py:KELVIN_VOIGT``, and
+by ``tests/test_contact_law_plugin.py``."""
 
 import math
 
@@ -51,6 +54,68 @@ LINEAR = Component(
               low_open=True, group="drive"),
     ),
 )  # fmt: skip
+
+# -- contact laws of the pin joints (family ``contact_law``). Their functions take complex
+# arguments too (the joints' Jacobian is the complex step): branches on the real part.
+
+
+@nb.njit(cache=True, inline="always")
+def ln_normal(delta, ddelta, v_impact, K, p, o):
+    """Lankarani & Nikravesh (1990) written again: ``K delta^1.5 (1 + chi delta' / v-)``,
+    clamped at 0 (slice: chi)."""
+    f = K * delta * np.sqrt(delta) * (1.0 + p[o] * ddelta / v_impact)
+    return f if f.real > 0.0 else 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def hertz_elastic(delta, K, p, o):
+    """Hertz's elastic force ``K delta^1.5``."""
+    return K * delta * np.sqrt(delta)
+
+
+@nb.njit(cache=True, inline="always")
+def hertz_potential(delta, K, p, o):
+    """Its energy ``K delta^2.5 / 2.5``."""
+    return K * delta**2.5 / 2.5
+
+
+LANKARANI = Component(
+    "contact_law", "ln-again", "Lankarani-Nikravesh, from a user's file", module=__name__,
+    kernels={"normal": "ln_normal", "elastic": "hertz_elastic", "potential": "hertz_potential"},
+    pack=lambda v: np.array([0.75 * (1.0 - v["ln_restitution"] * v["ln_restitution"])]),
+    params=(Param("ln_restitution", "", 0.9, "nominal coefficient of restitution", 0.0, 1.0,
+                  low_open=True, group="joint"),),
+)  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always")
+def kv_normal(delta, ddelta, v_impact, K, p, o):
+    """A linear spring and dashpot (Kelvin-Voigt) ``k delta + c delta'``, clamped at 0 (a
+    contact cannot pull); K and the approach velocity are not used (slice: k, c)."""
+    f = p[o] * delta + p[o + 1] * ddelta
+    return f if f.real > 0.0 else 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def kv_elastic(delta, K, p, o):
+    """The spring ``k delta``."""
+    return p[o] * delta
+
+
+KELVIN_VOIGT = Component(
+    "contact_law", "kelvin-voigt", "a linear spring-dashpot contact", module=__name__,
+    kernels={"normal": "kv_normal", "elastic": "kv_elastic"},
+    pack=lambda v: np.array([v["kv_stiffness"], v["kv_damping"]]),
+    params=(
+        Param("kv_stiffness", "N/m", 1.0e9, "contact stiffness k", 0.0, 1e13, low_open=True,
+              group="joint"),
+        Param("kv_damping", "N*s/m", 1.0e5, "contact damping c", 0.0, 1e9, group="joint"),
+    ),
+)  # fmt: skip
+
+#: A contact law without its elastic part: refused (the power lost needs it).
+NO_ELASTIC = Component("contact_law", "broken", "a normal force alone", module=__name__,
+                       kernels={"normal": "kv_normal"})  # fmt: skip
 
 #: Not a component: a spec naming it is refused.
 NOT_A_COMPONENT = 42

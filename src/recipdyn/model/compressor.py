@@ -32,6 +32,7 @@ from .components.contract import (
     check_fragments,
     glue_module,
     resolve_component,
+    source_digest,
 )
 from .components.drive import DRIVES, MOTORS
 from .components.load import cycle_outputs, cycle_summary, load_component
@@ -89,18 +90,10 @@ def _kernels(equations: str, drive: str, motor: str | None, load: str,
     for c in (load_c, motor_c):  # a user's file: its edits give a new glue file, never stale
         if c is not None and c.module not in ("recipdyn", "") and not c.module.startswith(
                 "recipdyn."):  # fmt: skip
-            src += f"\n# {c.family} = {c.module}: {_source_digest(c.module)}\n"
+            src += f"\n# {c.family} = {c.module}: {source_digest(c.module)}\n"
     stem = f"compressor_{drive}_{load_c.name}_{equations}".replace("-", "_")  # fmt: skip
     mod = glue_module(src, stem if motor_c is None else f"{stem}_{motor_c.name}")
     return mod.rhs, mod.jac, mod.rhs_jac, mod.observe
-
-
-def _source_digest(module: str) -> str:
-    import hashlib
-    import sys
-
-    path = getattr(sys.modules.get(module), "__file__", None)
-    return hashlib.sha1(open(path, "rb").read()).hexdigest()[:16] if path else "?"
 
 
 @dataclass(frozen=True)

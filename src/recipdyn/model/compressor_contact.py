@@ -259,8 +259,8 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
     et = tx * u + ty * v
     Rb = Rj + c
     if delta.real > 0.0:
-        fn = normal_force(delta, drho, v_imp if v_imp.real > p[P_VMIN] else p[P_VMIN], K,
-                          p[P_CHI])  # fmt: skip
+        vi = v_imp if v_imp.real > p[P_VMIN] else p[P_VMIN]  # (the floor: grazing contacts)
+        fn = normal_force(delta, drho, vi, K, p[P_CHI])
         vt = et + w_j * Rj - w_b * Rb  # sliding velocity, bearing relative to journal
         ft = fn * friction_factor(vt, p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]))
         fx = -fn * nx + ft * tx
@@ -610,6 +610,80 @@ def load_part(values: Mapping[str, Any]):
     return load_component(values)
 
 
+#: The roles of a contact law from a user's file (`law_part`): required, then optional.
+LAW_ROLES = ("normal", "elastic")
+LAW_OPTIONAL = ("friction", "potential")
+
+
+def law_spec(values: Mapping[str, Any]) -> str | None:
+    """The ``contact_law`` of ``values`` (or its alias ``law``) if it names a component of a
+    user's module or file (``file.py:OBJ``), else None (one of the built-in laws, `LAWS`)."""
+    from .registry import is_spec
+
+    spec = values.get("contact_law", values.get("law"))
+    return spec if is_spec(spec) else None
+
+
+def law_part(values: Mapping[str, Any]):
+    """The contact-law component a user's file gives (``contact_law = file.py:OBJ``), or None
+    for a built-in law. It must be of the family ``contact_law`` and provide the roles
+    `LAW_ROLES` (module ``recipdyn.model.components.contact``, docs/components.md);
+    [`ParameterError`][recipdyn.errors.ParameterError] in one line otherwise."""
+    from ..errors import ParameterError
+    from .components.contract import resolve_component
+
+    spec = law_spec(values)
+    if spec is None:
+        return None
+    law = resolve_component("contact_law", spec, {})
+    missing = [r for r in LAW_ROLES if r not in law.kernels]
+    if missing:
+        raise ParameterError(f"contact_law = {spec!r} provides no {' or '.join(missing)} "
+                             f"kernel; a contact law provides {', '.join(LAW_ROLES)} and "
+                             f"optionally {', '.join(LAW_OPTIONAL)}")  # fmt: skip
+    return law
+
+
+def law_size(values: Mapping[str, Any]) -> int:
+    """The length of the contact law's slice (0 for a built-in law: its ``chi`` is in the
+    joints' part, `P_CHI`). The slice follows the joints' part; the guide's and the load's
+    follow it."""
+    law = law_part(values)
+    return 0 if law is None else int(np.asarray(law.pack(values)).size)
+
+
+def law_source(law, offset: int) -> str:
+    """The joints' force functions (`_pair`, `_joints`, `_joints_guide`) with the contact law
+    ``law`` of a user's file, its slice at ``offset``: the source of the built-in functions
+    with the law's calls in place of the built-in normal force, its elastic part (in the
+    power lost) and, if the law has one, the friction; the rest (kinematics, the oil film,
+    the torques) is the same text, so the physics stays written once. For the generated glue
+    (`recipdyn.model.components.contact`)."""
+    import inspect
+
+    pair = inspect.getsource(_pair.py_func)
+    swaps = {"normal_force(delta, drho, vi, K, p[P_CHI])":
+             f"law_normal(delta, drho, vi, K, p, {offset})",
+             "K * delta * np.sqrt(delta)": f"law_elastic(delta, K, p, {offset})"}  # fmt: skip
+    if "friction" in law.kernels:
+        swaps["friction_factor(vt, p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]))"] = (
+            f"law_friction(vt, p, {offset})")  # fmt: skip
+    for old, new in swaps.items():
+        if pair.count(old) != 1:  # pragma: no cover - guards an edit of _pair
+            raise RuntimeError(f"_pair no longer holds {old!r} once; update law_source")
+        pair = pair.replace(old, new)
+    names = sorted(k for k in globals() if k.startswith("P_"))
+    head = [f"from {law.module} import {law.kernel(r)} as law_{r}" for r in LAW_ROLES]
+    if "friction" in law.kernels:
+        head.append(f"from {law.module} import {law.kernel('friction')} as law_friction")
+    head.append(
+        "from recipdyn.model.compressor_contact import (_abs, _kinematics, "
+        "friction_factor, short_bearing_forces, " + ", ".join(names) + ")"
+    )
+    body = [pair] + [inspect.getsource(f.py_func) for f in (_joints, _joints_guide)]
+    return "\n".join(head) + "\n\n\n" + "\n\n".join(body)
+
+
 #: The guide's slice, with its clearance: after the joints' part, before the load's.
 N_GUIDE = len(CLEARANCE.pack({"d": 0.0, "crosshead_half_length": 1.0,
                               "crosshead_half_height": 1.0, "guide_clearance": 0.0,
@@ -641,27 +715,42 @@ def first_load_state(values: Mapping[str, Any]) -> int:
 
 
 @lru_cache(maxsize=32)
-def _glue(joints: str, load: str, guide: bool = False):
+def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
+          n_law: int = 0):  # fmt: skip
     from .components.contact import glue_source
-    from .components.contract import glue_module
+    from .components.contract import glue_module, resolve_component, source_digest
     from .components.load import LOADS, VALVES
 
     part = VALVES if load == VALVES.name else LOADS[load]
+    block, stem = "", f"contact_{joints}_{load}"
+    if law is not None:  # a contact law of a user's file: its slice first, after the joints'
+        law_c = resolve_component("contact_law", law, {})
+        block = law_source(law_c, N_PACKED)
+        # its edits give a new glue file, never stale machine code
+        block += f"\n# contact_law = {law_c.module}: {source_digest(law_c.module)}\n"
+        stem += f"_{law_c.name}".replace("-", "_")
     if not guide:
-        src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED,
-                          first_state=G_GAS)  # fmt: skip
-        return glue_module(src, f"contact_{joints}_{load}")
-    src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + N_GUIDE,
-                      first_state=G_GAS + N_GUIDE_STATES, guide=N_PACKED,
-                      guide_state=G_GUIDE)  # fmt: skip
-    return glue_module(src, f"contact_{joints}_{load}_guide")
+        src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
+                          first_state=G_GAS, law=block)  # fmt: skip
+        return glue_module(src, stem)
+    src = glue_source(cfg=CFG[joints], joints=joints, load=part,
+                      offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
+                      guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block)  # fmt: skip
+    return glue_module(src, f"{stem}_guide")
 
 
 def kernels(values: Mapping[str, Any], load=None):
-    """The generated glue of the joints, the guide and the load ``values`` choose (or
-    ``load``): a module with ``rhs``, ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe``
-    and ``fd_jac`` (`recipdyn.model.components.contact`)."""
+    """The generated glue of the joints, the guide, the load ``values`` choose (or ``load``)
+    and the contact law of a user's file if one is chosen: a module with ``rhs``, ``jac``,
+    ``rhs_jac``, ``event``, ``reset``, ``observe`` and ``fd_jac``
+    (`recipdyn.model.components.contact`)."""
     part = load_part(values) if load is None else load
+    spec = law_spec(values)
+    if spec is not None:
+        from .registry import absolute_spec
+
+        return _glue(values["clearance_joints"], part.name, has_guide(values),
+                     absolute_spec(spec), law_size(values))  # fmt: skip
     if has_guide(values):
         return _glue(values["clearance_joints"], part.name, True)
     return _glue(values["clearance_joints"], part.name)
@@ -798,20 +887,49 @@ def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
     head = [v[k] for k in MECH] + [0.0] * len(INPUTS)
     head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
              v["rc_crosshead"], stiffness(v, "crosshead"), v["crosshead_pin_radius"],
-             hysteresis_factor(v["contact_law"], v["restitution"]), v["friction"], v["v0"],
+             0.0 if law_spec(v) else hysteresis_factor(v["contact_law"], v["restitution"]),
+             v["friction"], v["v0"],
              v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
              v["oil_viscosity"] if pins[0] == "lubricated" else 0.0, v["bearing_length"],
              v["eps_dry"], v["v_impact_min"],
              v["oil_viscosity"] if pins[1] == "lubricated" else 0.0]  # fmt: skip
     part = load_part(v) if load is None else load
+    law = law_part(v)  # a contact law of a user's file: its slice first
+    first = () if law is None else (law,)
+    n_law = law_size(v)
     if has_guide(v):
-        vec, offsets = Assembly(N_PACKED, (CLEARANCE, part)).pack(
+        vec, offsets = Assembly(N_PACKED, (*first, CLEARANCE, part)).pack(
             np.asarray(head, dtype=np.float64), v)  # fmt: skip
-        assert offsets["guide"] == N_PACKED and offsets["load"] == N_PACKED + N_GUIDE
+        assert offsets["guide"] == N_PACKED + n_law  # literals in the glue
+        assert offsets["load"] == N_PACKED + n_law + N_GUIDE
         return vec
-    vec, offsets = Assembly(N_PACKED, (part,)).pack(np.asarray(head, dtype=np.float64), v)
-    assert offsets["load"] == N_PACKED  # a literal in the glue
+    vec, offsets = Assembly(N_PACKED, (*first, part)).pack(np.asarray(head, dtype=np.float64),
+                                                           v)  # fmt: skip
+    assert offsets["load"] == N_PACKED + n_law  # a literal in the glue
     return vec
+
+
+def _law_energy(values: Mapping[str, Any], delta: np.ndarray, joint: str) -> np.ndarray:
+    """The elastic energy stored at penetrations ``delta`` (>= 0) by the contact law of a
+    user's file: its ``potential(delta, K, p, o)`` if it has one, else the integral of its
+    ``elastic`` force from 0 to ``delta`` (adaptive quadrature, relative error 1e-12)."""
+    import importlib
+
+    from scipy.integrate import quad
+
+    law = law_part(values)
+    mod = importlib.import_module(law.module)
+    p, o, K = pack(values), N_PACKED, stiffness(values, joint)
+    out = np.zeros_like(delta)
+    if "potential" in law.kernels:
+        fun = getattr(mod, law.kernel("potential"))
+        for i in np.flatnonzero(delta > 0.0):
+            out[i] = fun(float(delta[i]), K, p, o)
+        return out
+    fun = getattr(mod, law.kernel("elastic"))
+    for i in np.flatnonzero(delta > 0.0):
+        out[i] = quad(fun, 0.0, float(delta[i]), args=(K, p, o), epsabs=0.0, epsrel=1e-12)[0]
+    return out
 
 
 def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
@@ -833,8 +951,11 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
     pot = m2 * g * (r * np.sin(th1) + e1y + ls * s2)
     d1 = np.maximum(np.hypot(e1x, e1y) - float(values["rc"]), 0.0)
     d2 = np.maximum(np.hypot(e2x, e2y) - float(values["rc_crosshead"]), 0.0)
-    elastic = stiffness(values, "crank") * d1**2.5 / 2.5
-    elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
+    if law_spec(values) is not None:
+        elastic = _law_energy(values, d1, "crank") + _law_energy(values, d2, "crosshead")
+    else:
+        elastic = stiffness(values, "crank") * d1**2.5 / 2.5
+        elastic = elastic + stiffness(values, "crosshead") * d2**2.5 / 2.5
     if has_guide(values):  # the crosshead's lateral motion, tilt and weight
         from .components.guide import tilt_inertia
 
@@ -842,6 +963,33 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray) -> dict[str,
         kin = kin + 0.5 * (m3 * ygd**2 + tilt_inertia(values) * phid**2)
         pot = pot + m3 * g * yg
     return {"mechanical": kin + pot, "elastic": elastic}
+
+
+_LAW_SCHEMAS: dict[tuple[int, str], tuple[Schema, Schema]] = {}
+
+
+def _law_schema(schema: Schema, spec: str) -> Schema:
+    """``schema`` with the contact law ``spec`` of a user's file (remembered per schema and
+    spec): the spec one more choice of ``contact_law``, the law's fragment appended (a name
+    that ``schema`` already has is refused)."""
+    from dataclasses import replace
+
+    from ..errors import ParameterError
+    from .components.contract import check_fragments
+
+    key = (id(schema), spec)
+    hit = _LAW_SCHEMAS.get(key)
+    if hit is None or hit[0] is not schema:
+        law = law_part({"contact_law": spec})
+        try:
+            check_fragments((law,), base=schema.params)
+        except ValueError as exc:
+            raise ParameterError(f"contact_law = {spec!r}: {exc}") from None
+        params = tuple(replace(p, choices=(*p.choices, spec)) if p.name == "contact_law" else p
+                       for p in schema)  # fmt: skip
+        hit = _LAW_SCHEMAS[key] = schema, Schema((*params, *law.params), schema.aliases,
+                                                 schema.extras)  # fmt: skip
+    return hit[1]
 
 
 class CompressorContact(Model):
@@ -886,6 +1034,27 @@ class CompressorContact(Model):
         if values["v1"] <= values["v0"]:
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
+        law = law_part(values)
+        if law is not None:
+            if values.get("clearance_joints") == "ideal":
+                raise ParameterError(
+                    f"contact_law = {values['contact_law']!r}: no pin joint has contact in "
+                    "this configuration (both pins ideal); a contact law belongs to "
+                    "crank_joint or crosshead_joint = 'contact' | 'lubricated'"
+                )
+            if law.check is not None:
+                law.check(values)
+
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """The schema; with a contact law of a user's file (``contact_law = file.py:OBJ``)
+        that spec one more choice of ``contact_law`` and the law's fragment appended (its
+        parameters validated, recorded and swept like the built-in ones)."""
+        from .registry import absolute_spec
+
+        spec = law_spec(values)
+        if spec is None:
+            return self.schema
+        return _law_schema(self.schema, absolute_spec(spec))
 
     def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
         """Validated values; besides the schema's, a force table as the massless link takes
@@ -894,9 +1063,14 @@ class CompressorContact(Model):
         diagram, a CSV file, `recipdyn.model.load.read_pressure_table`, with this run's bore,
         rod diameter and frame pressure). The table replaces the ``load`` (the table load
         component)."""
+        from .registry import absolute_spec, is_spec
+
         v = {**(values or {}), **kw}
         table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
-        out = self.schema.validate(v)
+        for k in ("contact_law", "law"):  # a law of a user's file: found from any folder
+            if is_spec(v.get(k)):
+                v[k] = absolute_spec(v[k])
+        out = self.schema_for(v).validate(v)
         _resolve_joints(out)
         self.check(out)
         tab = self._table(out, table, ptab)

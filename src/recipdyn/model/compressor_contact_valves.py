@@ -55,9 +55,11 @@ P_VALVE = cc.N_PACKED + cy.N_CYCLE
 
 def _layout(values: Mapping[str, Any]) -> tuple[int, int, int]:
     """The first gas state, the first mass counter, and the load's offset in the parameter
-    vector (after the guide's states and slice, with its clearance)."""
+    vector (after a user's contact law's slice, and the guide's states and slice, with its
+    clearance)."""
     g = cc.first_load_state(values)
-    return g, g + va.N_GAS, cc.N_PACKED + (cc.N_GUIDE if cc.has_guide(values) else 0)
+    lo = cc.N_PACKED + cc.law_size(values) + (cc.N_GUIDE if cc.has_guide(values) else 0)
+    return g, g + va.N_GAS, lo
 
 
 _DROP = {"load", "load_amplitude", "load_sign", "gas"}

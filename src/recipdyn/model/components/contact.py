@@ -16,6 +16,22 @@ configuration, the load's offset ``LO`` in the parameter vector and its first st
 * else ``force_sc`` from the sine and cosine of the crank angle the kinematics computed, or
   ``force`` of the crank angle.
 
+A contact law from a user's file (``contact_law = file.py:OBJ``, a `Component` of the family
+``contact_law``) replaces the built-in normal-force law at the pins: the glue then defines the
+joints' force functions itself, with the law's functions imported and its offset a literal
+(`recipdyn.model.compressor_contact.law_source`). Its roles, each a ``numba.njit(inline=
+"always")`` function of scalars and ``(p, o)`` that takes complex arguments too (the Jacobian is
+the complex step; branch on ``.real``):
+
+* ``normal(delta, ddelta, v_impact, K, p, o) -> F_n``: the normal force at penetration
+  ``delta > 0``, its rate and the approach velocity of the impact; ``K`` is the Hertz stiffness
+  of the pin (from the radii and materials, or the ``K`` given), which the law may ignore;
+* ``elastic(delta, K, p, o) -> F``: the conservative part of ``F_n`` (the joint's power lost is
+  ``(F_n - elastic) ddelta - F_t v_t``);
+* optionally ``friction(vt, p, o) -> F_t / F_n`` at sliding velocity ``vt`` (default: the
+  built-in ``friction_law``), and ``potential(delta, K, p, o)``, the elastic energy (default:
+  the integral of ``elastic``; it enters the recorded ``energy``).
+
 No kind code is read at run time, and a load's function is never called with another's slice.
 """
 
@@ -412,11 +428,15 @@ def reset(t, y, p, out):
 
 
 def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
-                guide: int | None = None, guide_state: int | None = None) -> str:  # fmt: skip
+                guide: int | None = None, guide_state: int | None = None,
+                law: str = "") -> str:  # fmt: skip
     """The glue module's source for the joints ``cfg`` (0 crank, 1 crosshead, 2 both; 3 both
     ideal, with the guide's clearance only) and the load component ``load`` whose slice starts
     at ``offset`` (its states, if any, at ``first_state``: module docstring); with the guide's
-    clearance, ``guide`` is the offset of its slice and ``guide_state`` its first state."""
+    clearance, ``guide`` is the offset of its slice and ``guide_state`` its first state.
+    ``law``: the joints' force functions with a contact law of a user's file
+    (`recipdyn.model.compressor_contact.law_source`), defined here in place of the built-in
+    ones; empty for a built-in law (the glue then imports the joints' functions)."""
     stateful = bool(load.states)
     fill = dict(combo=f"clearance_joints={joints}, load={load.name}", CFG=cfg, LO=offset,
                 G=first_state, A=first_state + len(load.states), module=load.module)  # fmt: skip
@@ -433,6 +453,8 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     if guide is not None:
         fill.update(GO=guide, GY=guide_state)
         src += _GUIDE_HEADER
+        if law:
+            src += "\n\n" + law
         src += _GUIDE_BODY.format(
             STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
             JAC=_JAC_FD if stateful else _JAC_CS,
@@ -443,6 +465,8 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
             LOAD_RESET=(f"        load_reset(y, {first_state}, p, {offset}, out)" if stateful
                         else "        pass"), **fill)  # fmt: skip
         return src
+    if law:
+        src += "\n\n" + law
     src += _BODY.format(STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
                         JAC=_JAC_FD if stateful else _JAC_CS, **fill)  # fmt: skip
     src += _STATE_EVENTS.format(**fill) if stateful else "\n\n" + _EVENTS[cfg]

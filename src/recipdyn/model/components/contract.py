@@ -43,7 +43,14 @@ import numpy as np
 
 from ..protocol import Param
 
-__all__ = ["Component", "Assembly", "check_fragments", "glue_module", "resolve_component"]
+__all__ = [
+    "Component",
+    "Assembly",
+    "check_fragments",
+    "glue_module",
+    "resolve_component",
+    "source_digest",
+]
 
 
 def _no_params(values: Mapping[str, Any]) -> np.ndarray:
@@ -118,6 +125,17 @@ def resolve_component(family: str, name: str, builtin: Mapping[str, Component]) 
         raise ParameterError(f"{family} = {name!r} is {got}, not a {family} component "
                              "(recipdyn.model.components.contract.Component)")  # fmt: skip
     return obj
+
+
+def source_digest(module: str) -> str:
+    """A short hash of the source file of the imported ``module`` (a user's component): written
+    into the generated glue, so an edited component gives a new glue file, never stale
+    machine code."""
+    path = getattr(sys.modules.get(module), "__file__", None)
+    if not path:
+        return "?"
+    with open(path, "rb") as fh:
+        return hashlib.sha1(fh.read()).hexdigest()[:16]
 
 
 def check_fragments(components: Iterable[Component], base: Iterable[Param] = ()) -> None:
