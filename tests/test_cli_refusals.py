@@ -285,3 +285,20 @@ def test_first_run_says_it_compiles_before_compiling(tmp_path):
     assert first.stderr.startswith("compiling the lorenz model's kernels (first run only")
     again = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert again.returncode == 0 and "compiling" not in again.stderr
+
+
+def test_a_record_too_short_for_the_signal_estimators_is_refused(tmp_path, monkeypatch, capsys):
+    """A record of 64-199 samples passed analyze's length check and then stopped inside the
+    signal's exponent estimators (which need MIN_SIGNAL_SAMPLES): "internal error", exit 1.
+    It is refused up front now: exit 2, one line naming the length and the remedy."""
+    from recipdyn.defaults import MIN_SIGNAL_SAMPLES
+
+    monkeypatch.chdir(tmp_path)
+    # one forcing period of the Duffing oscillator (5.24 time units) at 30 samples a unit
+    assert main(["simulate", "--model", "duffing", "--revolutions", "1", "--fs", "30", "-o",
+                 "short.nc", "--no-progress"]) == 0  # fmt: skip
+    capsys.readouterr()
+    code = main(["analyze", "short.nc"])
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert code == 2 and len(err) == 1, err
+    assert f"analyze needs at least {MIN_SIGNAL_SAMPLES}" in err[0] and "Traceback" not in err[0]
