@@ -65,7 +65,7 @@ def simulate_channels(job):
 def main() -> None:
     from recipdyn.diagnosis import default_model_path, load
     from recipdyn.diagnosis.dataset import DatasetSpec, design, features_of
-    from recipdyn.diagnosis.diagnose import RING_SLACK
+    from recipdyn.diagnosis.diagnose import FLOOR_SLACK, RING_SLACK, noise_floor
     from recipdyn.errors import deferred_signals
     from recipdyn.parallel import run_unordered
 
@@ -153,7 +153,9 @@ def main() -> None:
             lo, hi = diag.state["ring_range"]
             d, thr, _ = diag.ood(x[0])
             ring_ok = lo * (1 - RING_SLACK) <= f["acc_ring_hz"] <= hi * (1 + RING_SLACK)
-            refused += (not ring_ok) or d > thr
+            floor = noise_floor(diag, x[0])
+            floor_ok = floor is None or floor[1] / FLOOR_SLACK <= floor[0] <= floor[2] * FLOOR_SLACK
+            refused += (not ring_ok) or (not floor_ok) or d > thr
             ok = classes[int(np.argmax(diag.predict_proba(x)[0]))] == t["label"]
             right += ok
             n += 1
