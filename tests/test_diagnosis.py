@@ -691,3 +691,14 @@ def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
     assert r == pytest.approx(0.125)
     s, lo, hi = fixed.severity(row, label)
     assert (lo[0], hi[0]) == pytest.approx((max(s[0] - r, 0.0), min(s[0] + r, 1.0)), abs=1e-15)
+
+
+def test_the_impacts_evidence_names_distinct_places_of_the_revolution():
+    """The same knock in ten revolutions printed as "35, 35, 35, 35, 39, 224": the angles now
+    name the largest impacts at places at least 5 degrees apart (across 0/360 too)."""
+    from recipdyn.diagnosis.diagnose import _top_angles
+
+    imp = {"angles_deg": [35.2, 34.8, 35.1, 224.0, 39.0, 358.0, 1.0, 120.0, 35.3],
+           "sizes": [9.0, 8.5, 8.0, 7.0, 6.5, 6.0, 5.5, 1.0, 7.5]}  # fmt: skip
+    assert _top_angles(imp, n=6) == [35.2, 120.0, 224.0, 358.0]
+    assert _top_angles(imp, n=2) == [35.2, 224.0]

@@ -372,9 +372,18 @@ def _refuse(res: Diagnosis, reason: str, t0: float) -> Diagnosis:
     return res
 
 
-def _top_angles(imp, n: int = 6) -> list[float]:
-    order = np.argsort(imp["sizes"])[::-1][:n]
-    return sorted(round(imp["angles_deg"][i], 1) for i in order)
+def _top_angles(imp, n: int = 6, apart_deg: float = 5.0) -> list[float]:
+    """The crank angles of the ``n`` largest impacts at distinct places of the revolution: an
+    impact within ``apart_deg`` of a larger one kept already (the same knock in another
+    revolution) is passed over, so the list names places, not repeats."""
+    kept: list[float] = []
+    for i in np.argsort(imp["sizes"])[::-1]:
+        a = float(imp["angles_deg"][i])
+        if all(abs((a - b + 180.0) % 360.0 - 180.0) > apart_deg for b in kept):
+            kept.append(a)
+            if len(kept) == n:
+                break
+    return sorted(round(a, 1) for a in kept)
 
 
 def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
