@@ -702,3 +702,30 @@ def test_the_impacts_evidence_names_distinct_places_of_the_revolution():
            "sizes": [9.0, 8.5, 8.0, 7.0, 6.5, 6.0, 5.5, 1.0, 7.5]}  # fmt: skip
     assert _top_angles(imp, n=6) == [35.2, 120.0, 224.0, 358.0]
     assert _top_angles(imp, n=2) == [35.2, 224.0]
+
+
+def test_drawn_snrs_are_seeded_in_range_and_leave_the_rest_of_the_design():
+    """With an SNR range, each record's accelerometer SNR is its own uniform draw in the range,
+    the same for the same seed; every other field of every task is that of the fixed-SNR
+    design (the conditions, severities, noise seeds), and a fixed-SNR spec keeps its JSON
+    identity (the setting is left out while None: stores resume). A bad range is refused
+    in one line naming the setting."""
+    from recipdyn.cli import main
+
+    fixed = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3)
+    drawn = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3,
+                        snr_range=(10.0, 40.0))  # fmt: skip
+    a, b = design(fixed), design(drawn)
+    snr = np.array([t["snr_db"] for t in b])
+    assert {t["snr_db"] for t in a} == {20.0}
+    assert snr.min() >= 10.0 and snr.max() <= 40.0 and len(set(snr.tolist())) == len(b)
+    assert snr.max() - snr.min() > 15.0  # spread over the range, not a constant
+    assert [t["snr_db"] for t in design(drawn)] == snr.tolist()
+    for x, y in zip(a, b, strict=True):
+        assert {k: v for k, v in x.items() if k != "snr_db"} == {
+            k: v for k, v in y.items() if k != "snr_db"
+        }
+    assert "snr_range" not in fixed.to_json() and '"snr_range": [10.0, 40.0]' in drawn.to_json()
+    with pytest.raises(ParameterError, match="snr_range"):
+        DatasetSpec(snr_range=(40.0, 10.0))
+    assert main(["dataset", "--snr-range", "40,x", "-o", "unused-folder"]) == 2

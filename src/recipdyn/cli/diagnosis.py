@@ -21,6 +21,17 @@ def _levels(text: str, name: str = "levels", example: str = "0.25,0.5,0.75,1"):
         ) from None
 
 
+def _snrs(text: str):
+    from ..errors import ParameterError
+
+    try:
+        return tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise ParameterError(
+            f"snr_range = {text!r}; allowed: two SNRs in dB, LO,HI, e.g. 10,40"
+        ) from None
+
+
 @app.command()
 def dataset(
     out: Path = typer.Option(Path("out/dataset"), "--out", "-o", help="Data set folder."),
@@ -38,6 +49,12 @@ def dataset(
         "as many as --levels).",
     ),
     snr: float = typer.Option(20.0, "--snr", help="Accelerometer SNR, dB."),
+    snr_range: str = typer.Option(
+        None,
+        "--snr-range",
+        help="LO,HI: draw each record's accelerometer SNR uniformly in [LO, HI] dB (seeded) "
+        "instead of --snr for all.",
+    ),
     revolutions: float = typer.Option(2.0, help="Revolutions recorded per record."),
     transient: float = typer.Option(1.0, help="Revolutions discarded first."),
     classes: str = typer.Option(None, help="Comma list of classes (default: all)."),
@@ -62,6 +79,8 @@ def dataset(
     if severity_range is not None:
         kw["severity_range"] = _levels(severity_range, "severity_range", "0.1,1")
         kw["severity_draws"] = draws
+    if snr_range is not None:
+        kw["snr_range"] = _snrs(snr_range)
     spec = DatasetSpec(
         n_conditions=conditions,
         levels=_levels(levels),

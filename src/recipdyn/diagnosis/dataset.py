@@ -92,6 +92,10 @@ class DatasetSpec:
     severity_draws : int or None
         With ``severity_range``: records of each class at each condition (default: as many
         as ``levels``). Ignored without it.
+    snr_range : (float, float) or None
+        Each record's accelerometer SNR drawn uniformly in ``[lo, hi]`` dB (seeded per
+        condition, class and record) instead of ``snr_db`` for all, so that a diagnoser learns
+        the machine apart from the sensor's noise floor (docs/diagnosis.md, robustness).
 
     Notes
     -----
@@ -110,6 +114,7 @@ class DatasetSpec:
     classes: tuple[str, ...] = field(default_factory=lambda: tuple(class_names()))
     severity_range: tuple[float, float] | None = None
     severity_draws: int | None = None
+    snr_range: tuple[float, float] | None = None
 
     def __post_init__(self):
         if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
@@ -144,6 +149,17 @@ class DatasetSpec:
                     f"severity_range = {r!r}; allowed: two severities 0 <= lo < hi <= 1"
                 )
             object.__setattr__(self, "severity_range", (lo, hi))
+        r = self.snr_range
+        if r is not None:
+            try:
+                lo, hi = (float(v) for v in r)
+            except (TypeError, ValueError):
+                lo = hi = math.nan
+            if not -20 <= lo < hi <= 200:
+                raise ParameterError(
+                    f"snr_range = {r!r}; allowed: two SNRs -20 <= lo < hi <= 200 dB"
+                )
+            object.__setattr__(self, "snr_range", (lo, hi))
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
@@ -164,7 +180,7 @@ class DatasetSpec:
         """The spec's identity (a store holds the data set of exactly this string); the
         continuous-severity settings are left out while None (fixed levels)."""
         d = asdict(self)
-        for k in ("severity_range", "severity_draws"):
+        for k in ("severity_range", "severity_draws", "snr_range"):
             if d[k] is None:
                 del d[k]
         return json.dumps(d, sort_keys=True)
@@ -205,6 +221,17 @@ def severities(spec: DatasetSpec, condition: int, name: str) -> list[float]:
     return rng.uniform(lo, hi, spec.per_class).tolist()
 
 
+def snrs(spec: DatasetSpec, condition: int, name: str, n: int) -> list[float]:
+    """The accelerometer SNR (dB) of class ``name``'s ``n`` records at ``condition``:
+    ``spec.snr_db``, or draws uniform in ``spec.snr_range`` from a generator seeded by the
+    data set's seed, the condition and the class name (as `severities`)."""
+    if spec.snr_range is None:
+        return [float(spec.snr_db)] * n
+    lo, hi = spec.snr_range
+    rng = np.random.default_rng([spec.seed, 4, condition, zlib.crc32(name.encode())])
+    return rng.uniform(lo, hi, n).tolist()
+
+
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     """The records of ``spec``: one task per (condition, class, severity), in a fixed order
     (``level`` numbers a class's records at a condition)."""
@@ -213,7 +240,8 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     for ci, cond in enumerate(_conditions(spec)):
         for name in spec.classes:
             fc = get_class(name)
-            for li, s in enumerate(severities(spec, ci, name)):
+            sev = severities(spec, ci, name)
+            for li, (s, snr) in enumerate(zip(sev, snrs(spec, ci, name, len(sev)), strict=True)):
                 idx = len(tasks)
                 params = dict(BASELINE)
                 params.update(
@@ -235,13 +263,18 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                         "params": params,
                         "fs": cond["fs"],
                         "resonance_hz": cond["resonance_hz"],
-                        "snr_db": spec.snr_db,
+                        "snr_db": snr,
                         "revolutions": spec.revolutions,
                         "transient": spec.transient,
                         "noise_seed": int(spec.seed * 1_000_003 + idx),
                     }
                 )
     return tasks
+
+
+def _snr_text(spec: dict[str, Any]) -> str:
+    r = spec.get("snr_range")
+    return f"{spec['snr_db']}" if r is None else f"{r[0]:g}..{r[1]:g} (drawn a record)"
 
 
 def n_samples_max(tasks) -> int:
@@ -637,8 +670,13 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
             for k, r in CONDITIONS.items()
         },
         "sensors": {
-            "accelerometer": f"recipdyn.sensors.Accelerometer(snr_db={spec.snr_db}, "
-            "resonance_hz=<condition>), other settings default",
+            "accelerometer": "recipdyn.sensors.Accelerometer(snr_db="
+            + (
+                f"{spec.snr_db}"
+                if spec.snr_range is None
+                else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
+            )
+            + ", resonance_hz=<condition>), other settings default",
             "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
             "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
         },
@@ -681,7 +719,8 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"Model `{card['model']}`, healthy baseline {card['baseline']}; "
         f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
         f"{how}; {s['revolutions']} "
-        f"revolutions after {s['transient']}; accelerometer SNR {s['snr_db']} dB; "
+        f"revolutions after {s['transient']}; accelerometer SNR "
+        f"{_snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
         "",
         f"| class | parameter | {head} | meaning |",

@@ -273,8 +273,8 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
                 f"holds {q:.2g} of the mean bin's energy, about {_db(q):.0f} dB below it) is "
                 f"outside the training range {lo:.2g}..{hi:.2g} ({_db(hi):.0f}..{_db(lo):.0f} "
                 f"dB): an accelerometer signal-to-noise ratio the diagnoser was not trained "
-                f"at (its data set: {diag.card['spec']['snr_db']:g} dB); train on a data set "
-                "at this record's SNR (recipdyn dataset --snr)",
+                f"at (its data set: {_trained_snr(diag.card['spec'])} dB); train on a data set "
+                "at this record's SNR (recipdyn dataset --snr or --snr-range)",
                 t0,
             )
     d, thr, subset = diag.ood(X[0])
@@ -336,6 +336,11 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
         res.figure = str(overlay_figure(diag, j, x, tacho, fs, f_rev, Path(out), res))
     res.seconds = time.perf_counter() - t0
     return res
+
+
+def _trained_snr(spec: dict[str, Any]) -> str:
+    r = spec.get("snr_range")
+    return f"{spec['snr_db']:g}" if r is None else f"{r[0]:g}..{r[1]:g}"
 
 
 def _db(share: float) -> float:
