@@ -138,28 +138,11 @@ class DatasetSpec:
             get_class(c)
         if "healthy" not in self.classes:
             raise ParameterError("classes: must include 'healthy' (the baseline)")
-        r = self.severity_range
-        if r is not None:
-            try:
-                lo, hi = (float(v) for v in r)
-            except (TypeError, ValueError):
-                lo = hi = math.nan
-            if not 0 <= lo < hi <= 1:
-                raise ParameterError(
-                    f"severity_range = {r!r}; allowed: two severities 0 <= lo < hi <= 1"
-                )
-            object.__setattr__(self, "severity_range", (lo, hi))
-        r = self.snr_range
-        if r is not None:
-            try:
-                lo, hi = (float(v) for v in r)
-            except (TypeError, ValueError):
-                lo = hi = math.nan
-            if not -20 <= lo < hi <= 200:
-                raise ParameterError(
-                    f"snr_range = {r!r}; allowed: two SNRs -20 <= lo < hi <= 200 dB"
-                )
-            object.__setattr__(self, "snr_range", (lo, hi))
+        for name, lo, hi, what in (("severity_range", 0, 1, "severities"),
+                                   ("snr_range", -20, 200, "SNRs")):  # fmt: skip
+            r = getattr(self, name)
+            if r is not None:
+                object.__setattr__(self, name, _bounds(r, name, lo, hi, what))
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
@@ -189,6 +172,18 @@ class DatasetSpec:
     def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
         """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+
+
+def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, float]:
+    """``(a, b)`` of a range setting ``r`` with ``lo <= a < b <= hi``, else the refusal naming
+    the setting."""
+    try:
+        a, b = (float(v) for v in r)
+    except (TypeError, ValueError):
+        a = b = math.nan
+    if not lo <= a < b <= hi:
+        raise ParameterError(f"{name} = {r!r}; allowed: two {what} {lo} <= lo < hi <= {hi}")
+    return a, b
 
 
 def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:

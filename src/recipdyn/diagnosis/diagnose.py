@@ -428,13 +428,14 @@ def overlay_figure(diag, j: int, x, tacho, fs: float, f_rev: float, out: Path, r
     """The record's first whole revolution and the closest simulated record's, against the
     crank angle (from the tacho's mark; with a speed only, from the record's start)."""
     from ..mplstyle import _mpl
-    from .train import CURVE_POINTS, curve
+    from .train import curve
 
     plt = _mpl()
     out.mkdir(parents=True, exist_ok=True)
-    ang = np.arange(CURVE_POINTS) * 360.0 / CURVE_POINTS
-    mine = curve(x, None, fs, f_rev)  # x is already cut to start at the tacho's first edge
     sim = np.asarray(diag.state["library_accel"][j], float)
+    n = sim.size  # the library's own resolution (a file of another CURVE_POINTS reads too)
+    ang = np.arange(n) * 360.0 / n
+    mine = curve(x, None, fs, f_rev, n)  # x is already cut to start at the tacho's first edge
     fig, ax = plt.subplots(figsize=(8, 3.5))
     ax.plot(ang, mine, lw=0.8, label="record")
     ev = res.evidence["closest_record"]

@@ -72,8 +72,9 @@ AVAILABILITY = {
 }
 #: Layout version of a diagnoser file.
 FORMAT = 2
-#: Samples per revolution of the stored angle-domain curves (the overlay's library).
-CURVE_POINTS = 256
+#: Samples per revolution of the stored angle-domain curves (the overlay's library; 2.8
+#: degrees: the acceleration library, noisy float16, is the largest part of a diagnoser file).
+CURVE_POINTS = 128
 
 
 def _hgb_classifier(seed: int):
