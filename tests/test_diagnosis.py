@@ -7,6 +7,7 @@ bookkeeping), not the accuracy of a full-size diagnoser (docs/diagnosis.md measu
 
 from __future__ import annotations
 
+import importlib
 import math
 
 import numpy as np
@@ -516,14 +517,14 @@ def test_diagnose_refuses_another_sensor_band(tmp_path):
     assert res.refused and "sensor band" in res.reason
 
 
-@pytest.mark.parametrize("snr_db, answered", [(10.0, False), (20.0, True), (40.0, False)])
+@pytest.mark.parametrize("snr_db, answered", [(5.0, False), (10.0, True), (40.0, True)])
 def test_diagnose_refuses_another_accelerometer_snr(tmp_path, snr_db, answered):
     """The angle features are shares of the high-passed energy over the revolution, so the
-    sensor's noise moves them all at once: at 10 dB the shipped diagnoser called every healthy
-    record of the robustness benchmark a worn guide. The quietest crank-angle bin measures the
-    noise floor (about 1e-2 of the mean bin at the 20 dB trained on, 0.08-0.10 at 10 dB,
-    2e-4 at 40 dB: a factor of 5 beyond the accepted range either way); the same record at
-    10 or 40 dB is refused with that reason, at 20 dB it is answered and the floor is shown."""
+    sensor's noise moves them all at once: a diagnoser trained at 20 dB alone called every
+    healthy record at 10 dB a worn guide. The shipped one is trained on SNRs drawn in 10-40 dB
+    and answers anywhere in that range; the quietest crank-angle bin measures the noise floor
+    (about 0.08-0.10 of the mean bin at 10 dB, 2e-4 at 40 dB), and a record below the range
+    (5 dB) is refused with that reason; an answered one shows its floor."""
     from recipdyn.diagnosis.diagnose import diagnose
 
     path = _record(tmp_path, f"snr{snr_db:g}", snr_db=snr_db)
@@ -729,3 +730,83 @@ def test_drawn_snrs_are_seeded_in_range_and_leave_the_rest_of_the_design():
     with pytest.raises(ParameterError, match="snr_range"):
         DatasetSpec(snr_range=(40.0, 10.0))
     assert main(["dataset", "--snr-range", "40,x", "-o", "unused-folder"]) == 2
+
+
+# ---- the healthy baseline -------------------------------------------------------------------
+
+
+def _operating_rows(rng, n, shift=0.0):
+    """Rows of (speed_hz, cy_p_suction, cy_p_discharge, cy_head_so_dip, acc_rms): the dip an
+    affine function of the operating point plus noise of standard deviation 1e-4, ``shift``
+    added (a fault)."""
+    speed = rng.uniform(2.5, 3.8, n)
+    ps, pd = rng.uniform(0.9e5, 1.1e5, n), rng.uniform(2.7e5, 3.3e5, n)
+    dip = 0.015 + 4e-3 * (speed - 3) + 1e-7 * (ps - 1e5) - 5e-8 * (pd - 3e5)
+    dip = dip + rng.normal(0, 1e-4, n) + shift
+    return np.column_stack([speed, ps, pd, dip, rng.normal(1, 0.1, n)])
+
+
+BASELINE_NAMES = ["speed_hz", "cy_p_suction", "cy_p_discharge", "cy_head_so_dip", "acc_rms"]
+
+
+def test_the_healthy_baseline_takes_the_operating_point_off():
+    """A feature whose spread over the operating points is ~18 times its noise (the dip of
+    the data set's healthy machine moves by ~2x what a mildly sticking plate adds):
+    fitted on 200 healthy rows, fresh healthy rows at other operating points deviate by
+    N(0, 1) (their sample standard deviation within 3 sampling errors, 3/sqrt(2 n), of 1,
+    their mean within 3/sqrt(n) of 0), and a fault that adds 5 noise units deviates by 5
+    although its raw feature overlaps the healthy range. Only the pressure and cycle features
+    are referred (not ``acc_rms``); too few healthy rows give no baseline."""
+    from recipdyn.diagnosis.train import BASELINE_RECORDS_PER_COEF, deviations, fit_baseline
+
+    rng = np.random.default_rng(7)
+    X = _operating_rows(rng, 200)
+    b = fit_baseline(X, BASELINE_NAMES, np.ones(200, bool))
+    assert b["targets"] == ["cy_head_so_dip"] and b["spread"][0] == pytest.approx(1e-4, rel=0.15)
+    n = 400
+    fresh, fault = _operating_rows(rng, n), _operating_rows(rng, n, shift=5e-4)
+    assert np.std(fresh[:, 3]) > 10 * 1e-4  # raw: the operating point dominates
+    assert np.mean(fault[:, 3] < fresh[:, 3].max()) > 0.9  # raw: the fault is hidden
+    d, f = deviations(fresh, BASELINE_NAMES, b)[:, 0], deviations(fault, BASELINE_NAMES, b)[:, 0]
+    assert abs(np.std(d) - 1) < 3 / math.sqrt(2 * n) + 0.15  # + the spread's own fit error
+    assert abs(np.mean(d)) < 3 / math.sqrt(n) + 0.15
+    assert abs(np.mean(f) - 5) < 3 / math.sqrt(n) + 0.15 * 5
+    few = BASELINE_RECORDS_PER_COEF * 4 - 1
+    assert fit_baseline(X[:few], BASELINE_NAMES, np.ones(few, bool)) is None
+    one_speed = X.copy()
+    one_speed[:, 0] = np.repeat(rng.uniform(2.5, 3.8, 5), 40)  # 5 operating points only
+    assert fit_baseline(one_speed, BASELINE_NAMES, np.ones(200, bool)) is None
+    row = X[:1].copy()
+    row[0, 1] = np.nan  # no pressure: no operating point, no deviation
+    assert np.isnan(deviations(row, BASELINE_NAMES, b)).all()
+
+
+def test_a_diagnoser_with_a_baseline_reads_the_deviations_and_saves_them(
+    continuous, tmp_path, monkeypatch
+):
+    """Trained with the baseline (the small data set's few healthy records allowed by a
+    lower minimum), the classifier reads the ``dv_`` columns; the healthy training records'
+    deviations average to zero (least squares with an intercept: a check of the wiring from
+    the table to the fit), and the diagnoser read back from its file predicts to the bit."""
+    tr = importlib.import_module("recipdyn.diagnosis.train")  # the package exports train()
+
+    out = continuous[0]
+    monkeypatch.setattr(tr, "BASELINE_RECORDS_PER_COEF", 1)  # 6 healthy training records
+    monkeypatch.setattr(tr, "BASELINE_POINTS_PER_COEF", 0.5)  # at 2 speeds
+    diag, _ = tr.train(out, seed=0)
+    b = diag.baseline
+    assert b is not None and b["targets"]
+    _, names = diag.model_rows(np.zeros((1, len(diag.names))))
+    assert names[len(diag.names) :] == ["dv_" + t for t in b["targets"]]
+    assert diag.state["classifiers"]["full"].n_features_in_ > len(tr._cols(diag.names, "full"))
+    df, _ = read_features(out)
+    train_df = df[df.split == "train"]
+    X = train_df[[f"f_{n}" for n in diag.names]].to_numpy(float)
+    dv = tr.deviations(X[(train_df.label == "healthy").to_numpy()], diag.names, b)
+    ok = np.isfinite(dv).all(axis=0)
+    assert ok.sum() > 10
+    assert np.abs(dv[:, ok].mean(axis=0)).max() < 1e-6
+    back = tr.load(tr.save(diag, tmp_path / "b.skops"))
+    assert np.array_equal(back.predict_proba(X), diag.predict_proba(X))
+    c = diag.classes[1]
+    assert np.array_equal(back.severity(X, c)[0], diag.severity(X, c)[0])

@@ -29,7 +29,10 @@ Three groups, by what the record must hold:
     reference). For the joints: the crosshead-pin load (the gas force of the two pressures
     plus the nominal crosshead-and-piston mass times the kinematic acceleration), the share
     of the impact energy in the `REVERSAL_WINDOW_DEG` after its reversals, and how far after
-    a reversal the largest burst lies.
+    a reversal the largest burst lies. And the operating point the record shows: the suction
+    and discharge levels (``cy_p_suction``, ``cy_p_discharge``, Pa: the two chambers'
+    plateaus averaged), to which a diagnoser refers the other features
+    (`recipdyn.diagnosis.train`, the healthy baseline).
 
 A missing group is NaN; the classifiers are trained with the groups removed as a record
 would lack them, so a record with fewer channels is still diagnosed (less sharply).
@@ -221,7 +224,7 @@ def _chamber_cycle(p, V, vs) -> dict[str, float]:
     chamber (``p``, ``V``: 360 one-degree samples from outer dead centre)."""
     from ..model.cycle import ideal_indicated_work, indicated_work
 
-    out = dict.fromkeys(CHAMBER_FEATURES, math.nan)
+    out = dict.fromkeys((*CHAMBER_FEATURES, "p_lo", "p_hi"), math.nan)
     if not (np.isfinite(p).all() and np.isfinite(V).all()):
         return out
     k0 = int(np.argmin(V))  # this chamber's top dead centre
@@ -232,6 +235,7 @@ def _chamber_cycle(p, V, vs) -> dict[str, float]:
     span = p_hi - p_lo
     if not (p_lo > 0 and span > 0):
         return out
+    out["p_lo"], out["p_hi"] = p_lo, p_hi
     lev_lo, lev_hi = p_lo + EVENT_LEVEL * span, p_hi - EVENT_LEVEL * span
     v0, vmax = V[0], V[bdc]
     ideal_v = {  # ideal cycle's volume at each event (polytropic through the two levels)
@@ -288,6 +292,8 @@ def cycle_features(p_head360, p_crank360, energy360, speed_hz: float) -> dict[st
         row[f"cy_head_{k}"] = head[k]
         row[f"cy_crank_{k}"] = crank[k]
         row[f"cy_diff_{k}"] = head[k] - crank[k]
+    for name, k in (("cy_p_suction", "p_lo"), ("cy_p_discharge", "p_hi")):
+        row[name] = 0.5 * (head[k] + crank[k])
     # crosshead-pin load (> 0: compression) and where the impact energy sits after reversals
     omega = 2 * math.pi * speed_hz
     f_gas = -ph * g["area_head"] + pc * g["area_crank"] + g["frame_pressure"] * g["area_rod"]
@@ -318,7 +324,7 @@ def feature_groups(names) -> dict[str, list[str]]:
     """Feature names by group (``base``, ``angle``, ``pressure``, ``cycle``)."""
     groups: dict[str, list[str]] = {"base": [], "angle": [], "pressure": [], "cycle": []}
     for n in names:
-        if n.startswith("cy_"):
+        if n.startswith(("cy_", "dv_")):  # dv_: a deviation from the healthy baseline
             groups["cycle"].append(n)
         elif n.startswith("ang_"):
             groups["angle"].append(n)

@@ -12,6 +12,16 @@
   with **split-conformal** intervals: a quarter of the training conditions (whole conditions)
   is held out to calibrate the absolute residuals, so the interval's coverage is that of a
   new operating condition (Vovk et al. 2005; Angelopoulos & Bates 2021, sec. 1).
+* **Healthy baseline**: every pressure and cycle feature of the healthy training records is
+  fitted by least squares as an affine function of the operating point the record itself
+  shows (`OPERATING`: the crank speed, the suction and discharge levels), and the classifier
+  and the regressors also read each record's deviation from it, in units of the fit's
+  residual spread (``dv_`` features): what a fault changes and the operating point does not
+  (condition normalisation, as condition monitoring refers a machine's readings to its own
+  healthy baseline at the same load). On the 40-condition data set it raised the healthy
+  machine's recall on held-out conditions from 0.70 to about 0.9: a mildly sticking plate's
+  extra suction dip is a few per mille of the span, as large as the dip's own change with
+  speed and pressures, and stands out once those are taken off.
 * **Out of distribution**: the features are scaled by the training median and interquartile
   range; a record's distance to its `K_NEIGHBOURS`-th nearest training record (over the
   features the record has) is compared with the 99th percentile of the same distance for the
@@ -54,6 +64,8 @@ __all__ = [
     "expected_calibration_error",
     "detection_limits",
     "severity_bins",
+    "fit_baseline",
+    "deviations",
 ]
 
 #: Neighbours of the out-of-distribution distance.
@@ -71,7 +83,20 @@ AVAILABILITY = {
     "vibration_only": ("base",),
 }
 #: Layout version of a diagnoser file.
-FORMAT = 2
+FORMAT = 3
+#: The operating point the healthy baseline refers features to (`fit_baseline`).
+OPERATING = ("speed_hz", "cy_p_suction", "cy_p_discharge")
+#: Prefix of a feature's deviation from the healthy baseline.
+DEVIATION = "dv_"
+#: Healthy training records, and distinct crank speeds among them (operating points: the
+#: records of one condition share theirs), needed per coefficient of a baseline fit: fewer,
+#: and the diagnoser has no baseline (a small data set's reads the raw features only).
+BASELINE_RECORDS_PER_COEF = 5
+BASELINE_POINTS_PER_COEF = 2
+#: Floor of a baseline fit's residual spread, as a fraction of the feature's spread over all
+#: training records: a feature the healthy machine holds constant (a count) would otherwise
+#: turn any departure into an unbounded deviation.
+BASELINE_SPREAD_FLOOR = 0.05
 #: Samples per revolution of the stored angle-domain curves (the overlay's library; 2.8
 #: degrees: the acceleration library, noisy float16, is the largest part of a diagnoser file).
 CURVE_POINTS = 128
@@ -117,6 +142,77 @@ def _subset_rows(X: np.ndarray, names: list[str]) -> dict[str, np.ndarray]:
 def _fit_subsets(make, X: np.ndarray, y: np.ndarray, names: list[str]) -> dict[str, Any]:
     """One model per availability subset, fitted on that subset's columns of every row."""
     return {k: make().fit(X[:, _cols(names, k)], y) for k in AVAILABILITY}
+
+
+def fit_baseline(X: np.ndarray, names: list[str], healthy: np.ndarray) -> dict | None:
+    """The healthy baseline (module docstring) of the rows ``X`` (columns ``names``), fitted
+    on the rows where ``healthy``; None if they are too few (`BASELINE_RECORDS_PER_COEF`)."""
+    groups = feature_groups(names)
+    if not set(OPERATING) <= set(names):
+        return None
+    ops = np.array([names.index(o) for o in OPERATING])
+    O = X[:, ops]
+    H = np.asarray(healthy, bool) & np.isfinite(O).all(axis=1)
+    k = len(OPERATING) + 1
+    need = BASELINE_RECORDS_PER_COEF * k
+    points = np.unique(np.round(O[H, 0], 2)).size  # distinct speeds to 0.01 Hz
+    if H.sum() < need or points < BASELINE_POINTS_PER_COEF * k:
+        return None
+    mu, sd = O[H].mean(axis=0), O[H].std(axis=0)
+    sd = np.where(sd > 0, sd, 1.0)
+    A = (O[H] - mu) / sd
+    targets, coefs, spreads = [], [], []
+    for n in groups["pressure"] + groups["cycle"]:
+        if n in OPERATING:
+            continue
+        j = names.index(n)
+        y = X[H, j]
+        ok = np.isfinite(y)
+        if ok.sum() < need:
+            continue
+        # centred, so the intercept is exact and the residuals average to zero even where
+        # the operating points are nearly collinear (lstsq then drops a direction)
+        a_mean, y_mean = A[ok].mean(axis=0), y[ok].mean()
+        slope, *_ = np.linalg.lstsq(A[ok] - a_mean, y[ok] - y_mean, rcond=None)
+        c = np.concatenate([[y_mean - a_mean @ slope], slope])
+        r = y[ok] - c[0] - A[ok] @ slope
+        spread = float(np.std(r, ddof=k))
+        whole = float(np.nanstd(X[:, j]))
+        spread = max(spread, BASELINE_SPREAD_FLOOR * whole)
+        if not spread > 0:
+            continue
+        targets.append(n)
+        coefs.append(c)
+        spreads.append(spread)
+    return {
+        "operating": list(OPERATING),
+        "mean": mu,
+        "scale": sd,
+        "targets": targets,
+        "coef": np.array(coefs, float),
+        "spread": np.array(spreads, float),
+        "n_healthy": int(H.sum()),
+    }
+
+
+def deviations(X: np.ndarray, names: list[str], baseline: dict) -> np.ndarray:
+    """Each row's deviation from the healthy baseline, in units of the fit's residual spread
+    (columns: ``baseline["targets"]``; NaN where the row lacks the feature or the operating
+    point)."""
+    X = np.atleast_2d(np.asarray(X, float))
+    O = X[:, [names.index(o) for o in baseline["operating"]]]
+    A = np.column_stack([np.ones(X.shape[0]), (O - baseline["mean"]) / baseline["scale"]])
+    Y = X[:, [names.index(t) for t in baseline["targets"]]]
+    return (Y - A @ np.asarray(baseline["coef"]).T) / baseline["spread"]
+
+
+def _with_baseline(X: np.ndarray, names: list[str], baseline: dict | None):
+    """``(rows, names)`` with the deviation columns appended (unchanged without baseline)."""
+    X = np.atleast_2d(np.asarray(X, float))
+    if not baseline:
+        return X, list(names)
+    dv = [DEVIATION + t for t in baseline["targets"]]
+    return np.hstack([X, deviations(X, names, baseline)]), [*names, *dv]
 
 
 def _predict_subsets(models: dict, X: np.ndarray, names: list[str], proba: bool):
@@ -265,9 +361,20 @@ class Diagnoser:
     def card(self) -> dict:
         return json.loads(self.state["datacard_json"])
 
+    @property
+    def baseline(self) -> dict | None:
+        """The healthy baseline (`fit_baseline`), or None."""
+        return self.state.get("baseline")
+
+    def model_rows(self, X: np.ndarray) -> tuple[np.ndarray, list[str]]:
+        """The rows the learners read: ``X`` (columns `names`) and the deviations from the
+        healthy baseline; and their column names."""
+        return _with_baseline(X, self.names, self.baseline)
+
     def predict_proba(self, X: np.ndarray) -> np.ndarray:
         """Class probabilities, each row by the classifier of the features it has."""
-        return _predict_subsets(self.state["classifiers"], X, self.names, proba=True)
+        Xm, names = self.model_rows(X)
+        return _predict_subsets(self.state["classifiers"], Xm, names, proba=True)
 
     def severity(self, X: np.ndarray, label: str):
         """Severity in [0, 1] and its `COVERAGE` interval for class ``label``."""
@@ -276,7 +383,8 @@ class Diagnoser:
             n = np.asarray(X).shape[0]
             return np.zeros(n), np.zeros(n), np.zeros(n)
         X = np.asarray(X, float)
-        s = np.clip(_predict_subsets(reg, X, self.names, proba=False), 0.0, 1.0)
+        Xm, names = self.model_rows(X)
+        s = np.clip(_predict_subsets(reg, Xm, names, proba=False), 0.0, 1.0)
         subs = [available(row, self.names) for row in X]
         q = np.array([self.state["conformal"][label][k] for k in subs])
         q = np.maximum(q, self.severity_resolution)
@@ -386,7 +494,9 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         )
     X = train_df[[f"f_{n}" for n in names]].to_numpy(float)
     y = train_df.label.map({c: i for i, c in enumerate(classes)}).to_numpy()
-    clfs = _fit_subsets(lambda: _hgb_classifier(seed), X, y, names)
+    baseline = fit_baseline(X, names, (train_df.label == "healthy").to_numpy())
+    Xm, mnames = _with_baseline(X, names, baseline)
+    clfs = _fit_subsets(lambda: _hgb_classifier(seed), Xm, y, mnames)
     proper, cal = _split_train(train_df, seed)
     regs, conformal = {}, {}
     for c in classes:
@@ -394,10 +504,11 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
             continue
         m = (train_df.label == c).to_numpy()
         s = train_df.severity.to_numpy()
-        reg = _fit_subsets(lambda: _hgb_regressor(seed), X[m & proper], s[m & proper], names)
+        reg = _fit_subsets(lambda: _hgb_regressor(seed), Xm[m & proper], s[m & proper], mnames)
         Xcal, scal = _augment(X[m & cal], names)
+        Xcal, _ = _with_baseline(Xcal, names, baseline)
         resid = np.abs(
-            np.clip(_predict_subsets(reg, Xcal, names, proba=False), 0, 1) - s[m & cal][scal]
+            np.clip(_predict_subsets(reg, Xcal, mnames, proba=False), 0, 1) - s[m & cal][scal]
         )
         n_cal = int((m & cal).sum())
         conformal[c] = {}
@@ -424,6 +535,7 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         "datacard_json": json.dumps(card, default=float),
         "classes": classes,
         "feature_names": names,
+        "baseline": baseline,
         "classifiers": clfs,
         "regressors": regs,
         "conformal": conformal,
@@ -436,6 +548,7 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         "fs_range": [float(train_df.fs.min()), float(train_df.fs.max())],
         # the central 90 % (a few records with few impacts peak elsewhere: RING_QUANTILES)
         "ring_range": [float(np.nanquantile(train_df.f_acc_ring_hz, q)) for q in RING_QUANTILES],
+        "noise_floor_range": _noise_floor_range(X, names),
         "train_labels": train_df.label.tolist(),
         "train_severity": train_df.severity.to_numpy(float),
         "train_records": train_df.record.to_numpy(int),
@@ -453,6 +566,16 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         _fingerprints(train_df, card, names, diag), default=float
     )
     return diag, evaluate(diag, test_df, train_df, seed=seed)
+
+
+def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
+    """The training records' noise floors (`recipdyn.diagnosis.diagnose.noise_floor`: the
+    quietest crank-angle bin's share of the mean bin), least and largest; None without the
+    angle features."""
+    cols = [i for i, n in enumerate(names) if n.startswith("ang_")]
+    q = len(cols) * np.nanmin(X[:, cols], axis=1) if cols else np.zeros(0)
+    q = q[np.isfinite(q)]
+    return [float(q.min()), float(q.max())] if q.size else None
 
 
 def _library(folder, train_df):
@@ -603,17 +726,18 @@ def condition_only(train_df, test_df, classes, seed: int) -> dict[str, float]:
 def _importance(diag, X, y, seed) -> list[tuple[str, float]]:
     from sklearn.inspection import permutation_importance
 
-    cols = _cols(diag.names, "full")
+    Xm, names = diag.model_rows(X)
+    cols = _cols(names, "full")
     r = permutation_importance(
         diag.state["classifiers"]["full"],
-        X[:, cols],
+        Xm[:, cols],
         y,
         n_repeats=3,
         random_state=seed,
         scoring="accuracy",
     )
     order = np.argsort(r.importances_mean)[::-1][:15]
-    return [(diag.names[cols[i]], float(r.importances_mean[i])) for i in order]
+    return [(names[cols[i]], float(r.importances_mean[i])) for i in order]
 
 
 #: Types a diagnoser file may hold (checked before loading: skops refuses anything else).
@@ -658,9 +782,10 @@ def _pack(state: dict) -> dict:
         slim._predictors = []
         # the bin edges serve the fit and the categorical features only (prediction compares
         # raw values with each node's threshold): 180 features x 255 edges a model, dropped
+        # (None, not an empty array: each array is an entry of its own in the file)
         bm = copy.copy(est._bin_mapper)
         bm.bin_thresholds_ = [
-            t if cat else np.zeros(0)
+            t if cat else None
             for t, cat in zip(bm.bin_thresholds_, bm.is_categorical_, strict=True)
         ]
         slim._bin_mapper = bm
