@@ -538,6 +538,33 @@ def test_diagnose_refuses_another_accelerometer_snr(tmp_path, snr_db, answered):
         assert res.refused and "noise floor" in res.reason and "SNR" in res.reason
 
 
+@pytest.mark.parametrize("snr_db, answered", [(5.0, False), (20.0, True)])
+def test_without_a_tacho_the_noise_floor_is_still_read(tmp_path, snr_db, answered):
+    """Without a tacho there are no crank-angle bins; the quietest 5 % of the windows as long
+    as a 10-degree bin hold the sensor's noise (``acc_quiet_share``: 1e-4 of the mean window
+    at 40 dB, 0.05-0.12 at 10 dB on the shipped data set, its log within 1 % of a straight
+    line in the SNR, correlation -0.99). The same record with a constant speed instead of
+    the tacho: at 5 dB refused on its noise floor, at 20 dB answered with the floor shown.
+    The feature is the sensor's, not the machine's: no classifier reads it."""
+    from recipdyn.diagnosis.diagnose import default_model_path, diagnose
+    from recipdyn.diagnosis.train import AVAILABILITY, _cols, load
+
+    diag = load(default_model_path())
+    i = diag.names.index("acc_quiet_share")
+    assert all(i not in _cols(diag.names, k) for k in AVAILABILITY)
+    path = _record(tmp_path, f"snr{snr_db:g}", snr_db=snr_db)
+    spec = DatasetSpec(
+        **{k: tuple(v) if isinstance(v, list) else v for k, v in diag.card["spec"].items()}
+    )
+    omega = next(t for t in design(spec) if t["split"] == "test")["params"]["omega"]
+    res = diagnose(path, speed=f"{omega} rad/s", model=diag)  # _record's condition
+    if answered:
+        assert not res.refused, res.reason
+        assert "noise floor" in res.text()
+    else:
+        assert res.refused and "noise floor" in res.reason and "SNR" in res.reason
+
+
 def test_shipped_diagnoser_matches_todays_physics():
     """Regenerate the records the shipped diagnoser pinned (same tasks, same seeds) with
     today's code: the features and the diagnoser's probabilities must be those stored. Fails

@@ -325,9 +325,11 @@ def _allowed(kw) -> bool:
 def _cost(kw) -> int:
     """A rank of a cell's compile time (the glue with a valve chamber or a worn guide is the
     largest: 150-190 s on one core)."""
-    return (1 + 2 * (kw["load"] == "valves") + 2 * (kw["guide"] == "clearance")
-            + (kw["crank_joint"] in ("contact", "lubricated"))
-            + (kw["crosshead_joint"] != "ideal") + (kw["drive"] != "prescribed"))  # fmt: skip
+    g = kw.get
+    return (1 + 2 * (g("load") == "valves") + 2 * (g("guide") == "clearance")
+            + (g("crank_joint") in ("contact", "lubricated"))
+            + (g("crosshead_joint", "ideal") != "ideal")
+            + (g("drive", "prescribed") != "prescribed"))  # fmt: skip
 
 
 def _pairs(kw) -> set:

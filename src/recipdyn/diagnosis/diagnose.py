@@ -96,7 +96,7 @@ class Diagnosis:
             nf = ev["noise_floor"]
             lines.append(
                 f"accelerometer noise floor: {_db(nf['share']):.0f} dB below the mean "
-                f"crank-angle bin (training records {_db(nf['training_range'][1]):.0f}.."
+                f"10-degree stretch (training records {_db(nf['training_range'][1]):.0f}.."
                 f"{_db(nf['training_range'][0]):.0f} dB)"
             )
         if "pressure_deviation" in ev:
@@ -251,6 +251,22 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
             "record or train on that rate",
             t0,
         )
+    # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
+    floor = noise_floor(diag, X[0])
+    if floor is not None:
+        q, lo, hi = floor
+        floor_ev = {"share": q, "training_range": [lo, hi]}
+        if not lo / FLOOR_SLACK <= q <= hi * FLOOR_SLACK:
+            return _refuse(
+                res,
+                f"the acceleration's noise floor (its quietest 10-degree stretches of the "
+                f"revolution hold {q:.2g} of the mean's energy, about {_db(q):.0f} dB below it) is "
+                f"outside the training range {lo:.2g}..{hi:.2g} ({_db(hi):.0f}..{_db(lo):.0f} "
+                f"dB): an accelerometer signal-to-noise ratio the diagnoser was not trained "
+                f"at (its data set: {_trained_snr(diag.card['spec'])} dB); train on a data set "
+                "at this record's SNR (recipdyn dataset --snr or --snr-range)",
+                t0,
+            )
     lo, hi = st["ring_range"]
     ring = row["acc_ring_hz"]
     if not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
@@ -262,21 +278,6 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
             "resonance",
             t0,
         )
-    floor = noise_floor(diag, X[0])
-    if floor is not None:
-        q, lo, hi = floor
-        floor_ev = {"share": q, "training_range": [lo, hi]}
-        if not lo / FLOOR_SLACK <= q <= hi * FLOOR_SLACK:
-            return _refuse(
-                res,
-                f"the acceleration's noise floor (its quietest 10-degree crank-angle bin "
-                f"holds {q:.2g} of the mean bin's energy, about {_db(q):.0f} dB below it) is "
-                f"outside the training range {lo:.2g}..{hi:.2g} ({_db(hi):.0f}..{_db(lo):.0f} "
-                f"dB): an accelerometer signal-to-noise ratio the diagnoser was not trained "
-                f"at (its data set: {_trained_snr(diag.card['spec'])} dB); train on a data set "
-                "at this record's SNR (recipdyn dataset --snr or --snr-range)",
-                t0,
-            )
     d, thr, subset = diag.ood(X[0])
     res.ood = {"distance": d, "threshold": thr, "features": subset}
     if d > thr:
@@ -350,8 +351,10 @@ def _db(share: float) -> float:
 def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:
     """``(share, lo, hi)``: the acceleration's noise floor, as the share of the mean crank-angle
     bin's high-passed energy that its quietest 10-degree bin holds (``BINS`` times the least
-    ``ang_`` feature), and the range of the same over the diagnoser's training records; None
-    without a tacho (no angle features).
+    ``ang_`` feature), and the range of the same over the diagnoser's training records.
+    Without a tacho (no angle features): the quietest windows of a 10-degree bin's duration
+    (``acc_quiet_share``, a statistic of its own with its own training range); None if the
+    diagnoser has neither.
 
     A machine's impacts and valve events fill some bins and leave others quiet, so the
     quietest bin is the sensor's noise: at 20 dB it holds about 1e-2 of the mean bin
@@ -363,9 +366,14 @@ def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:
     names = diag.names
     cols = [i for i, n in enumerate(names) if n.startswith("ang_")]
     a = np.asarray(row, float)[cols]
-    if not cols or not np.isfinite(a).all():
-        return None
     st = diag.state
+    if not cols or not np.isfinite(a).all():
+        # no crank angle: the quietest 10-degree-long windows (evidence.quiet_share)
+        rng = st.get("quiet_range")
+        if rng is None or "acc_quiet_share" not in names:
+            return None
+        q = float(np.asarray(row, float)[names.index("acc_quiet_share")])
+        return (q, float(rng[0]), float(rng[1])) if math.isfinite(q) else None
     if st.get("noise_floor_range") is not None:  # stored exactly at training
         lo, hi = st["noise_floor_range"]
         return len(cols) * float(a.min()), float(lo), float(hi)

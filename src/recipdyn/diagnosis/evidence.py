@@ -4,8 +4,8 @@ Three groups, by what the record must hold:
 
 ``base`` (an acceleration channel and the crank speed)
     The vibration features of `recipdyn.features.signal_features` (RMS, peak, crest
-    factor, kurtosis, spectral shape, crank orders 1-10) and the impacts
-    per revolution.
+    factor, kurtosis, spectral shape, crank orders 1-10), the impacts per revolution, the
+    ringing frequency and the noise floor without a crank angle (`quiet_share`).
 ``angle`` (a tacho whose mark is at outer dead centre)
     Where in the revolution the vibration energy sits: the share of the high-passed
     acceleration's energy in each 10-degree crank-angle bin, averaged over the revolutions.
@@ -83,6 +83,26 @@ def ringing_hz(x, fs: float) -> float:
     if not peaks.size:
         return math.nan
     return float(f[start + peaks[np.argmax(props["prominences"])]])
+
+
+#: Quantile of the 10-degree windows' energy that `quiet_share` reads (the quietest windows,
+#: not the single quietest: without a crank angle nothing is averaged over revolutions).
+QUIET_QUANTILE = 0.05
+
+
+def quiet_share(x, fs: float, speed_hz: float) -> float:
+    """The acceleration's noise floor without a crank angle: the `QUIET_QUANTILE` of the
+    high-passed energy in consecutive windows as long as a 10-degree crank-angle bin, over
+    the windows' mean. The impacts and valve events fill
+    some stretches of a revolution and leave others quiet, so the quiet windows hold the
+    sensor's noise (the tacho's ``ang_`` bins measure the same, averaged over revolutions)."""
+    e = _highpass(np.asarray(x, float), fs) ** 2
+    w = round(fs / (speed_hz * BINS)) if speed_hz > 0 else 0
+    n = e.size // w if w >= 1 else 0
+    if n < BINS:  # less than a revolution
+        return math.nan
+    E = e[: n * w].reshape(n, w).mean(axis=1)
+    return float(np.quantile(E, QUIET_QUANTILE) / E.mean()) if E.mean() > 0 else math.nan
 
 
 def _whole_revs(revs):
@@ -320,11 +340,21 @@ def cycle_features(p_head360, p_crank360, energy360, speed_hz: float) -> dict[st
     return row
 
 
+#: Features of the sensor, not of the machine: stored and read by the refusals (the noise
+#: floor), never by a classifier or a regressor (the ``sensor`` group of `feature_groups`,
+#: which no channel subset of `recipdyn.diagnosis.train.AVAILABILITY` holds).
+SENSOR_FEATURES = ("acc_quiet_share",)
+
+
 def feature_groups(names) -> dict[str, list[str]]:
-    """Feature names by group (``base``, ``angle``, ``pressure``, ``cycle``)."""
-    groups: dict[str, list[str]] = {"base": [], "angle": [], "pressure": [], "cycle": []}
+    """Feature names by group (``base``, ``angle``, ``pressure``, ``cycle``, ``sensor``)."""
+    groups: dict[str, list[str]] = {
+        "base": [], "angle": [], "pressure": [], "cycle": [], "sensor": []
+    }  # fmt: skip
     for n in names:
-        if n.startswith(("cy_", "dv_")):  # dv_: a deviation from the healthy baseline
+        if n in SENSOR_FEATURES:
+            groups["sensor"].append(n)
+        elif n.startswith(("cy_", "dv_")):  # dv_: a deviation from the healthy baseline
             groups["cycle"].append(n)
         elif n.startswith("ang_"):
             groups["angle"].append(n)
@@ -362,6 +392,7 @@ def record_features(
         row[f"acc_{k}"] = float(v)
     row["acc_impacts_per_rev"] = impacts(x, fs, r)["per_rev"]
     row["acc_ring_hz"] = ringing_hz(x, fs)
+    row["acc_quiet_share"] = quiet_share(x, fs, speed)
     mask, n_revs, start = _whole_revs(r)
     ok_angle = angle and n_revs >= 1
     e = _highpass(x, fs) ** 2

@@ -549,6 +549,7 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         # the central 90 % (a few records with few impacts peak elsewhere: RING_QUANTILES)
         "ring_range": [float(np.nanquantile(train_df.f_acc_ring_hz, q)) for q in RING_QUANTILES],
         "noise_floor_range": _noise_floor_range(X, names),
+        "quiet_range": _finite_range(X, names, "acc_quiet_share"),
         "train_labels": train_df.label.tolist(),
         "train_severity": train_df.severity.to_numpy(float),
         "train_records": train_df.record.to_numpy(int),
@@ -576,6 +577,15 @@ def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
     q = len(cols) * np.nanmin(X[:, cols], axis=1) if cols else np.zeros(0)
     q = q[np.isfinite(q)]
     return [float(q.min()), float(q.max())] if q.size else None
+
+
+def _finite_range(X: np.ndarray, names: list[str], name: str) -> list[float] | None:
+    """Least and largest finite value of feature ``name`` (None: absent or never finite)."""
+    if name not in names:
+        return None
+    v = X[:, names.index(name)]
+    v = v[np.isfinite(v)]
+    return [float(v.min()), float(v.max())] if v.size else None
 
 
 def _library(folder, train_df):
