@@ -124,10 +124,6 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
         )
     if rigid_pins:
         if load == "valves":
-            if drive == "motor":
-                raise ParameterError("drive = 'motor' with load = 'valves' is not available "
-                                     "yet; allowed with drive = 'motor': load = 'paper', "
-                                     "'table', 'cycle' or file.py:OBJ")  # fmt: skip
             return "link-valves"
         return "link"
     if drive == "motor":
