@@ -1027,7 +1027,9 @@ SCHEMA = Schema((
     *GUIDE_PARAMS,
     _link("omega"), _link("theta1_0"),
     *(_link(k) for k in ("drive", "motor", "J_drive", "motor_torque", "motor_sync_speed",
-                         "motor_breakdown_torque", "motor_breakdown_slip", "rs", "m1", "J1")),
+                         "motor_breakdown_torque", "motor_breakdown_slip")),
+    # the crank's own mass and inertia act on a free crank only (drive = motor)
+    *(_link(k, group="drive") for k in ("rs", "m1", "J1")),
     _link("load_amplitude"), _link("load_sign"), _link("load"),
     *(_link(k) for k in (*CYCLE_PARAMS, "gas", "suction_temperature")),
     Param("e0_angle", "rad", None, "initial direction of e (default: aligned with the rod "
