@@ -32,6 +32,15 @@ With ``guide = clearance`` the crosshead is a body of its own between the guide'
 freedom (eight states after the twelve above: position, tilt, their rates, the four corners'
 approach velocities), the rod's small end follows it, and both pins may then be ideal.
 
+With ``drive = motor`` the crank angle is a coordinate too (`free_crank_lagrangian`, generated
+into ``_compressor_contact_drive.py``): the crank's states ``(theta1, omega1, W_motor)`` come
+after every other state, the joints' forces are evaluated at the crank's angle and speed
+(`_joints_at`), the crank carries ``J1 + m1 rs^2 + J_drive`` and the motor's torque and the
+crank-pin joint's friction torque act on it; ``W_in`` is then the work of the gas and the
+motor. Its Jacobian is a central difference (the crank angle enters through ``math.sin``),
+and Benettin's method is refused (the saltation matrices with the crank free are not
+checked).
+
 The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
 `recipdyn.model.components.contact`): the compiled kernels take complex states, and
 ``J[:, k] = Im f(y + i h e_k) / h`` is exact to rounding (no difference is taken), on the

@@ -10,7 +10,7 @@ double-acting cycle needs: its rod load reverses twice a revolution, where the m
 ``compressor-valves`` leaves its validity and the journal really crosses its clearance.
 
 State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
-mass counters of `valves`.
+mass counters of `valves` (with a motor, then the crank's ``theta1, omega1, W_motor``).
 
 Events: the integrator locates one event function, so the contact onsets and separations and
 the valve impacts share one: the minimum of the joints' phased contact factors
