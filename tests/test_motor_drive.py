@@ -293,3 +293,26 @@ def test_the_command_line_runs_and_analyses_a_motor_with_a_contact_joint(tmp_pat
                  "--lyap-revolutions", "1"]) == 0  # fmt: skip
     summary = json.loads((out / "summary.json").read_text())
     assert "drive = 'motor'" in summary["lyapunov_equations"]["refused"]
+
+
+def test_the_last_revolution_of_a_slower_crank_is_a_whole_revolution():
+    """The summaries (indicated power, valve impacts a revolution, the pin reversal) read
+    the record's last revolution. A motor turns slower than ``omega`` by its slip: a window
+    sized by ``omega`` would cover only 90 % of a revolution of a crank at 0.9 omega, and
+    the power would be ``omega`` times the work. Synthetic record, theta1 = 0.9 omega t:
+    the window covers a whole turn, and the mean speed is 0.9 omega (to rounding) with a
+    motor, ``omega`` with the prescribed drive."""
+    import xarray as xr
+
+    from recipdyn.model.cycle import last_revolution, mean_speed
+
+    omega, fs = 20.0, 5000.0
+    t = np.arange(int(3 * 2 * math.pi / (0.9 * omega) * fs)) / fs
+    ds = xr.Dataset({"theta1": ("time", 0.9 * omega * t)}, coords={"time": t})
+    part = last_revolution(ds, omega)
+    th = part["theta1"].values
+    assert th[-1] - th[0] >= 2 * math.pi
+    assert th[-1] - th[0] < 2 * (2 * math.pi)  # a window, not the whole record
+    values = {"omega": omega, "drive": "motor"}
+    assert mean_speed(values, ds) == pytest.approx(0.9 * omega, rel=1e-9)
+    assert mean_speed({**values, "drive": "prescribed"}, ds) == omega

@@ -55,7 +55,8 @@ __all__ = [
     "pressure_force", "CYCLE_PARAMS", "cycle_data", "pin_reversal_summary",
     "CycleGeometry", "cycle_geometry", "pack_cycle", "cycle_state", "cycle_force_kernel",
     "ideal_volumetric_efficiency", "ideal_indicated_work", "indicated_work",
-    "volumetric_efficiency", "RodReversal", "rod_load_reversal", "ACTING",
+    "volumetric_efficiency", "RodReversal", "rod_load_reversal", "ACTING", "last_revolution",
+    "mean_speed",
 ]  # fmt: skip
 
 #: Parameter names of the compression cycle, in [`pack_cycle`][recipdyn.model.cycle.pack_cycle]'s
@@ -299,7 +300,29 @@ def last_revolution(ds, omega: float, extra: int = 2):
         return ds
     t01 = np.asarray(ds["time"].isel(time=slice(0, 2)).values, dtype=float)
     k = int(math.ceil(2.0 * math.pi / omega / (t01[1] - t01[0]))) + extra if t01[1] > t01[0] else n
-    return ds.isel(time=slice(max(0, n - k), None))
+    out = ds.isel(time=slice(max(0, n - k), None))
+    # a crank driven by a motor turns slower than omega: widen until theta1 covers a turn
+    while "theta1" in ds.variables and k < n:
+        th = np.asarray(out["theta1"].values, dtype=float)
+        if th[-1] - th[0] >= 2.0 * math.pi * (1.0 - 1e-9):  # (a window of exactly one turn)
+            break
+        k *= 2
+        out = ds.isel(time=slice(max(0, n - k), None))
+    return out
+
+
+def mean_speed(values, ds) -> float:
+    """The crank's mean angular speed over the record's last revolution, rad/s: ``omega``
+    for a prescribed crank, measured from ``theta1`` with a motor (whose mean speed sits
+    below the synchronous one by the slip, not at ``omega``)."""
+    omega = float(values["omega"])
+    if values.get("drive", "prescribed") != "motor" or "theta1" not in ds.variables:
+        return omega
+    part = last_revolution(ds, omega)
+    th = np.asarray(part["theta1"].values, dtype=float)
+    t = np.asarray(part["time"].values, dtype=float)
+    k = int(np.argmax(th >= th[-1] - 2.0 * math.pi))
+    return float((th[-1] - th[k]) / (t[-1] - t[k])) if t[-1] > t[k] else omega
 
 
 def pin_reversal_summary(values, ds) -> dict[str, float | str]:

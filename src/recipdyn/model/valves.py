@@ -733,9 +733,10 @@ def valve_summary(values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
                 near = lag[np.abs(lag) <= 90.0]
                 if near.size:
                     out[f"closing_lag_{kind}_{end}_deg"] = float(near.max())
-    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
+    speed = cy.mean_speed(values, ds)
+    out["indicated_power_W"] = work * speed / (2.0 * math.pi)
     if "impact_time" in ds:
         out["valve_impacts_per_rev"] = int(np.count_nonzero(
             np.asarray(ds["impact_time"].values) >= float(ds["time"].values[-1])
-            - 2.0 * math.pi / float(values["omega"])))  # fmt: skip
+            - 2.0 * math.pi / speed))  # fmt: skip
     return out

@@ -42,6 +42,7 @@ from ..cycle import (
     cycle_force_kernel,
     cycle_states,
     indicated_work,
+    mean_speed,
     pin_reversal_summary,
     volumetric_efficiency,
 )
@@ -237,5 +238,5 @@ def cycle_summary(values, ds) -> dict[str, float | str]:
             out[f"volumetric_efficiency_{end}"] = volumetric_efficiency(
                 st[f"p_{end}"], st[f"V_{end}"], float(values["suction_pressure"]), rtol=1e-9
             )
-    out["indicated_power_W"] = work * float(values["omega"]) / (2.0 * math.pi)
+    out["indicated_power_W"] = work * mean_speed(values, ds) / (2.0 * math.pi)
     return out
