@@ -22,7 +22,8 @@ from recipdyn.model.registry import get_model, model_names
 EXAMPLE = str(Path(__file__).parents[1] / "examples" / "pendulum.py") + ":PENDULUM"
 #: Component combinations (model/components) that pass the same tests as the registered
 #: models: every drive and torque law, loads, the ideal joint; the joint family of the contact
-#: model with a new combination (oil at the crank pin, dry contact at the crosshead pin).
+#: model with a new combination (oil at the crank pin, dry contact at the crosshead pin), and
+#: with a motor (the crank free).
 #: ``MODEL[k=v,...]``: the model MODEL with these defaults.
 PRESETS = {
     "compressor[load=cycle]": {"load": "cycle"},
@@ -33,6 +34,7 @@ PRESETS = {
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
+    "compressor-contact[drive=motor,motor=constant]": {"drive": "motor", "motor": "constant"},
     "compressor-contact[guide=clearance,guide_clearance=2e-4]": {
         "guide": "clearance", "guide_clearance": 2e-4},
 }  # fmt: skip

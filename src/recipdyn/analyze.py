@@ -453,7 +453,9 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         unit = "per iteration"
     else:
         period = m.period(values)
-        if period:
+        # a free crank (a motor drive) is autonomous: no forcing period to strobe at (the
+        # period still scales the Benettin run)
+        if period and system.period is not None:
             with phase(f"analyze: Poincaré section ({section_points} periods)"):
                 sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol,
                                            atol=atol)  # fmt: skip

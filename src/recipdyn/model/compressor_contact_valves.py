@@ -10,7 +10,7 @@ double-acting cycle needs: its rod load reverses twice a revolution, where the m
 ``compressor-valves`` leaves its validity and the journal really crosses its clearance.
 
 State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
-mass counters of `valves`.
+mass counters of `valves` (with a motor, then the crank's ``theta1, omega1, W_motor``).
 
 Events: the integrator locates one event function, so the contact onsets and separations and
 the valve impacts share one: the minimum of the joints' phased contact factors
@@ -59,6 +59,8 @@ def _layout(values: Mapping[str, Any]) -> tuple[int, int, int]:
     clearance)."""
     g = cc.first_load_state(values)
     lo = cc.N_PACKED + cc.law_size(values) + (cc.N_GUIDE if cc.has_guide(values) else 0)
+    if cc.has_motor(values):  # the free crank's and the torque law's slices
+        lo += cc.N_CRANK + cc.motor_size(values)
     return g, g + va.N_GAS, lo
 
 
@@ -115,12 +117,14 @@ class CompressorContactValves(cc.CompressorContact):
                       "an onset records the approach velocity, a plate rebounds or "
                       "rests"),)  # fmt: skip
 
-    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
-        """The contact model's states (the joints', the guide's with its clearance), then the
-        gas states and the four mass counters."""
-        return super().states(values) + _GAS
+    def _load_states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """The gas states and the four mass counters, after the contact model's (the
+        joints', the guide's with its clearance; with a motor the crank's follow)."""
+        return _GAS
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
+        if cc.has_motor(values):
+            return self._motor_system(values)
         k = self.kernels(values)
         if cc.has_guide(values):
             names, units = zip(*self.states(values), strict=True)
@@ -141,10 +145,11 @@ class CompressorContactValves(cc.CompressorContact):
         """The contact model's initial state (journal along the ideal cycle's rod load), the
         ideal cycle's gas states at the initial crank angle, plates closed, counters 0."""
         g0, a0, _ = _layout(values)
+        own = super().initial_state(self._values(values))
         y = np.zeros(a0 + va.N_AUX)
-        y[:g0] = super().initial_state(self._values(values))
+        y[:g0] = own[:g0]
         y[g0:a0] = va.gas_initial(values, cy.cycle_data(values), float(values["theta1_0"]))
-        return y
+        return np.concatenate([y, own[g0:]])  # (with a motor, the crank's states)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """The contact model's scales for its states; the gas states at their own size."""

@@ -19,6 +19,15 @@ the gas force, which enters linearly, times the piston areas); the gas rows are 
 differences of the gas right-hand side (the valve stops and the regularised nozzle are not
 everywhere smooth), with steps scaled by each state's size.
 
+With ``drive = "motor"`` the crank angle and speed are states too: the free-crank
+accelerations of the massless-link mechanism (`recipdyn.model._generated_drive`, as the
+motor-driven `compressor`) with the gas force of the chamber pressures, in the generated glue
+of `recipdyn.model.components.mechanism` (the valve component's own derivatives, event and
+reset). State::
+
+    (theta_c, theta_c', theta1, omega1, W_motor, W_gas, <the twelve gas states>,
+     <the four mass counters>)
+
 Benettin's method is refused: a plate that comes to rest on a stop loses its velocity in a
 reset whose saltation matrix is singular, so the tangent dynamics of the valves has exponents
 of -infinity and the QR iteration is not defined (see `lyapunov_refusal`).
@@ -28,6 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from functools import lru_cache
 from typing import Any
 
 import numba as nb
@@ -46,11 +56,16 @@ from .base import (
     compiled,
     rhs_series,
 )
-from .components.contract import Assembly
-from .components.drive import PRESCRIBED
+from .components.contract import Assembly, glue_module
+from .components.drive import MOTOR, MOTORS, PRESCRIBED
 from .components.load import VALVES
-from .components.mechanism import HEAD, N_HEAD
-from .compressor import Compressor, equilibrium_theta_c, mechanism_outputs
+from .components.mechanism import HEAD, N_HEAD, glue_source
+from .compressor import (
+    Compressor,
+    equilibrium_theta_c,
+    mechanism_energy_series,
+    mechanism_outputs,
+)
 from .kinematics import kinematics
 from .parameters import SCHEMA as LINK_SCHEMA
 from .parameters import CompressorParams
@@ -188,6 +203,44 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
     return vec
 
 
+#: With a motor: the mechanism's two states, the motor's four (crank angle and speed, the
+#: work integrals of the motor and of the gas), then the gas states and the mass counters.
+MOTOR_STATE_NAMES = ("theta_c", "thetadot_c", "theta1", "omega1", "W_motor", "W_gas",
+                     *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)  # fmt: skip
+MOTOR_STATE_UNITS = ("rad", "rad/s", "rad", "rad/s", "J", "J", *va.GAS_STATE_UNITS,
+                     *va.AUX_STATE_UNITS)  # fmt: skip
+MG0 = 6
+MA0 = MG0 + va.N_GAS
+
+
+def _motor_values(values: Mapping[str, Any]) -> dict[str, Any]:
+    """``values`` as the torque laws read them: a constant torque's default, the mean load
+    torque, is the ideal-valve cycle's of the same cylinder (ideal gas), the valves' own
+    mean torque to the valve losses."""
+    return {**values, "load": "cycle", "gas": "ideal", "load_table": None}
+
+
+def _motor_assembly(values: Mapping[str, Any]) -> Assembly:
+    motor = MOTORS[values.get("motor", "induction")]
+    return Assembly(N_HEAD, (MOTOR, motor, VALVES))
+
+
+def pack_motor(values: Mapping[str, Any]) -> tuple[np.ndarray, dict[str, int]]:
+    """Packed vector with a motor: the mechanism's head, the motor drive's slice (J_drive),
+    the torque law's, the valve load's; and each part's offset."""
+    p = _cparams(values)
+    head = np.array([getattr(p, k) for k in HEAD], dtype=np.float64)
+    return _motor_assembly(values).pack(head, _motor_values(values))
+
+
+@lru_cache(maxsize=8)
+def _motor_glue(motor: str, offsets: tuple[tuple[str, int], ...]):
+    """The generated glue of the massless link, the motor ``motor`` and the valves."""
+    src = glue_source(equations="exact", drive=MOTOR, load=VALVES, motor=MOTORS[motor],
+                      offsets=dict(offsets), first_state=MG0)  # fmt: skip
+    return glue_module(src, f"compressor_motor_valves_{motor}")
+
+
 class CompressorValves(Compressor):
     """The compressor with dynamic valves as a registered model (module docstring)."""
 
@@ -214,16 +267,45 @@ class CompressorValves(Compressor):
         return False
 
     @staticmethod
+    def _motor(values: Mapping[str, Any]) -> bool:
+        return values.get("drive", "prescribed") == "motor"
+
+    def _motor_kernels(self, values: Mapping[str, Any]):
+        vec, offsets = pack_motor(values)
+        return vec, _motor_glue(values.get("motor", "induction"),
+                                tuple(sorted(offsets.items())))  # fmt: skip
+
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """The mechanism's, the gas's and the counters'; with a motor, the crank angle and
+        speed and the work integrals after the mechanism's (module docstring)."""
+        if self._motor(values):
+            return tuple(zip(MOTOR_STATE_NAMES, MOTOR_STATE_UNITS, strict=True))
+        return tuple(zip(STATE_NAMES, STATE_UNITS, strict=True))
+
+    @staticmethod
     def params(values: Mapping[str, Any]) -> CompressorParams:
         return _cparams(values)
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
-        return (Event("impact", valve_impact, direction=-1, action="reset", reset=valve_rebound,
+        event, reset = valve_impact, valve_rebound
+        if self._motor(values):
+            k = self._motor_kernels(values)[1]
+            event, reset = k.event, k.reset
+        return (Event("impact", event, direction=-1, action="reset", reset=reset,
                       description="a valve plate reaches its seat or guard: rebound with the "
                       "restitution, or rest"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         p = self.params(values)
+        if self._motor(values):
+            vec, k = self._motor_kernels(values)
+            # the crank is a state: autonomous; the work integrals (and with rc = 0 the
+            # clearance angle) are passive, the mass counters auxiliary
+            passive = (4, 5) if p.rc > 0 else (0, 1, 4, 5)
+            return ODESystem(rhs=k.rhs, jac=k.jac, params=vec, state_names=MOTOR_STATE_NAMES,
+                             state_units=MOTOR_STATE_UNITS, period=None, name=self.name,
+                             attrs=p.to_attrs(), events=self.events(values),
+                             aux_states=va.N_AUX, passive=passive)  # fmt: skip
         return ODESystem(rhs=rhs_valves, jac=jac_valves, params=pack(values),
                          state_names=STATE_NAMES, state_units=STATE_UNITS,
                          period=p.crank_period, name=self.name, attrs=p.to_attrs(),
@@ -234,15 +316,22 @@ class CompressorValves(Compressor):
         cycle at the initial crank angle, plates closed and at rest, counters 0."""
         p = self.params(values)
         thc0 = equilibrium_theta_c(p) if p.theta_c0 is None else p.theta_c0
+        gas = va.gas_initial(values, pack(values)[P_CYCLE:P_VALVE], p.theta1_0)
+        if self._motor(values):  # with a motor: the crank at theta1_0 turning at omega
+            return np.concatenate([[thc0 + p.theta_c_offset, p.thetadot_c0, p.theta1_0,
+                                    p.omega, 0.0, 0.0], gas, np.zeros(va.N_AUX)])  # fmt: skip
         y = np.zeros(N_STATE)
         y[0], y[1] = thc0 + p.theta_c_offset, p.thetadot_c0
-        y[G0:A0] = va.gas_initial(values, pack(values)[P_CYCLE:P_VALVE], p.theta1_0)
+        y[G0:A0] = gas
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """The mechanism's states at 1; the gas states at their own size
         ([`gas_scale`][recipdyn.model.valves.gas_scale])."""
-        return va.gas_scale(values, self.initial_state(values), G0, A0, np.ones(N_STATE))
+        y0 = self.initial_state(values)
+        if self._motor(values):
+            return va.gas_scale(values, y0, MG0, MA0, np.maximum(1.0, np.abs(y0)))
+        return va.gas_scale(values, y0, G0, A0, np.ones(N_STATE))
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
@@ -251,6 +340,8 @@ class CompressorValves(Compressor):
         p = self.params(values)
         sys_ = self.system(values)
         t = np.asarray(t, dtype=float)
+        if self._motor(values):
+            return self._motor_outputs(values, p, sys_, t, y)
         dy = rhs_series(sys_.rhs, sys_.params, t, y)
         thc, thcd = y[:, 0], y[:, 1]
         k = kinematics(p, t, thc, thcd, dy[:, 1])
@@ -260,6 +351,30 @@ class CompressorValves(Compressor):
             **mechanism_outputs(p, k, thc, thcd, dy[:, 1], fg),
             **va.gas_outputs(values, k.x3, y, dy, G0, A0, sys_.params[P_CYCLE:P_VALVE]),
         }
+
+    def _motor_outputs(self, values, p, sys_, t, y) -> dict[str, Signal]:
+        """With a motor: the massless link's outputs from the observed crank angle, speed and
+        gas force (the compiled functions that were integrated), the crank's speed and
+        acceleration, the motor torque, the work integrals and the mechanism's energy, and
+        the chambers' signals."""
+        y = np.ascontiguousarray(y, dtype=float)
+        dy = rhs_series(sys_.rhs, sys_.params, t, y)
+        obs = self._motor_kernels(values)[1].observe(np.ascontiguousarray(t), y, sys_.params)
+        th1, w1, fg = obs[:, 0], obs[:, 1], obs[:, 2]
+        thc, thcd, a1 = y[:, 0], y[:, 1], dy[:, 3]
+        k = kinematics(p, t, thc, thcd, dy[:, 1], theta1=th1, omega1=w1, alpha1=a1)
+        c = pack(values)[P_CYCLE:P_VALVE]
+        return {
+            **mechanism_outputs(p, k, thc, thcd, dy[:, 1], fg),
+            **va.gas_outputs(values, k.x3, y, dy, MG0, MA0, c),
+            "omega1": Signal(w1, "rad/s", "crank speed"),
+            "alpha1": Signal(a1, "rad/s**2", "crank angular acceleration"),
+            "motor_torque": Signal(dy[:, 4] / w1, "N*m", "motor torque at the crank"),
+            "W_motor": Signal(y[:, 4], "J", "work done by the motor since t = 0"),
+            "W_gas": Signal(y[:, 5], "J", "work done by the gas on the crosshead since t = 0"),
+            "energy": Signal(mechanism_energy_series(p, y), "J",
+                             "kinetic + potential energy of the mechanism and the drive"),
+        }  # fmt: skip
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         return va.valve_summary(values, ds)

@@ -81,9 +81,9 @@ def implementation(name: str) -> Model:
 
 
 _MOTOR_CONTACT = (
-    "drive = 'motor' with a contact or lubricated joint is not available yet "
-    "(the contact joints' equations take a prescribed crank); allowed with drive "
-    "= 'motor': crank_joint = 'link' or 'ideal' and crosshead_joint = 'ideal'"
+    "drive = 'motor' with a contact or lubricated joint and a load of your own is not "
+    "available yet; allowed with drive = 'motor' and a contact joint: load = 'paper', "
+    "'table', 'cycle', 'valves'"
 )
 
 
@@ -124,13 +124,9 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
         )
     if rigid_pins:
         if load == "valves":
-            if drive == "motor":
-                raise ParameterError("drive = 'motor' with load = 'valves' is not available "
-                                     "yet; allowed with drive = 'motor': load = 'paper', "
-                                     "'table', 'cycle' or file.py:OBJ")  # fmt: skip
             return "link-valves"
         return "link"
-    if drive == "motor":
+    if drive == "motor" and is_spec(load):
         raise ParameterError(_MOTOR_CONTACT)
     if is_spec(load):
         raise ParameterError(

@@ -427,16 +427,106 @@ def reset(t, y, p, out):
 '''
 
 
+#: The joints with the crank angle free (a motor drive): the crank's states ``y[M:M + 3]``
+#: (angle, speed, the motor's work) after every other state; the joints' forces at the crank's
+#: state (`_joints_at`), the free-crank accelerations (`_accelerate_free`) with the motor's
+#: torque law; the Jacobian by central differences (the crank angle enters the kinematics
+#: through math.sin, which the complex step does not take).
+_MOTOR_BODY = '''from recipdyn.model.compressor_contact import _accelerate_free, _joints_at
+from {motor_module} import {torque_fn} as torque
+
+
+@nb.njit(cache=True, inline="always")
+def _mechanism(t, y, p, out):
+    j = _joints_at(y[{M}], y[{M} + 1], y, p, {CFG})
+    return _accelerate_free(y, p, out, {CFG}, j, _force(t, y, p, j[7], j[8]), {M},
+                            torque(y[{M} + 1], p, {MO}), {CO})
+
+
+@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out):
+    v3, c2 = _mechanism(t, y, p, out)
+{STATE_RHS}
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def fd_jac(t, y, p, J):
+    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
+    (positions), c omega (rates), 1e-3 of their unit for the rest (the crank's, the gas's)."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    c = p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))
+    for k in range(n):
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
+        h = 1e-5 * max(abs(y[k]), scale)
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in range(n):
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac(t, y, p, J):
+    fd_jac(t, y, p, J)
+
+
+rhs_jac = None
+
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    """Per sample: both joints' rows of `_pair` (14), the accelerations e1'', e2'' (4),
+    theta2', x3', gas force; the crank's angle, speed and acceleration."""
+    n = t.shape[0]
+    out = np.zeros((n, 24))
+    d = np.empty(y.shape[1])
+    for i in range(n):
+        yi = y[i].copy()
+        _rhs(t[i], yi, p, d)
+        f1, f2, _, _, th2d, v3, _, s1, c1 = _joints_at(yi[{M}], yi[{M} + 1], yi, p, {CFG})
+        for k in range(7):
+            out[i, k] = f1[k]
+            out[i, 7 + k] = f2[k]
+        out[i, 14:18] = d[4:8]
+        out[i, 18] = th2d
+        out[i, 19] = v3
+        out[i, 20] = _force(t[i], yi, p, s1, c1)
+        out[i, 21] = yi[{M}]
+        out[i, 22] = yi[{M} + 1]
+        out[i, 23] = d[{M} + 1]
+    return out
+'''
+
+#: A free crank's angle where the prescribed glue writes theta1_0 + omega t.
+_PRESCRIBED_ANGLE = "p[P_TH10] + p[P_OMEGA] * t"
+
+
 def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
                 guide: int | None = None, guide_state: int | None = None,
-                law: str = "") -> str:  # fmt: skip
+                law: str = "", motor=None, motor_state: int | None = None,
+                motor_offset: int | None = None, crank_offset: int | None = None
+                ) -> str:  # fmt: skip
     """The glue module's source for the joints ``cfg`` (0 crank, 1 crosshead, 2 both; 3 both
     ideal, with the guide's clearance only) and the load component ``load`` whose slice starts
     at ``offset`` (its states, if any, at ``first_state``: module docstring); with the guide's
     clearance, ``guide`` is the offset of its slice and ``guide_state`` its first state.
     ``law``: the joints' force functions with a contact law of a user's file
     (`recipdyn.model.compressor_contact.law_source`), defined here in place of the built-in
-    ones; empty for a built-in law (the glue then imports the joints' functions)."""
+    ones; empty for a built-in law (the glue then imports the joints' functions). With a
+    motor (``motor``, its torque law's component): the crank's states start at
+    ``motor_state``, the torque law's slice at ``motor_offset``, the crank's (inertia, static
+    moment) at ``crank_offset``; no guide clearance."""
+    if motor is not None:
+        return _motor_source(cfg=cfg, joints=joints, load=load, offset=offset,
+                             first_state=first_state, law=law, motor=motor, m=motor_state,
+                             mo=motor_offset, co=crank_offset)  # fmt: skip
     stateful = bool(load.states)
     fill = dict(combo=f"clearance_joints={joints}, load={load.name}", CFG=cfg, LO=offset,
                 G=first_state, A=first_state + len(load.states), module=load.module)  # fmt: skip
@@ -469,5 +559,31 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
         src += "\n\n" + law
     src += _BODY.format(STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
                         JAC=_JAC_FD if stateful else _JAC_CS, **fill)  # fmt: skip
+    src += _STATE_EVENTS.format(**fill) if stateful else "\n\n" + _EVENTS[cfg]
+    return src
+
+
+def _motor_source(*, cfg, joints, load, offset, first_state, law, motor, m, mo, co) -> str:
+    """`glue_source` with a motor (the crank angle free)."""
+    stateful = bool(load.states)
+    fill = dict(combo=f"clearance_joints={joints}, load={load.name}, drive=motor, "
+                f"motor={motor.name}", CFG=cfg, LO=offset, G=first_state,
+                A=first_state + len(load.states), module=load.module, M=m, MO=mo,
+                CO=co)  # fmt: skip
+    src = _HEADER.format(**fill)
+    if stateful:
+        kinds = ("state_force", "state_rhs", "event", "reset")
+        src += _FORCE["state"].format(**{k: load.kernel(k) for k in kinds}, **fill)
+    elif "force_sc" in load.kernels:
+        src += _FORCE["sc"].format(force_sc=load.kernel("force_sc"), **fill)
+    else:
+        src += _FORCE["angle"].replace(_PRESCRIBED_ANGLE, "y[{M}]").format(
+            force=load.kernel("force"), **fill)  # fmt: skip
+    if law:
+        src += "\n\n" + law
+    state_rhs = _STATE_RHS.replace(_PRESCRIBED_ANGLE, "y[{M}]") if stateful else ""
+    src += "\n\n" + _MOTOR_BODY.format(STATE_RHS=state_rhs.format(**fill),
+                                       motor_module=motor.module,
+                                       torque_fn=motor.kernel("torque"), **fill)  # fmt: skip
     src += _STATE_EVENTS.format(**fill) if stateful else "\n\n" + _EVENTS[cfg]
     return src

@@ -13,6 +13,13 @@ choice of drive, torque law, load and equations, calling
   work integrals of the motor and of the gas.
 
 State: ``(theta_c, theta_c')``, then with a motor ``(theta1, omega1, W_motor, W_gas)``.
+
+A load with states (the dynamic valves) runs with the motor too (`glue_source` with
+``first_state``): its states follow the motor's, ``y[G:A]`` (``G = 6``), its auxiliary ones
+last; the right-hand side takes the gas force from its ``state_force`` and the derivatives of
+its states from its ``state_rhs`` for the crosshead of the mechanism's own state, and its
+``event``/``reset`` are the system's event. The mechanism's accelerations are the same
+free-crank functions as with a load without states.
 """
 
 from __future__ import annotations
@@ -21,7 +28,14 @@ import math
 
 import numba as nb
 
-__all__ = ["HEAD", "N_HEAD", "glue_source", "crosshead_velocity", "equilibrium_theta_c"]
+__all__ = [
+    "HEAD",
+    "N_HEAD",
+    "glue_source",
+    "crosshead_velocity",
+    "crosshead_motion",
+    "equilibrium_theta_c",
+]
 
 #: The mechanism's slice of the parameter vector, in order.
 HEAD = ("r", "rs", "l", "ls", "m1", "m2", "m3", "J1", "J2", "g", "rc", "d")
@@ -37,6 +51,20 @@ def crosshead_velocity(th1, thc, w1, thcd, p):
     s2 = -(p[11] + r * s1 + rc * sc) / l
     t2 = s2 / math.sqrt(1.0 - s2 * s2)
     return (-r * s1 + t2 * r * c1) * w1 + (-rc * sc + t2 * rc * cc) * thcd
+
+
+@nb.njit(cache=True, inline="always")
+def crosshead_motion(th1, thc, w1, thcd, p):
+    """``(x3, x3')`` of the crosshead, m and m/s, from the crank and clearance angles and rates
+    (the closure of `crosshead_velocity`; ``x3 = r cos theta1 + rc cos theta_c + l cos
+    theta2``)."""
+    r, l, rc = p[0], p[2], p[10]
+    s1, c1, sc, cc = math.sin(th1), math.cos(th1), math.sin(thc), math.cos(thc)
+    s2 = -(p[11] + r * s1 + rc * sc) / l
+    c2 = math.sqrt(1.0 - s2 * s2)
+    t2 = s2 / c2
+    x = r * c1 + rc * cc + l * c2
+    return x, (-r * s1 + t2 * r * c1) * w1 + (-rc * sc + t2 * rc * cc) * thcd
 
 
 def equilibrium_theta_c(p, t: float = 0.0, extra=None) -> float:
@@ -236,6 +264,106 @@ def observe(t, y, p):
 '''
 
 
+#: The motor with a load that has states (the dynamic valves): the free-crank accelerations
+#: with the gas force of the load's states, the load's own derivatives for the crosshead of
+#: the mechanism's state, the load's event and reset. State: ``(theta_c, theta_c', theta1,
+#: omega1, W_motor, W_gas)``, then the load's states from ``G``, its auxiliary ones from ``A``.
+_MOTOR_STATE = '''from {motor_module} import {torque_fn} as torque
+from {load_module} import {state_rhs} as load_rhs
+from {load_module} import {event_fn} as load_event
+from {load_module} import {reset_fn} as load_reset
+
+
+@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out):
+    th1 = y[2]
+    w1 = y[3]
+    F = load_force(y, {G}, p, {LO})
+    Tm = torque(w1, p, {MO})
+    if p[10] == 0.0:
+        a1 = free_crank_ideal_accelerations(t, (th1, w1), p, (p[{DO}], F, Tm))[0]
+        ac = 0.0
+    else:
+        a1, ac = free_crank_accelerations(t, (th1, y[0], w1, y[1]), p, (p[{DO}], F, Tm))
+    out[0] = y[1]
+    out[1] = ac
+    out[2] = w1
+    out[3] = a1
+    out[4] = Tm * w1
+    x3, v3 = crosshead_motion(th1, y[0], w1, y[1], p)
+    out[5] = F * v3
+    load_rhs(x3, v3, y, {G}, {A}, p, {LO}, out)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac(t, y, p, J):
+    """Central differences with one Richardson step, (4 D(h/2) - D(h)) / 3, as the motor's
+    without a load's states: h = 1e-4 for the angles, 1e-4 max(1, |y_k|) for the rates, and
+    1e-7 max(|y_k|, 1e-3) for the load's states (a pressure, a gas mass, a plate's lift and
+    velocity: the valves' stops and regularised nozzle are not smooth everywhere, so the step
+    stays small). The work integrals' and the load's auxiliary columns are 0 (nothing depends
+    on them)."""
+    n = y.shape[0]
+    fp = np.empty(n)
+    fm = np.empty(n)
+    d1 = np.empty(n)
+    yy = y.copy()
+    for k in range(n):
+        if k == 4 or k == 5 or k >= {A}:
+            for i in range(n):
+                J[i, k] = 0.0
+            continue
+        if k == 0 or k == 2:
+            h = 1e-4
+        elif k < 4:
+            h = 1e-4 * max(1.0, abs(y[k]))
+        else:
+            h = 1e-7 * max(abs(y[k]), 1e-3)
+        for level in range(2):
+            hk = h if level == 0 else 0.5 * h
+            yy[k] = y[k] + hk
+            _rhs(t, yy, p, fp)
+            yy[k] = y[k] - hk
+            _rhs(t, yy, p, fm)
+            yy[k] = y[k]
+            for i in range(n):
+                dk = (fp[i] - fm[i]) / (2.0 * hk)
+                if level == 0:
+                    d1[i] = dk
+                else:
+                    J[i, k] = (4.0 * dk - d1[i]) / 3.0
+
+
+rhs_jac = None
+
+
+@compiled(EVENT_SIGNATURE)
+def event(t, y, p):
+    """The load's event factor (a valve plate at its stop)."""
+    return load_event(y, {G}, p, {LO})
+
+
+@compiled(RHS_SIGNATURE)
+def reset(t, y, p, out):
+    load_reset(y, {G}, p, {LO}, out)
+
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    out = np.empty((t.shape[0], 3))
+    for i in range(t.shape[0]):
+        out[i, 0] = y[i, 2]
+        out[i, 1] = y[i, 3]
+        out[i, 2] = load_force(y[i], {G}, p, {LO})
+    return out
+'''
+
+
 #: The observer: what the outputs are computed from (crank angle and speed, the load's force),
 #: by the same compiled functions that were integrated, so a record cannot disagree with its
 #: own dynamics.
@@ -253,14 +381,35 @@ def observe(t, y, p):
 """
 
 
-def glue_source(*, equations: str, drive, load, motor, offsets) -> str:
-    """The glue module's source for one combination (module docstring)."""
+def glue_source(*, equations: str, drive, load, motor, offsets,
+                first_state: int | None = None) -> str:  # fmt: skip
+    """The glue module's source for one combination (module docstring); ``first_state``: the
+    index of a load's first state (a load with states runs with the motor only, after its
+    four states)."""
     combo = f"drive={drive.name}, load={load.name}, equations={equations}"
     if motor is not None:
         combo += f", motor={motor.name}"
+    stateful = bool(load.states)
     fill = dict(combo=combo, offsets=dict(offsets), load_module=load.module,
-                load_fn=load.kernel("force"), LO=offsets["load"], DO=offsets["drive"])  # fmt: skip
+                load_fn=load.kernel("state_force" if stateful else "force"),
+                LO=offsets["load"], DO=offsets["drive"])  # fmt: skip
     src = _HEADER.format(**fill)
+    if stateful:
+        if motor is None or equations != "exact" or first_state is None:
+            raise ValueError(
+                "a load with states runs here with the motor and the exact "
+                "equations only (the prescribed crank: compressor_valves)"
+            )
+        src = src.replace(
+            "from recipdyn.model.base import JAC_SIGNATURE",
+            "from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE",
+        )
+        src = src.replace("import crosshead_velocity", "import crosshead_motion")
+        return src + _MOTOR_STATE.format(
+            motor_module=motor.module, torque_fn=motor.kernel("torque"), MO=offsets["motor"],
+            state_rhs=load.kernel("state_rhs"), event_fn=load.kernel("event"),
+            reset_fn=load.kernel("reset"), G=first_state,
+            A=first_state + len(load.states), **fill)  # fmt: skip
     if drive.name == "prescribed":
         body = _PRESCRIBED if equations == "exact" else _PRINTED
         src += body.format(drive_module=drive.module, crank_fn=drive.kernel("crank"), **fill)
