@@ -11,15 +11,16 @@ import numpy as np
 import pytest
 
 from recipdyn.integrate import integrate
-from recipdyn.model import compressor_contact as cc
 from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem
-from recipdyn.model.compressor_contact import I_WIN, I_WLOSS
+from recipdyn.model.components import contact_model as cm
+from recipdyn.model.joints import pins as jp
 from recipdyn.model.joints.contact import (
     LAWS,
     delivered_restitution,
     hysteresis_factor,
     normal_force,
 )
+from recipdyn.model.joints.pins import I_WIN, I_WLOSS
 from recipdyn.model.registry import get_model
 
 # --- a single impact: a mass against a compliant wall, the model's own force law ---------
@@ -160,7 +161,7 @@ def _newton_euler_rhs(t, y, p, out):  # y = (theta2, x3, theta2', x3', v_impact)
     ey = r * math.sin(th1) + l * s2 + d
     u = -r * w * math.sin(th1) - l * s2 * w2 - v3
     v = r * w * math.cos(th1) + l * c2 * w2
-    f = cc._pair(ex, ey, u, v, 0.0, w2, p[cc.P_C2], p[cc.P_K2], p[cc.P_RJ2], y[4], p[cc.P_OIL2],
+    f = jp._pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
                  p)  # fmt: skip
     aax, aay = -r * w * w * math.cos(th1), -r * w * w * math.sin(th1)
     # moments about the crank pin A: (J2 + m2 ls^2) theta2'' = -m2 ls (rGA x aA) + rPA x F2
@@ -179,7 +180,7 @@ def _ne_onset(t, y, p):
     r, l, d, th1 = p[0], p[1], p[7], p[9] + p[8] * t
     ex = r * math.cos(th1) + l * math.cos(y[0]) - y[1]
     ey = r * math.sin(th1) + l * math.sin(y[0]) + d
-    return math.sqrt(ex * ex + ey * ey) - p[cc.P_C2]
+    return math.sqrt(ex * ex + ey * ey) - p[jp.P_C2]
 
 
 @nb.njit(RHS_SIGNATURE, cache=True)
@@ -448,7 +449,7 @@ def test_complex_step_jacobian_on_every_branch_of_the_joint_laws():
         v = m.parameters(dict(omega=150.0, load_amplitude=2e4, **kw))
         s = m.system(v)
         T = m.period(v)
-        cfg = cc.CFG[v["clearance_joints"]]
+        cfg = jp.CFG[v["clearance_joints"]]
         fd_jac = m.kernels(v).fd_jac
         sol = integrate(s, m.initial_state(v), (0.0, T), t_eval=np.linspace(0.0, T, 25))
         phases = set()
@@ -465,7 +466,7 @@ def test_complex_step_jacobian_on_every_branch_of_the_joint_laws():
             # real one)
             f, Jb = np.empty(y.size), np.empty_like(J)
             s.rhs_jac(t, y, s.params, f, Jb)
-            rigid = list(cc.RIGID[v["clearance_joints"]])
+            rigid = list(jp.RIGID[v["clearance_joints"]])
             act = [k for k in range(y.size) if k not in rigid]
             assert set(rigid) <= set(s.passive)
             assert np.array_equal(Jb[:, act], J[:, act]) and not Jb[:, rigid].any()
@@ -488,12 +489,12 @@ def test_the_overlap_arc_is_where_the_two_circles_intersect(R_j, c):
         e = c + delta
         inside = np.hypot((R_j + c) * np.cos(phi) - e, (R_j + c) * np.sin(phi)) < R_j
         brute = np.degrees(np.abs(phi[inside]).max())
-        got = cc.overlap_half_angle(R_j, c, delta)
+        got = cm.overlap_half_angle(R_j, c, delta)
         assert got == pytest.approx(brute, abs=2e-4)
         approx = np.degrees(np.arccos(1.0 - delta / (c + delta)))
         assert got == pytest.approx(approx, rel=3 * c / R_j)
-    assert cc.overlap_half_angle(R_j, c, 0.0) == 0.0
-    assert cc.overlap_half_angle(R_j, c, -1e-6) == 0.0
+    assert cm.overlap_half_angle(R_j, c, 0.0) == 0.0
+    assert cm.overlap_half_angle(R_j, c, -1e-6) == 0.0
 
 
 def test_the_run_summary_reports_the_penetration_against_the_clearance():
@@ -516,7 +517,7 @@ def test_the_run_summary_reports_the_penetration_against_the_clearance():
         a = ds.attrs
         assert a["max_penetration_ratio"] == pytest.approx(a["max_penetration_m"] / rc, rel=1e-12)
         assert a["contact_arc_deg"] == pytest.approx(
-            cc.overlap_half_angle(0.05, rc, a["max_penetration_m"]), rel=1e-12
+            cm.overlap_half_angle(0.05, rc, a["max_penetration_m"]), rel=1e-12
         )
         got[rc] = a["max_penetration_ratio"]
     assert 3.0 < got[1e-4] / got[1e-3] < 6.0
@@ -554,7 +555,7 @@ def test_the_summary_reports_the_steady_state_and_the_startup_apart():
 
 def test_a_point_contact_law_stretched_beyond_its_range_warns(tmp_path, capsys):
     """Issue 31, item 3: Hertz's law needs a contact small against the radii; a run whose
-    overlap arc exceeds cc.HERTZ_ARC_LIMIT_DEG (an arc as long as the radius, 28.6 deg) warns
+    overlap arc exceeds cm.HERTZ_ARC_LIMIT_DEG (an arc as long as the radius, 28.6 deg) warns
     (LawRangeWarning, the record's law_range attribute, one CLI line) with the threshold and
     its source. Under the paper's load a 0.1 mm clearance is pushed to a ~44 deg arc (warns),
     a 1 mm one to ~22 deg (does not; measured in the test above and in docs/contact.md)."""
@@ -564,17 +565,17 @@ def test_a_point_contact_law_stretched_beyond_its_range_warns(tmp_path, capsys):
     from recipdyn.cli import main
     from recipdyn.errors import LawRangeWarning
 
-    assert cc.HERTZ_ARC_LIMIT_DEG == pytest.approx(28.648, abs=1e-3)
+    assert cm.HERTZ_ARC_LIMIT_DEG == pytest.approx(28.648, abs=1e-3)
     with pytest.warns(LawRangeWarning, match="Johnson 1985"):
         ds = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-4),
                                revolutions=0.5, fs=2000)  # fmt: skip
     assert "28.6 deg" in ds.attrs["law_range"] and "crank pin" in ds.attrs["law_range"]
-    assert ds.attrs["contact_arc_deg"] > cc.HERTZ_ARC_LIMIT_DEG
+    assert ds.attrs["contact_arc_deg"] > cm.HERTZ_ARC_LIMIT_DEG
     with warnings.catch_warnings():
         warnings.simplefilter("error", LawRangeWarning)
         ok = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-3),
                                revolutions=0.5, fs=2000)  # fmt: skip
-    assert ok.attrs["law_range"] == "ok" and ok.attrs["contact_arc_deg"] < cc.HERTZ_ARC_LIMIT_DEG
+    assert ok.attrs["law_range"] == "ok" and ok.attrs["contact_arc_deg"] < cm.HERTZ_ARC_LIMIT_DEG
     assert main(["simulate", "--model", "compressor-contact", "--set", "rc=0.1 mm", "-n", "0.5",
                  "--fs", "2 kHz", "-o", str(tmp_path / "r.nc"), "--no-figure",
                  "--no-progress"]) == 0  # fmt: skip
@@ -595,7 +596,7 @@ def test_lubricated_and_dry_pins_together_close_the_energy_balance(pins):
                        rc_crosshead=2e-4, omega=150.0, load_amplitude=2e4)  # fmt: skip
     assert v["clearance_joints"] == "both"
     p = M.system(v).params
-    assert (p[cc.P_OIL] > 0.0, p[cc.P_OIL2] > 0.0) == (pins[0] == "lubricated",
+    assert (p[jp.P_OIL] > 0.0, p[jp.P_OIL2] > 0.0) == (pins[0] == "lubricated",
                                                        pins[1] == "lubricated")  # fmt: skip
     E = out["energy"].values
     bal = E - E[0] - (sol.y[:, I_WIN] - sol.y[:, I_WLOSS])

@@ -14,10 +14,11 @@ import pytest
 import recipdyn
 from recipdyn.errors import ParameterError
 from recipdyn.model.components.contact import glue_source
+from recipdyn.model.components.contact_model import pack
 from recipdyn.model.components.load import PAPER
 from recipdyn.model.compressor_contact import COMPRESSOR_CONTACT as CC
-from recipdyn.model.compressor_contact import N_PACKED, pack
 from recipdyn.model.compressor_guide import ideal_crosshead
+from recipdyn.model.joints.pins import N_PACKED
 
 #: Both pins ideal, the guide worn: the configuration `compressor-guide` integrates.
 IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}

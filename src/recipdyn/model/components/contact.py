@@ -1,6 +1,6 @@
 r"""The contact-impact joints with a chosen load, as glue source.
 
-`recipdyn.model.compressor_contact` holds the joints' compiled parts that do not depend on the
+`recipdyn.model.joints.pins` holds the joints' compiled parts that do not depend on the
 load: the kinematics, the force of one joint (`_pair`), both joints (`_joints`), the
 accelerations of the mechanism given the gas force (`_accelerate`), the contact events. The
 glue written here joins them with one load component (`.load`) for one joint configuration
@@ -19,7 +19,7 @@ configuration, the load's offset ``LO`` in the parameter vector and its first st
 A contact law from a user's file (``contact_law = file.py:OBJ``, a `Component` of the family
 ``contact_law``) replaces the built-in normal-force law at the pins: the glue then defines the
 joints' force functions itself, with the law's functions imported and its offset a literal
-(`recipdyn.model.compressor_contact.law_source`). Its roles, each a ``numba.njit(inline=
+(`recipdyn.model.joints.pins.law_source`). Its roles, each a ``numba.njit(inline=
 "always")`` function of scalars and ``(p, o)`` that takes complex arguments too (the Jacobian is
 the complex step; branch on ``.real``):
 
@@ -56,7 +56,7 @@ from recipdyn.model.base import (
     RHS_SIGNATURE,
     compiled,
 )
-from recipdyn.model.compressor_contact import (
+from recipdyn.model.joints.pins import (
     CS_STEP,
     I_WIN,
     P_C1,
@@ -217,15 +217,15 @@ def jac(t, y, p, J):
 rhs_jac = None
 """
 
-#: The joints' own events (`recipdyn.model.compressor_contact`): onsets at one pin, onsets
+#: The joints' own events (`recipdyn.model.joints.pins`): onsets at one pin, onsets
 #: and separations with both.
 _EVENTS = {
-    0: "from recipdyn.model.compressor_contact import onset_crank as event\n"
-    "from recipdyn.model.compressor_contact import record_crank as reset\n",
-    1: "from recipdyn.model.compressor_contact import onset_crosshead as event\n"
-    "from recipdyn.model.compressor_contact import record_crosshead as reset\n",
-    2: "from recipdyn.model.compressor_contact import onset_both as event\n"
-    "from recipdyn.model.compressor_contact import record_both as reset\n",
+    0: "from recipdyn.model.joints.pins import onset_crank as event\n"
+    "from recipdyn.model.joints.pins import record_crank as reset\n",
+    1: "from recipdyn.model.joints.pins import onset_crosshead as event\n"
+    "from recipdyn.model.joints.pins import record_crosshead as reset\n",
+    2: "from recipdyn.model.joints.pins import onset_both as event\n"
+    "from recipdyn.model.joints.pins import record_both as reset\n",
 }
 
 _STATE_EVENTS = '''
@@ -257,7 +257,7 @@ def reset(t, y, p, out):
 
 
 _GUIDE_HEADER = """
-from recipdyn.model.compressor_contact import (
+from recipdyn.model.joints.pins import (
     _accelerate_guide,
     _joints_guide,
 )
@@ -432,7 +432,7 @@ def reset(t, y, p, out):
 #: state (`_joints_at`), the free-crank accelerations (`_accelerate_free`) with the motor's
 #: torque law; the Jacobian by central differences (the crank angle enters the kinematics
 #: through math.sin, which the complex step does not take).
-_MOTOR_BODY = '''from recipdyn.model.compressor_contact import _accelerate_free, _joints_at
+_MOTOR_BODY = '''from recipdyn.model.joints.pins import _accelerate_free, _joints_at
 from {motor_module} import {torque_fn} as torque
 
 
@@ -518,7 +518,7 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     at ``offset`` (its states, if any, at ``first_state``: module docstring); with the guide's
     clearance, ``guide`` is the offset of its slice and ``guide_state`` its first state.
     ``law``: the joints' force functions with a contact law of a user's file
-    (`recipdyn.model.compressor_contact.law_source`), defined here in place of the built-in
+    (`recipdyn.model.joints.pins.law_source`), defined here in place of the built-in
     ones; empty for a built-in law (the glue then imports the joints' functions). With a
     motor (``motor``, its torque law's component): the crank's states start at
     ``motor_state``, the torque law's slice at ``motor_offset``, the crank's (inertia, static

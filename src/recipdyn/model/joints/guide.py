@@ -198,7 +198,7 @@ def phased_gap_factor(delta, v_phase, scale):
     ``delta/scale + PHASE_MARGIN`` in contact (``v_phase > 0``). Positive in both phases, it
     falls through 0 at an onset and at a separation; the reset flips the phase, so the
     smallest factor of all corners is one event function that sees every onset and
-    separation (as `recipdyn.model.compressor_contact.phased_factor` does for pins)."""
+    separation (as `recipdyn.model.joints.pins.phased_factor` does for pins)."""
     return delta / scale + PHASE_MARGIN if v_phase > 0.0 else -delta / scale
 
 
