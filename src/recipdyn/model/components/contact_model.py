@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import valves as va
 from ..base import Event, ODESystem, Signal
-from ..joints.contact import FRICTION_LAWS, LAWS, hertz_stiffness, hysteresis_factor
+from ..joints.contact import FRICTION_LAWS, FRICTION_ROLES, LAWS, hertz_stiffness, hysteresis_factor
 from ..joints.pins import (
     CFG,
     CLEARANCE,
@@ -35,6 +35,7 @@ from ..joints.pins import (
     N_GUIDE,
     N_GUIDE_STATES,
     N_PACKED,
+    P_MU,
     RIGID,
     STATE_NAMES,
     STATE_UNITS,
@@ -206,15 +207,27 @@ def first_load_state(values: Mapping[str, Any]) -> int:
     return G_GAS + (N_GUIDE_STATES if has_guide(values) else 0)
 
 
+def friction_part(values: Mapping[str, Any]) -> tuple[str, str, int]:
+    """The friction law at the pins, as the glue imports it: ``(module, function, offset of
+    its slice)``. A contact law of a user's file with a ``friction`` role: that function, its
+    slice after the joints' part; else the built-in law ``friction_law`` names
+    (`recipdyn.model.joints.contact.FRICTION_ROLES`), reading ``(mu, v0, v1)`` at `P_MU`."""
+    law = law_part(values)
+    if law is not None and "friction" in law.kernels:
+        return law.module, law.kernel("friction"), N_PACKED
+    return "recipdyn.model.joints.contact", FRICTION_ROLES[values["friction_law"]], P_MU
+
+
 @lru_cache(maxsize=32)
 def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
-          n_law: int = 0, motor: str | None = None, n_motor: int = 0):  # fmt: skip
+          n_law: int = 0, friction: tuple[str, str, int] = (), motor: str | None = None,
+          n_motor: int = 0):  # fmt: skip
     from .contact import glue_source
     from .contract import glue_module, resolve_component, source_digest
     from .load import LOADS, VALVES
 
     part = VALVES if load == VALVES.name else LOADS[load]
-    block, stem = "", f"contact_{joints}_{load}"
+    block, stem = "", f"contact_{joints}_{load}_{friction[1]}"
     if law is not None:  # a contact law of a user's file: its slice first, after the joints'
         law_c = resolve_component("contact_law", law, {})
         block = law_source(law_c, N_PACKED)
@@ -230,15 +243,16 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
                           law=block, motor=MOTORS[motor],
                           motor_state=first + (va.N_GAS + va.N_AUX if part.states else 0),
                           motor_offset=N_PACKED + n_law + N_CRANK,
-                          crank_offset=N_PACKED + n_law)  # fmt: skip
+                          crank_offset=N_PACKED + n_law, friction=friction)  # fmt: skip
         return glue_module(src, f"{stem}_motor_{motor}")
     if not guide:
         src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
-                          first_state=G_GAS, law=block)  # fmt: skip
+                          first_state=G_GAS, law=block, friction=friction)  # fmt: skip
         return glue_module(src, stem)
     src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                       offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
-                      guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block)  # fmt: skip
+                      guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block,
+                      friction=friction)  # fmt: skip
     return glue_module(src, f"{stem}_guide")
 
 
@@ -249,20 +263,19 @@ def kernels(values: Mapping[str, Any], load=None):
     (`recipdyn.model.components.contact`)."""
     part = load_part(values) if load is None else load
     spec = law_spec(values)
+    friction = friction_part(values)
     if has_motor(values):
         from ..registry import absolute_spec
 
         law = None if spec is None else absolute_spec(spec)
         return _glue(values["clearance_joints"], part.name, False, law, law_size(values),
-                     values["motor"], motor_size(values))  # fmt: skip
+                     friction, values["motor"], motor_size(values))  # fmt: skip
     if spec is not None:
         from ..registry import absolute_spec
 
         return _glue(values["clearance_joints"], part.name, has_guide(values),
-                     absolute_spec(spec), law_size(values))  # fmt: skip
-    if has_guide(values):
-        return _glue(values["clearance_joints"], part.name, True)
-    return _glue(values["clearance_joints"], part.name)
+                     absolute_spec(spec), law_size(values), friction)  # fmt: skip
+    return _glue(values["clearance_joints"], part.name, has_guide(values), None, 0, friction)
 
 
 def _link(name: str, **changes) -> Param:
@@ -401,8 +414,7 @@ def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
     head += [v["rc"], stiffness(v, "crank"), v["journal_radius"],
              v["rc_crosshead"], stiffness(v, "crosshead"), v["crosshead_pin_radius"],
              0.0 if law_spec(v) else hysteresis_factor(v["contact_law"], v["restitution"]),
-             v["friction"], v["v0"],
-             v["v1"], float(FRICTION_LAWS.index(v["friction_law"])),
+             v["friction"], v["v0"], v["v1"],
              v["oil_viscosity"] if pins[0] == "lubricated" else 0.0, v["bearing_length"],
              v["eps_dry"], v["v_impact_min"],
              v["oil_viscosity"] if pins[1] == "lubricated" else 0.0]  # fmt: skip

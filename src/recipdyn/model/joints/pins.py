@@ -35,7 +35,7 @@ from .._compressor_contact_drive import (
 )
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, compiled
 from ..components.guide import CLEARANCE
-from .contact import friction_factor, normal_force, short_bearing_forces
+from .contact import normal_force, short_bearing_forces
 
 #: Where the clearance is: the crank pin, the crosshead pin, or both (``clearance_joints``).
 JOINTS = ("crank", "crosshead", "both")
@@ -49,11 +49,12 @@ NHEAD = len(MECH) + len(INPUTS)
 (P_R, P_L, P_LS, P_M2, P_M3, P_J2, P_G, P_D, P_OMEGA, P_TH10,
  P_FGAS, P_F1X, P_F1Y, P_F2X, P_F2Y, P_TROD) = range(NHEAD)  # fmt: skip
 # The oil viscosity of each pin (P_OIL crank pin, P_OIL2 crosshead pin) is 0 at a dry joint.
-(P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_OIL, P_LB, P_EPSDRY,
- P_VMIN, P_OIL2) = range(NHEAD, NHEAD + 16)  # fmt: skip
+# The built-in friction laws read (mu, v0, v1) at P_MU (their ``friction(vt, p, o)`` role).
+(P_C1, P_K1, P_RJ1, P_C2, P_K2, P_RJ2, P_CHI, P_MU, P_V0, P_V1, P_OIL, P_LB, P_EPSDRY, P_VMIN,
+ P_OIL2) = range(NHEAD, NHEAD + 15)  # fmt: skip
 #: The joints' part of the parameter vector; the load component's slice follows
 #: (`recipdyn.model.components.contract.Assembly`).
-N_PACKED = NHEAD + 16
+N_PACKED = NHEAD + 15
 
 
 #: The state, the same for every joint configuration (a rigid joint's components stay 0).
@@ -113,10 +114,13 @@ def _kinematics_at(th1, w, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
 
 
 @nb.njit(cache=True, inline="always")
-def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
+def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p, friction, fo):
     """Forces of one clearance joint, e = (ex, ey) from the journal centre to the bearing
     centre, journal and bearing turning at w_j and w_b: the tuple (F_x, F_y (on the bearing),
-    T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost)."""
+    T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost).
+    ``friction(vt, p, fo)``: the friction law (a contact law's ``friction`` role, e.g.
+    `recipdyn.model.joints.contact.ambrosio_friction` with ``fo = P_MU``), a compiled
+    function the caller names: each law compiles its own kernel."""
     z = 0.0 * ex  # zero of the state's type (real, or complex for the complex step)
     fx, fy, tb, tj, fnn, ftt, lost = z, z, z, z, z, z, z
     rho = np.sqrt(ex * ex + ey * ey)
@@ -132,7 +136,7 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
         vi = v_imp if v_imp.real > p[P_VMIN] else p[P_VMIN]  # (the floor: grazing contacts)
         fn = normal_force(delta, drho, vi, K, p[P_CHI])
         vt = et + w_j * Rj - w_b * Rb  # sliding velocity, bearing relative to journal
-        ft = fn * friction_factor(vt, p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]))
+        ft = fn * friction(vt, p, fo)
         fx = -fn * nx + ft * tx
         fy = -fn * ny + ft * ty
         tb = -Rb * ft
@@ -155,16 +159,16 @@ def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _joints(t, y, p, cfg):
-    """Both joints' forces (tuples as `_pair`; a rigid joint's are 0) and (power from
-    the crank, power lost in the joints, theta2', x3', cos theta2, sin and cos theta1), the
-    crank turning at the prescribed speed."""
+def _joints(t, y, p, cfg, friction, fo):
+    """Both joints' forces (tuples as `_pair`, with its friction law ``friction`` and its
+    slice ``fo``; a rigid joint's are 0) and (power from the crank, power lost in the joints,
+    theta2', x3', cos theta2, sin and cos theta1), the crank turning at the prescribed speed."""
     w = p[P_OMEGA]
-    return _joints_at(p[P_TH10] + w * t, w, y, p, cfg)
+    return _joints_at(p[P_TH10] + w * t, w, y, p, cfg, friction, fo)
 
 
 @nb.njit(cache=True, inline="always")
-def _joints_at(th1, w, y, p, cfg):
+def _joints_at(th1, w, y, p, cfg, friction, fo):
     """`_joints` at the crank angle ``th1`` and speed ``w`` (a free crank's states)."""
     _, c2, th2d, v3, s1, c1 = _kinematics_at(th1, w, p, y[0], y[1], y[4], y[5], y[2], y[3],
                                              y[6], y[7])  # fmt: skip
@@ -174,12 +178,12 @@ def _joints_at(th1, w, y, p, cfg):
     f2 = (z, z, z, z, z, z, z)
     if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
         f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
-                   p[P_OIL], p)  # fmt: skip
+                   p[P_OIL], p, friction, fo)  # fmt: skip
         vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
         p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
     if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
         f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]),
-                   p[P_OIL2], p)  # fmt: skip
+                   p[P_OIL2], p, friction, fo)  # fmt: skip
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
@@ -277,7 +281,7 @@ def _accelerate_free(y, p, out, cfg, j, fg, m, tm, co):
 
 
 @nb.njit(cache=True, inline="always")
-def _joints_guide(t, y, p, cfg, gy):
+def _joints_guide(t, y, p, cfg, gy, friction, fo):
     """`_joints` with the guide's clearance (``cfg`` 3: both pins ideal): the rod's small end
     follows the crosshead pin's lateral position, and the crosshead pin's journal turns with
     the crosshead's tilt."""
@@ -290,12 +294,12 @@ def _joints_guide(t, y, p, cfg, gy):
     f2 = (z, z, z, z, z, z, z)
     if cfg == 0 or cfg == 2:  # crank pin: journal on the crank (w), bearing on the rod
         f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
-                   p[P_OIL], p)  # fmt: skip
+                   p[P_OIL], p, friction, fo)  # fmt: skip
         vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
         p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
     if cfg == 1 or cfg == 2:  # crosshead pin: journal on the crosshead (turning with its tilt)
         f2 = _pair(y[2], y[3], y[6], y[7], y[gy + 3], th2d, p[P_C2], p[P_K2], p[P_RJ2],
-                   _abs(y[9]), p[P_OIL2], p)  # fmt: skip
+                   _abs(y[9]), p[P_OIL2], p, friction, fo)  # fmt: skip
     return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
@@ -481,9 +485,10 @@ LAW_OPTIONAL = ("friction", "potential")
 def law_source(law, offset: int) -> str:
     """The joints' force functions (`_pair`, `_joints`, `_joints_guide`) with the contact law
     ``law`` of a user's file, its slice at ``offset``: the source of the built-in functions
-    with the law's calls in place of the built-in normal force, its elastic part (in the
-    power lost) and, if the law has one, the friction; the rest (kinematics, the oil film,
-    the torques) is the same text, so the physics stays written once. For the generated glue
+    with the law's calls in place of the built-in normal force and its elastic part (in the
+    power lost); the rest (kinematics, the oil film, the torques) is the same text, so the
+    physics stays written once. Its friction, like a built-in law's, is the function the glue
+    passes to `_joints` (`friction_part`). For the generated glue
     (`recipdyn.model.components.contact`)."""
     import inspect
 
@@ -491,20 +496,15 @@ def law_source(law, offset: int) -> str:
     swaps = {"normal_force(delta, drho, vi, K, p[P_CHI])":
              f"law_normal(delta, drho, vi, K, p, {offset})",
              "K * delta * np.sqrt(delta)": f"law_elastic(delta, K, p, {offset})"}  # fmt: skip
-    if "friction" in law.kernels:
-        swaps["friction_factor(vt, p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]))"] = (
-            f"law_friction(vt, p, {offset})")  # fmt: skip
     for old, new in swaps.items():
         if pair.count(old) != 1:  # pragma: no cover - guards an edit of _pair
             raise RuntimeError(f"_pair no longer holds {old!r} once; update law_source")
         pair = pair.replace(old, new)
     names = sorted(k for k in globals() if k.startswith("P_"))
     head = [f"from {law.module} import {law.kernel(r)} as law_{r}" for r in LAW_ROLES]
-    if "friction" in law.kernels:
-        head.append(f"from {law.module} import {law.kernel('friction')} as law_friction")
     head.append(
         "from recipdyn.model.joints.pins import (_abs, _kinematics, _kinematics_at, "
-        "friction_factor, short_bearing_forces, " + ", ".join(names) + ")"
+        f"short_bearing_forces, {', '.join(names)})"
     )
     body = [pair] + [inspect.getsource(f.py_func) for f in (_joints_at, _joints,
                                                              _joints_guide)]  # fmt: skip
