@@ -267,8 +267,9 @@ from recipdyn.model.joints.pins import (
     _accelerate_guide,
     _joints_guide,
 )
-from recipdyn.model.joints.guide import S_A, S_B, S_C, S_CHI, S_FLAW, S_J3, S_K, S_MU, S_V0
-from recipdyn.model.joints.guide import S_V1, S_VMIN, corner_force
+from {guide_friction_module} import {guide_friction_fn} as guide_friction
+from recipdyn.model.joints.guide import S_A, S_B, S_C, S_CHI, S_J3, S_K, S_MU, S_VMIN
+from recipdyn.model.joints.guide import corner_force
 from recipdyn.model.joints.guide import slice_flip_phases as guide_reset
 from recipdyn.model.joints.guide import slice_forces as guide_forces
 from recipdyn.model.joints.guide import slice_smallest_factor as guide_factor
@@ -279,8 +280,8 @@ _GUIDE_BODY = '''
 @nb.njit(cache=True, inline="always")
 def _guide(y, p, v3):
     # the corners' contact: resultant on the crosshead at its pin, moment, power lost, elastic
-    return guide_forces(p, {GO}, y[{GY}], v3, y[{GY} + 2], y[{GY} + 1], y[{GY} + 3],
-                        y[{GY} + 4], y[{GY} + 5], y[{GY} + 6], y[{GY} + 7])
+    return guide_forces(p, {GO}, guide_friction, y[{GY}], v3, y[{GY} + 2], y[{GY} + 1],
+                        y[{GY} + 3], y[{GY} + 4], y[{GY} + 5], y[{GY} + 6], y[{GY} + 7])
 
 
 @nb.njit(cache=True, inline="always")
@@ -380,9 +381,8 @@ def observe(t, y, p):
         for k in range(4):
             fk = corner_force(k, yi[{GY}], v3, yi[{GY} + 2], yi[{GY} + 1], yi[{GY} + 3],
                               p[{GO} + S_A], p[{GO} + S_B], p[{GO} + S_C], p[{GO} + S_K],
-                              p[{GO} + S_CHI], p[{GO} + S_MU], p[{GO} + S_V0],
-                              p[{GO} + S_V1], int(p[{GO} + S_FLAW]), p[{GO} + S_VMIN],
-                              yi[{GY} + 4 + k])
+                              p[{GO} + S_CHI], guide_friction, p, {GO} + S_MU,
+                              p[{GO} + S_VMIN], yi[{GY} + 4 + k])
             out[i, 25 if k < 2 else 26] += fk[5]
             if fk[5] > 0.0:
                 out[i, 27] += 1.0
@@ -518,7 +518,8 @@ _PRESCRIBED_ANGLE = "p[P_TH10] + p[P_OMEGA] * t"
 
 def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
                 guide: int | None = None, guide_state: int | None = None,
-                law: str = "", friction: tuple[str, str, int] | None = None, motor=None,
+                law: str = "", friction: tuple[str, str, int] | None = None,
+                guide_friction: str = "ambrosio_friction", motor=None,
                 motor_state: int | None = None, motor_offset: int | None = None,
                 crank_offset: int | None = None) -> str:  # fmt: skip
     """The glue module's source for the joints ``cfg`` (0 crank, 1 crosshead, 2 both; 3 both
@@ -533,7 +534,8 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     moment) at ``crank_offset``; no guide clearance. ``friction``: the friction law,
     ``(module, function, offset of its slice)``
     (`recipdyn.model.components.contact_model.friction_part`; default: the schema's default
-    ``friction_law``, Ambrósio's)."""
+    ``friction_law``, Ambrósio's). ``guide_friction``: the guide's friction law, a function
+    of `recipdyn.model.joints.contact` (``guide_friction_law``'s)."""
     if friction is None:
         from ..joints.pins import P_MU
 
@@ -557,8 +559,13 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     else:
         src += _FORCE["angle"].format(force=load.kernel("force"), **fill)
     if guide is not None:
-        fill.update(GO=guide, GY=guide_state)
-        src += _GUIDE_HEADER
+        fill.update(
+            GO=guide,
+            GY=guide_state,
+            guide_friction_module="recipdyn.model.joints.contact",
+            guide_friction_fn=guide_friction,
+        )
+        src += _GUIDE_HEADER.format(**fill)
         if law:
             src += "\n\n" + law
         src += _GUIDE_BODY.format(

@@ -220,8 +220,8 @@ def friction_part(values: Mapping[str, Any]) -> tuple[str, str, int]:
 
 @lru_cache(maxsize=32)
 def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
-          n_law: int = 0, friction: tuple[str, str, int] = (), motor: str | None = None,
-          n_motor: int = 0):  # fmt: skip
+          n_law: int = 0, friction: tuple[str, str, int] = (), guide_friction: str = "",
+          motor: str | None = None, n_motor: int = 0):  # fmt: skip
     from .contact import glue_source
     from .contract import glue_module, resolve_component, source_digest
     from .load import LOADS, VALVES
@@ -252,8 +252,8 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
     src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                       offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
                       guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block,
-                      friction=friction)  # fmt: skip
-    return glue_module(src, f"{stem}_guide")
+                      friction=friction, guide_friction=guide_friction)  # fmt: skip
+    return glue_module(src, f"{stem}_guide_{guide_friction}")
 
 
 def kernels(values: Mapping[str, Any], load=None):
@@ -269,13 +269,15 @@ def kernels(values: Mapping[str, Any], load=None):
 
         law = None if spec is None else absolute_spec(spec)
         return _glue(values["clearance_joints"], part.name, False, law, law_size(values),
-                     friction, values["motor"], motor_size(values))  # fmt: skip
+                     friction, "", values["motor"], motor_size(values))  # fmt: skip
+    guide = has_guide(values)
+    shoes = FRICTION_ROLES[values["guide_friction_law"]] if guide else ""
     if spec is not None:
         from ..registry import absolute_spec
 
-        return _glue(values["clearance_joints"], part.name, has_guide(values),
-                     absolute_spec(spec), law_size(values), friction)  # fmt: skip
-    return _glue(values["clearance_joints"], part.name, has_guide(values), None, 0, friction)
+        return _glue(values["clearance_joints"], part.name, guide, absolute_spec(spec),
+                     law_size(values), friction, shoes)  # fmt: skip
+    return _glue(values["clearance_joints"], part.name, guide, None, 0, friction, shoes)
 
 
 def _link(name: str, **changes) -> Param:
