@@ -1,4 +1,4 @@
-"""Benchmark: the contact joints with friction, per revolution, for each built-in friction law.
+"""Benchmark: the joints with friction (the pins and the guide's shoes), per revolution, per law.
 
 The friction law (``friction_law``: Ambrósio's dynamic correction or tanh) is a function the
 generated glue imports by name; this times one period of the contact joints with friction on
@@ -20,6 +20,9 @@ import subprocess
 import sys
 import time
 
+#: The guide's shoes with friction, v0 and v1 of the order of the crosshead's speed.
+_SHOES = {"guide_clearance": 2e-4, "load_amplitude": 2e4, "guide_friction": 0.2,
+          "guide_v0": 0.5, "guide_v1": 2.0}  # fmt: skip
 _IMPACTS = {"omega": 150.0, "load_amplitude": 2e4, "friction": 0.1, "v0": 5.0, "v1": 10.0}
 CASES = {
     "crank pin, ambrosio": ("compressor-contact", {**_IMPACTS, "friction_law": "ambrosio"}),
@@ -27,6 +30,12 @@ CASES = {
     "oil film + dry crosshead pin, tanh": ("compressor-contact", {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "rc_crosshead": 2e-4,
         "friction": 0.1, "friction_law": "tanh", "v0": 0.01, "v1": 0.02}),
+    "crank pin with a motor, tanh": ("compressor-contact", {
+        **_IMPACTS, "friction_law": "tanh", "drive": "motor", "motor": "constant"}),
+    "compressor-guide kernel, ambrosio": ("compressor-guide", {**_SHOES}),
+    "compressor-guide kernel, tanh": ("compressor-guide", {**_SHOES, "guide_friction_law": "tanh"}),
+    "glue's guide (ideal pins), tanh": ("compressor", {
+        **_SHOES, "guide": "clearance", "crank_joint": "ideal", "guide_friction_law": "tanh"}),
 }  # fmt: skip
 
 
@@ -68,20 +77,21 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--baseline", help="src folder of the code to compare with")
     ap.add_argument("--rounds", type=int, default=5, help="alternations (default 5)")
     ap.add_argument("--repeat", type=int, default=3, help="periods per measurement")
+    ap.add_argument("--match", default="", help="only the cases whose name holds this")
     ap.add_argument("--case", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.case:  # one measurement, in its own process
         print(json.dumps(measure(args.case, args.repeat)))
         return {}
     rows = {}
-    for name in CASES:
+    for name in [k for k in CASES if args.match in k]:
         new, old = [], []
         for _ in range(args.rounds):  # alternately, so a change of the machine's load hits both
             new.append(_run(None, name, args.repeat))
             if args.baseline:
                 old.append(_run(args.baseline, name, args.repeat))
         rows[name] = (min(new), min(old) if old else None)
-    print(f"contact joints with friction, one period (best of {args.rounds} x {args.repeat}):")
+    print(f"joints with friction, one period (best of {args.rounds} x {args.repeat}):")
     for name, ((t, n), old) in rows.items():
         line = f"  {name:36s} {1e3 * t:9.2f} ms {n:8d} steps"
         if old:

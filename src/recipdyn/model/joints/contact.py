@@ -76,7 +76,7 @@ import numpy as np
 
 __all__ = [
     "LAWS", "FRICTION_LAWS", "hysteresis_factor", "delivered_restitution", "hertz_stiffness",
-    "normal_force", "friction_factor", "ambrosio_friction", "tanh_friction", "FRICTION_ROLES",
+    "normal_force", "ambrosio_friction", "tanh_friction", "FRICTION_ROLES",
     "short_bearing_forces",
 ]  # fmt: skip
 
@@ -139,27 +139,10 @@ def normal_force(delta, ddelta, v_impact, K, chi):
     return f if f.real > 0.0 else 0.0
 
 
-@nb.njit(cache=True)
-def friction_factor(vt, mu, v0, v1, law):
-    """``F_t / F_n`` opposing the sliding velocity ``vt`` (law 0: Ambrósio, 1: tanh)."""
-    if mu == 0.0:
-        return 0.0
-    if law == 1:
-        x = vt / v0
-        if abs(x.real) > 20.0:  # tanh = +-1 to 1e-17 (a complex tanh would overflow here)
-            return -mu if x.real > 0.0 else mu
-        return -mu * np.tanh(x)
-    a = vt if vt.real > 0.0 else -vt
-    if a.real <= v0:
-        return 0.0
-    cd = 1.0 if a.real >= v1 else (a - v0) / (v1 - v0)
-    return -mu * cd * (1.0 if vt.real > 0.0 else -1.0)
-
-
-# The built-in friction laws as the contact law's ``friction(vt, p, o)`` role: ``F_t / F_n`` at
-# the sliding velocity ``vt``, with the slice ``(mu, v0, v1)`` at ``o``. The joints' glue
-# imports the one ``friction_law`` names (`FRICTION_ROLES`) when it is written, so no kernel
-# reads a law code; their arithmetic is `friction_factor`'s, operation for operation.
+# The built-in friction laws as the contact law's ``friction(vt, p, o)`` role: ``F_t / F_n``
+# opposing the sliding velocity ``vt``, with the slice ``(mu, v0, v1)`` at ``o``. The pins'
+# glue imports the one ``friction_law`` names (`FRICTION_ROLES`) when it is written, the
+# guide's the one ``guide_friction_law`` names, so no kernel reads a law code.
 
 
 @nb.njit(cache=True, inline="always")

@@ -36,8 +36,10 @@ side. Penetration ``delta_i = -g_i`` (``g_i`` the gap, siconos's ``g1..g4``); th
 is recipdyn's compliant law [`normal_force`][recipdyn.model.joints.contact.normal_force]
 (``F = K delta^1.5 (1 + chi delta'/delta'-)``, ``chi`` from the chosen law and restitution,
 ``delta'-`` the approach velocity recorded by the contact-onset event), and friction is
-[`friction_factor`][recipdyn.model.joints.contact.friction_factor] (Coulomb with Ambrósio's
-regularisation or tanh) on the corner's sliding velocity along the guide.
+the friction law the caller names,
+[`ambrosio_friction`][recipdyn.model.joints.contact.ambrosio_friction] or ``tanh_friction``
+(Coulomb with Ambrósio's regularisation or tanh), on the corner's sliding velocity along the
+guide.
 """
 
 from __future__ import annotations
@@ -264,9 +266,8 @@ def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vm
 #: guide's offset below the crank axis, the slider's half-length and half-height, the radial
 #: clearance, the contact stiffness and hysteresis factor, friction (coefficient, v0, v1: the
 #: friction law's slice), the floor of the approach velocity, the event's length scale, the
-#: slider's tilt
-#: inertia (read by the glue of the contact joints only; the benchmark and `compressor-guide`
-#: have it in the `MECH` head).
+#: slider's tilt inertia (read by the glue of the contact joints only; the benchmark and
+#: `compressor-guide` have it in the `MECH` head).
 (S_D, S_A, S_B, S_C, S_K, S_CHI, S_MU, S_V0, S_V1, S_VMIN, S_SCALE,
  S_J3) = range(12)  # fmt: skip
 #: The same after the `MECH` head (the benchmark's and `compressor-guide`'s layout).
