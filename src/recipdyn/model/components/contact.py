@@ -439,8 +439,7 @@ def reset(t, y, p, out):
 #: state (`_joints_at`), the free-crank accelerations (`_accelerate_free`) with the motor's
 #: torque law; the Jacobian by central differences (the crank angle enters the kinematics
 #: through math.sin, which the complex step does not take).
-_MOTOR_BODY = '''from recipdyn.model.joints.pins import _accelerate_free, _joints_at
-from {motor_module} import {torque_fn} as torque
+_MOTOR_BODY = '''{JOINTS_AT}from {motor_module} import {torque_fn} as torque
 
 
 @nb.njit(cache=True, inline="always")
@@ -607,8 +606,14 @@ def _motor_source(*, cfg, joints, load, offset, first_state, law, motor, m, mo, 
     if law:
         src += "\n\n" + law
     state_rhs = _STATE_RHS.replace(_PRESCRIBED_ANGLE, "y[{M}]") if stateful else ""
+    # a contact law of a user's file defines its own _joints_at above: not rebound here
+    joints_at = (
+        "from recipdyn.model.joints.pins import _accelerate_free\n"
+        if law
+        else "from recipdyn.model.joints.pins import _accelerate_free, _joints_at\n"
+    )
     src += "\n\n" + _MOTOR_BODY.format(STATE_RHS=state_rhs.format(**fill),
-                                       motor_module=motor.module,
+                                       motor_module=motor.module, JOINTS_AT=joints_at,
                                        torque_fn=motor.kernel("torque"), **fill)  # fmt: skip
     src += _STATE_EVENTS.format(**fill) if stateful else "\n\n" + _EVENTS[cfg]
     return src
