@@ -10,16 +10,21 @@ import numba as nb
 import numpy as np
 import pytest
 
+import recipdyn
 from recipdyn.integrate import integrate
-from recipdyn.model import compressor_contact as cc
 from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem
-from recipdyn.model.compressor_contact import I_WIN, I_WLOSS
+from recipdyn.model.components import contact_model as cm
+from recipdyn.model.joints import pins as jp
 from recipdyn.model.joints.contact import (
+    FRICTION_LAWS,
+    FRICTION_ROLES,
     LAWS,
+    ambrosio_friction,
     delivered_restitution,
     hysteresis_factor,
     normal_force,
 )
+from recipdyn.model.joints.pins import I_WIN, I_WLOSS
 from recipdyn.model.registry import get_model
 
 # --- a single impact: a mass against a compliant wall, the model's own force law ---------
@@ -160,8 +165,9 @@ def _newton_euler_rhs(t, y, p, out):  # y = (theta2, x3, theta2', x3', v_impact)
     ey = r * math.sin(th1) + l * s2 + d
     u = -r * w * math.sin(th1) - l * s2 * w2 - v3
     v = r * w * math.cos(th1) + l * c2 * w2
-    f = cc._pair(ex, ey, u, v, 0.0, w2, p[cc.P_C2], p[cc.P_K2], p[cc.P_RJ2], y[4], p[cc.P_OIL2],
-                 p)  # fmt: skip
+    # (no friction in this case: any friction law gives 0)
+    f = jp._pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
+                 p, ambrosio_friction, jp.P_MU)  # fmt: skip
     aax, aay = -r * w * w * math.cos(th1), -r * w * w * math.sin(th1)
     # moments about the crank pin A: (J2 + m2 ls^2) theta2'' = -m2 ls (rGA x aA) + rPA x F2
     #   + rGA x m2 g + T_b
@@ -179,7 +185,7 @@ def _ne_onset(t, y, p):
     r, l, d, th1 = p[0], p[1], p[7], p[9] + p[8] * t
     ex = r * math.cos(th1) + l * math.cos(y[0]) - y[1]
     ey = r * math.sin(th1) + l * math.sin(y[0]) + d
-    return math.sqrt(ex * ex + ey * ey) - p[cc.P_C2]
+    return math.sqrt(ex * ex + ey * ey) - p[jp.P_C2]
 
 
 @nb.njit(RHS_SIGNATURE, cache=True)
@@ -448,7 +454,7 @@ def test_complex_step_jacobian_on_every_branch_of_the_joint_laws():
         v = m.parameters(dict(omega=150.0, load_amplitude=2e4, **kw))
         s = m.system(v)
         T = m.period(v)
-        cfg = cc.CFG[v["clearance_joints"]]
+        cfg = jp.CFG[v["clearance_joints"]]
         fd_jac = m.kernels(v).fd_jac
         sol = integrate(s, m.initial_state(v), (0.0, T), t_eval=np.linspace(0.0, T, 25))
         phases = set()
@@ -465,7 +471,7 @@ def test_complex_step_jacobian_on_every_branch_of_the_joint_laws():
             # real one)
             f, Jb = np.empty(y.size), np.empty_like(J)
             s.rhs_jac(t, y, s.params, f, Jb)
-            rigid = list(cc.RIGID[v["clearance_joints"]])
+            rigid = list(jp.RIGID[v["clearance_joints"]])
             act = [k for k in range(y.size) if k not in rigid]
             assert set(rigid) <= set(s.passive)
             assert np.array_equal(Jb[:, act], J[:, act]) and not Jb[:, rigid].any()
@@ -488,12 +494,12 @@ def test_the_overlap_arc_is_where_the_two_circles_intersect(R_j, c):
         e = c + delta
         inside = np.hypot((R_j + c) * np.cos(phi) - e, (R_j + c) * np.sin(phi)) < R_j
         brute = np.degrees(np.abs(phi[inside]).max())
-        got = cc.overlap_half_angle(R_j, c, delta)
+        got = cm.overlap_half_angle(R_j, c, delta)
         assert got == pytest.approx(brute, abs=2e-4)
         approx = np.degrees(np.arccos(1.0 - delta / (c + delta)))
         assert got == pytest.approx(approx, rel=3 * c / R_j)
-    assert cc.overlap_half_angle(R_j, c, 0.0) == 0.0
-    assert cc.overlap_half_angle(R_j, c, -1e-6) == 0.0
+    assert cm.overlap_half_angle(R_j, c, 0.0) == 0.0
+    assert cm.overlap_half_angle(R_j, c, -1e-6) == 0.0
 
 
 def test_the_run_summary_reports_the_penetration_against_the_clearance():
@@ -516,7 +522,7 @@ def test_the_run_summary_reports_the_penetration_against_the_clearance():
         a = ds.attrs
         assert a["max_penetration_ratio"] == pytest.approx(a["max_penetration_m"] / rc, rel=1e-12)
         assert a["contact_arc_deg"] == pytest.approx(
-            cc.overlap_half_angle(0.05, rc, a["max_penetration_m"]), rel=1e-12
+            cm.overlap_half_angle(0.05, rc, a["max_penetration_m"]), rel=1e-12
         )
         got[rc] = a["max_penetration_ratio"]
     assert 3.0 < got[1e-4] / got[1e-3] < 6.0
@@ -554,7 +560,7 @@ def test_the_summary_reports_the_steady_state_and_the_startup_apart():
 
 def test_a_point_contact_law_stretched_beyond_its_range_warns(tmp_path, capsys):
     """Issue 31, item 3: Hertz's law needs a contact small against the radii; a run whose
-    overlap arc exceeds cc.HERTZ_ARC_LIMIT_DEG (an arc as long as the radius, 28.6 deg) warns
+    overlap arc exceeds cm.HERTZ_ARC_LIMIT_DEG (an arc as long as the radius, 28.6 deg) warns
     (LawRangeWarning, the record's law_range attribute, one CLI line) with the threshold and
     its source. Under the paper's load a 0.1 mm clearance is pushed to a ~44 deg arc (warns),
     a 1 mm one to ~22 deg (does not; measured in the test above and in docs/contact.md)."""
@@ -564,17 +570,17 @@ def test_a_point_contact_law_stretched_beyond_its_range_warns(tmp_path, capsys):
     from recipdyn.cli import main
     from recipdyn.errors import LawRangeWarning
 
-    assert cc.HERTZ_ARC_LIMIT_DEG == pytest.approx(28.648, abs=1e-3)
+    assert cm.HERTZ_ARC_LIMIT_DEG == pytest.approx(28.648, abs=1e-3)
     with pytest.warns(LawRangeWarning, match="Johnson 1985"):
         ds = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-4),
                                revolutions=0.5, fs=2000)  # fmt: skip
     assert "28.6 deg" in ds.attrs["law_range"] and "crank pin" in ds.attrs["law_range"]
-    assert ds.attrs["contact_arc_deg"] > cc.HERTZ_ARC_LIMIT_DEG
+    assert ds.attrs["contact_arc_deg"] > cm.HERTZ_ARC_LIMIT_DEG
     with warnings.catch_warnings():
         warnings.simplefilter("error", LawRangeWarning)
         ok = recipdyn.simulate(model="compressor-contact", params=dict(rc=1e-3),
                                revolutions=0.5, fs=2000)  # fmt: skip
-    assert ok.attrs["law_range"] == "ok" and ok.attrs["contact_arc_deg"] < cc.HERTZ_ARC_LIMIT_DEG
+    assert ok.attrs["law_range"] == "ok" and ok.attrs["contact_arc_deg"] < cm.HERTZ_ARC_LIMIT_DEG
     assert main(["simulate", "--model", "compressor-contact", "--set", "rc=0.1 mm", "-n", "0.5",
                  "--fs", "2 kHz", "-o", str(tmp_path / "r.nc"), "--no-figure",
                  "--no-progress"]) == 0  # fmt: skip
@@ -595,7 +601,7 @@ def test_lubricated_and_dry_pins_together_close_the_energy_balance(pins):
                        rc_crosshead=2e-4, omega=150.0, load_amplitude=2e4)  # fmt: skip
     assert v["clearance_joints"] == "both"
     p = M.system(v).params
-    assert (p[cc.P_OIL] > 0.0, p[cc.P_OIL2] > 0.0) == (pins[0] == "lubricated",
+    assert (p[jp.P_OIL] > 0.0, p[jp.P_OIL2] > 0.0) == (pins[0] == "lubricated",
                                                        pins[1] == "lubricated")  # fmt: skip
     E = out["energy"].values
     bal = E - E[0] - (sol.y[:, I_WIN] - sol.y[:, I_WLOSS])
@@ -750,3 +756,56 @@ def test_a_sweep_with_an_ideal_crank_pin_records_its_poincare_sections(tmp_path)
     for v in names:  # the ideal pin's eccentricity: exactly zero at every section point
         vals = ds[v].values
         assert np.all(vals[np.isfinite(vals)] == 0.0), (v, vals)
+
+
+#: Friction on at the crank pin, with v0 and v1 of the order of the sliding velocity there
+#: (omega R_j = 7.5 m/s): each law is then in its own, unsaturated branch.
+FRICTION = dict(crank_joint="contact", omega=150.0, load_amplitude=2e4, friction=0.2, v0=5.0,
+                v1=10.0, e0_ratio=1.001)  # fmt: skip
+
+
+@pytest.mark.parametrize("drive", ["prescribed", "motor"])
+@pytest.mark.parametrize("law", FRICTION_LAWS)
+def test_the_glue_calls_the_friction_law_it_names(law, drive):
+    """The friction law is chosen when the glue is written: the glue imports the function
+    ``friction_law`` names and reads no law code (the packed vector holds none); at a state in
+    contact the observed ``F_t / F_n`` is that law's closed form at the sliding velocity
+    ``v_t = omega R_j - theta2' (R_j + c)`` (journal on the crank, bearing on the rod), to
+    rounding, and the two laws differ there by far more (0.5 against tanh(1.5) = 0.905 of
+    mu at v_t = 7.5 m/s). The same with a motor (the free crank's glue: its initial state
+    turns at ``omega``)."""
+    m = get_model("compressor-contact")
+    motor = {"drive": "motor", "motor": "constant"} if drive == "motor" else {}
+    v = m.parameters(FRICTION, friction_law=law, **motor)
+    k = m.kernels(v)
+    src = Path(k.__file__).read_text(encoding="utf-8")
+    assert f"import {FRICTION_ROLES[law]} as friction" in src
+    assert ("_motor_" in k.__name__) == (drive == "motor")
+    assert "P_FLAW" not in src and "int(p[" not in src and not hasattr(jp, "P_FLAW")
+    p = m.system(v).params
+    drive_slices = cm.N_CRANK + cm.motor_size(v) if drive == "motor" else 0
+    assert p.size == jp.N_PACKED + drive_slices + m.load_part(v).pack(v).size
+    obs = k.observe(np.zeros(1), m.initial_state(v)[None, :].copy(), p)[0]
+    rj, c, mu, v0, v1 = (v[n] for n in ("journal_radius", "rc", "friction", "v0", "v1"))
+    vt = v["omega"] * rj - obs[18] * (rj + c)
+    assert obs[4] > 0.0 and v0 < abs(vt) < v1  # in contact, both laws unsaturated
+    cd = (abs(vt) - v0) / (v1 - v0)
+    expected = {"ambrosio": -mu * cd * np.sign(vt), "tanh": -mu * np.tanh(vt / v0)}[law]
+    assert obs[5] / obs[4] == pytest.approx(expected, rel=1e-12, abs=0.0)
+
+
+@pytest.mark.filterwarnings("ignore::recipdyn.errors.LawRangeWarning")  # (a deep cold start)
+def test_a_change_of_the_friction_law_changes_the_run():
+    """A run with the other friction law is another run (the selector is not ignored): the
+    recorded tangential force differs by a large part of its size, while without friction
+    the two laws give the same run to the bit (the difference is the law's alone)."""
+    runs = {}
+    for mu in (0.2, 0.0):
+        for law in FRICTION_LAWS:
+            runs[mu, law] = recipdyn.simulate(model="compressor-contact", revolutions=0.05,
+                                              fs=20000.0, params={**FRICTION, "friction": mu,
+                                                                  "friction_law": law})  # fmt: skip
+    a, b = (runs[0.2, law]["tangential_force"].values for law in FRICTION_LAWS)
+    assert np.abs(a - b).max() > 0.1 * np.abs(a).max() > 0.0
+    for k in runs[0.0, "tanh"].data_vars:
+        assert np.array_equal(runs[0.0, "ambrosio"][k].values, runs[0.0, "tanh"][k].values), k

@@ -19,8 +19,8 @@ from scipy.integrate import solve_ivp
 from recipdyn.cli import main
 from recipdyn.errors import ParameterError
 from recipdyn.integrate import integrate
-from recipdyn.model.compressor_contact import I_WIN, I_WLOSS
 from recipdyn.model.joints.contact import delivered_restitution, hysteresis_factor
+from recipdyn.model.joints.pins import I_WIN, I_WLOSS
 from recipdyn.model.registry import get_model
 
 HERE = Path(__file__).parent

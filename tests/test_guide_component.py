@@ -7,6 +7,7 @@ zero-clearance limit, the energy balance with every worn part at once, and the k
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,10 +15,12 @@ import pytest
 import recipdyn
 from recipdyn.errors import ParameterError
 from recipdyn.model.components.contact import glue_source
+from recipdyn.model.components.contact_model import pack
 from recipdyn.model.components.load import PAPER
 from recipdyn.model.compressor_contact import COMPRESSOR_CONTACT as CC
-from recipdyn.model.compressor_contact import N_PACKED, pack
-from recipdyn.model.compressor_guide import ideal_crosshead
+from recipdyn.model.compressor_guide import KERNELS, ideal_crosshead
+from recipdyn.model.joints.contact import FRICTION_LAWS, FRICTION_ROLES
+from recipdyn.model.joints.pins import N_PACKED
 
 #: Both pins ideal, the guide worn: the configuration `compressor-guide` integrates.
 IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}
@@ -183,3 +186,41 @@ def test_with_a_worn_crank_pin_the_crosshead_knocks_after_each_side_force_revers
         lag = math.degrees((12 * m * v["omega"] ** 2 * v["guide_clearance"] / k) ** (1 / 3))
         assert 0 < th_k - th_r < 2 * lag, (th_r, th_k, lag)
     assert ds.attrs["peak_abs_guide_acc_m_s2"] > 50.0
+
+
+#: The shoes' friction on, with v0 and v1 of the order of the crosshead's speed along the
+#: guide (up to 2.4 m/s at the default omega), so that each law runs its own, unsaturated
+#: branch (at 150 rad/s both saturate to Coulomb's value nearly everywhere).
+SHOES = {**IDEAL_PINS, "guide_clearance": 2e-4, "load_amplitude": 2e4, "guide_friction": 0.2,
+         "guide_v0": 0.5, "guide_v1": 2.0}  # fmt: skip
+
+
+@pytest.mark.parametrize("law", FRICTION_LAWS)
+def test_the_shoes_friction_law_is_chosen_by_name(law):
+    """The guide's friction law is a function chosen when the kernel is built: the glue's
+    guide imports the one ``guide_friction_law`` names and reads no law code (its slice holds
+    none), and `compressor-guide` runs the compiled kernel of that law."""
+    v = CC.parameters({**SHOES, "guide_friction_law": law})
+    src = Path(CC.kernels(v).__file__).read_text(encoding="utf-8")
+    assert f"import {FRICTION_ROLES[law]} as guide_friction" in src
+    assert "FLAW" not in src and "int(p[" not in src
+    g = recipdyn.get_model("compressor-guide")
+    gv = g.parameters(guide_friction_law=law)
+    assert g.system(gv).rhs is KERNELS[law][0] and g.system(gv).jac is KERNELS[law][1]
+
+
+@pytest.mark.filterwarnings("ignore::recipdyn.errors.LawRangeWarning")
+def test_a_change_of_the_shoes_friction_law_changes_the_run():
+    """A run with the shoes' other friction law is another run (the selector is not
+    ignored): the recorded friction of the shoes differs by a large part of its size, while
+    without friction both laws give the same run to the bit."""
+    runs = {}
+    for mu in (0.2, 0.0):
+        for law in FRICTION_LAWS:
+            runs[mu, law] = recipdyn.simulate(model=CC, revolutions=0.25, fs=4000.0,
+                                              params={**SHOES, "guide_friction": mu,
+                                                      "guide_friction_law": law})  # fmt: skip
+    a, b = (runs[0.2, law]["guide_friction_force"].values for law in FRICTION_LAWS)
+    assert np.abs(a - b).max() > 0.1 * np.abs(a).max() > 0.0
+    for k in runs[0.0, "tanh"].data_vars:
+        assert np.array_equal(runs[0.0, "ambrosio"][k].values, runs[0.0, "tanh"][k].values), k

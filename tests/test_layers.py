@@ -5,6 +5,7 @@ dependency on it.
 """
 
 import ast
+import re
 from pathlib import Path
 
 import recipdyn
@@ -82,44 +83,161 @@ def test_the_checker_sees_a_violation(tmp_path):
 
 # Inside the model layer: models are assembled from shared parts, never from each other.
 MODEL = SRC / "model"
-#: Modules that are models (a Model subclass each) rather than parts of one.
-MODEL_MODULES = {"compressor", "compressor_contact", "compressor_valves",
-                 "compressor_contact_valves"}  # fmt: skip
-#: Imports between models that remain until the dynamic valves and the contact joint are
-#: components of the assembled compressor (docs/components.md); the list may only shrink.
-LEGACY_MODEL_EDGES = {("compressor_valves", "compressor"),
-                      ("compressor_contact_valves", "compressor_contact")}  # fmt: skip
+#: A dotted module named in a string: the text of generated glue (``from recipdyn.model.X
+#: import``), which the glue's module imports when it is loaded.
+_GLUE_IMPORT = re.compile(r"(?:from|import)\s+recipdyn\.model\.([\w.]+)")
+#: An import string ``recipdyn.model.X:OBJ`` (a routing table: the registry's, family's).
+_IMPORT_STRING = re.compile(r"recipdyn\.model\.([\w.]+):\w+")
 
 
-def _model_graph() -> dict[str, set[str]]:
-    """Module -> model modules it imports (dotted names inside recipdyn.model, lazy imports
-    included)."""
+def _node(rel: tuple[str, ...]) -> str:
+    """The dotted name of a module inside the model package (a package by its own name)."""
+    return ".".join(rel[:-1] if rel[-1] == "__init__" else rel)
+
+
+def _strings(tree: ast.AST) -> list[str]:
+    return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)
+            and isinstance(n.value, str)]  # fmt: skip
+
+
+def _model_graph(root: Path = MODEL) -> dict[str, set[str]]:
+    """Module -> modules of the model package it imports: relative and absolute imports
+    (lazy ones included) and the imports written in the text of generated glue (a string
+    ``from recipdyn.model.X import ...``, run when the glue is loaded). Import strings
+    ``recipdyn.model.X:OBJ`` are routing tables, not edges (`_routes`)."""
     graph: dict[str, set[str]] = {}
-    names = {".".join(p.relative_to(MODEL).with_suffix("").parts) for p in MODEL.rglob("*.py")}
-    for path in MODEL.rglob("*.py"):
-        rel = path.relative_to(MODEL).with_suffix("").parts
-        me = ".".join(rel)
+    paths = {p: p.relative_to(root).with_suffix("").parts for p in root.rglob("*.py")}
+    names = {_node(rel) for rel in paths.values()} - {""}
+
+    def known(dotted: list[str]) -> set[str]:
+        """The longest prefix of ``dotted`` that is a module here (a package's own module is
+        not a dependency of what it holds)."""
+        hits = [".".join(dotted[:k]) for k in range(len(dotted), 0, -1)]
+        return {next((h for h in hits if h in names), "")} - {""}
+
+    for path, rel in paths.items():
         package = list(rel[:-1])
+        tree = ast.parse(path.read_text(encoding="utf-8"))
         deps = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if not (isinstance(node, ast.ImportFrom) and node.level):
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                if node.level - 1 > len(package):
+                    continue  # above the model package
+                mod = package[: len(package) - node.level + 1]
+                mod += node.module.split(".") if node.module else []
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                    "recipdyn.model."):  # fmt: skip
+                mod = node.module.split(".")[2:]
+            elif isinstance(node, ast.Import):
+                for a in node.names:
+                    if a.name.startswith("recipdyn.model."):
+                        deps |= known(a.name.split(".")[2:])
                 continue
-            if node.level - 1 > len(package):
-                continue  # above the model package
-            base = package[: len(package) - node.level + 1]
-            mod = base + (node.module.split(".") if node.module else [])
-            for cand in [".".join(mod)] + [".".join([*mod, a.name]) for a in node.names]:
-                if cand in names:
-                    deps.add(cand)
-        graph[me] = deps - {me}
+            else:
+                continue
+            for a in node.names:
+                deps |= known([*mod, a.name])
+        for text in _strings(tree):
+            for m in _GLUE_IMPORT.findall(text):
+                deps |= known(m.split("."))
+        graph[_node(rel)] = deps - {_node(rel)}
     return graph
 
 
+def _routes(path: Path) -> set[str]:
+    """The modules of the model package that ``path`` names in import strings."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return {m for text in _strings(tree) for m in _IMPORT_STRING.findall(text)
+            if _IMPORT_STRING.fullmatch(text)}  # fmt: skip
+
+
+def _model_modules() -> set[str]:
+    """The modules that are models (a registered `Model` each): the ones the registry's
+    built-in table names, and the implementations ``compressor`` routes to."""
+    from recipdyn.model import family, registry
+
+    tables = [*registry._BUILTIN.values(), *family.ROUTES.values()]
+    return {t.partition(":")[0].removeprefix("recipdyn.model.") for t in tables}
+
+
+def _model_edges(graph: dict[str, set[str]], models: set[str]) -> set[tuple[str, str]]:
+    """``(a, b)``: model module ``a`` imports model module ``b``, directly or through parts
+    (modules that are no model: a part that imports a model would join two models)."""
+    edges = set()
+    for a in sorted(models & set(graph)):
+        seen, todo = {a}, list(graph[a])
+        while todo:
+            m = todo.pop()
+            if m in seen:
+                continue
+            seen.add(m)
+            if m in models:
+                edges.add((a, m))
+            else:
+                todo.extend(graph.get(m, ()))
+    return edges
+
+
+#: The model modules of the compressor (the registry's and family's tables must name them).
+MODEL_MODULES = {"family", "compressor", "compressor_contact", "compressor_valves",
+                 "compressor_contact_valves", "compressor_guide"}  # fmt: skip
+
+
 def test_no_model_module_imports_another():
-    graph = _model_graph()
-    edges = {(a, b) for a, deps in graph.items() for b in deps
-             if a in MODEL_MODULES and b in MODEL_MODULES}  # fmt: skip
-    assert edges <= LEGACY_MODEL_EDGES, sorted(edges - LEGACY_MODEL_EDGES)
+    """No model module imports another model's module, directly, lazily, through a part
+    (a shared module that is no model) or in the text of the glue a part generates: every
+    model is assembled from shared parts (`model/components/`, `model/joints/`, ...).
+
+    ``family`` (the model ``compressor``) is a model module like the others: its imports are
+    checked the same way (it imports none). It reaches its implementations only through
+    its routing table, ``family.ROUTES`` (import strings ``recipdyn.model.X:OBJ``, imported
+    when a configuration first asks for one): `test_only_the_routing_tables_name_models`
+    checks that those strings are the table's and nothing else's, and since family is a
+    model module, an implementation that imported it back would fail here."""
+    models = _model_modules()
+    assert MODEL_MODULES <= models, sorted(MODEL_MODULES - models)
+    assert {"reference", "reference.double_pendulum"} <= models  # the reference models too
+    edges = _model_edges(_model_graph(), models)
+    assert not edges, sorted(edges)
+
+
+def test_only_the_routing_tables_name_models():
+    """Import strings of models appear in the two routing tables only: the registry's
+    (model name -> model) and family's ``ROUTES`` (selectors -> implementation), each naming
+    exactly its table's modules; no other module of the model package holds one."""
+    from recipdyn.model import family, registry
+
+    found = {_node(p.relative_to(MODEL).with_suffix("").parts): _routes(p)
+             for p in MODEL.rglob("*.py")}  # fmt: skip
+    tables = {"registry": registry._BUILTIN, "family": family.ROUTES}
+    for name, table in tables.items():
+        want = {t.partition(":")[0].removeprefix("recipdyn.model.") for t in table.values()}
+        assert found.pop(name) == want, name
+    assert not {k: v for k, v in found.items() if v}
+
+
+def test_the_model_checker_sees_an_edge(tmp_path):
+    """The model-import checker can fail: a direct relative import, an absolute lazy one, an
+    import through a part and one in the text of a part's generated glue are each found,
+    and a part shared by two models is not an edge."""
+    root = tmp_path / "model"
+    (root / "parts").mkdir(parents=True)
+    files = {
+        "__init__.py": "",
+        "a.py": "from .parts.shared import f\n",
+        "b.py": "from .parts import shared\n",
+        "c.py": "from . import b\n",
+        "d.py": "def f():\n    from recipdyn.model.c import x\n",
+        "e.py": "from .parts.glue import g\n",
+        "parts/__init__.py": "",
+        "parts/shared.py": "import math\n",
+        "parts/glue.py": 'SRC = """\nfrom recipdyn.model.a import f\n"""\n',
+    }
+    for name, text in files.items():
+        (root / name).write_text(text)
+    graph = _model_graph(root)
+    assert _model_edges(graph, {"a", "b", "c", "d", "e"}) == {("c", "b"), ("d", "c"),
+                                                               ("e", "a")}  # fmt: skip
 
 
 def test_no_import_cycles_inside_the_model_layer():

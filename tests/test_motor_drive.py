@@ -166,7 +166,7 @@ def test_free_crank_contact_equations_reduce_to_the_prescribed_ones(joints):
     numbers up to ~1e5)."""
     from recipdyn.model import _compressor_contact as pres
     from recipdyn.model import _compressor_contact_drive as free
-    from recipdyn.model.compressor_contact import NHEAD
+    from recipdyn.model.joints.pins import NHEAD
 
     rng = np.random.default_rng(30)
     n_e = 4 if joints == "both" else 2

@@ -325,15 +325,15 @@ def test_a_valve_impact_and_a_contact_onset_closer_than_a_step_are_both_located(
     chamber whose volume differs by the journal's 1 mm (measured offset 1.3e-11 s; the onset
     1.5e-14 s)."""
     from recipdyn.integrate import integrate
-    from recipdyn.model import compressor_contact as cc
     from recipdyn.model import compressor_contact_valves as ccv
+    from recipdyn.model.joints import pins
 
     s, y0, kw, t_valve = _close_pair_state(gap)
     for rtol, tol in ((1e-3, 1e-3 * t_valve), (1e-8, 1e-10)):
         r = integrate(s, y0, (0, 5e-6), rtol=rtol, **kw)
         assert r.t_events.size == 2, (rtol, r.t_events)
-        on_valve = [abs(va.valve_event(y, cc.G_GAS, s.params[ccv.P_VALVE :]))
-                    < abs(cc.contact_factor(y, s.params, 0)[0]) for y in r.y_events]  # fmt: skip
+        on_valve = [abs(va.valve_event(y, pins.G_GAS, s.params[ccv.P_VALVE :]))
+                    < abs(pins.contact_factor(y, s.params, 0)[0]) for y in r.y_events]  # fmt: skip
         assert sorted(on_valve) == [False, True]
         t_v, t_c = r.t_events[on_valve.index(True)], r.t_events[on_valve.index(False)]
         assert abs(t_v - t_valve) < tol

@@ -33,50 +33,51 @@ from typing import Any
 
 import numpy as np
 
-from . import compressor_contact as cc
 from . import cycle as cy
 from . import valves as va
 from .base import Event, ODESystem, Signal
+from .components import contact_model as cm
 from .components.load import VALVES
+from .joints import pins
 from .protocol import Schema
 
 __all__ = ["CompressorContactValves", "COMPRESSOR_CONTACT_VALVES"]
 
-G0, A0 = cc.G_GAS, cc.G_AUX
-STATE_NAMES = (*cc.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
+G0, A0 = pins.G_GAS, pins.G_AUX
+STATE_NAMES = (*pins.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
 #: The gas states' and the counters' names and units (after the guide's, with its clearance).
 _GAS = tuple(zip((*va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES),
                  (*va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS), strict=True))  # fmt: skip
-STATE_UNITS = (*cc.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
+STATE_UNITS = (*pins.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
 N_STATE = len(STATE_NAMES)
 #: The valve data in the parameter vector: after the joints' and the cycle's.
-P_VALVE = cc.N_PACKED + cy.N_CYCLE
+P_VALVE = pins.N_PACKED + cy.N_CYCLE
 
 
 def _layout(values: Mapping[str, Any]) -> tuple[int, int, int]:
     """The first gas state, the first mass counter, and the load's offset in the parameter
     vector (after a user's contact law's slice, and the guide's states and slice, with its
     clearance)."""
-    g = cc.first_load_state(values)
-    lo = cc.N_PACKED + cc.law_size(values) + (cc.N_GUIDE if cc.has_guide(values) else 0)
-    if cc.has_motor(values):  # the free crank's and the torque law's slices
-        lo += cc.N_CRANK + cc.motor_size(values)
+    g = cm.first_load_state(values)
+    lo = pins.N_PACKED + cm.law_size(values) + (pins.N_GUIDE if cm.has_guide(values) else 0)
+    if cm.has_motor(values):  # the free crank's and the torque law's slices
+        lo += cm.N_CRANK + cm.motor_size(values)
     return g, g + va.N_GAS, lo
 
 
 _DROP = {"load", "load_amplitude", "load_sign", "gas"}
-SCHEMA = Schema((*(p for p in cc.SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
-                aliases=dict(cc.SCHEMA.aliases))  # fmt: skip
+SCHEMA = Schema((*(p for p in cm.SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
+                aliases=dict(cm.SCHEMA.aliases))  # fmt: skip
 _LOAD = {"load": "cycle", "load_amplitude": 0.0, "load_sign": "physical", "gas": "ideal"}
 
 
 def pack(values: Mapping[str, Any]) -> np.ndarray:
     """The contact model's vector, then the cycle data and the valve data (the load component
     `recipdyn.model.components.load.VALVES`)."""
-    return cc.pack(values, load=VALVES)
+    return cm.pack(values, load=VALVES)
 
 
-class CompressorContactValves(cc.CompressorContact):
+class CompressorContactValves(cm.CompressorContact):
     """The contact-impact joint with the cylinder gas and dynamic valves (module docstring)."""
 
     name = "compressor-contact-valves"
@@ -123,10 +124,10 @@ class CompressorContactValves(cc.CompressorContact):
         return _GAS
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
-        if cc.has_motor(values):
+        if cm.has_motor(values):
             return self._motor_system(values)
         k = self.kernels(values)
-        if cc.has_guide(values):
+        if cm.has_guide(values):
             names, units = zip(*self.states(values), strict=True)
             return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=names,
                              state_units=units, period=self.period(values), name=self.name,
@@ -179,13 +180,13 @@ class CompressorContactValves(cc.CompressorContact):
             names = [k for k, _ in self.states(values)]
             ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
                                                        for k in names]))  # fmt: skip
-            cfg = cc.CFG[values["clearance_joints"]]
+            cfg = pins.CFG[values["clearance_joints"]]
             g0, _, lo = _layout(values)
-            contact = np.array([abs(cc.contact_factor(e, p, cfg)[0]) if cfg < 3 else np.inf
+            contact = np.array([abs(pins.contact_factor(e, p, cfg)[0]) if cfg < 3 else np.inf
                                 for e in ev])  # fmt: skip
             valve = np.array([abs(va.valve_event(e, g0, p[lo + cy.N_CYCLE :])) for e in ev])
             is_valve = valve < contact
-            if cc.has_guide(values):  # a guide's event: its corners changed phase
+            if cm.has_guide(values):  # a guide's event: its corners changed phase
                 after = np.column_stack([ds[f"impact_v_impact_guide_{k}_after"].values
                                          for k in range(1, 5)])  # fmt: skip
                 before = np.column_stack([ds[f"impact_v_impact_guide_{k}"].values

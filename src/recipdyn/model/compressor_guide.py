@@ -47,18 +47,21 @@ from .components.load import (
     table_force,
 )
 from .joints._guide import guide_energy, guide_system
-from .joints.contact import FRICTION_LAWS, delivered_restitution, hysteresis_factor
+from .joints.contact import (
+    FRICTION_ROLES,
+    ambrosio_friction,
+    delivered_restitution,
+    hysteresis_factor,
+    tanh_friction,
+)
 from .joints.guide import (
     N_HEAD,
     P_A,
     P_B,
     P_C,
     P_CHI,
-    P_FLAW,
     P_K,
     P_MU,
-    P_V0,
-    P_V1,
     P_VMIN,
     corner_force,
     flip_phases,
@@ -98,15 +101,15 @@ def _gas(th1, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _core(t, y, p):
+def _core(t, y, p, friction):
     """Everything the right-hand side and the outputs need: the accelerations, the drive's
     torque, the gas force, the contact's resultant, power lost and elastic energy, and the
-    pin's kinematics."""
+    pin's kinematics (``friction``: the shoes' friction law)."""
     w = p[P_OMEGA]
     th1 = p[P_TH10] + w * t
     y_rel, vx, vy = pin_kinematics(p, th1, w, y[0], y[2])
-    fx, fy, mz, lost, elastic = guide_forces(p, y_rel, vx, vy, y[1], y[3], y[4], y[5], y[6],
-                                             y[7])  # fmt: skip
+    fx, fy, mz, lost, elastic = guide_forces(p, friction, y_rel, vx, vy, y[1], y[3], y[4], y[5],
+                                             y[6], y[7])  # fmt: skip
     fg = _gas(th1, p)
     m = guide_system((th1, y[0], y[1], w, y[2], y[3]), p, (fx + fg, fy, mz, 0.0))
     a2, aphi, torque = solve_prescribed(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8])
@@ -114,9 +117,9 @@ def _core(t, y, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out):
+def _rhs(t, y, p, out, friction):
     """The right-hand side for real or complex ``y`` and ``out`` (no arrays allocated)."""
-    a2, aphi, torque, fg, _, _, _, lost, _, _, _, vx, _ = _core(t, y, p)
+    a2, aphi, torque, fg, _, _, _, lost, _, _, _, vx, _ = _core(t, y, p, friction)
     out[0], out[1], out[2], out[3] = y[2], y[3], a2, aphi
     for k in range(4, 8):
         out[k] = 0.0
@@ -125,16 +128,21 @@ def _rhs(t, y, p, out):
 
 
 @compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
-    _rhs(t, y, p, out)
+def rhs_ambrosio(t, y, p, out):
+    _rhs(t, y, p, out, ambrosio_friction)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs_tanh(t, y, p, out):
+    _rhs(t, y, p, out, tanh_friction)
 
 
 #: Imaginary step of the complex-step Jacobian (no difference is taken: any tiny size).
 CS_STEP = 1e-60
 
 
-@compiled(JAC_SIGNATURE, allocates=True)
-def jac(t, y, p, J):
+@nb.njit(cache=True, inline="always")
+def _jac(t, y, p, J, friction):
     """The complex step (Squire & Trapp 1998, SIAM Rev. 40, 110-112):
     ``J[:, k] = Im f(y + i h e_k) / h``, exact to rounding on the branch of each switch
     (contact, clamp, friction law) that the real state takes, as in `compressor_contact`.
@@ -147,10 +155,20 @@ def jac(t, y, p, J):
     J[:, :] = 0.0
     for k in range(8):
         yc[k] = complex(y[k], CS_STEP)
-        _rhs(t, yc, p, fc)
+        _rhs(t, yc, p, fc, friction)
         yc[k] = y[k]
         for i in range(n):
             J[i, k] = fc[i].imag / CS_STEP
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac_ambrosio(t, y, p, J):
+    _jac(t, y, p, J, ambrosio_friction)
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac_tanh(t, y, p, J):
+    _jac(t, y, p, J, tanh_friction)
 
 
 @nb.njit(cache=True, inline="always")
@@ -175,8 +193,8 @@ def contact_reset(t, y, p, out):
     flip_phases(p, y_rel, vx, vy, y[1], y[3], y, K0, out)
 
 
-@nb.njit(cache=True)
-def _series(t, y, p):
+@nb.njit(cache=True, inline="always")
+def _series(t, y, p, friction):
     """Per sample: x, v, a (axial), lateral position, velocity, acceleration of the pin, the
     gas force, the drive torque, the side force of the shoes (upper and lower, N), the
     contact's moment, the energy T + V + U, the number of corners in contact."""
@@ -186,7 +204,7 @@ def _series(t, y, p):
     w = p[P_OMEGA]
     for i in range(n):
         yi = y[i]
-        a2, _, torque, fg, _, _, mz, _, elastic, th1, y_rel, vx, vy = _core(t[i], yi, p)
+        a2, _, torque, fg, _, _, mz, _, elastic, th1, y_rel, vx, vy = _core(t[i], yi, p, friction)
         s1, c1 = math.sin(th1), math.cos(th1)
         s2, c2 = math.sin(yi[0]), math.cos(yi[0])
         w2 = yi[2]
@@ -203,8 +221,7 @@ def _series(t, y, p):
         inc = 0.0
         for k in range(4):
             fk = corner_force(k, y_rel, vx, vy, yi[1], yi[3], p[P_A], p[P_B], p[P_C], p[P_K],
-                              p[P_CHI], p[P_MU], p[P_V0], p[P_V1], int(p[P_FLAW]), p[P_VMIN],
-                              yi[K0 + k])  # fmt: skip
+                              p[P_CHI], friction, p, P_MU, p[P_VMIN], yi[K0 + k])  # fmt: skip
             if k < 2:
                 up += fk[5]
             else:
@@ -219,6 +236,22 @@ def _series(t, y, p):
     return out
 
 
+@nb.njit(cache=True)
+def series_ambrosio(t, y, p):
+    return _series(t, y, p, ambrosio_friction)
+
+
+@nb.njit(cache=True)
+def series_tanh(t, y, p):
+    return _series(t, y, p, tanh_friction)
+
+
+#: The compiled right-hand side, Jacobian and outputs for each ``guide_friction_law``.
+KERNELS = {"ambrosio": (rhs_ambrosio, jac_ambrosio, series_ambrosio),
+           "tanh": (rhs_tanh, jac_tanh, series_tanh)}  # fmt: skip
+assert set(KERNELS) == set(FRICTION_ROLES)
+
+
 def pack(v: Mapping[str, Any]) -> np.ndarray:
     mech = (v["r"], 0.0, v["l"], v["ls"], 0.0, v["m2"], v["m3"], 0.0, v["J2"], tilt_inertia(v),
             v["g"])  # fmt: skip
@@ -226,8 +259,7 @@ def pack(v: Mapping[str, Any]) -> np.ndarray:
     head = [*mech, v["d"], v["crosshead_half_length"], v["crosshead_half_height"], c,
             v["guide_stiffness"], hysteresis_factor(v["guide_contact_law"],
                                                     v["guide_restitution"]),
-            v["guide_friction"], v["guide_v0"], v["guide_v1"],
-            float(FRICTION_LAWS.index(v["guide_friction_law"])), v["v_impact_min"],
+            v["guide_friction"], v["guide_v0"], v["guide_v1"], v["v_impact_min"],
             v["crosshead_half_height"]]  # fmt: skip
     part = load_component(v)
     if part.name not in GUIDE_LOADS:
@@ -313,6 +345,7 @@ class CompressorGuide(Model):
                       "law"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
+        rhs, jac, _ = KERNELS[values["guide_friction_law"]]
         return ODESystem(rhs=rhs, jac=jac, params=pack(values), state_names=self.state_names,
                          state_units=self.state_units, period=self.period(values),
                          name=self.name, events=self.events(values), aux_states=6,
@@ -349,7 +382,7 @@ class CompressorGuide(Model):
         p = pack(values)
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
-        s = _series(t, y, p)
+        s = KERNELS[values["guide_friction_law"]][2](t, y, p)
         th1 = float(values["theta1_0"]) + float(values["omega"]) * t
         return {
             "x": Signal(s[:, 0], "m", "crosshead (pin) displacement along the guide"),

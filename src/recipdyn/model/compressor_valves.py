@@ -58,14 +58,9 @@ from .base import (
 )
 from .components.contract import Assembly, glue_module
 from .components.drive import MOTOR, MOTORS, PRESCRIBED
+from .components.link import LinkModel, mechanism_energy_series, mechanism_outputs
 from .components.load import VALVES
-from .components.mechanism import HEAD, N_HEAD, glue_source
-from .compressor import (
-    Compressor,
-    equilibrium_theta_c,
-    mechanism_energy_series,
-    mechanism_outputs,
-)
+from .components.mechanism import HEAD, N_HEAD, equilibrium_theta_c, glue_source
 from .kinematics import kinematics
 from .parameters import SCHEMA as LINK_SCHEMA
 from .parameters import CompressorParams
@@ -241,7 +236,7 @@ def _motor_glue(motor: str, offsets: tuple[tuple[str, int], ...]):
     return glue_module(src, f"compressor_motor_valves_{motor}")
 
 
-class CompressorValves(Compressor):
+class CompressorValves(LinkModel):
     """The compressor with dynamic valves as a registered model (module docstring)."""
 
     name = "compressor-valves"
@@ -259,7 +254,7 @@ class CompressorValves(Compressor):
     )
 
     validity_bounds = ((
-        *Compressor.validity_bounds[0][:4],
+        *LinkModel.validity_bounds[0][:4],
         "the contact-impact joint with dynamic valves (--model compressor-contact-valves)",
     ),)  # fmt: skip
 

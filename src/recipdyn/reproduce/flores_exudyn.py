@@ -68,7 +68,7 @@ def simulate_exudyn(values: dict[str, Any], t_end: float, step: float,
     r, l, ls, m2, J2, m3, g, w, d, th1 = (float(values[k]) for k in (
         "r", "l", "ls", "m2", "J2", "m3", "g", "omega", "d", "theta1_0"))  # fmt: skip
     c = float(values["rc_crosshead"])
-    from ..model.compressor_contact import stiffness
+    from ..model.components.contact_model import stiffness
 
     K = stiffness(values, "crosshead")
     chi = HYSTERESIS[law](float(values["restitution"]))

@@ -78,14 +78,14 @@ def tilt_inertia(v: Mapping[str, Any]) -> float:
 def guide_slice(v: Mapping[str, Any]) -> np.ndarray:
     """The clearance guide's slice (layout ``S_*`` of `recipdyn.model.joints.guide`): ``d``,
     the corners' geometry, the clearance, the contact law's stiffness and hysteresis factor,
-    friction, the approach velocity's floor, the event's length scale (the half-height), the
+    friction (the slice of the law ``guide_friction_law`` names, chosen when the glue is
+    written), the approach velocity's floor, the event's length scale (the half-height), the
     tilt inertia."""
     b = v["crosshead_half_height"]
     return np.array([v["d"], v["crosshead_half_length"], b, v["guide_clearance"],
                      v["guide_stiffness"], hysteresis_factor(v["guide_contact_law"],
                                                              v["guide_restitution"]),
-                     v["guide_friction"], v["guide_v0"], v["guide_v1"],
-                     float(FRICTION_LAWS.index(v["guide_friction_law"])), v["v_impact_min"],
+                     v["guide_friction"], v["guide_v0"], v["guide_v1"], v["v_impact_min"],
                      b, tilt_inertia(v)], dtype=np.float64)  # fmt: skip
 
 

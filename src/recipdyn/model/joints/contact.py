@@ -76,7 +76,8 @@ import numpy as np
 
 __all__ = [
     "LAWS", "FRICTION_LAWS", "hysteresis_factor", "delivered_restitution", "hertz_stiffness",
-    "normal_force", "friction_factor", "short_bearing_forces",
+    "normal_force", "ambrosio_friction", "tanh_friction", "FRICTION_ROLES",
+    "short_bearing_forces",
 ]  # fmt: skip
 
 #: Normal-force laws (index = the code passed to the compiled kernels).
@@ -138,21 +139,41 @@ def normal_force(delta, ddelta, v_impact, K, chi):
     return f if f.real > 0.0 else 0.0
 
 
-@nb.njit(cache=True)
-def friction_factor(vt, mu, v0, v1, law):
-    """``F_t / F_n`` opposing the sliding velocity ``vt`` (law 0: Ambrósio, 1: tanh)."""
+# The built-in friction laws as the contact law's ``friction(vt, p, o)`` role: ``F_t / F_n``
+# opposing the sliding velocity ``vt``, with the slice ``(mu, v0, v1)`` at ``o``. The pins'
+# glue imports the one ``friction_law`` names (`FRICTION_ROLES`) when it is written, the
+# guide's the one ``guide_friction_law`` names, so no kernel reads a law code.
+
+
+@nb.njit(cache=True, inline="always")
+def ambrosio_friction(vt, p, o):
+    """Coulomb with Ambrósio's dynamic correction (module docstring): 0 for ``|vt| <= v0``,
+    linear up to full Coulomb at ``v1``; slice ``(mu, v0, v1)`` at ``o``."""
+    mu, v0, v1 = p[o], p[o + 1], p[o + 2]
     if mu == 0.0:
         return 0.0
-    if law == 1:
-        x = vt / v0
-        if abs(x.real) > 20.0:  # tanh = +-1 to 1e-17 (a complex tanh would overflow here)
-            return -mu if x.real > 0.0 else mu
-        return -mu * np.tanh(x)
     a = vt if vt.real > 0.0 else -vt
     if a.real <= v0:
         return 0.0
     cd = 1.0 if a.real >= v1 else (a - v0) / (v1 - v0)
     return -mu * cd * (1.0 if vt.real > 0.0 else -1.0)
+
+
+@nb.njit(cache=True, inline="always")
+def tanh_friction(vt, p, o):
+    """Coulomb regularised by ``tanh(vt / v0)`` (smooth); slice ``(mu, v0, v1)`` at ``o``
+    (``v1`` unused)."""
+    mu, v0 = p[o], p[o + 1]
+    if mu == 0.0:
+        return 0.0
+    x = vt / v0
+    if abs(x.real) > 20.0:  # tanh = +-1 to 1e-17 (a complex tanh would overflow here)
+        return -mu if x.real > 0.0 else mu
+    return -mu * np.tanh(x)
+
+
+#: The friction role function of each built-in ``friction_law`` (its name in this module).
+FRICTION_ROLES = {"ambrosio": "ambrosio_friction", "tanh": "tanh_friction"}
 
 
 @nb.njit(cache=True)

@@ -36,8 +36,10 @@ side. Penetration ``delta_i = -g_i`` (``g_i`` the gap, siconos's ``g1..g4``); th
 is recipdyn's compliant law [`normal_force`][recipdyn.model.joints.contact.normal_force]
 (``F = K delta^1.5 (1 + chi delta'/delta'-)``, ``chi`` from the chosen law and restitution,
 ``delta'-`` the approach velocity recorded by the contact-onset event), and friction is
-[`friction_factor`][recipdyn.model.joints.contact.friction_factor] (Coulomb with Ambrósio's
-regularisation or tanh) on the corner's sliding velocity along the guide.
+the friction law the caller names,
+[`ambrosio_friction`][recipdyn.model.joints.contact.ambrosio_friction] or ``tanh_friction``
+(Coulomb with Ambrósio's regularisation or tanh), on the corner's sliding velocity along the
+guide.
 """
 
 from __future__ import annotations
@@ -49,7 +51,7 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
-from .contact import friction_factor, normal_force
+from .contact import normal_force
 
 __all__ = ["MECH", "INPUTS", "CORNERS", "N_HEAD", "lagrangian", "generate", "corner_forces",
            "pin_kinematics", "guide_forces", "smallest_factor", "flip_phases", "slice_forces",
@@ -198,7 +200,7 @@ def phased_gap_factor(delta, v_phase, scale):
     ``delta/scale + PHASE_MARGIN`` in contact (``v_phase > 0``). Positive in both phases, it
     falls through 0 at an onset and at a separation; the reset flips the phase, so the
     smallest factor of all corners is one event function that sees every onset and
-    separation (as `recipdyn.model.compressor_contact.phased_factor` does for pins)."""
+    separation (as `recipdyn.model.joints.pins.phased_factor` does for pins)."""
     return delta / scale + PHASE_MARGIN if v_phase > 0.0 else -delta / scale
 
 
@@ -223,11 +225,14 @@ def corner_kinematics(k, y_rel, vx, vy, phi, phid, a, b):
 
 
 @nb.njit(cache=True, inline="always")
-def corner_force(k, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin, v_imp):
+def corner_force(k, y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin, v_imp):
     """One corner's contact: the force on the slider ``(f_x, f_y)``, its moment about the pin,
     the power lost (contact damping and friction), the elastic energy, the normal and the
     friction force. ``v_imp`` is the corner's recorded approach velocity (its sign the phase,
-    its magnitude floored at ``vmin`` scales the damping)."""
+    its magnitude floored at ``vmin`` scales the damping). ``friction(vt, p, fo)``: the
+    friction law, ``F_t / F_n`` with its slice ``(mu, v0, v1)`` at ``fo`` (a built-in law of
+    `recipdyn.model.joints.contact`, named by the caller: each law compiles its own
+    kernel)."""
     dx, dy, pen, dpen, vt, side = corner_kinematics(k, y_rel, vx, vy, phi, phid, a, b)
     delta = pen - c
     z = 0.0 * delta  # zero of the state's type (real, or complex for the complex step)
@@ -235,22 +240,22 @@ def corner_force(k, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw,
         return z, z, z, z, z, z, z
     vi = v_imp if v_imp.real >= 0.0 else -v_imp
     fn = normal_force(delta, dpen, vi if vi.real > vmin else vmin + z, K, chi) + z
-    ft = fn * friction_factor(vt, mu, v0, v1, flaw)
+    ft = fn * friction(vt, p, fo)
     cy = -side * fn
     lost = (fn - K * delta * np.sqrt(delta)) * dpen - ft * vt
     return ft, cy, dx * cy - dy * ft, lost, K * delta * delta * np.sqrt(delta) / 2.5, fn, ft
 
 
 @nb.njit(cache=True, inline="always")
-def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin,
+def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin,
                   v1i, v2i, v3i, v4i):  # fmt: skip
     """The four corners' contact summed: the resultant on the slider ``(F_x, F_y)`` at the
     pin, its moment ``M_z`` about the pin, the power lost, the elastic energy (tuple of 5);
     ``v1i..v4i`` the corners' recorded approach velocities."""
-    c1 = corner_force(0, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin, v1i)
-    c2 = corner_force(1, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin, v2i)
-    c3 = corner_force(2, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin, v3i)
-    c4 = corner_force(3, y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, vmin, v4i)
+    c1 = corner_force(0, y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin, v1i)
+    c2 = corner_force(1, y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin, v2i)
+    c3 = corner_force(2, y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin, v3i)
+    c4 = corner_force(3, y_rel, vx, vy, phi, phid, a, b, c, K, chi, friction, p, fo, vmin, v4i)
     return (c1[0] + c2[0] + c3[0] + c4[0], c1[1] + c2[1] + c3[1] + c4[1],
             c1[2] + c2[2] + c3[2] + c4[2], c1[3] + c2[3] + c3[3] + c4[3],
             c1[4] + c2[4] + c3[4] + c4[4])  # fmt: skip
@@ -259,16 +264,16 @@ def corner_forces(y_rel, vx, vy, phi, phid, a, b, c, K, chi, mu, v0, v1, flaw, v
 # ---- packed parameters shared by every model built on this joint ------------------------------
 #: The guide's slice of the parameter vector, from its first value (its offset ``o``): the
 #: guide's offset below the crank axis, the slider's half-length and half-height, the radial
-#: clearance, the contact stiffness and hysteresis factor, friction (coefficient, v0, v1, law
-#: code), the floor of the approach velocity, the event's length scale, the slider's tilt
-#: inertia (read by the glue of the contact joints only; the benchmark and `compressor-guide`
-#: have it in the `MECH` head).
-(S_D, S_A, S_B, S_C, S_K, S_CHI, S_MU, S_V0, S_V1, S_FLAW, S_VMIN, S_SCALE,
- S_J3) = range(13)  # fmt: skip
+#: clearance, the contact stiffness and hysteresis factor, friction (coefficient, v0, v1: the
+#: friction law's slice), the floor of the approach velocity, the event's length scale, the
+#: slider's tilt inertia (read by the glue of the contact joints only; the benchmark and
+#: `compressor-guide` have it in the `MECH` head).
+(S_D, S_A, S_B, S_C, S_K, S_CHI, S_MU, S_V0, S_V1, S_VMIN, S_SCALE,
+ S_J3) = range(12)  # fmt: skip
 #: The same after the `MECH` head (the benchmark's and `compressor-guide`'s layout).
-(P_D, P_A, P_B, P_C, P_K, P_CHI, P_MU, P_V0, P_V1, P_FLAW, P_VMIN,
- P_SCALE) = range(len(MECH), len(MECH) + 12)  # fmt: skip
-N_HEAD = len(MECH) + 12
+(P_D, P_A, P_B, P_C, P_K, P_CHI, P_MU, P_V0, P_V1, P_VMIN,
+ P_SCALE) = range(len(MECH), len(MECH) + 11)  # fmt: skip
+N_HEAD = len(MECH) + 11
 
 
 @nb.njit(cache=True, inline="always")
@@ -282,17 +287,18 @@ def pin_kinematics(p, th1, th1d, th2, th2d):
 
 
 @nb.njit(cache=True, inline="always")
-def slice_forces(p, o, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
-    """`corner_forces` with the guide's slice at ``o`` (layout ``S_*``)."""
+def slice_forces(p, o, friction, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
+    """`corner_forces` with the guide's slice at ``o`` (layout ``S_*``) and the friction law
+    ``friction`` (its slice at ``o + S_MU``)."""
     return corner_forces(y_rel, vx, vy, phi, phid, p[o + S_A], p[o + S_B], p[o + S_C],
-                         p[o + S_K], p[o + S_CHI], p[o + S_MU], p[o + S_V0], p[o + S_V1],
-                         int(p[o + S_FLAW]), p[o + S_VMIN], v1i, v2i, v3i, v4i)  # fmt: skip
+                         p[o + S_K], p[o + S_CHI], friction, p, o + S_MU, p[o + S_VMIN], v1i,
+                         v2i, v3i, v4i)  # fmt: skip
 
 
 @nb.njit(cache=True, inline="always")
-def guide_forces(p, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
+def guide_forces(p, friction, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i):
     """`corner_forces` with the guide's packed parameters."""
-    return slice_forces(p, P_D, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i)
+    return slice_forces(p, P_D, friction, y_rel, vx, vy, phi, phid, v1i, v2i, v3i, v4i)
 
 
 @nb.njit(cache=True, inline="always")

@@ -30,7 +30,13 @@ import numpy as np
 
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, compiled
 from ..joints._guide import guide_energy, guide_system
-from ..joints.contact import FRICTION_LAWS, LAWS, hysteresis_factor
+from ..joints.contact import (
+    FRICTION_LAWS,
+    LAWS,
+    ambrosio_friction,
+    hysteresis_factor,
+    tanh_friction,
+)
 from ..joints.guide import (
     P_A,
     P_B,
@@ -116,8 +122,7 @@ class FloresTranslational:
                 self.J1, self.J2, self.J3, self.g)  # fmt: skip
         return np.array([*mech, 0.0, self.a, self.b, self.c, self.K,
                          hysteresis_factor(self.law, self.restitution), self.mu, self.v0,
-                         self.v1, float(FRICTION_LAWS.index(self.friction_law)),
-                         self.v_impact_min, self.b], dtype=np.float64)  # fmt: skip
+                         self.v1, self.v_impact_min, self.b], dtype=np.float64)  # fmt: skip
 
 
 @nb.njit(cache=True, inline="always")
@@ -126,15 +131,15 @@ def _pin(y, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _forces(y, p):
+def _forces(y, p, friction):
     y_rel, vx, vy = _pin(y, p)
-    return guide_forces(p, y_rel, vx, vy, y[2], y[5], y[6], y[7], y[8], y[9])
+    return guide_forces(p, friction, y_rel, vx, vy, y[2], y[5], y[6], y[7], y[8], y[9])
 
 
-@compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
+@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out, friction):
     """``(q', q'', 0, 0, 0, 0, W_in', W_loss')`` with the crank free."""
-    fx, fy, mz, lost, _ = _forces(y, p)
+    fx, fy, mz, lost, _ = _forces(y, p, friction)
     m = guide_system((y[0], y[1], y[2], y[3], y[4], y[5]), p, (fx, fy, mz, 0.0))
     a0, a1, a2 = solve_free(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8])
     out[0], out[1], out[2] = y[3], y[4], y[5]
@@ -143,6 +148,16 @@ def rhs(t, y, p, out):
         out[k] = 0.0
     out[10] = 0.0
     out[11] = lost
+
+
+@compiled(RHS_SIGNATURE)
+def rhs_ambrosio(t, y, p, out):
+    _rhs(t, y, p, out, ambrosio_friction)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs_tanh(t, y, p, out):
+    _rhs(t, y, p, out, tanh_friction)
 
 
 @compiled(EVENT_SIGNATURE)
@@ -165,7 +180,8 @@ def system(par: FloresTranslational) -> ODESystem:
     """The benchmark as an [`ODESystem`][recipdyn.model.base.ODESystem] with its contact event."""
     ev = Event("contact", contact_event, direction=-1, action="reset", reset=contact_reset,
                description="contact onset or separation of a slider corner")  # fmt: skip
-    return ODESystem(rhs=rhs, params=par.pack(), state_names=STATE_NAMES,
+    return ODESystem(rhs=KERNELS[par.friction_law][0], params=par.pack(),
+                     state_names=STATE_NAMES,
                      state_units=STATE_UNITS, name="flores-translational", events=(ev,),
                      aux_states=6)  # fmt: skip
 
@@ -180,14 +196,14 @@ def initial_state(par: FloresTranslational) -> np.ndarray:
     return y
 
 
-@nb.njit(cache=True)
-def _series(y, p):
+@nb.njit(cache=True, inline="always")
+def _series(y, p, friction):
     n = y.shape[0]
     out = np.empty((n, 10))
     for i in range(n):
         yi = y[i]
         y_rel, vx, vy = _pin(yi, p)
-        fx, fy, mz, lost, el = _forces(yi, p)
+        fx, fy, mz, lost, el = _forces(yi, p, friction)
         out[i, 0] = guide_energy((yi[0], yi[1], yi[2], yi[3], yi[4], yi[5]), p) + el
         out[i, 1] = y_rel
         for k in range(4):
@@ -198,14 +214,29 @@ def _series(y, p):
     return out
 
 
+@nb.njit(cache=True)
+def series_ambrosio(y, p):
+    return _series(y, p, ambrosio_friction)
+
+
+@nb.njit(cache=True)
+def series_tanh(y, p):
+    return _series(y, p, tanh_friction)
+
+
+#: The compiled right-hand side and outputs for each friction law (chosen by name).
+KERNELS = {"ambrosio": (rhs_ambrosio, series_ambrosio), "tanh": (rhs_tanh, series_tanh)}
+
+
 def energy(par: FloresTranslational, y: np.ndarray) -> np.ndarray:
     """``T + V + U`` (kinetic, gravity and the contacts' elastic energy, J) along ``y``."""
-    return _series(np.ascontiguousarray(np.atleast_2d(y)), par.pack())[:, 0]
+    series = KERNELS[par.friction_law][1]
+    return series(np.ascontiguousarray(np.atleast_2d(y)), par.pack())[:, 0]
 
 
 def corner_series(par: FloresTranslational, y: np.ndarray) -> dict[str, np.ndarray]:
     """Along a trajectory ``y``: the energy, the slider's lateral position ``y_rel`` (m), the
     corners' lateral positions ``corner_y`` (n x 4, m) and their gaps ``gap`` (n x 4, m;
     siconos's ``g1..g4``)."""
-    s = _series(np.ascontiguousarray(np.atleast_2d(y)), par.pack())
+    s = KERNELS[par.friction_law][1](np.ascontiguousarray(np.atleast_2d(y)), par.pack())
     return {"energy": s[:, 0], "y_rel": s[:, 1], "corner_y": s[:, 2:6], "gap": -s[:, 6:10]}
