@@ -122,8 +122,8 @@ def test_energy_balance_with_the_valves_closes(kw):
 def test_the_command_line_runs_and_analyses_a_motor_with_valves(tmp_path, capsys):
     """``recipdyn simulate --model compressor --set drive=motor --set load=valves``: the
     record holds the selectors, reruns to the bit from itself (``simulate -c``), and
-    ``analyze`` reads it (Benettin's exponents refused for the valves, with the reason; no
-    stroboscopic section for a free crank)."""
+    ``analyze`` reads it (Benettin's exponents refused for the valves, with the reason; the
+    section once per turn of the free crank, not once per nominal period)."""
     import xarray as xr
 
     rec = tmp_path / "r.nc"
@@ -145,7 +145,26 @@ def test_the_command_line_runs_and_analyses_a_motor_with_valves(tmp_path, capsys
                  "--lyap-revolutions", "1"]) == 0  # fmt: skip
     summary = json.loads((out / "summary.json").read_text())
     assert "valve plates" in summary["lyapunov_equations"]["refused"]
-    assert "poincare" not in summary
+    assert summary["poincare"] == {"points": 3, "kind": "angle", "angle": "theta1"}
+    # the record's section (app, compare, figures): where the recorded crank angle passes its
+    # first value modulo 2 pi, to the linear interpolation's error (628 samples a turn:
+    # h^2 theta'' / 8 theta' ~ 1e-9 rad); the nominal period's instants miss it by the slip
+    from recipdyn.plotting import section_times
+
+    assert ds.attrs["section_angle"] == "theta1"
+    ts, what = section_times(ds, 2 * math.pi / 20.0)
+    t, th = ds["time"].values, ds["theta1"].values
+    assert what == "once per turn of theta1" and ts.size == 2
+    np.testing.assert_allclose(np.interp(ts, t, th) - th[0], [0.0, 2 * math.pi], atol=1e-6)
+    nominal = np.interp(2 * math.pi / 20.0, t, th) - th[0] - 2 * math.pi
+    assert abs(nominal) > 1e-4, nominal  # the slip: why the nominal period is not a section
+    # the features place the orders by the recorded angle: the mean speed, not omega's
+    from recipdyn.features import file_features
+
+    (row,) = file_features(rec)
+    measured = (th[-1] - th[0]) / (t[-1] - t[0]) / (2 * math.pi)
+    assert row["speed_hz"] == pytest.approx(measured, rel=1e-12)
+    assert abs(row["speed_hz"] * 2 * math.pi / 20.0 - 1.0) > 1e-5  # not the nominal speed
 
 
 # ---------------------------------------------------------------------------------------------
@@ -293,6 +312,7 @@ def test_the_command_line_runs_and_analyses_a_motor_with_a_contact_joint(tmp_pat
                  "--lyap-revolutions", "1"]) == 0  # fmt: skip
     summary = json.loads((out / "summary.json").read_text())
     assert "drive = 'motor'" in summary["lyapunov_equations"]["refused"]
+    assert summary["poincare"]["kind"] == "angle"  # once per turn, through the impacts' resets
 
 
 def test_the_last_revolution_of_a_slower_crank_is_a_whole_revolution():

@@ -14,6 +14,7 @@ import numpy as np
 
 from .analysis import (
     amplitude_spectrum,
+    angle_section,
     classify,
     find_spectral_peaks,
     lyapunov_spectrum,
@@ -75,6 +76,12 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     fs = 1.0 / float(np.median(np.diff(t)))
     fc = forcing_frequency(ds.attrs)
     a = ds[vib].values
+    revs = None
+    turning = ds.attrs.get("section_angle")  # a crank of its own speed (a motor drive): its
+    if turning in ds.variables and ds[turning].dims == (dim,):  # recorded angle, not omega
+        th = np.asarray(ds[turning].values, dtype=float)
+        revs = (th - float(ds.attrs.get("param_theta1_0", th[0]))) / (2 * np.pi)
+        fc = float((revs[-1] - revs[0]) / (t[-1] - t[0]))  # its mean speed names the orders
     summary: dict[str, Any] = {"input": path.name, "samples": int(t.size), "fs_hz": fs,
                                "model": m.name, "signal": vib, "units": vib_unit}  # fmt: skip
 
@@ -99,7 +106,8 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
     if fc and vib_unit == "m/s**2":  # a machine's acceleration: its vibration page
         from .analysis.vibration import crank_angle
 
-        revs = crank_angle(a.size, fs, speed_hz=fc, zero_rev=float(t[0]) * fc)
+        if revs is None:
+            revs = crank_angle(a.size, fs, speed_hz=fc, zero_rev=float(t[0]) * fc)
         with phase("analyze: vibration page (orders, envelope, cepstrum, impacts)"):
             summary["vibration"] = vibration_section(
                 a, fs, out, plt, revs=revs, title=f"{path.name}: {what.removeprefix('the ')}"
@@ -453,23 +461,36 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         unit = "per iteration"
     else:
         period = m.period(values)
-        # a free crank (a motor drive) is autonomous: no forcing period to strobe at (the
-        # period still scales the Benettin run)
+        # a free crank (a motor drive) is autonomous: no forcing period to strobe at, its
+        # section is taken once per turn of the crank, at the record's first crank angle (the
+        # nominal period still scales the runs)
+        angle = m.section_angle(values) if system.period is None else None
+        sec = None
         if period and system.period is not None:
             with phase(f"analyze: Poincaré section ({section_points} periods)"):
                 sec = stroboscopic_section(system, y0, section_points, t0=t0, rtol=rtol,
                                            atol=atol)  # fmt: skip
+            title = f"Poincaré section, once per period ({section_points})"
+        elif angle in state_names and period:
+            i = state_names.index(angle)
+            with phase(f"analyze: Poincaré section ({section_points} turns of {angle})"):
+                sec = angle_section(system, y0, section_points, index=i, turn_time=period,
+                                    phase=float(y0[i]) % (2 * np.pi), t0=t0, rtol=rtol,
+                                    atol=atol)  # fmt: skip
+            title = f"Poincaré section, once per turn of {angle} ({section_points})"
+        if sec is not None:
             if all(k in sec for k in declared):
                 pair = declared
             section = np.c_[tuple(sec[s].values for s in pair)]
-            title = f"Poincaré section, once per period ({section_points})"
             fig = plot_phase(sec[pair[0]], sec[pair[1]], pair[0], pair[1], points=True,
                              title=title)  # fmt: skip
             save_figure(fig, out / "poincare.png", dpi=110)
             plt.close(fig)
             if section_points >= 100:
                 k01 = zero_one_test(sec[pair[0]].values)
-            summary["poincare"] = {"points": section_points}
+            summary["poincare"] = {"points": section_points,
+                                   "kind": sec.attrs["section"], **({"angle": angle}
+                                   if sec.attrs["section"] == "angle" else {})}  # fmt: skip
         if not m.has_dynamics(values):  # nothing moves but the forcing: no exponents
             summary["zero_one_K"] = k01
             return None, 0.0, section, k01

@@ -30,7 +30,7 @@ import numpy as np
 from .analysis.spectrum import amplitude_spectrum, display_band, nonharmonic_peak
 from .errors import ParameterError
 from .io import check_output, forcing_frequency, jsonable, read_dataset, save_figure, write_text
-from .plotting import PALETTE, _mpl, axis_label, plot_signal
+from .plotting import PALETTE, _mpl, axis_label, plot_signal, section_times
 
 __all__ = ["compare_runs", "MEASURES"]
 
@@ -76,12 +76,8 @@ def _section(ds, signal: str) -> tuple[np.ndarray, np.ndarray, str, str] | None:
     """Once-per-period samples of (velocity, signal) for the compressor, else of the first
     two state variables; ``None`` when the record is shorter than two periods."""
     fc = forcing_frequency(ds.attrs)
-    if not fc:
-        return None
     t = ds["time"].values
-    from .analysis.poincare import strobe_times
-
-    ts = strobe_times(t[0], t[-1], 1.0 / fc)
+    ts, _ = section_times(ds, 1.0 / fc if fc else None)  # (a motor's crank: once per turn)
     if ts.size < 2:
         return None
     first = "v" if "v" in ds and signal != "v" else next(

@@ -182,6 +182,7 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
     path = Path(path)
     labels: dict[str, Any] = {}
     unit = ""
+    revs = None
     if column is None and fs is None and is_record(path):
         from .io import read_dataset
 
@@ -194,6 +195,11 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         labels = _record_labels(ds.attrs, meta)
         f_rev = record_speed_hz(ds.attrs)
         name, unit = vib, str(ds[vib].attrs.get("units", ""))
+        turning = ds.attrs.get("section_angle")  # a crank of its own speed (a motor drive)
+        if turning in ds.variables and ds[turning].dims == ds[vib].dims and t.size > 1:
+            # its recorded angle, not the nominal speed, places the orders and the bins
+            revs = (ds[turning].values - float(ds[turning].values[0])) / (2 * math.pi)
+            f_rev = float(revs[-1] / (t[-1] - t[0]))
     else:
         if window:  # window by window: files longer than memory are fine
             rows = _streamed_rows(path, column, fs, window, speed, chaos, progress, tacho)
@@ -212,7 +218,6 @@ def file_features(path: str | Path, *, column=None, fs=None, window: str | None 
         x, rate, name = sig.x, sig.fs, sig.name
         f_rev = None
         unit = sig.units
-    revs = None
     if tacho is not None:
         revs = crank_revs(path, x.size, rate, tacho=tacho)
         ok = np.isfinite(revs)

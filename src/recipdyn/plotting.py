@@ -105,6 +105,23 @@ def plot_signal(ax, t, y, *, color=None, label=None, lw: float = 0.7, zoom: bool
     return art
 
 
+def section_times(ds: xr.Dataset, period: float | None) -> tuple[np.ndarray, str]:
+    """The instants at which a record's section samples it, and what they are: once per turn
+    of the state its record names as ``section_angle`` (a crank driven by a motor, whose turns
+    do not keep time: `angle_times` at the record's first angle), else once per forcing
+    ``period`` (`strobe_times`); none without either."""
+    from .analysis.poincare import angle_times, strobe_times
+
+    t = ds["time"].values
+    name = ds.attrs.get("section_angle")
+    if name and name in ds.variables and t.size >= 2:
+        th = np.asarray(ds[name].values, dtype=float)
+        return angle_times(t, th, phase=float(th[0]) % (2 * np.pi)), f"once per turn of {name}"
+    if period:
+        return strobe_times(t[0], t[-1], period), "once per period"
+    return np.empty(0), "none"
+
+
 def axis_label(name: str, da) -> str:
     """``name (units)`` from a DataArray's ``units`` attribute (no unit for dimensionless)."""
     u = da.attrs.get("units", "")
@@ -359,9 +376,7 @@ def contact_figure(ds: xr.Dataset, *, title: str | None = None):
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="upper right")
     ax = fig.add_subplot(grid[0, 1])
-    from .analysis.poincare import strobe_times
-
-    ts = strobe_times(t[0], t[-1], 2 * np.pi / omega)
+    ts, _ = section_times(ds, 2 * np.pi / omega)  # (once per turn of a motor-driven crank)
     if t_up is not None:
         ts = ts[ts >= t_up - 1e-9 * (t[1] - t[0])]  # the steady part's revolutions
     vu, au = ds["v"].attrs.get("units", "m/s"), ds["a"].attrs.get("units", "m/s**2")

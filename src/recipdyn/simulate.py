@@ -412,6 +412,8 @@ def simulate(
         "transient_revolutions": transient,
         "sampling_rate_hz": fs,
         "period": period if period else "none (autonomous: revolutions count time units)",
+        # the state whose turns give an autonomous record its section (a motor's crank angle)
+        **({"section_angle": angle} if (angle := m.section_angle(values)) else {}),
         **{f"min_{name}{_unit_suffix(unit)}": minima.get(name, float("nan"))
            for name, unit, *_ in m.validity_bounds},
         "columns": "all" if columns is None else ",".join(keep),

@@ -16,7 +16,13 @@ from .embedding import (
 )
 from .lyapunov import LyapunovResult, lyapunov_spectrum, lyapunov_spectrum_map, tangent_system
 from .lyapunov_signal import SignalLyapunov, lyap_kantz, lyap_rosenstein, lyap_wolf
-from .poincare import count_distinct_points, hyperplane_section, stroboscopic_section
+from .poincare import (
+    angle_section,
+    angle_times,
+    count_distinct_points,
+    hyperplane_section,
+    stroboscopic_section,
+)
 from .spectrum import Peak, Spectrum, amplitude_spectrum, find_spectral_peaks, order_spectrum
 from .zero_one import zero_one_test
 
@@ -25,6 +31,6 @@ __all__ = [
     "false_nearest_neighbours", "mean_period", "mutual_information", "LyapunovResult",
     "lyapunov_spectrum", "lyapunov_spectrum_map", "tangent_system", "SignalLyapunov",
     "lyap_kantz", "lyap_rosenstein", "lyap_wolf", "count_distinct_points", "hyperplane_section",
-    "stroboscopic_section", "Peak", "Spectrum", "amplitude_spectrum", "find_spectral_peaks",
-    "order_spectrum", "zero_one_test",
+    "stroboscopic_section", "angle_section", "angle_times", "Peak", "Spectrum",
+    "amplitude_spectrum", "find_spectral_peaks", "order_spectrum", "zero_one_test",
 ]  # fmt: skip

@@ -8,6 +8,11 @@ Two kinds:
   exact instants ``t_k = t0 + (k + phase / 2 pi) T``, never from the nearest stored sample.
 * [`hyperplane_section`][recipdyn.analysis.poincare.hyperplane_section] -- crossings of a hyperplane
   ``y[i] = value`` in a chosen direction, root-found on the dense output inside the integrator.
+* [`angle_section`][recipdyn.analysis.poincare.angle_section] -- for an autonomous system with a
+  turning angle among its states (a crank driven by a motor), the state once per turn of that
+  angle, where it passes ``phase`` modulo ``2 pi``: the section a stroboscopic one becomes when
+  the speed is not imposed. [`angle_times`][recipdyn.analysis.poincare.angle_times] gives the
+  same instants from a recorded angle.
 
 Both return an `xarray.Dataset` over a ``section`` dimension with the state components
 and (optionally) the model's derived outputs at the section points, plus the settings in attrs.
@@ -28,8 +33,8 @@ import xarray as xr
 from ..integrate import integrate
 from ..model.base import EVENT_SIGNATURE, ODESystem
 
-__all__ = ["stroboscopic_section", "hyperplane_section", "count_distinct_points",
-           "strobe_times"]  # fmt: skip
+__all__ = ["stroboscopic_section", "hyperplane_section", "angle_section", "count_distinct_points",
+           "strobe_times", "angle_times"]  # fmt: skip
 
 
 def strobe_times(t_first: float, t_last: float, period: float) -> np.ndarray:
@@ -38,6 +43,28 @@ def strobe_times(t_first: float, t_last: float, period: float) -> np.ndarray:
     stroboscopic section of a record."""
     return np.arange(np.ceil(t_first / period - 1e-9), np.floor(t_last / period + 1e-9) + 1
                      ) * period  # fmt: skip
+
+
+def angle_times(t, angle, phase: float = 0.0) -> np.ndarray:
+    """The instants at which a recorded angle ``angle(t)`` (rad, unwrapped and increasing: a
+    crank turning one way) passes ``phase + 2 pi k``: the once-per-turn instants at which a
+    record of an autonomous system is sampled for its section (`angle_section`'s, from a
+    record). Linear inverse interpolation between samples: its error in time is at most
+    ``h^2 max|angle''| / (8 min angle')`` for a sample spacing ``h`` (for a crank with a 2 %
+    speed ripple sampled 100 times a turn, ~1e-7 of a turn)."""
+    t = np.asarray(t, dtype=float).reshape(-1)
+    a = np.asarray(angle, dtype=float).reshape(-1)
+    if t.size != a.size:
+        raise ValueError(f"t and angle have {t.size} and {a.size} samples; allowed: as many")
+    if a.size < 2:
+        return np.empty(0)
+    if not np.all(np.diff(a) > 0):
+        raise ValueError("angle must increase from sample to sample (an unwrapped angle of a "
+                         "crank turning one way)")  # fmt: skip
+    two_pi = 2.0 * math.pi
+    k = np.arange(math.ceil((a[0] - phase) / two_pi - 1e-9),
+                  math.floor((a[-1] - phase) / two_pi + 1e-9) + 1)  # fmt: skip
+    return np.interp(phase + two_pi * k, a, t)
 
 
 def _dataset(system: ODESystem, t, y, outputs: bool, attrs: dict[str, Any]) -> xr.Dataset:
@@ -105,6 +132,121 @@ def stroboscopic_section(
         nfev=sol.nfev, **{f"solver_{k}": v for k, v in sol.settings.items()},
     )  # fmt: skip
     return _dataset(system, sol.t, sol.y, outputs, attrs)
+
+
+def _crossing(system: ODESystem, t_a: float, y_a: np.ndarray, t_b: float, a_b: float,
+              index: int, target: float, solver: dict[str, Any]):  # fmt: skip
+    """The instant in ``[t_a, t_b]`` at which ``y[index]`` passes ``target``, and the state
+    there: Newton's iteration on ``t``, each iterate's state integrated from the sample
+    ``(t_a, y_a)`` (the system's own events act), its rate from the right-hand side. Converges
+    quadratically from the linear guess; returns also the evaluations spent."""
+    a_a = float(y_a[index])
+    if a_a == target:
+        return t_a, y_a.copy(), 0
+    t_g = t_a + (target - a_a) / (a_b - a_a) * (t_b - t_a)
+    tol = 4.0 * np.finfo(float).eps * max(1.0, abs(target))
+    f = np.empty(y_a.size)
+    nfev = 0
+    for _ in range(8):
+        if t_g <= t_a:
+            t_g = t_a + 1e-3 * (t_b - t_a)
+        sol = integrate(system, y_a, (t_a, t_g), **solver)
+        nfev += sol.nfev
+        y_g = np.asarray(sol.y_final, dtype=float)
+        r = float(y_g[index]) - target
+        system.rhs(t_g, y_g, system.params, f)
+        if abs(r) <= tol or f[index] == 0.0:
+            break
+        t_g -= r / f[index]
+    return t_g, y_g, nfev
+
+
+def angle_section(
+    system: ODESystem,
+    y0,
+    n_points: int,
+    *,
+    index: int,
+    turn_time: float,
+    phase: float = 0.0,
+    t0: float = 0.0,
+    transient_turns: float = 0.0,
+    samples_per_turn: int = 32,
+    outputs: bool = True,
+    **solver: Any,
+) -> xr.Dataset:
+    """State once per turn of the angle ``y[index]`` (rad, increasing), where it passes
+    ``phase`` modulo ``2 pi``: the Poincaré section of an autonomous system that turns, such as
+    a crank driven by a motor, whose speed (and so the instant of each turn) is part of the
+    solution.
+
+    The run is sampled ``samples_per_turn`` times per ``turn_time`` (an estimate of one turn's
+    duration: the nominal crank period) to bracket each passage; each is then located by
+    Newton's iteration on time, the state at each iterate integrated from the bracket's first
+    sample, to ``4 eps |target|`` in the angle. The section's states are the integration's
+    (its tolerances), at the instant the angle passes, whatever the system's own events.
+
+    Parameters
+    ----------
+    index : int
+        The angle's place in the state.
+    turn_time : float
+        About how long one turn takes (> 0; only the sampling and the run's length follow it).
+    phase : float
+        The angle, modulo ``2 pi``, at which the section is taken, in [0, 2 pi).
+    transient_turns : float
+        Turns integrated and discarded first (counted on the angle from ``y0``).
+    **solver
+        Passed to [`recipdyn.integrate.integrate`][recipdyn.integrate.solve.integrate].
+    """
+    if not (0 <= index < system.dim):
+        raise ValueError(f"index = {index}; allowed: 0..{system.dim - 1}")
+    if n_points < 1:
+        raise ValueError(f"n_points = {n_points}; allowed: >= 1")
+    if not (0.0 <= phase < 2 * math.pi):
+        raise ValueError(f"phase = {phase}; allowed: [0, 2 pi)")
+    if not (turn_time > 0 and math.isfinite(turn_time)):
+        raise ValueError(f"turn_time = {turn_time}; allowed: > 0")
+    two_pi = 2.0 * math.pi
+    y = np.array(y0, dtype=float)
+    t = float(t0)
+    start = float(y[index]) + two_pi * transient_turns
+    first = math.ceil((start - phase) / two_pi - 1e-12)
+    targets = phase + two_pi * (first + np.arange(n_points))
+    ts, ys = [], []
+    nfev = 0
+    dt = turn_time / max(2, int(samples_per_turn))
+    while len(ts) < n_points:
+        left = float(targets[-1] - y[index]) / two_pi  # turns still to go, at least one chunk
+        t_end = t + max(1.0, 1.25 * left + 0.5) * turn_time
+        grid = np.arange(t, t_end, dt)
+        sol = integrate(system, y, (t, float(grid[-1])), t_eval=grid, **solver)
+        nfev += sol.nfev
+        a = sol.y[:, index]
+        if not np.all(np.diff(a) > 0):
+            raise ValueError(f"the angle y[{index}] does not increase along the run; allowed: "
+                             "an angle that turns one way (a crank driven forwards)")  # fmt: skip
+        for k in range(len(ts), n_points):
+            j = int(np.searchsorted(a, targets[k], side="right"))  # a[j-1] <= target < a[j]
+            if j >= a.size:
+                break
+            if j == 0:  # the start itself, within rounding (a section at the angle of y0)
+                ts.append(float(sol.t[0]))
+                ys.append(np.array(sol.y[0]))
+                continue
+            tk, yk, n = _crossing(system, float(sol.t[j - 1]), sol.y[j - 1],
+                                  float(sol.t[j]), float(a[j]), index, float(targets[k]),
+                                  solver)  # fmt: skip
+            nfev += n
+            ts.append(tk)
+            ys.append(yk)
+        t, y = float(sol.t[-1]), np.array(sol.y[-1])
+    attrs = dict(
+        section="angle", angle=system.state_names[index], phase=phase,
+        transient_turns=transient_turns, turn_time_estimate=turn_time, nfev=nfev,
+        **{f"solver_{k}": v for k, v in sol.settings.items()},
+    )  # fmt: skip
+    return _dataset(system, np.array(ts), np.array(ys).reshape(-1, system.dim), outputs, attrs)
 
 
 def _plane_event(index: int, value: float):

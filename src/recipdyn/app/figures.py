@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.poincare import strobe_times
 from ..analysis.spectrum import amplitude_spectrum, display_band
 from ..errors import ModelValidityWarning
+from ..plotting import section_times
 from .form import Form
 
 __all__ = ["simulate_form", "views", "images", "status_lines", "period_of", "POINTS"]
@@ -99,13 +99,11 @@ def views(ds, model) -> list[Any]:
                          yaxis_title=_label(ds, b))  # fmt: skip
         if is_map:
             sx, sy, what = xa, xb, f"the map's iterates ({xa.size})"
-        elif period:
-            ts = strobe_times(t[0], t[-1], period)
-            sx, sy = np.interp(ts, t, xa), np.interp(ts, t, xb)
-            what = f"{ts.size} points, one per period"
         else:
-            sx = sy = np.empty(0)
-            what = "none: an autonomous system has no forcing period"
+            ts, once = section_times(ds, period)  # a motor's crank: once per turn
+            sx, sy = np.interp(ts, t, xa), np.interp(ts, t, xb)
+            what = (f"{ts.size} points, {once}" if once != "none" else
+                    "none: an autonomous system has no forcing period")  # fmt: skip
         sec.add_trace(go.Scatter(x=sx, y=sy, mode="markers", marker=dict(size=5)))
         sec.update_layout(title=f"section ({what})", xaxis_title=_label(ds, a),
                           yaxis_title=_label(ds, b))  # fmt: skip

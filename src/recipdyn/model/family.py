@@ -439,6 +439,12 @@ class Compressor(Model):
         impl, own = self._split(values)
         return impl.period(own)
 
+    def section_angle(self, values: Mapping[str, Any]) -> str | None:
+        """The crank angle ``theta1`` with ``drive = motor`` (a state then: the section is
+        taken once per turn of the crank, wherever its speed puts it in time); None with the
+        prescribed speed (the section is stroboscopic, once per crank period)."""
+        return "theta1" if values.get("drive") == "motor" else None
+
     def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
         impl, own = self._split(values)
         return impl.states(own)

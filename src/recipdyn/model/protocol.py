@@ -438,6 +438,13 @@ class Model(ABC):
         sys_ = self.system(values)
         return getattr(sys_, "period", None)
 
+    def section_angle(self, values: Mapping[str, Any]) -> str | None:
+        """The state that turns (an angle in rad that increases, such as a crank's driven by a
+        motor) whose turns give an autonomous system its Poincaré section, once per turn
+        ([`angle_section`][recipdyn.analysis.poincare.angle_section]); None (the default) when
+        there is none: a forced system's section is taken once per forcing period."""
+        return None
+
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         """Named signals over a trajectory (default: the state components)."""
