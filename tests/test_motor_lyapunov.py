@@ -181,3 +181,37 @@ def test_exponent_sum_is_the_mean_trace_of_the_jacobian(kw, revolutions):
     if "crank_joint" in kw:
         assert res.settings["events"] >= 4
     assert abs(res.exponents.sum() - mean_trace) <= 1e-6 * np.abs(res.exponents).sum()
+
+
+def test_the_autonomous_flow_has_a_zero_exponent():
+    """Hypothesis: with the crank free the system is autonomous, and the direction of the
+    flow neither grows nor shrinks on average: one exponent is 0. Ideal pins with an
+    induction motor: a stable periodic orbit (the crank's speed ripple), exponents 0 and the
+    motor's speed regulation (~ -2 1/s). The tangent vector along the flow is the vector
+    field itself (d f(y(t))/dt = J f), so once the contracting direction has decayed
+    (e^(-2 T/2) ~ 3e-6 over the second half of 40 revolutions) the first vector's log growth
+    over [T/2, T] is ln(|f(T)| / |f(T/2)|), at most ln rho, rho = max |f| / min |f| of the
+    degrees of freedom's field along the orbit: that half's exponent is within
+    ln rho / (T/2) of 0 (plus 1e-3 for the leaked component and the integration). The
+    finite-time estimate over the whole run carries the initial vector's projection on the
+    flow too; its extrapolation to infinite time (`largest_limit`, the verdict's test) must be
+    within twice its error of 0. The other exponent is far outside both bounds."""
+    from recipdyn.analysis import lyapunov_spectrum
+
+    m, v = _values({"drive": "motor", "rc": 0.0})
+    s = m.system(v)
+    assert s.dof == (2, 3)
+    T = 40 * m.period(v)
+    res = lyapunov_spectrum(s, m.initial_state(v), T)
+    times, hist = res.times, res.history
+    half = int(np.searchsorted(times, times[-1] / 2))
+    growth = hist[-1, 0] * times[-1] - hist[half, 0] * times[half]
+    sol = integrate(s, m.initial_state(v), (0.0, T), t_eval=np.linspace(T / 2, T, 4001))
+    fnorm = np.array(
+        [np.linalg.norm(s.f(t, y)[list(s.dof)]) for t, y in zip(sol.t, sol.y, strict=True)]
+    )
+    log_rho = float(np.log(fnorm.max() / fnorm.min()))
+    assert abs(growth) <= log_rho + 1e-3, (growth, log_rho)
+    lam, err = res.largest_limit()
+    assert abs(lam) <= 2.0 * err, (lam, err)
+    assert res.exponents[1] < min(-10.0 * log_rho / (T / 2), -2.0 * err)
