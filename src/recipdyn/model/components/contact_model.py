@@ -140,11 +140,10 @@ def law_size(values: Mapping[str, Any]) -> int:
 
 
 GUIDE_REFUSAL = (
-    "Benettin's method is not offered with guide = 'clearance' or drive = 'motor': the "
-    "tangent integration across the impacts (the saltation matrices of the guide's four "
-    "corners' event, or of the pins' with the crank free) has not been checked against "
-    "differences of the flow, as the pins' with a prescribed crank has; set guide = 'ideal' "
-    "and drive = 'prescribed' for exponents of worn pins"
+    "Benettin's method is not offered with guide = 'clearance': the tangent integration "
+    "across the impacts (the saltation matrices of the guide's four corners' event) has not "
+    "been checked against differences of the flow, as the pins' has (with the crank "
+    "prescribed or free); set guide = 'ideal' for exponents of worn pins"
 )
 
 
@@ -727,10 +726,9 @@ class CompressorContact(Model):
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Not with the guide's clearance: its corners' saltation matrices have not been
-        checked against differences of the flow (as the pins' have); nor with a motor (the
-        same check with the crank free is not made)."""
-        return (self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
-                and not has_motor(values))  # fmt: skip
+        checked against differences of the flow (as the pins' have, with the crank
+        prescribed and with a motor: tests/test_contact.py, tests/test_motor_lyapunov.py)."""
+        return self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
 
     def _motor_system(self, values: Mapping[str, Any]) -> ODESystem:
         """The joints with the crank free: autonomous, the crank's states last. The approach
