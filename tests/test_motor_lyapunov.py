@@ -215,3 +215,29 @@ def test_the_autonomous_flow_has_a_zero_exponent():
     lam, err = res.largest_limit()
     assert abs(lam) <= 2.0 * err, (lam, err)
     assert res.exponents[1] < min(-10.0 * log_rho / (T / 2), -2.0 * err)
+
+
+def test_a_sweep_measures_the_exponents_with_a_motor(tmp_path):
+    """A sweep with ``--measure lyapunov`` of contact pins driven by a motor is accepted and
+    stores each point's exponents (finite; the largest above the sum, which the
+    contracting contact modes make negative); the guide's clearance keeps its refusal, with
+    the reason."""
+    from recipdyn.errors import ParameterError
+    from recipdyn.sweep.run import open_sweep, run_sweep
+    from recipdyn.sweep.spec import SweepSpec, parse_axis
+
+    base = {**IMPACTS, "crank_joint": "contact"}
+    spec = SweepSpec(axes=(parse_axis("load_amplitude=1.5e4:2e4:2", "compressor", base),),
+                     measures=("lyapunov",), model="compressor", base=base,
+                     settings=dict(revolutions=0.05, transient=0, lyap_revolutions=0.1,
+                                   fs=5000.0))  # fmt: skip
+    ds = open_sweep(run_sweep(spec, tmp_path, backend="serial", progress=False))
+    lam, total = ds["lambda1"].values, ds["lambda_sum"].values
+    assert np.all(np.isfinite(lam)) and np.all(lam > total) and np.all(total < 0)
+    with pytest.raises(ParameterError, match="guide = 'clearance'"):
+        SweepSpec(
+            axes=(parse_axis("omega=20:30:2", "compressor"),),
+            measures=("lyapunov",),
+            model="compressor",
+            base={"crank_joint": "contact", "guide": "clearance"},
+        )
