@@ -39,8 +39,10 @@ def _values(kw):
 
 @pytest.mark.parametrize("pins,fraction,eps,bound", [
     ({"crank_joint": "contact"}, 1.0, 1e-5, 2e-3),
-    ({"crank_joint": "contact", "crosshead_joint": "contact"}, 0.35, 1e-6, 4e-3),
-    ({"crank_joint": "lubricated", "crosshead_joint": "contact"}, 1.0, 1e-5, 2e-3),
+    pytest.param({"crank_joint": "contact", "crosshead_joint": "contact"}, 0.35, 1e-6, 4e-3,
+                 marks=pytest.mark.slow),
+    pytest.param({"crank_joint": "lubricated", "crosshead_joint": "contact"}, 1.0, 1e-5, 2e-3,
+                 marks=pytest.mark.slow),
 ], ids=["crank", "both", "oil-and-contact"])  # fmt: skip
 def test_tangent_flow_with_the_crank_free_matches_differences_of_the_flow(pins, fraction,
                                                                           eps, bound):  # fmt: skip
@@ -298,6 +300,7 @@ def _pin_tangent(kw, T):
     return W, tan.t_events.size
 
 
+@pytest.mark.slow
 def test_a_huge_flywheel_gives_the_prescribed_cranks_tangent_flow():
     """Limit J_drive -> inf (a constant torque equal to the mean load torque, so the mean
     speed stays at omega): the crank's speed ripple falls like 1 / J, the trajectory
