@@ -34,7 +34,10 @@ PRESETS = {
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
-    "compressor-contact[drive=motor,motor=constant]": {"drive": "motor", "motor": "constant"},
+    # at 150 rad/s with a tenth of the load: impacts with the crank free, and a sweep's
+    # Benettin run (5 revolutions) 7.5x shorter in time than at the default 20 rad/s
+    "compressor-contact[drive=motor,motor=constant]": {"drive": "motor", "motor": "constant",
+                                                       "omega": 150.0, "load_amplitude": 2e4},
     "compressor-contact[guide=clearance,guide_clearance=2e-4]": {
         "guide": "clearance", "guide_clearance": 2e-4},
 }  # fmt: skip

@@ -289,8 +289,11 @@ def test_energy_balance_with_contact_joints_closes(kw):
 
 def test_the_command_line_runs_and_analyses_a_motor_with_a_contact_joint(tmp_path, capsys):
     """``recipdyn simulate --set crank_joint=contact --set drive=motor``: the record reruns
-    to the bit from itself and ``analyze`` reads it (Benettin's exponents refused with the
-    reason: the saltation matrices with the crank free are not checked)."""
+    to the bit from itself and ``analyze`` reads it: Benettin's exponents of the six degrees
+    of freedom (the eccentricity and its rate, the crank's angle and speed), over
+    ``--lyap-revolutions`` revolutions of the nominal speed (the system is autonomous: no
+    forcing period; 0.2 of one, 2 pi / omega each, not 0.2 s), per second and per nominal
+    revolution."""
     import xarray as xr
 
     rec = tmp_path / "r.nc"
@@ -309,9 +312,15 @@ def test_the_command_line_runs_and_analyses_a_motor_with_a_contact_joint(tmp_pat
     capsys.readouterr()
     out = tmp_path / "an"
     assert main(["analyze", str(rec), "-o", str(out), "--section-points", "3",
-                 "--lyap-revolutions", "1"]) == 0  # fmt: skip
+                 "--lyap-revolutions", "0.2"]) == 0  # fmt: skip
+    lyap = json.loads((out / "summary.json").read_text())["lyapunov_equations"]
+    assert "refused" not in lyap and len(lyap["exponents_per_s"]) == 6
+    period = 2.0 * math.pi / float(ds.attrs["param_omega"])
+    assert lyap["duration"] == pytest.approx(0.2 * period, rel=1e-12)
+    assert lyap["exponents_per_revolution"] == pytest.approx(
+        [x * period for x in lyap["exponents_per_s"]], rel=1e-12)  # fmt: skip
+    assert (out / "lyapunov_benettin.png").exists()
     summary = json.loads((out / "summary.json").read_text())
-    assert "drive = 'motor'" in summary["lyapunov_equations"]["refused"]
     assert summary["poincare"]["kind"] == "angle"  # once per turn, through the impacts' resets
 
 

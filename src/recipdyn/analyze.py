@@ -497,6 +497,8 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         if not supported:
             summary["zero_one_K"] = k01
             return None, 0.0, section, k01
+        # in periods of the model (a motor's crank: its nominal revolution 2 pi / omega, the
+        # system being autonomous), else in time units
         with phase(f"analyze: Benettin exponents ({lyap_revolutions:g} periods)"):
             res = lyapunov_spectrum(system, y0, lyap_revolutions * (period or 1.0), t0=t0,
                                     rtol=rtol, atol=atol)  # fmt: skip
@@ -506,9 +508,13 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
         "lambda1_limit": lam, "lambda1_limit_error": lam_err,
         "exponents_per_s": res.exponents.tolist(), "units": unit, "sum_per_s": res.sum,
         "spread_second_half": _spread(res), "revolutions": lyap_revolutions,
+        "duration": float(res.settings.get("t_total", np.nan)),
     }  # fmt: skip
-    if m.kind == "ode" and m.period(values) and getattr(res, "per_period", None) is not None:
-        summary["lyapunov_equations"]["exponents_per_revolution"] = res.per_period.tolist()
+    if m.kind == "ode" and m.period(values):
+        # a free crank (autonomous: no forcing period) per nominal revolution, 2 pi / omega
+        per = getattr(res, "per_period", None)
+        per = res.exponents * m.period(values) if per is None else per
+        summary["lyapunov_equations"]["exponents_per_revolution"] = per.tolist()
     fig = plot_lyapunov_history(res, unit=unit)  # per s or per iteration
     save_figure(fig, out / "lyapunov_benettin.png", dpi=110)
     plt.close(fig)

@@ -456,8 +456,9 @@ def lyapunov_spectrum(
     t_total : float
         Averaging time (after ``t_transient``).
     k : int, optional
-        Number of exponents (default: all, one per degree-of-freedom component: not the
-        ``system.aux_states`` last ones, not the ``system.passive`` ones). The tangent vectors
+        Number of exponents (default: all, one per degree-of-freedom component,
+        ``system.dof``: not the ``system.aux_states`` last ones nor ``system.aux``, not the
+        ``system.passive`` ones). The tangent vectors
         start without components along auxiliary and passive states; values an event records
         (an impact's approach velocity) then follow the state through the saltation matrix,
         and passive components (a rigid joint's eccentricity, constant 0; work integrals that
@@ -479,8 +480,8 @@ def lyapunov_spectrum(
     """
     y = np.asarray(y0, dtype=float).copy()
     n = system.dim
-    # auxiliary states (recorded values, work integrals) last; fixed ones anywhere
-    dof = [i for i in range(n - system.aux_states) if i not in system.passive]
+    # not auxiliary (recorded values, work integrals), not passive (fixed ones)
+    dof = list(system.dof)
     n_dof = len(dof)
     k = n_dof if k is None else int(k)
     if not (1 <= k <= n_dof):

@@ -325,6 +325,19 @@ class ODESystem:
     #: components are held at 0): ones that stay 0 by construction (the eccentricity of a
     #: joint modelled as rigid) and ones nothing depends on (work integrals).
     passive: tuple[int, ...] = ()
+    #: Auxiliary components that are not last (values an event records that the motion
+    #: depends on, followed by later degrees of freedom: the contact joints' approach
+    #: velocities before a free crank's angle and speed). Like the last ``aux_states`` they
+    #: are no degrees of freedom, but their tangent components follow the flow (a passive
+    #: one's are held at 0, which would drop the damping law's dependence on them).
+    aux: tuple[int, ...] = ()
+
+    @property
+    def dof(self) -> tuple[int, ...]:
+        """The degrees of freedom: the components that are neither auxiliary (the last
+        ``aux_states``, ``aux``) nor passive; Lyapunov exponents are theirs."""
+        skip = set(self.passive) | set(self.aux)
+        return tuple(i for i in range(self.dim - self.aux_states) if i not in skip)
 
     @property
     def acting_event(self) -> Event | None:

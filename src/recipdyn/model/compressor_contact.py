@@ -38,8 +38,11 @@ after every other state, the joints' forces are evaluated at the crank's angle a
 (`recipdyn.model.joints.pins._joints_at`), the crank carries ``J1 + m1 rs^2 + J_drive`` and the
 motor's torque and the crank-pin joint's friction torque act on it; ``W_in`` is then the work
 of the gas and the motor. Its Jacobian is a central difference (the crank angle enters through
-``math.sin``), and Benettin's method is refused (the saltation matrices with the crank free are
-not checked).
+``math.sin``); Benettin's method runs with the crank free too: the recorded approach velocities
+are auxiliary states whose tangent components follow the flow (the damping law reads them), and
+tests/test_motor_lyapunov.py checks the tangent flow against differences of the flow across
+impacts, the exponent sum against the trace of the Jacobian and the flow direction's zero
+exponent.
 
 The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
 `recipdyn.model.components.contact`): the compiled kernels take complex states, and

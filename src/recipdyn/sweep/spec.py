@@ -150,9 +150,10 @@ class SweepSpec:
 
         check_tolerances(s["rtol"], s["atol"])
         if {"lyapunov", "verdict"} & set(self.measures) and not m.lyapunov_supported(self.base):
+            # the reason of the configuration the base values choose (the compressor's)
             raise ParameterError(
                 f"--measure lyapunov/verdict: not available for model {m.name!r}: "
-                f"{m.lyapunov_refusal}"
+                f"{m.configured(self.base).lyapunov_refusal}"
             )
         n = self.n_points
         if n > MAX_POINTS:

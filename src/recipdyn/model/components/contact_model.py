@@ -140,11 +140,10 @@ def law_size(values: Mapping[str, Any]) -> int:
 
 
 GUIDE_REFUSAL = (
-    "Benettin's method is not offered with guide = 'clearance' or drive = 'motor': the "
-    "tangent integration across the impacts (the saltation matrices of the guide's four "
-    "corners' event, or of the pins' with the crank free) has not been checked against "
-    "differences of the flow, as the pins' with a prescribed crank has; set guide = 'ideal' "
-    "and drive = 'prescribed' for exponents of worn pins"
+    "Benettin's method is not offered with guide = 'clearance': the tangent integration "
+    "across the impacts (the saltation matrices of the guide's four corners' event) has not "
+    "been checked against differences of the flow, as the pins' has (with the crank "
+    "prescribed or free); set guide = 'ideal' for exponents of worn pins"
 )
 
 
@@ -727,21 +726,30 @@ class CompressorContact(Model):
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Not with the guide's clearance: its corners' saltation matrices have not been
-        checked against differences of the flow (as the pins' have); nor with a motor (the
-        same check with the crank free is not made)."""
-        return (self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
-                and not has_motor(values))  # fmt: skip
+        checked against differences of the flow (as the pins' have, with the crank
+        prescribed and with a motor: tests/test_contact.py, tests/test_motor_lyapunov.py)."""
+        return self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
 
     def _motor_system(self, values: Mapping[str, Any]) -> ODESystem:
-        """The joints with the crank free: autonomous, the crank's states last."""
+        """The joints with the crank free: autonomous, the crank's states last. The approach
+        velocities (8, 9) are auxiliary, not passive: the damping law reads them, so their
+        tangent components must follow the flow through each onset's saltation matrix (held
+        at 0, the tangent flow missed that dependence: off by several times its size after
+        twelve impacts, tests/test_motor_lyapunov.py). The work integrals, the motor's
+        included, are passive: nothing depends on them, and a component that acts on nothing
+        but is rescaled with the vectors each interval grows without bound along a
+        contracting one (the motor's work overflowed Benettin's vectors within a
+        revolution)."""
         k = self.kernels(values)
         names, units = zip(*self.states(values), strict=True)
+        rigid = RIGID[values["clearance_joints"]]
         return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=None,
                          params=pack(values, self.load_part(values)), state_names=names,
                          state_units=units, period=None, name=self.name,
                          events=self.events(values), aux_states=1,
-                         passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN, I_WLOSS,
-                                  *range(G_GAS, len(names) - 3)))  # fmt: skip
+                         aux=tuple(i for i in (8, 9) if i not in rigid),
+                         passive=(*rigid, I_WIN, I_WLOSS, *range(G_GAS, len(names) - 3),
+                                  len(names) - 1))  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
         if has_motor(values):
