@@ -106,7 +106,32 @@ def _force(t, y, p, s1, c1):
 """,
 }
 
-_BODY = '''
+#: The glue's Jacobian by fourth-order central differences, one text for every body (the
+#: complex step's where the crank angle is a state or a load has states); ``{FD_C}``: the
+#: clearance that scales the steps (the guide's bodies: the smaller pin's, whatever the pins).
+_FD_JAC = '''@nb.njit(cache=True)
+def fd_jac(t, y, p, J):
+    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
+    (positions), c omega (rates), work integrals 1 J, at least 1e-3 of their unit for the rest
+    (the guide's, the gas's and the plates', the crank's)."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    c = {FD_C}
+    for k in range(n):
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
+        h = 1e-5 * max(abs(y[k]), scale)
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in range(n):
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+'''
+_PIN_C = "p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))"
+
+_BODY = (
+    """
 
 @nb.njit(cache=True, inline="always")
 def _mechanism(t, y, p, out):
@@ -124,26 +149,9 @@ def rhs(t, y, p, out):
     _rhs(t, y, p, out)
 
 
-@nb.njit(cache=True)
-def fd_jac(t, y, p, J):
-    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates)."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
-    c = p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))
-    for k in range(n):
-        # positions by the clearance, rates by c omega, work integrals 1 J; the gas states
-        # (dynamic valves) at least 1e-3 of their unit (a lift, a plate velocity)
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
-        h = 1e-5 * max(abs(y[k]), scale)
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m])
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
-
+"""
+    + _FD_JAC.replace("{FD_C}", _PIN_C)
+    + '''
 
 @nb.njit(cache=True)
 def _cs_columns(t, y, p, f, J, skip_rigid):
@@ -195,6 +203,7 @@ def observe(t, y, p):
         out[i, 20] = _force(t[i], yi, p, math.sin(th1), math.cos(th1))
     return out
 '''
+)
 
 _STATE_RHS = """    # the cylinder gas and the plates follow the crosshead of the joints' state
     x3 = p[P_R] * math.cos(p[P_TH10] + p[P_OMEGA] * t) + y[0] + p[P_L] * c2 - y[2]
@@ -275,7 +284,8 @@ from recipdyn.model.joints.guide import slice_forces as guide_forces
 from recipdyn.model.joints.guide import slice_smallest_factor as guide_factor
 """
 
-_GUIDE_BODY = '''
+_GUIDE_BODY = (
+    """
 
 @nb.njit(cache=True, inline="always")
 def _guide(y, p, v3):
@@ -301,26 +311,9 @@ def rhs(t, y, p, out):
     _rhs(t, y, p, out)
 
 
-@nb.njit(cache=True)
-def fd_jac(t, y, p, J):
-    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates)."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
-    c = min(p[P_C1], p[P_C2])
-    for k in range(n):
-        # positions by the clearance, rates by c omega, work integrals 1 J; the guide's and
-        # the gas states (dynamic valves) at least 1e-3 of their unit
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
-        h = 1e-5 * max(abs(y[k]), scale)
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m])
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
-
+"""
+    + _FD_JAC.replace("{FD_C}", "min(p[P_C1], p[P_C2])")
+    + '''
 
 @nb.njit(cache=True)
 def _cs_columns(t, y, p, f, J, skip_rigid):
@@ -432,6 +425,7 @@ def reset(t, y, p, out):
     else:
 {LOAD_RESET}
 '''
+)
 
 
 #: The joints with the crank angle free (a motor drive): the crank's states ``y[M:M + 3]``
@@ -439,7 +433,8 @@ def reset(t, y, p, out):
 #: state (`_joints_at`), the free-crank accelerations (`_accelerate_free`) with the motor's
 #: torque law; the Jacobian by central differences (the crank angle enters the kinematics
 #: through math.sin, which the complex step does not take).
-_MOTOR_BODY = '''{JOINTS_AT}from {motor_module} import {torque_fn} as torque
+_MOTOR_BODY = (
+    """{JOINTS_AT}from {motor_module} import {torque_fn} as torque
 
 
 @nb.njit(cache=True, inline="always")
@@ -459,24 +454,9 @@ def rhs(t, y, p, out):
     _rhs(t, y, p, out)
 
 
-@nb.njit(cache=True)
-def fd_jac(t, y, p, J):
-    """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates), 1e-3 of their unit for the rest (the crank's, the gas's)."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
-    c = p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))
-    for k in range(n):
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
-        h = 1e-5 * max(abs(y[k]), scale)
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m])
-        yp[k] = y[k]
-        for i in range(n):
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
-
+"""
+    + _FD_JAC.replace("{FD_C}", _PIN_C)
+    + '''
 
 @compiled(JAC_SIGNATURE, allocates=True)
 def jac(t, y, p, J):
@@ -510,6 +490,7 @@ def observe(t, y, p):
         out[i, 23] = d[{M} + 1]
     return out
 '''
+)
 
 #: A free crank's angle where the prescribed glue writes theta1_0 + omega t.
 _PRESCRIBED_ANGLE = "p[P_TH10] + p[P_OMEGA] * t"
