@@ -110,15 +110,22 @@ def _force(t, y, p, s1, c1):
 #: complex step's where the crank angle is a state or a load has states); ``{FD_C}``: the
 #: clearance that scales the steps (the guide's bodies: the smaller pin's, whatever the pins).
 _FD_JAC = '''@nb.njit(cache=True)
-def fd_jac(t, y, p, J):
+def _fd_columns(t, y, p, J, skip_passive):
     """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
     (positions), c omega (rates), work integrals 1 J, at least 1e-3 of their unit for the rest
-    (the guide's, the gas's and the plates', the crank's)."""
+    (the guide's, the gas's and the plates', the crank's). With ``skip_passive`` the columns of
+    the joints' work integrals (nothing depends on them) and of a rigid pin's states are left
+    0: the tangent flow's components along them stay 0, so it never reads them."""
     n = y.shape[0]
     yp = y.copy()
     f = np.empty((4, n))
     c = {FD_C}
     for k in range(n):
+        if skip_passive and (k == I_WIN or k == I_WIN + 1 or (k < I_WIN and
+                                                               _RIGID_MASK[{CFG}, k])):
+            for i in range(n):
+                J[i, k] = 0.0
+            continue
         scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
         h = 1e-5 * max(abs(y[k]), scale)
         for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
@@ -127,6 +134,11 @@ def fd_jac(t, y, p, J):
         yp[k] = y[k]
         for i in range(n):
             J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+
+
+@nb.njit(cache=True)
+def fd_jac(t, y, p, J):
+    _fd_columns(t, y, p, J, False)
 '''
 _PIN_C = "p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))"
 
@@ -463,7 +475,11 @@ def jac(t, y, p, J):
     fd_jac(t, y, p, J)
 
 
-rhs_jac = None
+@compiled(RHS_JAC_SIGNATURE, allocates=True)
+def rhs_jac(t, y, p, f, J):
+    """For the tangent flow: the passive columns (a rigid pin's, the work integrals') left 0."""
+    _rhs(t, y, p, f)
+    _fd_columns(t, y, p, J, True)
 
 
 @nb.njit(cache=True)
