@@ -55,6 +55,46 @@ LINEAR = Component(
     ),
 )  # fmt: skip
 
+#: The paper's load of recipdyn under another name, from this file (the same kernels and
+#: slice: ``load_amplitude`` and ``load_sign``, the compressor's own parameters): a user's
+#: load must give the built-in load's trajectory.
+PAPER_AGAIN = Component(
+    "load", "paper-again", "the paper's load, re-exported", module="recipdyn.model.components.load",
+    kernels={"force": "paper_force", "force_sc": "paper_force_sc"},
+    pack=lambda v: np.array([v["load_amplitude"],
+                             -1.0 if v["load_sign"] == "physical" else 1.0]),
+)  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always")
+def spring_force(th1, p, o):
+    """A gas spring in the crank angle: ``-p0 (1 + k (1 - cos th1))`` (slice: p0, k), a
+    pressure force that grows as the crosshead nears the crank end."""
+    return -p[o] * (1.0 + p[o + 1] * (1.0 - math.cos(th1)))
+
+
+SPRING = Component(
+    "load", "spring", "a gas spring in the crank angle", module=__name__,
+    kernels={"force": "spring_force"},
+    pack=lambda v: np.array([v["spring_preload"], v["spring_rate"]]),
+    params=(
+        Param("spring_preload", "N", 2.0e4, "force at outer dead centre", 0.0, 1e9,
+              group="load"),
+        Param("spring_rate", "", 1.5, "growth of the force over half a stroke", 0.0, 100.0,
+              group="load"),
+    ),
+)  # fmt: skip
+
+#: A load with a state of its own (a chamber pressure): the contract's roles are declared,
+#: not written (it is refused before any kernel is compiled, where a load of a user's file
+#: may not have states).
+WITH_STATES = Component(
+    "load", "chamber", "a load with a pressure state", module=__name__,
+    kernels={"state_force": "spring_force", "state_rhs": "spring_force",
+             "event": "spring_force", "reset": "spring_force"},
+    states=(("p_chamber", "Pa"),),
+)  # fmt: skip
+
 # -- contact laws of the pin joints (family ``contact_law``). Their functions take complex
 # arguments too (the joints' Jacobian is the complex step): branches on the real part.
 

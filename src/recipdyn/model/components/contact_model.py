@@ -96,10 +96,56 @@ def _resolve_joints(values: dict[str, Any]) -> None:
 def load_part(values: Mapping[str, Any]):
     """The load component the values choose (`recipdyn.model.components.load`): a table when
     ``load_table`` is given (a measured indicator diagram, or a real gas's cycle tabulated
-    from CoolProp), else the ``load`` parameter's."""
+    from CoolProp), else the ``load`` parameter's, a built-in load or one of a user's file
+    (``load = file.py:OBJ``, `load_spec`)."""
     from .load import load_component
 
     return load_component(values)
+
+
+def load_spec(values: Mapping[str, Any]) -> str | None:
+    """The ``load`` of ``values`` if it names a component of a user's module or file
+    (``file.py:OBJ``), else None (a built-in load)."""
+    from ..registry import is_spec
+
+    spec = values.get("load")
+    return spec if is_spec(spec) else None
+
+
+def user_load(values: Mapping[str, Any]):
+    """The load component of a user's file that ``values`` choose, or None. It must be of the
+    family ``load``, without states, and provide ``force`` (`ParameterError` in one line
+    otherwise: a load with states needs its initial states and outputs, which the contract
+    does not declare yet; the dynamic valves, ``load = valves``, are recipdyn's own)."""
+    from ...errors import ParameterError
+    from .contract import resolve_component
+
+    spec = load_spec(values)
+    if spec is None:
+        return None
+    load = resolve_component("load", spec, {})
+    if load.states or load.aux_states:
+        raise ParameterError(f"load = {spec!r} has states ({', '.join(n for n, _ in load.states)}"
+                             "): a load of your own with states is not available with a "
+                             "contact or lubricated joint or the guide's clearance; allowed: a "
+                             "load of your own without states (force, force_sc), or load = "
+                             "'valves'")  # fmt: skip
+    if "force" not in load.kernels:
+        raise ParameterError(f"load = {spec!r} provides no 'force' kernel; a load provides "
+                             "force(theta1, p, o) and optionally force_sc(sin theta1, cos "
+                             "theta1, p, o)")  # fmt: skip
+    return load
+
+
+def _load_key(values: Mapping[str, Any], part) -> str:
+    """How the glue's cache names the load ``part``: a built-in load by its name, a load of a
+    user's file by its absolute spec (`_glue` resolves it again and hashes its file)."""
+    from ..registry import absolute_spec
+    from .load import LOADS, VALVES
+
+    if part is VALVES or LOADS.get(part.name) is part:
+        return part.name
+    return absolute_spec(values["load"])
 
 
 def law_spec(values: Mapping[str, Any]) -> str | None:
@@ -226,8 +272,11 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
     from .contract import glue_module, resolve_component, source_digest
     from .load import LOADS, VALVES
 
-    part = VALVES if load == VALVES.name else LOADS[load]
-    block, stem = "", f"contact_{joints}_{load}_{friction[1]}"
+    part = VALVES if load == VALVES.name else resolve_component("load", load, LOADS)
+    block, stem = "", f"contact_{joints}_{part.name}_{friction[1]}".replace("-", "_")
+    # a load of a user's file (``load`` its absolute spec): its edits give a new glue file
+    tail = "" if load in LOADS or part is VALVES else (
+        f"\n# load = {part.module}: {source_digest(part.module)}\n")  # fmt: skip
     if law is not None:  # a contact law of a user's file: its slice first, after the joints'
         law_c = resolve_component("contact_law", law, {})
         block = law_source(law_c, N_PACKED)
@@ -244,16 +293,16 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
                           motor_state=first + (va.N_GAS + va.N_AUX if part.states else 0),
                           motor_offset=N_PACKED + n_law + N_CRANK,
                           crank_offset=N_PACKED + n_law, friction=friction)  # fmt: skip
-        return glue_module(src, f"{stem}_motor_{motor}")
+        return glue_module(src + tail, f"{stem}_motor_{motor}")
     if not guide:
         src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
                           first_state=G_GAS, law=block, friction=friction)  # fmt: skip
-        return glue_module(src, stem)
+        return glue_module(src + tail, stem)
     src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                       offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
                       guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block,
                       friction=friction, guide_friction=guide_friction)  # fmt: skip
-    return glue_module(src, f"{stem}_guide_{guide_friction}")
+    return glue_module(src + tail, f"{stem}_guide_{guide_friction}")
 
 
 def kernels(values: Mapping[str, Any], load=None):
@@ -262,22 +311,23 @@ def kernels(values: Mapping[str, Any], load=None):
     ``rhs_jac``, ``event``, ``reset``, ``observe`` and ``fd_jac``
     (`recipdyn.model.components.contact`)."""
     part = load_part(values) if load is None else load
+    name = _load_key(values, part)
     spec = law_spec(values)
     friction = friction_part(values)
     if has_motor(values):
         from ..registry import absolute_spec
 
         law = None if spec is None else absolute_spec(spec)
-        return _glue(values["clearance_joints"], part.name, False, law, law_size(values),
+        return _glue(values["clearance_joints"], name, False, law, law_size(values),
                      friction, "", values["motor"], motor_size(values))  # fmt: skip
     guide = has_guide(values)
     shoes = FRICTION_ROLES[values["guide_friction_law"]] if guide else ""
     if spec is not None:
         from ..registry import absolute_spec
 
-        return _glue(values["clearance_joints"], part.name, guide, absolute_spec(spec),
+        return _glue(values["clearance_joints"], name, guide, absolute_spec(spec),
                      law_size(values), friction, shoes)  # fmt: skip
-    return _glue(values["clearance_joints"], part.name, guide, None, 0, friction, shoes)
+    return _glue(values["clearance_joints"], name, guide, None, 0, friction, shoes)
 
 
 def _link(name: str, **changes) -> Param:
@@ -503,30 +553,39 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray, theta1=None,
     return {"mechanical": kin + pot, "elastic": elastic}
 
 
-_LAW_SCHEMAS: dict[tuple[int, str], tuple[Schema, Schema]] = {}
+_PLUGGED_SCHEMAS: dict[tuple[int, str | None, str | None], tuple[Schema, Schema]] = {}
 
 
-def _law_schema(schema: Schema, spec: str) -> Schema:
-    """``schema`` with the contact law ``spec`` of a user's file (remembered per schema and
-    spec): the spec one more choice of ``contact_law``, the law's fragment appended (a name
-    that ``schema`` already has is refused)."""
+def _plugged_schema(schema: Schema, law: str | None, load: str | None) -> Schema:
+    """``schema`` with the contact law ``law`` and the load ``load`` of users' files (specs, or
+    None; remembered per schema and specs): each spec one more choice of its parameter
+    (``contact_law``, ``load``), each component's fragment appended (a name that ``schema`` or
+    the other component already has is refused in one line)."""
     from dataclasses import replace
 
     from ...errors import ParameterError
     from .contract import check_fragments
 
-    key = (id(schema), spec)
-    hit = _LAW_SCHEMAS.get(key)
+    key = (id(schema), law, load)
+    hit = _PLUGGED_SCHEMAS.get(key)
     if hit is None or hit[0] is not schema:
-        law = law_part({"contact_law": spec})
+        specs, parts = {}, []
+        if law is not None:
+            specs["contact_law"] = law
+            parts.append(law_part({"contact_law": law}))
+        if load is not None:
+            specs["load"] = load
+            parts.append(user_load({"load": load}))
         try:
-            check_fragments((law,), base=schema.params)
+            check_fragments(parts, base=schema.params)
         except ValueError as exc:
-            raise ParameterError(f"contact_law = {spec!r}: {exc}") from None
-        params = tuple(replace(p, choices=(*p.choices, spec)) if p.name == "contact_law" else p
-                       for p in schema)  # fmt: skip
-        hit = _LAW_SCHEMAS[key] = schema, Schema((*params, *law.params), schema.aliases,
-                                                 schema.extras)  # fmt: skip
+            which = " and ".join(f"{k} = {v!r}" for k, v in specs.items())
+            raise ParameterError(f"{which}: {exc}") from None
+        params = tuple(replace(p, choices=(*p.choices, specs[p.name])) if p.name in specs
+                       else p for p in schema)  # fmt: skip
+        hit = _PLUGGED_SCHEMAS[key] = schema, Schema(
+            (*params, *(q for c in parts for q in c.params)), schema.aliases,
+            schema.extras)  # fmt: skip
     return hit[1]
 
 
@@ -580,6 +639,9 @@ class CompressorContact(Model):
             check = _motor_parts(values)[1].check
             if check is not None:
                 check(values)
+        load = user_load(values)
+        if load is not None and load.check is not None:
+            load.check(values)
         law = law_part(values)
         if law is not None:
             if values.get("clearance_joints") == "ideal":
@@ -592,15 +654,17 @@ class CompressorContact(Model):
                 law.check(values)
 
     def schema_for(self, values: Mapping[str, Any]) -> Schema:
-        """The schema; with a contact law of a user's file (``contact_law = file.py:OBJ``)
-        that spec one more choice of ``contact_law`` and the law's fragment appended (its
-        parameters validated, recorded and swept like the built-in ones)."""
+        """The schema; with a contact law or a load of a user's file (``contact_law =
+        file.py:OBJ``, ``load = file.py:OBJ``) each spec one more choice of its parameter and
+        the component's fragment appended (its parameters validated, recorded and swept like
+        the built-in ones)."""
         from ..registry import absolute_spec
 
-        spec = law_spec(values)
-        if spec is None:
+        law, load = law_spec(values), load_spec(values)
+        if law is None and load is None:
             return self.schema
-        return _law_schema(self.schema, absolute_spec(spec))
+        return _plugged_schema(self.schema, None if law is None else absolute_spec(law),
+                               None if load is None else absolute_spec(load))  # fmt: skip
 
     def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
         """Validated values; besides the schema's, a force table as the massless link takes
@@ -609,13 +673,18 @@ class CompressorContact(Model):
         diagram, a CSV file, `recipdyn.model.load.read_pressure_table`, with this run's bore,
         rod diameter and frame pressure). The table replaces the ``load`` (the table load
         component)."""
+        from ...errors import ParameterError
         from ..registry import absolute_spec, is_spec
 
         v = {**(values or {}), **kw}
         table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
-        for k in ("contact_law", "law"):  # a law of a user's file: found from any folder
+        for k in ("contact_law", "law", "load"):  # a user's file: found from any folder
             if is_spec(v.get(k)):
                 v[k] = absolute_spec(v[k])
+        if load_spec(v) is not None and (table is not None or ptab is not None):
+            raise ParameterError(f"{'load_table' if table is not None else 'pressure_table'}: "
+                                 f"not with load = {v['load']!r}, a load of your own (it "
+                                 "gives its own force); allowed: load = 'table'")  # fmt: skip
         out = self.schema_for(v).validate(v)
         _resolve_joints(out)
         self.check(out)
@@ -783,7 +852,9 @@ class CompressorContact(Model):
             )
             cp = CompressorParams(rs=0.0, load_table=values.get("load_table"),
                                   **{k: values[k] for k in keys})  # fmt: skip
-            ang = equilibrium_theta_c(cp)
+            load = user_load(values)  # a load of a user's file: its own values too
+            extra = {} if load is None else {q.name: values[q.name] for q in load.params}
+            ang = equilibrium_theta_c(cp, extra=extra)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
         y = np.zeros(len(STATE_NAMES))
