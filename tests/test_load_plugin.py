@@ -140,13 +140,15 @@ def test_a_constant_torques_default_is_the_users_loads_mean_torque():
 
 
 def test_a_users_load_is_refused_where_it_cannot_run():
-    """One line each: a load with states (the contract declares no initial states for one
-    of a user's file), a load table beside a load of one's own, an object that is not a load,
-    a parameter of the load's out of its range, and the guide's clearance with a motor
-    (not available with any load)."""
+    """One line each: a load with states at a contact pin and on the massless link (the
+    contract declares no initial states for one of a user's file), a load table beside a
+    load of one's own, an object that is not a load, a parameter of the load's out of its
+    range, and the guide's clearance with a motor (not available with any load)."""
     for kw, words in (
         (dict(crank_joint="contact", load=f"{FILE}:WITH_STATES"),
          "a load of your own with states is not available"),
+        (dict(load=f"{FILE}:WITH_STATES"), "a load of your own with states is not available"),
+        (dict(load=f"{FILE}:WITH_STATES", drive="motor"), "with states is not available"),
         (dict(crank_joint="contact", load=SPRING, load_table=((0, 1.0), (180, 2.0))),
          "load_table: not with load"),
         (dict(crank_joint="contact", load=f"{FILE}:KELVIN_VOIGT"),
