@@ -31,6 +31,7 @@ from recipdyn.model.registry import get_model, register
 #: The test suite's file of components (a load of your own: tests/test_load_plugin.py).
 PLUGIN = (Path(__file__).parent / "plugin_components.py").resolve()
 HARMONIC, WITH_STATES = f"{PLUGIN}:HARMONIC", f"{PLUGIN}:WITH_STATES"
+CHAMBER = f"{PLUGIN}:CHAMBER"
 
 #: One configuration per route: the compressor's selectors, the route, and the values the
 #: implementation (the model class the old name reached) takes for the same run.
@@ -189,14 +190,13 @@ ALLOWED = [
 REFUSED = [
     ({"crosshead_joint": "contact"}, "the massless link exists at the crank pin"),
     ({"crank_joint": "contact", "drive": "motor", "load": WITH_STATES},
-     "a load of your own with states is not available with a contact"),
+     "has states but provides no initial"),
     ({"guide": "clearance"}, "guide = 'clearance' with crank_joint = 'link'"),
     ({"guide": "clearance", "crank_joint": "ideal", "drive": "motor"},
      "drive = 'motor' with guide"),
     ({"guide": "clearance", "crank_joint": "link", "crosshead_joint": "ideal"},
      "guide = 'clearance' with crank_joint = 'link'"),
-    ({"guide": "clearance", "crank_joint": "ideal", "load": WITH_STATES},
-     "allowed: a load of your own without states"),
+    ({"load": CHAMBER}, "with states runs at a contact or lubricated pin"),
     ({"crank_joint": "contact", "load": HARMONIC, "load_table": TABLE},
      "not with load = "),
     ({"load": "valves", "load_table": TABLE}, "not with load = 'valves'"),

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from .. import valves as va
 from ..base import Event, ODESystem, Signal
 from ..joints.contact import FRICTION_LAWS, FRICTION_ROLES, LAWS, hertz_stiffness, hysteresis_factor
 from ..joints.pins import (
@@ -112,11 +111,14 @@ def load_spec(values: Mapping[str, Any]) -> str | None:
     return spec if is_spec(spec) else None
 
 
+#: The roles of a load with states (`recipdyn.model.components.load`).
+STATE_ROLES = ("state_force", "state_rhs", "event", "reset")
+
+
 def user_load(values: Mapping[str, Any]):
     """The load component of a user's file that ``values`` choose, or None. It must be of the
-    family ``load``, without states, and provide ``force`` (`ParameterError` in one line
-    otherwise: a load with states needs its initial states and outputs, which the contract
-    does not declare yet; the dynamic valves, ``load = valves``, are recipdyn's own)."""
+    family ``load`` and provide ``force`` or, with states, the roles `STATE_ROLES` and its
+    initial states (``initial``): `ParameterError` in one line otherwise."""
     from ...errors import ParameterError
     from .contract import resolve_component
 
@@ -125,16 +127,49 @@ def user_load(values: Mapping[str, Any]):
         return None
     load = resolve_component("load", spec, {})
     if load.states or load.aux_states:
-        raise ParameterError(f"load = {spec!r} has states ({', '.join(n for n, _ in load.states)}"
-                             "): a load of your own with states is not available with a "
-                             "contact or lubricated joint or the guide's clearance; allowed: a "
-                             "load of your own without states (force, force_sc), or load = "
-                             "'valves'")  # fmt: skip
-    if "force" not in load.kernels:
+        missing = [r for r in STATE_ROLES if r not in load.kernels]
+        if load.initial is None:
+            missing.append("initial")
+        if missing:
+            raise ParameterError(f"load = {spec!r} has states but provides no "
+                                 f"{' or '.join(missing)}; a load with states provides "
+                                 f"{', '.join(STATE_ROLES)} and initial (values -> its states "
+                                 "at t = 0)")  # fmt: skip
+    elif "force" not in load.kernels:
         raise ParameterError(f"load = {spec!r} provides no 'force' kernel; a load provides "
                              "force(theta1, p, o) and optionally force_sc(sin theta1, cos "
                              "theta1, p, o)")  # fmt: skip
     return load
+
+
+def stateful_user_load(values: Mapping[str, Any]):
+    """The load of a user's file with states that ``values`` choose, or None."""
+    load = user_load(values)
+    return load if load is not None and (load.states or load.aux_states) else None
+
+
+def load_offset(values: Mapping[str, Any]) -> int:
+    """The offset of the load's slice in the parameter vector: after the joints', a contact
+    law's of a user's file, and the guide's or the free crank's and the torque law's."""
+    lo = N_PACKED + law_size(values)
+    if has_motor(values):
+        lo += N_CRANK + motor_size(values)
+    elif has_guide(values):
+        lo += N_GUIDE
+    return lo
+
+
+def _initial_force(values: Mapping[str, Any]) -> float:
+    """The gas force at t = 0 of a load of a user's file with states: its compiled
+    ``state_force`` on its initial states."""
+    import importlib
+
+    load = stateful_user_load(values)
+    g = first_load_state(values)
+    y = np.zeros(g + len(load.states) + len(load.aux_states))
+    y[g:] = np.asarray(load.initial(values), dtype=np.float64).ravel()
+    fn = getattr(importlib.import_module(load.module), load.kernel("state_force"))
+    return float(fn(y, g, pack(values), load_offset(values)))
 
 
 def _load_key(values: Mapping[str, Any], part) -> str:
@@ -186,11 +221,12 @@ def law_size(values: Mapping[str, Any]) -> int:
 
 
 GUIDE_REFUSAL = (
-    "Benettin's method is not offered with guide = 'clearance' or drive = 'motor': the "
-    "tangent integration across the impacts (the saltation matrices of the guide's four "
-    "corners' event, or of the pins' with the crank free) has not been checked against "
-    "differences of the flow, as the pins' with a prescribed crank has; set guide = 'ideal' "
-    "and drive = 'prescribed' for exponents of worn pins"
+    "Benettin's method is not offered with guide = 'clearance', drive = 'motor' or a load of "
+    "your own with states: the tangent integration across the impacts (the saltation matrices "
+    "of the guide's four corners' event, of the pins' with the crank free, or of the load's "
+    "events) has not been checked against differences of the flow, as the pins' with a "
+    "prescribed crank has; set guide = 'ideal', drive = 'prescribed' and a load without "
+    "states for exponents of worn pins"
 )
 
 
@@ -290,7 +326,7 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
         src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                           offset=N_PACKED + n_law + N_CRANK + n_motor, first_state=first,
                           law=block, motor=MOTORS[motor],
-                          motor_state=first + (va.N_GAS + va.N_AUX if part.states else 0),
+                          motor_state=first + len(part.states) + len(part.aux_states),
                           motor_offset=N_PACKED + n_law + N_CRANK,
                           crank_offset=N_PACKED + n_law, friction=friction)  # fmt: skip
         return glue_module(src + tail, f"{stem}_motor_{motor}")
@@ -749,6 +785,12 @@ class CompressorContact(Model):
                           "a guide shoe or at a worn pin (the smallest phased factor falls "
                           "through 0): at an onset the approach velocity is recorded for the "
                           "damping law"),)  # fmt: skip
+        if stateful_user_load(values) is not None:
+            return (Event("impact", onset, direction=-1, action="reset", reset=record,
+                          description="contact onset or separation at a worn pin, or an event "
+                          "of the load (one event function: the smallest of the factors falls "
+                          "through 0): at an onset the approach velocity is recorded for the "
+                          "damping law, the load's event resets its states"),)  # fmt: skip
         if joints == "both":
             return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
@@ -768,8 +810,10 @@ class CompressorContact(Model):
         return own + self._load_states(values) + (MOTOR_STATES if has_motor(values) else ())
 
     def _load_states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
-        """A load's states (none: the dynamic valves' model adds its own)."""
-        return ()
+        """A load's states: a load of a user's file, its states then its auxiliary ones (the
+        dynamic valves' model adds its own)."""
+        load = stateful_user_load(values)
+        return () if load is None else (*load.states, *load.aux_states)
 
     #: Why Benettin's method is refused with the guide's clearance (a subclass that refuses it
     #: always says its own reason).
@@ -797,9 +841,10 @@ class CompressorContact(Model):
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Not with the guide's clearance: its corners' saltation matrices have not been
         checked against differences of the flow (as the pins' have); nor with a motor (the
-        same check with the crank free is not made)."""
+        same check with the crank free is not made), nor with a load of a user's file that
+        has states (nor for its events)."""
         return (self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
-                and not has_motor(values))  # fmt: skip
+                and not has_motor(values) and stateful_user_load(values) is None)  # fmt: skip
 
     def _motor_system(self, values: Mapping[str, Any]) -> ODESystem:
         """The joints with the crank free: autonomous, the crank's states last."""
@@ -816,6 +861,15 @@ class CompressorContact(Model):
         if has_motor(values):
             return self._motor_system(values)
         k = self.kernels(values)
+        load = stateful_user_load(values)
+        if load is not None:  # its states after the joints' (and the guide's)
+            names, units = zip(*self.states(values), strict=True)
+            return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
+                             params=pack(values, self.load_part(values)), state_names=names,
+                             state_units=units, period=self.period(values), name=self.name,
+                             events=self.events(values), aux_states=len(load.aux_states),
+                             passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN,
+                                      I_WLOSS))  # fmt: skip
         if has_guide(values):
             names, units = zip(*self.states(values), strict=True)
             return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
@@ -854,7 +908,8 @@ class CompressorContact(Model):
                                   **{k: values[k] for k in keys})  # fmt: skip
             load = user_load(values)  # a load of a user's file: its own values too
             extra = {} if load is None else {q.name: values[q.name] for q in load.params}
-            ang = equilibrium_theta_c(cp, extra=extra)
+            force = None if stateful_user_load(values) is None else _initial_force(values)
+            ang = equilibrium_theta_c(cp, extra=extra, force=force)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
         y = np.zeros(len(STATE_NAMES))
@@ -877,6 +932,16 @@ class CompressorContact(Model):
             g = np.zeros(N_GUIDE_STATES)
             g[4:] = sign * values["v_impact_min"]
             y = np.concatenate([y, g])
+        load = stateful_user_load(values)
+        if load is not None:  # a load of a user's file: its states at t = 0
+            y0 = np.asarray(load.initial(values), dtype=np.float64).ravel()
+            n = len(load.states) + len(load.aux_states)
+            if y0.size != n:
+                from ...errors import ParameterError
+
+                raise ParameterError(f"load = {values['load']!r}: its initial gives {y0.size} "
+                                     f"values for its {n} states")  # fmt: skip
+            y = np.concatenate([y, y0])
         if has_motor(values):  # the crank at theta1_0 turning at omega, no work done yet
             y = np.concatenate([y, [float(values["theta1_0"]), float(values["omega"]), 0.0]])
         return y
@@ -884,8 +949,10 @@ class CompressorContact(Model):
     def tracks_separations(self, values: Mapping[str, Any]) -> bool:
         """Whether the event also locates separations (the phase is then the sign of
         ``v_impact``; [`phased_factor`][recipdyn.model.joints.pins.phased_factor]): with
-        clearance at both pins, or with the guide's clearance."""
-        return values["clearance_joints"] == "both" or has_guide(values)
+        clearance at both pins, with the guide's clearance, or with a load of a user's file
+        that has states (its events share the event function)."""
+        return (values["clearance_joints"] == "both" or has_guide(values)
+                or stateful_user_load(values) is not None)  # fmt: skip
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["omega"])
@@ -1040,6 +1107,12 @@ class CompressorContact(Model):
         active = [("", 0, 1, 4, 5, "rc")] if joints not in ("crosshead", "ideal") else []
         if joints not in ("crank", "ideal"):
             active.append(("_crosshead", 2, 3, 6, 7, "rc_crosshead"))
+        if "impact_time" in ds and stateful_user_load(values) is not None:
+            # a load's event (its reset) leaves the joints' phases, v_impact, as they were
+            moved = np.column_stack([ds[f"impact_{k}"].values != ds[f"impact_{k}_after"].values
+                                     for k in STATE_NAMES[8:10]]).any(axis=1)  # fmt: skip
+            out["load_events"] = float((~moved).sum())
+            ds = ds.isel(impact_event=np.flatnonzero(moved))
         has_ev = "impact_time" in ds
         if has_ev:
             ev = np.column_stack([ds[f"impact_{k}"].values for k in STATE_NAMES[:8]])

@@ -169,8 +169,10 @@ class LinkModel(Model):
                 c = resolve_component(f, values[f], {})
                 if c.states or c.aux_states:  # (no initial states are declared for them)
                     raise ParameterError(f"{f} = {values[f]!r} has states: a {f} of your own "
-                                         f"with states is not available; allowed: a {f} of "
-                                         "your own without states, or load = 'valves'")  # fmt: skip
+                                         "with states runs at a contact or lubricated pin or in "
+                                         "the worn guide; allowed on the massless link and ideal "
+                                         f"pins: a {f} of your own without states, or load = "
+                                         "'valves'")  # fmt: skip
                 if c.check is not None:
                     c.check(values)
 
