@@ -185,6 +185,7 @@ ALLOWED = [
     ({"guide": "clearance", "crank_joint": "ideal", "load": "cycle"}, "contact"),
     ({"guide": "clearance", "crank_joint": "contact", "guide_clearance": 2e-4}, "contact"),
     ({"crank_joint": "contact", "load": HARMONIC}, "contact"),
+    ({"crank_joint": "contact", "load": CHAMBER, "theta1_0": 3.14}, "contact"),
 ]
 #: Refused combinations and a phrase of the one line that says why.
 REFUSED = [
