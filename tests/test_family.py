@@ -17,6 +17,7 @@ from __future__ import annotations
 import itertools
 import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,6 +27,11 @@ from recipdyn.cli import main
 from recipdyn.errors import LawRangeWarning, ModelValidityWarning, ParameterError
 from recipdyn.model import family
 from recipdyn.model.registry import get_model, register
+
+#: The test suite's file of components (a load of your own: tests/test_load_plugin.py).
+PLUGIN = (Path(__file__).parent / "plugin_components.py").resolve()
+HARMONIC, WITH_STATES = f"{PLUGIN}:HARMONIC", f"{PLUGIN}:WITH_STATES"
+CHAMBER = f"{PLUGIN}:CHAMBER"
 
 #: One configuration per route: the compressor's selectors, the route, and the values the
 #: implementation (the model class the old name reached) takes for the same run.
@@ -178,24 +184,28 @@ ALLOWED = [
     ({"guide": "clearance", "crank_joint": "ideal"}, "contact"),
     ({"guide": "clearance", "crank_joint": "ideal", "load": "cycle"}, "contact"),
     ({"guide": "clearance", "crank_joint": "contact", "guide_clearance": 2e-4}, "contact"),
+    ({"crank_joint": "contact", "load": HARMONIC}, "contact"),
+    ({"crank_joint": "contact", "load": CHAMBER, "theta1_0": 3.14}, "contact"),
 ]
 #: Refused combinations and a phrase of the one line that says why.
 REFUSED = [
     ({"crosshead_joint": "contact"}, "the massless link exists at the crank pin"),
-    ({"crank_joint": "contact", "drive": "motor", "load": "my_loads.py:HARMONIC"},
-     "drive = 'motor' with a contact or lubricated joint and a load of your own"),
+    ({"crank_joint": "contact", "drive": "motor", "load": WITH_STATES},
+     "has states but provides no initial"),
     ({"guide": "clearance"}, "guide = 'clearance' with crank_joint = 'link'"),
     ({"guide": "clearance", "crank_joint": "ideal", "drive": "motor"},
      "drive = 'motor' with guide"),
     ({"guide": "clearance", "crank_joint": "link", "crosshead_joint": "ideal"},
      "guide = 'clearance' with crank_joint = 'link'"),
-    ({"guide": "clearance", "crank_joint": "contact", "load": "my_loads.py:HARMONIC"},
-     "with guide = 'clearance' is not available"),
+    ({"load": CHAMBER}, "with states runs at a contact or lubricated pin"),
+    ({"crank_joint": "contact", "load": HARMONIC, "load_table": TABLE},
+     "not with load = "),
     ({"load": "valves", "load_table": TABLE}, "not with load = 'valves'"),
     ({"crank_joint": "contact", "load": "valves", "load_table": TABLE},
      "not with load = 'valves'"),
     ({"load": "table"}, "load = 'table' needs load_table"),
-    ({"crank_joint": "contact", "load": "my_loads.py:HARMONIC"}, "a component of your own"),
+    ({"crank_joint": "lubricated", "load": f"{PLUGIN}:NOT_A_COMPONENT"},
+     "is int, not a load component"),
     ({"crank_joint": "ideal", "rc": 1e-3}, "the crank pin is ideal"),
     ({"rc_crosshead": 3e-4}, "belongs to crosshead_joint = 'contact' | 'lubricated'"),
     ({"oil_viscosity": 0.05}, "crosshead_joint = 'lubricated'"),

@@ -80,13 +80,6 @@ def implementation(name: str) -> Model:
     return _LOADED[name]
 
 
-_MOTOR_CONTACT = (
-    "drive = 'motor' with a contact or lubricated joint and a load of your own is not "
-    "available yet; allowed with drive = 'motor' and a contact joint: load = 'paper', "
-    "'table', 'cycle', 'valves'"
-)
-
-
 def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False) -> str:
     """The implementation (a key of `ROUTES`) for the selector values ``s`` (``table``: a
     load or pressure table is given; ``guide_kernel``: ideal pins in a worn guide with the
@@ -108,10 +101,6 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
                 "drive = 'motor' with guide = 'clearance' is not available "
                 "yet; allowed with the guide clearance: drive = 'prescribed'"
             )
-        if is_spec(load):
-            raise ParameterError(f"load = {load!r} (a component of your own) with guide = "
-                                 "'clearance' is not available yet; allowed: 'paper', "
-                                 "'table', 'cycle', 'valves'")  # fmt: skip
         if guide_kernel and rigid_pins and load in ("paper", "cycle") and not table:
             return "guide"  # compressor-guide: its own kernel, the Flores benchmark's
         # the contact joints' glue with its own guide (any pin joint, ideal pins included)
@@ -126,14 +115,6 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
         if load == "valves":
             return "link-valves"
         return "link"
-    if drive == "motor" and is_spec(load):
-        raise ParameterError(_MOTOR_CONTACT)
-    if is_spec(load):
-        raise ParameterError(
-            f"load = {load!r} (a component of your own) with a contact or lubricated joint is "
-            "not available yet; allowed: crank_joint = 'link' or 'ideal' and crosshead_joint = "
-            "'ideal', or load = 'paper', 'table', 'cycle', 'valves'"
-        )
     return "contact-valves" if load == "valves" else "contact"
 
 

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from .. import valves as va
 from ..base import Event, ODESystem, Signal
 from ..joints.contact import FRICTION_LAWS, FRICTION_ROLES, LAWS, hertz_stiffness, hysteresis_factor
 from ..joints.pins import (
@@ -96,10 +95,92 @@ def _resolve_joints(values: dict[str, Any]) -> None:
 def load_part(values: Mapping[str, Any]):
     """The load component the values choose (`recipdyn.model.components.load`): a table when
     ``load_table`` is given (a measured indicator diagram, or a real gas's cycle tabulated
-    from CoolProp), else the ``load`` parameter's."""
+    from CoolProp), else the ``load`` parameter's, a built-in load or one of a user's file
+    (``load = file.py:OBJ``, `load_spec`)."""
     from .load import load_component
 
     return load_component(values)
+
+
+def load_spec(values: Mapping[str, Any]) -> str | None:
+    """The ``load`` of ``values`` if it names a component of a user's module or file
+    (``file.py:OBJ``), else None (a built-in load)."""
+    from ..registry import is_spec
+
+    spec = values.get("load")
+    return spec if is_spec(spec) else None
+
+
+#: The roles of a load with states (`recipdyn.model.components.load`).
+STATE_ROLES = ("state_force", "state_rhs", "event", "reset")
+
+
+def user_load(values: Mapping[str, Any]):
+    """The load component of a user's file that ``values`` choose, or None. It must be of the
+    family ``load`` and provide ``force`` or, with states, the roles `STATE_ROLES` and its
+    initial states (``initial``): `ParameterError` in one line otherwise."""
+    from ...errors import ParameterError
+    from .contract import resolve_component
+
+    spec = load_spec(values)
+    if spec is None:
+        return None
+    load = resolve_component("load", spec, {})
+    if load.states or load.aux_states:
+        missing = [r for r in STATE_ROLES if r not in load.kernels]
+        if load.initial is None:
+            missing.append("initial")
+        if missing:
+            raise ParameterError(f"load = {spec!r} has states but provides no "
+                                 f"{' or '.join(missing)}; a load with states provides "
+                                 f"{', '.join(STATE_ROLES)} and initial (values -> its states "
+                                 "at t = 0)")  # fmt: skip
+    elif "force" not in load.kernels:
+        raise ParameterError(f"load = {spec!r} provides no 'force' kernel; a load provides "
+                             "force(theta1, p, o) and optionally force_sc(sin theta1, cos "
+                             "theta1, p, o)")  # fmt: skip
+    return load
+
+
+def stateful_user_load(values: Mapping[str, Any]):
+    """The load of a user's file with states that ``values`` choose, or None."""
+    load = user_load(values)
+    return load if load is not None and (load.states or load.aux_states) else None
+
+
+def load_offset(values: Mapping[str, Any]) -> int:
+    """The offset of the load's slice in the parameter vector: after the joints', a contact
+    law's of a user's file, and the guide's or the free crank's and the torque law's."""
+    lo = N_PACKED + law_size(values)
+    if has_motor(values):
+        lo += N_CRANK + motor_size(values)
+    elif has_guide(values):
+        lo += N_GUIDE
+    return lo
+
+
+def _initial_force(values: Mapping[str, Any]) -> float:
+    """The gas force at t = 0 of a load of a user's file with states: its compiled
+    ``state_force`` on its initial states."""
+    import importlib
+
+    load = stateful_user_load(values)
+    g = first_load_state(values)
+    y = np.zeros(g + len(load.states) + len(load.aux_states))
+    y[g:] = np.asarray(load.initial(values), dtype=np.float64).ravel()
+    fn = getattr(importlib.import_module(load.module), load.kernel("state_force"))
+    return float(fn(y, g, pack(values), load_offset(values)))
+
+
+def _load_key(values: Mapping[str, Any], part) -> str:
+    """How the glue's cache names the load ``part``: a built-in load by its name, a load of a
+    user's file by its absolute spec (`_glue` resolves it again and hashes its file)."""
+    from ..registry import absolute_spec
+    from .load import LOADS, VALVES
+
+    if part is VALVES or LOADS.get(part.name) is part:
+        return part.name
+    return absolute_spec(values["load"])
 
 
 def law_spec(values: Mapping[str, Any]) -> str | None:
@@ -140,10 +221,11 @@ def law_size(values: Mapping[str, Any]) -> int:
 
 
 GUIDE_REFUSAL = (
-    "Benettin's method is not offered with guide = 'clearance': the tangent integration "
-    "across the impacts (the saltation matrices of the guide's four corners' event) has not "
-    "been checked against differences of the flow, as the pins' has (with the crank "
-    "prescribed or free); set guide = 'ideal' for exponents of worn pins"
+    "Benettin's method is not offered with guide = 'clearance' or a load of your own with "
+    "states: the tangent integration across the impacts (the saltation matrices of the "
+    "guide's four corners' event, or of the load's events) has not been checked against "
+    "differences of the flow, as the pins' has (with the crank prescribed or free); set "
+    "guide = 'ideal' and a load without states for exponents of worn pins"
 )
 
 
@@ -225,8 +307,11 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
     from .contract import glue_module, resolve_component, source_digest
     from .load import LOADS, VALVES
 
-    part = VALVES if load == VALVES.name else LOADS[load]
-    block, stem = "", f"contact_{joints}_{load}_{friction[1]}"
+    part = VALVES if load == VALVES.name else resolve_component("load", load, LOADS)
+    block, stem = "", f"contact_{joints}_{part.name}_{friction[1]}".replace("-", "_")
+    # a load of a user's file (``load`` its absolute spec): its edits give a new glue file
+    tail = "" if load in LOADS or part is VALVES else (
+        f"\n# load = {part.module}: {source_digest(part.module)}\n")  # fmt: skip
     if law is not None:  # a contact law of a user's file: its slice first, after the joints'
         law_c = resolve_component("contact_law", law, {})
         block = law_source(law_c, N_PACKED)
@@ -240,19 +325,19 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
         src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                           offset=N_PACKED + n_law + N_CRANK + n_motor, first_state=first,
                           law=block, motor=MOTORS[motor],
-                          motor_state=first + (va.N_GAS + va.N_AUX if part.states else 0),
+                          motor_state=first + len(part.states) + len(part.aux_states),
                           motor_offset=N_PACKED + n_law + N_CRANK,
                           crank_offset=N_PACKED + n_law, friction=friction)  # fmt: skip
-        return glue_module(src, f"{stem}_motor_{motor}")
+        return glue_module(src + tail, f"{stem}_motor_{motor}")
     if not guide:
         src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
                           first_state=G_GAS, law=block, friction=friction)  # fmt: skip
-        return glue_module(src, stem)
+        return glue_module(src + tail, stem)
     src = glue_source(cfg=CFG[joints], joints=joints, load=part,
                       offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
                       guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block,
                       friction=friction, guide_friction=guide_friction)  # fmt: skip
-    return glue_module(src, f"{stem}_guide_{guide_friction}")
+    return glue_module(src + tail, f"{stem}_guide_{guide_friction}")
 
 
 def kernels(values: Mapping[str, Any], load=None):
@@ -261,22 +346,23 @@ def kernels(values: Mapping[str, Any], load=None):
     ``rhs_jac``, ``event``, ``reset``, ``observe`` and ``fd_jac``
     (`recipdyn.model.components.contact`)."""
     part = load_part(values) if load is None else load
+    name = _load_key(values, part)
     spec = law_spec(values)
     friction = friction_part(values)
     if has_motor(values):
         from ..registry import absolute_spec
 
         law = None if spec is None else absolute_spec(spec)
-        return _glue(values["clearance_joints"], part.name, False, law, law_size(values),
+        return _glue(values["clearance_joints"], name, False, law, law_size(values),
                      friction, "", values["motor"], motor_size(values))  # fmt: skip
     guide = has_guide(values)
     shoes = FRICTION_ROLES[values["guide_friction_law"]] if guide else ""
     if spec is not None:
         from ..registry import absolute_spec
 
-        return _glue(values["clearance_joints"], part.name, guide, absolute_spec(spec),
+        return _glue(values["clearance_joints"], name, guide, absolute_spec(spec),
                      law_size(values), friction, shoes)  # fmt: skip
-    return _glue(values["clearance_joints"], part.name, guide, None, 0, friction, shoes)
+    return _glue(values["clearance_joints"], name, guide, None, 0, friction, shoes)
 
 
 def _link(name: str, **changes) -> Param:
@@ -502,30 +588,39 @@ def energy(values: Mapping[str, Any], t: np.ndarray, y: np.ndarray, theta1=None,
     return {"mechanical": kin + pot, "elastic": elastic}
 
 
-_LAW_SCHEMAS: dict[tuple[int, str], tuple[Schema, Schema]] = {}
+_PLUGGED_SCHEMAS: dict[tuple[int, str | None, str | None], tuple[Schema, Schema]] = {}
 
 
-def _law_schema(schema: Schema, spec: str) -> Schema:
-    """``schema`` with the contact law ``spec`` of a user's file (remembered per schema and
-    spec): the spec one more choice of ``contact_law``, the law's fragment appended (a name
-    that ``schema`` already has is refused)."""
+def _plugged_schema(schema: Schema, law: str | None, load: str | None) -> Schema:
+    """``schema`` with the contact law ``law`` and the load ``load`` of users' files (specs, or
+    None; remembered per schema and specs): each spec one more choice of its parameter
+    (``contact_law``, ``load``), each component's fragment appended (a name that ``schema`` or
+    the other component already has is refused in one line)."""
     from dataclasses import replace
 
     from ...errors import ParameterError
     from .contract import check_fragments
 
-    key = (id(schema), spec)
-    hit = _LAW_SCHEMAS.get(key)
+    key = (id(schema), law, load)
+    hit = _PLUGGED_SCHEMAS.get(key)
     if hit is None or hit[0] is not schema:
-        law = law_part({"contact_law": spec})
+        specs, parts = {}, []
+        if law is not None:
+            specs["contact_law"] = law
+            parts.append(law_part({"contact_law": law}))
+        if load is not None:
+            specs["load"] = load
+            parts.append(user_load({"load": load}))
         try:
-            check_fragments((law,), base=schema.params)
+            check_fragments(parts, base=schema.params)
         except ValueError as exc:
-            raise ParameterError(f"contact_law = {spec!r}: {exc}") from None
-        params = tuple(replace(p, choices=(*p.choices, spec)) if p.name == "contact_law" else p
-                       for p in schema)  # fmt: skip
-        hit = _LAW_SCHEMAS[key] = schema, Schema((*params, *law.params), schema.aliases,
-                                                 schema.extras)  # fmt: skip
+            which = " and ".join(f"{k} = {v!r}" for k, v in specs.items())
+            raise ParameterError(f"{which}: {exc}") from None
+        params = tuple(replace(p, choices=(*p.choices, specs[p.name])) if p.name in specs
+                       else p for p in schema)  # fmt: skip
+        hit = _PLUGGED_SCHEMAS[key] = schema, Schema(
+            (*params, *(q for c in parts for q in c.params)), schema.aliases,
+            schema.extras)  # fmt: skip
     return hit[1]
 
 
@@ -579,6 +674,9 @@ class CompressorContact(Model):
             check = _motor_parts(values)[1].check
             if check is not None:
                 check(values)
+        load = user_load(values)
+        if load is not None and load.check is not None:
+            load.check(values)
         law = law_part(values)
         if law is not None:
             if values.get("clearance_joints") == "ideal":
@@ -591,15 +689,17 @@ class CompressorContact(Model):
                 law.check(values)
 
     def schema_for(self, values: Mapping[str, Any]) -> Schema:
-        """The schema; with a contact law of a user's file (``contact_law = file.py:OBJ``)
-        that spec one more choice of ``contact_law`` and the law's fragment appended (its
-        parameters validated, recorded and swept like the built-in ones)."""
+        """The schema; with a contact law or a load of a user's file (``contact_law =
+        file.py:OBJ``, ``load = file.py:OBJ``) each spec one more choice of its parameter and
+        the component's fragment appended (its parameters validated, recorded and swept like
+        the built-in ones)."""
         from ..registry import absolute_spec
 
-        spec = law_spec(values)
-        if spec is None:
+        law, load = law_spec(values), load_spec(values)
+        if law is None and load is None:
             return self.schema
-        return _law_schema(self.schema, absolute_spec(spec))
+        return _plugged_schema(self.schema, None if law is None else absolute_spec(law),
+                               None if load is None else absolute_spec(load))  # fmt: skip
 
     def parameters(self, values: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, Any]:
         """Validated values; besides the schema's, a force table as the massless link takes
@@ -608,13 +708,18 @@ class CompressorContact(Model):
         diagram, a CSV file, `recipdyn.model.load.read_pressure_table`, with this run's bore,
         rod diameter and frame pressure). The table replaces the ``load`` (the table load
         component)."""
+        from ...errors import ParameterError
         from ..registry import absolute_spec, is_spec
 
         v = {**(values or {}), **kw}
         table, ptab = v.pop("load_table", None), v.pop("pressure_table", None)
-        for k in ("contact_law", "law"):  # a law of a user's file: found from any folder
+        for k in ("contact_law", "law", "load"):  # a user's file: found from any folder
             if is_spec(v.get(k)):
                 v[k] = absolute_spec(v[k])
+        if load_spec(v) is not None and (table is not None or ptab is not None):
+            raise ParameterError(f"{'load_table' if table is not None else 'pressure_table'}: "
+                                 f"not with load = {v['load']!r}, a load of your own (it "
+                                 "gives its own force); allowed: load = 'table'")  # fmt: skip
         out = self.schema_for(v).validate(v)
         _resolve_joints(out)
         self.check(out)
@@ -679,6 +784,12 @@ class CompressorContact(Model):
                           "a guide shoe or at a worn pin (the smallest phased factor falls "
                           "through 0): at an onset the approach velocity is recorded for the "
                           "damping law"),)  # fmt: skip
+        if stateful_user_load(values) is not None:
+            return (Event("impact", onset, direction=-1, action="reset", reset=record,
+                          description="contact onset or separation at a worn pin, or an event "
+                          "of the load (one event function: the smallest of the factors falls "
+                          "through 0): at an onset the approach velocity is recorded for the "
+                          "damping law, the load's event resets its states"),)  # fmt: skip
         if joints == "both":
             return (Event("impact", onset, direction=-1, action="reset", reset=record,
                           description="contact onset or separation at either joint (the "
@@ -698,8 +809,10 @@ class CompressorContact(Model):
         return own + self._load_states(values) + (MOTOR_STATES if has_motor(values) else ())
 
     def _load_states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
-        """A load's states (none: the dynamic valves' model adds its own)."""
-        return ()
+        """A load's states: a load of a user's file, its states then its auxiliary ones (the
+        dynamic valves' model adds its own)."""
+        load = stateful_user_load(values)
+        return () if load is None else (*load.states, *load.aux_states)
 
     #: Why Benettin's method is refused with the guide's clearance (a subclass that refuses it
     #: always says its own reason).
@@ -727,8 +840,10 @@ class CompressorContact(Model):
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Not with the guide's clearance: its corners' saltation matrices have not been
         checked against differences of the flow (as the pins' have, with the crank
-        prescribed and with a motor: tests/test_contact.py, tests/test_motor_lyapunov.py)."""
-        return self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
+        prescribed and with a motor: tests/test_contact.py, tests/test_motor_lyapunov.py);
+        nor with a load of a user's file that has states (nor for its events)."""
+        return (self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
+                and stateful_user_load(values) is None)  # fmt: skip
 
     def _motor_system(self, values: Mapping[str, Any]) -> ODESystem:
         """The joints with the crank free: autonomous, the crank's states last. The approach
@@ -743,7 +858,7 @@ class CompressorContact(Model):
         k = self.kernels(values)
         names, units = zip(*self.states(values), strict=True)
         rigid = RIGID[values["clearance_joints"]]
-        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=None,
+        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
                          params=pack(values, self.load_part(values)), state_names=names,
                          state_units=units, period=None, name=self.name,
                          events=self.events(values), aux_states=1,
@@ -755,6 +870,15 @@ class CompressorContact(Model):
         if has_motor(values):
             return self._motor_system(values)
         k = self.kernels(values)
+        load = stateful_user_load(values)
+        if load is not None:  # its states after the joints' (and the guide's)
+            names, units = zip(*self.states(values), strict=True)
+            return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
+                             params=pack(values, self.load_part(values)), state_names=names,
+                             state_units=units, period=self.period(values), name=self.name,
+                             events=self.events(values), aux_states=len(load.aux_states),
+                             passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN,
+                                      I_WLOSS))  # fmt: skip
         if has_guide(values):
             names, units = zip(*self.states(values), strict=True)
             return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
@@ -791,7 +915,10 @@ class CompressorContact(Model):
             )
             cp = CompressorParams(rs=0.0, load_table=values.get("load_table"),
                                   **{k: values[k] for k in keys})  # fmt: skip
-            ang = equilibrium_theta_c(cp)
+            load = user_load(values)  # a load of a user's file: its own values too
+            extra = {} if load is None else {q.name: values[q.name] for q in load.params}
+            force = None if stateful_user_load(values) is None else _initial_force(values)
+            ang = equilibrium_theta_c(cp, extra=extra, force=force)
         ang2 = values["e0_angle_crosshead"]
         ang2 = ang + math.pi if ang2 is None else ang2
         y = np.zeros(len(STATE_NAMES))
@@ -814,6 +941,16 @@ class CompressorContact(Model):
             g = np.zeros(N_GUIDE_STATES)
             g[4:] = sign * values["v_impact_min"]
             y = np.concatenate([y, g])
+        load = stateful_user_load(values)
+        if load is not None:  # a load of a user's file: its states at t = 0
+            y0 = np.asarray(load.initial(values), dtype=np.float64).ravel()
+            n = len(load.states) + len(load.aux_states)
+            if y0.size != n:
+                from ...errors import ParameterError
+
+                raise ParameterError(f"load = {values['load']!r}: its initial gives {y0.size} "
+                                     f"values for its {n} states")  # fmt: skip
+            y = np.concatenate([y, y0])
         if has_motor(values):  # the crank at theta1_0 turning at omega, no work done yet
             y = np.concatenate([y, [float(values["theta1_0"]), float(values["omega"]), 0.0]])
         return y
@@ -821,8 +958,10 @@ class CompressorContact(Model):
     def tracks_separations(self, values: Mapping[str, Any]) -> bool:
         """Whether the event also locates separations (the phase is then the sign of
         ``v_impact``; [`phased_factor`][recipdyn.model.joints.pins.phased_factor]): with
-        clearance at both pins, or with the guide's clearance."""
-        return values["clearance_joints"] == "both" or has_guide(values)
+        clearance at both pins, with the guide's clearance, or with a load of a user's file
+        that has states (its events share the event function)."""
+        return (values["clearance_joints"] == "both" or has_guide(values)
+                or stateful_user_load(values) is not None)  # fmt: skip
 
     def period(self, values: Mapping[str, Any]) -> float:
         return 2.0 * math.pi / float(values["omega"])
@@ -977,6 +1116,12 @@ class CompressorContact(Model):
         active = [("", 0, 1, 4, 5, "rc")] if joints not in ("crosshead", "ideal") else []
         if joints not in ("crank", "ideal"):
             active.append(("_crosshead", 2, 3, 6, 7, "rc_crosshead"))
+        if "impact_time" in ds and stateful_user_load(values) is not None:
+            # a load's event (its reset) leaves the joints' phases, v_impact, as they were
+            moved = np.column_stack([ds[f"impact_{k}"].values != ds[f"impact_{k}_after"].values
+                                     for k in STATE_NAMES[8:10]]).any(axis=1)  # fmt: skip
+            out["load_events"] = float((~moved).sum())
+            ds = ds.isel(impact_event=np.flatnonzero(moved))
         has_ev = "impact_time" in ds
         if has_ev:
             ev = np.column_stack([ds[f"impact_{k}"].values for k in STATE_NAMES[:8]])

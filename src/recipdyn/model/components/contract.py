@@ -81,6 +81,10 @@ class Component:
         ``values -> ndarray``: its slice of the parameter vector.
     check : callable, optional
         ``values -> None``: cross-field checks; raise ``ParameterError`` naming the parameter.
+    initial : callable, optional
+        ``values -> ndarray``: a load with states, its states then its auxiliary states at
+        ``t = 0`` (a load of a user's file with states needs it; the dynamic valves' model
+        computes its own).
     """
 
     family: str
@@ -93,6 +97,7 @@ class Component:
     states: tuple[tuple[str, str], ...] = ()
     aux_states: tuple[tuple[str, str], ...] = ()
     check: Callable[[Mapping[str, Any]], None] | None = None
+    initial: Callable[[Mapping[str, Any]], np.ndarray] | None = None
 
     def kernel(self, role: str) -> str:
         """``from MODULE import FUNCTION as ALIAS`` target for ``role``."""

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ...errors import ParameterError
 from ..base import Signal
 from ..kinematics import joint_forces
 from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
@@ -166,6 +167,12 @@ class LinkModel(Model):
         for f in PLUGGABLE:  # a user's component's own checks
             if is_spec(values.get(f)):
                 c = resolve_component(f, values[f], {})
+                if c.states or c.aux_states:  # (no initial states are declared for them)
+                    raise ParameterError(f"{f} = {values[f]!r} has states: a {f} of your own "
+                                         "with states runs at a contact or lubricated pin or in "
+                                         "the worn guide; allowed on the massless link and ideal "
+                                         f"pins: a {f} of your own without states, or load = "
+                                         "'valves'")  # fmt: skip
                 if c.check is not None:
                     c.check(values)
 

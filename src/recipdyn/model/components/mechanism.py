@@ -67,7 +67,7 @@ def crosshead_motion(th1, thc, w1, thcd, p):
     return x, (-r * s1 + t2 * r * c1) * w1 + (-rc * sc + t2 * rc * cc) * thcd
 
 
-def equilibrium_theta_c(p, t: float = 0.0, extra=None) -> float:
+def equilibrium_theta_c(p, t: float = 0.0, extra=None, force: float | None = None) -> float:
     r"""Clearance angle at which the link is aligned with the rod load at time ``t``.
 
     The gas force on the crosshead is transmitted along the rod; the massless link is in
@@ -77,12 +77,15 @@ def equilibrium_theta_c(p, t: float = 0.0, extra=None) -> float:
     (``F_x < 0``, physical sign, rod in compression) and ``theta_c = theta2`` when it points
     away (``F_x > 0``, the paper's sign, rod in tension). theta2 depends weakly on theta_c
     (``|d theta2/d theta_c| <= rc/(l cos theta2)``), so a fixed-point iteration converges.
-    ``extra``: the values of a load from a user's file (beside ``p``'s fields).
+    ``extra``: the values of a load from a user's file (beside ``p``'s fields); ``force``: the
+    gas force at ``t`` if known (a load with states gives it from its states).
     """
     from .load import force_series
 
     th1 = p.theta1_0 + p.omega * t
-    F = float(force_series({**vars(p), **(extra or {})}, th1))  # extra: a user's component's
+    F = (
+        force if force is not None else float(force_series({**vars(p), **(extra or {})}, th1))
+    )  # extra: a user's component's
     shift = math.pi if F <= 0.0 else 0.0
     thc = shift
     for _ in range(100):
