@@ -193,7 +193,39 @@ def jac(t, y, p, J):
 rhs_jac = None
 """
 
-_MOTOR = '''from {motor_module} import {torque_fn} as torque
+#: The motor glues' Jacobian loop, one text for both: central differences with one
+#: Richardson step, (4 D(h/2) - D(h)) / 3; ``{SKIP}`` the columns left 0 (nothing depends on
+#: them), ``{STEP}`` the step of column ``k``.
+_RICHARDSON = """    n = y.shape[0]
+    fp = np.empty(n)
+    fm = np.empty(n)
+    d1 = np.empty(n)
+    yy = y.copy()
+    for k in range(n):
+        if {SKIP}:
+            for i in range(n):
+                J[i, k] = 0.0
+            continue
+        h = {STEP}
+        for level in range(2):
+            hk = h if level == 0 else 0.5 * h
+            yy[k] = y[k] + hk
+            _rhs(t, yy, p, fp)
+            yy[k] = y[k] - hk
+            _rhs(t, yy, p, fm)
+            yy[k] = y[k]
+            for i in range(n):
+                dk = (fp[i] - fm[i]) / (2.0 * hk)
+                if level == 0:
+                    d1[i] = dk
+                else:
+                    J[i, k] = (4.0 * dk - d1[i]) / 3.0
+"""
+#: the angles' absolute (the crank angle grows without bound), the rates' relative
+_ANGLE_STEP = "1e-4 if k == 0 or k == 2 else 1e-4 * max(1.0, abs(y[k]))"
+
+_MOTOR = (
+    '''from {motor_module} import {torque_fn} as torque
 
 
 @nb.njit(cache=True, inline="always")
@@ -227,31 +259,9 @@ def jac(t, y, p, J):
     without bound) and 1e-4 max(1, |y_k|) for the rates: with |f| ~ 1e6 (theta_c'') rounding
     ~2e-6 and truncation ~1e-10 (checked against finite differences in the interface
     test). The work integrals' columns are 0 (nothing depends on them)."""
-    n = y.shape[0]
-    fp = np.empty(n)
-    fm = np.empty(n)
-    d1 = np.empty(n)
-    yy = y.copy()
-    for k in range(n):
-        if k >= 4:
-            for i in range(n):
-                J[i, k] = 0.0
-            continue
-        h = 1e-4 if k == 0 or k == 2 else 1e-4 * max(1.0, abs(y[k]))
-        for level in range(2):
-            hk = h if level == 0 else 0.5 * h
-            yy[k] = y[k] + hk
-            _rhs(t, yy, p, fp)
-            yy[k] = y[k] - hk
-            _rhs(t, yy, p, fm)
-            yy[k] = y[k]
-            for i in range(n):
-                dk = (fp[i] - fm[i]) / (2.0 * hk)
-                if level == 0:
-                    d1[i] = dk
-                else:
-                    J[i, k] = (4.0 * dk - d1[i]) / 3.0
-
+'''
+    + _RICHARDSON.replace("{SKIP}", "k >= 4").replace("{STEP}", _ANGLE_STEP)
+    + """
 
 rhs_jac = None
 
@@ -264,14 +274,16 @@ def observe(t, y, p):
         out[i, 1] = y[i, 3]
         out[i, 2] = load_force(y[i, 2], p, {LO})
     return out
-'''
+"""
+)
 
 
 #: The motor with a load that has states (the dynamic valves): the free-crank accelerations
 #: with the gas force of the load's states, the load's own derivatives for the crosshead of
 #: the mechanism's state, the load's event and reset. State: ``(theta_c, theta_c', theta1,
 #: omega1, W_motor, W_gas)``, then the load's states from ``G``, its auxiliary ones from ``A``.
-_MOTOR_STATE = '''from {motor_module} import {torque_fn} as torque
+_MOTOR_STATE = (
+    '''from {motor_module} import {torque_fn} as torque
 from {load_module} import {state_rhs} as load_rhs
 from {load_module} import {event_fn} as load_event
 from {load_module} import {reset_fn} as load_reset
@@ -311,36 +323,11 @@ def jac(t, y, p, J):
     velocity: the valves' stops and regularised nozzle are not smooth everywhere, so the step
     stays small). The work integrals' and the load's auxiliary columns are 0 (nothing depends
     on them)."""
-    n = y.shape[0]
-    fp = np.empty(n)
-    fm = np.empty(n)
-    d1 = np.empty(n)
-    yy = y.copy()
-    for k in range(n):
-        if k == 4 or k == 5 or k >= {A}:
-            for i in range(n):
-                J[i, k] = 0.0
-            continue
-        if k == 0 or k == 2:
-            h = 1e-4
-        elif k < 4:
-            h = 1e-4 * max(1.0, abs(y[k]))
-        else:
-            h = 1e-7 * max(abs(y[k]), 1e-3)
-        for level in range(2):
-            hk = h if level == 0 else 0.5 * h
-            yy[k] = y[k] + hk
-            _rhs(t, yy, p, fp)
-            yy[k] = y[k] - hk
-            _rhs(t, yy, p, fm)
-            yy[k] = y[k]
-            for i in range(n):
-                dk = (fp[i] - fm[i]) / (2.0 * hk)
-                if level == 0:
-                    d1[i] = dk
-                else:
-                    J[i, k] = (4.0 * dk - d1[i]) / 3.0
-
+'''
+    + _RICHARDSON.replace("{SKIP}", "k == 4 or k == 5 or k >= {A}").replace(
+        "{STEP}", "(" + _ANGLE_STEP + ") if k < 4 else 1e-7 * max(abs(y[k]), 1e-3)"
+    )
+    + '''
 
 rhs_jac = None
 
@@ -365,6 +352,7 @@ def observe(t, y, p):
         out[i, 2] = load_force(y[i], {G}, p, {LO})
     return out
 '''
+)
 
 
 #: The observer: what the outputs are computed from (crank angle and speed, the load's force),
