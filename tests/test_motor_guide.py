@@ -195,3 +195,16 @@ def test_the_command_line_runs_and_analyses_a_motor_with_the_guide(tmp_path, cap
                  "--lyap-revolutions", "1"]) == 0  # fmt: skip
     summary = json.loads((out / "summary.json").read_text())
     assert "guide = 'clearance'" in summary["lyapunov_equations"]["refused"]
+
+
+def test_the_compressor_guide_preset_with_a_motor_runs_on_the_contact_joints_glue():
+    """`compressor-guide` (ideal pins in a worn guide) runs its own kernel, whose crank is
+    prescribed; with ``drive = motor`` it routes to the contact joints' glue, which carries
+    the same guide with the crank free (routing and states only: the runs are above)."""
+    m = get_model("compressor-guide")
+    assert m.route(m.parameters())[0] == "guide"
+    values = m.parameters({"drive": "motor"})
+    assert m.route(values)[0] == "contact"
+    assert (values["guide"], values["drive"]) == ("clearance", "motor")
+    names = [k for k, _ in m.states(values)]
+    assert names[-3:] == ["theta1", "omega1", "W_motor"] and len(names) == 12 + 8 + 3
