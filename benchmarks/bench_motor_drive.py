@@ -8,7 +8,7 @@ time of each side per revolution and their ratio are printed. The motor adds the
 states (two degrees of freedom more) and changes the step count with the ripple, so the ratio
 is the cost of the free crank, not a routing overhead.
 
-    python benchmarks/bench_motor_drive.py [--rounds 5] [--revolutions 1]
+    python benchmarks/bench_motor_drive.py [--rounds 5] [--revolutions 1] [--only guide]
 """
 
 from __future__ import annotations
@@ -24,6 +24,8 @@ CONFIGS = {
     "oil crank + contact crosshead, cycle": {"crank_joint": "lubricated",
                                              "crosshead_joint": "contact", "load": "cycle"},
     "contact crank pin + valves": {"crank_joint": "contact", "load": "valves"},
+    "ideal pins, worn guide (0.2 mm), paper": {"guide": "clearance", "crank_joint": "ideal",
+                                               "guide_clearance": 2e-4},
 }  # fmt: skip
 
 
@@ -31,6 +33,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--revolutions", type=float, default=1.0)
+    ap.add_argument("--only", default="", help="run the configurations whose label holds this")
     args = ap.parse_args()
 
     import recipdyn
@@ -44,6 +47,8 @@ def main() -> None:
     print(f"{'configuration':38s} {'prescribed (s/rev)':>18s} {'motor (s/rev)':>14s} "
           f"{'ratio':>7s} {'nfev ratio':>10s}")  # fmt: skip
     for label, selectors in CONFIGS.items():
+        if args.only not in label:
+            continue
         sides = {"prescribed": selectors, "motor": {**selectors, "drive": "motor"}}
         for p in sides.values():  # compile or load the cache
             recipdyn.simulate(model=model, params=p, revolutions=0.05, fs=2000.0)

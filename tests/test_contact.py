@@ -649,8 +649,8 @@ def test_the_old_joint_parameters_are_aliases_of_the_joint_family(old, new):
     (dict(crank_joint="link", crosshead_joint="contact"), ["crank_joint = 'link'",
                                                            "ideal crosshead pin only"]),
     (dict(crosshead_joint="link"), ["crosshead_joint", "allowed"]),
-    (dict(drive="motor", guide="clearance"), ["drive = 'motor' with guide = 'clearance'",
-                                              "not available yet"]),
+    (dict(crank_joint="link", guide="clearance"), ["guide = 'clearance' with crank_joint = "
+                                                   "'link'", "allowed"]),
 ])  # fmt: skip
 def test_a_joint_combination_that_does_not_exist_is_refused_in_one_line(kw, words, capsys):
     from recipdyn.cli import main

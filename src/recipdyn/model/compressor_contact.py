@@ -37,12 +37,17 @@ into ``_compressor_contact_drive.py``): the crank's states ``(theta1, omega1, W_
 after every other state, the joints' forces are evaluated at the crank's angle and speed
 (`recipdyn.model.joints.pins._joints_at`), the crank carries ``J1 + m1 rs^2 + J_drive`` and the
 motor's torque and the crank-pin joint's friction torque act on it; ``W_in`` is then the work
-of the gas and the motor. Its Jacobian is a central difference (the crank angle enters through
-``math.sin``); Benettin's method runs with the crank free too: the recorded approach velocities
-are auxiliary states whose tangent components follow the flow (the damping law reads them), and
-tests/test_motor_lyapunov.py checks the tangent flow against differences of the flow across
-impacts, the exponent sum against the trace of the Jacobian and the flow direction's zero
-exponent.
+of the gas and the motor. With the guide's clearance too (``free_crank_lagrangian(joints,
+guide=True)``, kernels ``*_guide_free``: coordinates ``(theta1, e..., yg)``, the same
+crosshead lateral kinetic energy, weight and ``F3_y`` work as `lagrangian`'s), the guide's
+eight states come after the joints' (and the valves' after them), the crank's last, and
+``W_loss`` holds the shoes' losses as with a prescribed crank. Its Jacobian is a central
+difference (the crank angle enters through ``math.sin``); Benettin's method runs with the crank
+free too: the recorded approach velocities are auxiliary states whose tangent components follow
+the flow (the damping law reads them), and tests/test_motor_lyapunov.py checks the tangent flow
+against differences of the flow across impacts, the exponent sum against the trace of the
+Jacobian and the flow direction's zero exponent; with the guide's clearance it is refused (its
+corners' saltation matrices are not checked, whatever the drive).
 
 The Jacobian is the complex step of the right-hand side (``cs_jac`` of the generated glue,
 `recipdyn.model.components.contact`): the compiled kernels take complex states, and
@@ -162,8 +167,8 @@ def _target() -> Path:
 CRANK_INPUTS = ("T_crank", "I_crank", "S_crank")
 
 
-@lru_cache(maxsize=4)
-def free_crank_lagrangian(joints: str = "crank"):
+@lru_cache(maxsize=8)
+def free_crank_lagrangian(joints: str = "crank", guide: bool = False):
     """The derived [`Lagrangian`][recipdyn.model.derive.Lagrangian] of the mechanism with
     clearance at ``joints`` and the crank angle free (a motor drive): coordinates
     ``(theta1, e...)``. The crank adds ``I_crank theta1'^2 / 2`` and ``g S_crank sin
@@ -171,8 +176,10 @@ def free_crank_lagrangian(joints: str = "crank"):
     eccentricities only (``F1 . d e1``: the force on the bearing and its reaction on the
     journal, whose position ``A(theta1)`` moves with the crank), the crank-pin joint's
     friction torque on the journal is in ``T_crank``, the gas force does ``F_gas dx3``. With
-    ``theta1 = theta1_0 + omega t`` the eccentricities' rows are `lagrangian`'s (the tests
-    check it)."""
+    ``guide``, the crosshead pin's lateral position ``yg`` is the last coordinate, as in
+    `lagrangian` (its kinetic energy ``m3 yg'^2 / 2``, its weight, the guide's lateral force
+    ``F3_y`` the last input; ``joints`` may then be ``ideal``). With ``theta1 = theta1_0 +
+    omega t`` the other rows are `lagrangian`'s (the tests check it)."""
     import sympy as sp
 
     from .derive import derive
@@ -181,16 +188,21 @@ def free_crank_lagrangian(joints: str = "crank"):
     e = dict(zip(("e1x", "e1y", "e2x", "e2y"), sp.symbols("e1x e1y e2x e2y", real=True),
                  strict=True))  # fmt: skip
     names = {"crank": ("e1x", "e1y"), "crosshead": ("e2x", "e2y"),
-             "both": ("e1x", "e1y", "e2x", "e2y")}[joints]  # fmt: skip
+             "both": ("e1x", "e1y", "e2x", "e2y"), "ideal": ()}[joints]  # fmt: skip
     th1, th1d = sp.symbols("theta1 theta1_dot", real=True)
     q = (th1, *(e[k] for k in names))
     qd = (th1d, *(sp.Symbol(f"{k}_dot", real=True) for k in names))
     e = {k: (v if k in names else sp.S.Zero) for k, v in e.items()}
+    yg = sp.S.Zero
+    if guide:
+        yg = sp.Symbol("yg", real=True)
+        q, qd = (*q, yg), (*qd, sp.Symbol("yg_dot", real=True))
     r, l, ls, m2, m3, J2, g, d, w, th10 = sp.symbols(" ".join(MECH), real=True)
     Fg, F1x, F1y, F2x, F2y, Tr = sp.symbols(" ".join(INPUTS), real=True)
     Tc, Ic, Sc = sp.symbols(" ".join(CRANK_INPUTS), real=True)
+    F3y = sp.Symbol(GUIDE_INPUTS[0], real=True)
     Bx, By = r * sp.cos(th1) + e["e1x"], r * sp.sin(th1) + e["e1y"]
-    th2 = sp.asin((e["e2y"] - d - By) / l)
+    th2 = sp.asin((yg + e["e2y"] - d - By) / l)
     x3 = Bx + l * sp.cos(th2) - e["e2x"]
     xg, yg_rod = Bx + ls * sp.cos(th2), By + ls * sp.sin(th2)
 
@@ -200,17 +212,21 @@ def free_crank_lagrangian(joints: str = "crank"):
     T = (m2 * (dt(xg) ** 2 + dt(yg_rod) ** 2) + J2 * dt(th2) ** 2 + m3 * dt(x3) ** 2
          + Ic * th1d**2) / 2  # fmt: skip
     V = m2 * g * yg_rod + g * Sc * sp.sin(th1)
+    if guide:  # the crosshead's lateral motion, and its weight
+        T = T + m3 * dt(yg) ** 2 / 2
+        V = V + m3 * g * yg
     Q = [F1x * sp.diff(e["e1x"], k) + F1y * sp.diff(e["e1y"], k) + F2x * sp.diff(e["e2x"], k)
          + F2y * sp.diff(e["e2y"], k) + Tr * sp.diff(th2, k) + Fg * sp.diff(x3, k)
-         + Tc * sp.diff(th1, k) for k in q]  # fmt: skip
+         + Tc * sp.diff(th1, k) + F3y * sp.diff(yg, k) for k in q]  # fmt: skip
     params = (r, l, ls, m2, m3, J2, g, d, w, th10, Fg, F1x, F1y, F2x, F2y, Tr, Tc, Ic, Sc)
-    return derive(T, V, q, qd, t, params, Q=Q)
+    return derive(T, V, q, qd, t, (*params, F3y) if guide else params, Q=Q)
 
 
 def generate_drive() -> str:
     """Source of ``_compressor_contact_drive.py``: the free-crank accelerations of the contact
     joints (`free_crank_lagrangian`) for clearance at the crank pin, the crosshead pin, or
-    both."""
+    both; then with the guide's clearance (``*_guide_free``: the crosshead's lateral position
+    the last coordinate), for those and both pins ideal."""
     import sympy as sp
 
     from .derive import accelerations_source
@@ -219,15 +235,18 @@ def generate_drive() -> str:
             "hand.", "", "Mechanism of the compressor with contact-impact clearance joints and "
             "the crank angle free", "(a motor drive; recipdyn.model.compressor_contact."
             "free_crank_lagrangian): the accelerations", "qdd of M qdd = b, q = (theta1, e...), "
-            "for clearance at the crank pin, the crosshead pin,", "or both.", '"""', "",
-            "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
+            "for clearance at the crank pin, the crosshead pin,", "or both; with the guide's "
+            "clearance (``*_guide_free``), q = (theta1, e..., yg), also for", "both pins "
+            "ideal.", '"""', "", "import numba as nb", "import numpy as np", "", ""]  # fmt: skip
     bodies = []
-    n_in = len(INPUTS) + len(CRANK_INPUTS)
-    for j in JOINTS:
-        lag = free_crank_lagrangian(j)
-        th1 = lag.q[0]
-        src = accelerations_source(lag, f"{j}_free", n_in, given=(sp.sin(th1), sp.cos(th1)))
-        bodies.append(src.replace("math.", "np."))
+    for guide in (False, True):
+        n_in = len(INPUTS) + len(CRANK_INPUTS) + (len(GUIDE_INPUTS) if guide else 0)
+        for j in GUIDE_JOINTS if guide else JOINTS:
+            lag = free_crank_lagrangian(j, guide)
+            th1 = lag.q[0]
+            name = f"{j}_guide_free" if guide else f"{j}_free"
+            src = accelerations_source(lag, name, n_in, given=(sp.sin(th1), sp.cos(th1)))
+            bodies.append(src.replace("math.", "np."))
     return "\n".join(head) + "\n\n".join(bodies)
 
 

@@ -96,14 +96,11 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
                 "link's equations hold the crosshead on its line; allowed with the guide "
                 "clearance: crank_joint = 'ideal', 'contact' or 'lubricated'"
             )
-        if drive == "motor":
-            raise ParameterError(
-                "drive = 'motor' with guide = 'clearance' is not available "
-                "yet; allowed with the guide clearance: drive = 'prescribed'"
-            )
-        if guide_kernel and rigid_pins and load in ("paper", "cycle") and not table:
+        if (guide_kernel and rigid_pins and load in ("paper", "cycle") and not table
+                and drive == "prescribed"):  # fmt: skip
             return "guide"  # compressor-guide: its own kernel, the Flores benchmark's
-        # the contact joints' glue with its own guide (any pin joint, ideal pins included)
+        # the contact joints' glue with its own guide (any pin joint, ideal pins included;
+        # with a motor, the crank's states after the guide's)
         return "contact-valves" if load == "valves" else "contact"
     if crank == "link" and cross != "ideal":
         raise ParameterError(

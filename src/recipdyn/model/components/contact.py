@@ -508,6 +508,52 @@ def observe(t, y, p):
 '''
 )
 
+#: The guide's clearance with a motor: the guide's header and the free crank's parts (imported
+#: before a user's contact law's block, which then defines its own `_joints_guide_at`).
+_MOTOR_GUIDE_HEADER = """from recipdyn.model.joints.pins import _accelerate_guide_free
+from recipdyn.model.joints.pins import _joints_guide_at
+from {motor_module} import {torque_fn} as torque
+"""
+
+#: What `_GUIDE_BODY` changes with a motor (each text once; `_motor_guide_body`): the joints'
+#: forces at the crank's state, the free-crank accelerations with the motor's torque, the
+#: Jacobian by central differences (no complex step through the crank angle's math.sin), the
+#: crank's angle, speed and acceleration after the guide's observed columns.
+_MOTOR_GUIDE_SWAPS = (
+    ("""    j = _joints_guide(t, y, p, {CFG}, {GY}, friction, {FO})
+    return _accelerate_guide(t, y, p, out, {CFG}, {GY}, p[{GO} + S_J3], j,
+                             _force(t, y, p, j[7], j[8]), _guide(y, p, j[5]))""",
+     """    j = _joints_guide_at(y[{M}], y[{M} + 1], y, p, {CFG}, {GY}, friction, {FO})
+    return _accelerate_guide_free(y, p, out, {CFG}, {GY}, p[{GO} + S_J3], j,
+                                  _force(t, y, p, j[7], j[8]), _guide(y, p, j[5]), {M},
+                                  torque(y[{M} + 1], p, {MO}), {CO})"""),
+    ("= _joints_guide(t[i], yi, p, {CFG}, {GY}, friction,\n" + " " * 58 + "{FO})",
+     "= _joints_guide_at(yi[{M}], yi[{M} + 1], yi, p, {CFG}, {GY},\n" + " " * 58
+     + "friction, {FO})"),
+    ("corners in contact, the shoes' elastic energy, the tilt's acceleration.",
+     "corners in contact, the shoes' elastic energy, the tilt's acceleration; then the "
+     "crank's angle,\n    speed and acceleration."),
+    ("    out = np.zeros((n, 30))", "    out = np.zeros((n, 33))"),
+    ("        out[i, 29] = d[{GY} + 3]\n",
+     "        out[i, 29] = d[{GY} + 3]\n        out[i, 30] = yi[{M}]\n"
+     "        out[i, 31] = yi[{M} + 1]\n        out[i, 32] = d[{M} + 1]\n"),
+)  # fmt: skip
+
+
+def _motor_guide_body() -> str:
+    """`_GUIDE_BODY` with a motor (`_MOTOR_GUIDE_SWAPS`), without the complex-step columns:
+    the same text otherwise, so the guide's physics and events stay written once."""
+    body = _GUIDE_BODY
+    start = body.index("@nb.njit(cache=True)\ndef _cs_columns")
+    end = body.index("{JAC}")
+    body = body[:start] + body[end:]
+    for old, new in _MOTOR_GUIDE_SWAPS:
+        if body.count(old) != 1:  # pragma: no cover - guards an edit of _GUIDE_BODY
+            raise RuntimeError(f"_GUIDE_BODY no longer holds {old!r} once; update the swaps")
+        body = body.replace(old, new)
+    return body
+
+
 #: A free crank's angle where the prescribed glue writes theta1_0 + omega t.
 _PRESCRIBED_ANGLE = "p[P_TH10] + p[P_OMEGA] * t"
 
@@ -527,7 +573,8 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     ones; empty for a built-in law (the glue then imports the joints' functions). With a
     motor (``motor``, its torque law's component): the crank's states start at
     ``motor_state``, the torque law's slice at ``motor_offset``, the crank's (inertia, static
-    moment) at ``crank_offset``; no guide clearance. ``friction``: the friction law,
+    moment) at ``crank_offset`` (with the guide's clearance too: its observer's crank columns
+    follow the guide's, 30-32). ``friction``: the friction law,
     ``(module, function, offset of its slice)``
     (`recipdyn.model.components.contact_model.friction_part`; default: the schema's default
     ``friction_law``, Ambrósio's). ``guide_friction``: the guide's friction law, a function
@@ -536,7 +583,7 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
         from ..joints.pins import P_MU
 
         friction = ("recipdyn.model.joints.contact", "ambrosio_friction", P_MU)
-    if motor is not None:
+    if motor is not None and guide is None:
         return _motor_source(cfg=cfg, joints=joints, load=load, offset=offset,
                              first_state=first_state, law=law, motor=motor, m=motor_state,
                              mo=motor_offset, co=crank_offset, friction=friction)  # fmt: skip
@@ -546,6 +593,12 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
                 friction_module=friction[0], friction_fn=friction[1], FO=friction[2])  # fmt: skip
     if guide is not None:
         fill["combo"] += ", guide=clearance"
+    # with a motor (and the guide: else `_motor_source`), the crank's angle is its state
+    angle = _PRESCRIBED_ANGLE if motor is None else "y[{M}]"
+    if motor is not None:
+        fill["combo"] += f", drive=motor, motor={motor.name}"
+        fill.update(M=motor_state, MO=motor_offset, CO=crank_offset, motor_module=motor.module,
+                    torque_fn=motor.kernel("torque"))  # fmt: skip
     src = _HEADER.format(**fill)
     if stateful:
         kinds = ("state_force", "state_rhs", "event", "reset")
@@ -553,7 +606,8 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
     elif "force_sc" in load.kernels:
         src += _FORCE["sc"].format(force_sc=load.kernel("force_sc"), **fill)
     else:
-        src += _FORCE["angle"].format(force=load.kernel("force"), **fill)
+        src += _FORCE["angle"].replace(_PRESCRIBED_ANGLE, angle).format(
+            force=load.kernel("force"), **fill)  # fmt: skip
     if guide is not None:
         fill.update(
             GO=guide,
@@ -562,11 +616,15 @@ def glue_source(*, cfg: int, joints: str, load, offset: int, first_state: int,
             guide_friction_fn=guide_friction,
         )
         src += _GUIDE_HEADER.format(**fill)
+        if motor is not None:
+            src += _MOTOR_GUIDE_HEADER.format(**fill)
         if law:
             src += "\n\n" + law
-        src += _GUIDE_BODY.format(
-            STATE_RHS=_STATE_RHS.format(**fill) if stateful else "",
-            JAC=_JAC_FD if stateful else _JAC_CS,
+        body = _GUIDE_BODY if motor is None else _motor_guide_body()
+        state_rhs = _STATE_RHS.replace(_PRESCRIBED_ANGLE, angle) if stateful else ""
+        src += body.format(
+            STATE_RHS=state_rhs.format(**fill),
+            JAC=_JAC_FD if stateful or motor is not None else _JAC_CS,
             JOINT_FACTOR="math.inf" if cfg == 3 else f"contact_factor(y, p, {cfg})[0]",
             JOINT_RESET=("        pass" if cfg == 3 else
                          f"        _flip(y, contact_factor(y, p, {cfg})[1], p, out)"),

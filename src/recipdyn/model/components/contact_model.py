@@ -321,13 +321,19 @@ def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
     if motor is not None:  # the crank's slice and the torque law's before the load's
         from .drive import MOTORS
 
-        first = G_GAS
+        # with the guide's clearance, its states follow the joints' and its slice the law's
+        n_g, first = (N_GUIDE, G_GAS + N_GUIDE_STATES) if guide else (0, G_GAS)
         src = glue_source(cfg=CFG[joints], joints=joints, load=part,
-                          offset=N_PACKED + n_law + N_CRANK + n_motor, first_state=first,
+                          offset=N_PACKED + n_law + n_g + N_CRANK + n_motor, first_state=first,
                           law=block, motor=MOTORS[motor],
                           motor_state=first + len(part.states) + len(part.aux_states),
-                          motor_offset=N_PACKED + n_law + N_CRANK,
-                          crank_offset=N_PACKED + n_law, friction=friction)  # fmt: skip
+                          motor_offset=N_PACKED + n_law + n_g + N_CRANK,
+                          crank_offset=N_PACKED + n_law + n_g, friction=friction,
+                          guide=N_PACKED + n_law if guide else None,
+                          guide_state=G_GUIDE if guide else None,
+                          guide_friction=guide_friction)  # fmt: skip
+        if guide:
+            stem += f"_guide_{guide_friction}"
         return glue_module(src + tail, f"{stem}_motor_{motor}")
     if not guide:
         src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
@@ -349,14 +355,14 @@ def kernels(values: Mapping[str, Any], load=None):
     name = _load_key(values, part)
     spec = law_spec(values)
     friction = friction_part(values)
+    guide = has_guide(values)
+    shoes = FRICTION_ROLES[values["guide_friction_law"]] if guide else ""
     if has_motor(values):
         from ..registry import absolute_spec
 
         law = None if spec is None else absolute_spec(spec)
-        return _glue(values["clearance_joints"], name, False, law, law_size(values),
-                     friction, "", values["motor"], motor_size(values))  # fmt: skip
-    guide = has_guide(values)
-    shoes = FRICTION_ROLES[values["guide_friction_law"]] if guide else ""
+        return _glue(values["clearance_joints"], name, guide, law, law_size(values),
+                     friction, shoes, values["motor"], motor_size(values))  # fmt: skip
     if spec is not None:
         from ..registry import absolute_spec
 
@@ -509,12 +515,15 @@ def pack(values: Mapping[str, Any], load=None) -> np.ndarray:
     law = law_part(v)  # a contact law of a user's file: its slice first
     first = () if law is None else (law,)
     n_law = law_size(v)
-    if has_motor(v):  # the crank's and the torque law's slices, then the load's
+    if has_motor(v):  # (the guide's,) the crank's and the torque law's slices, then the load's
         crank, motor = _motor_parts(v)
-        vec, offsets = Assembly(N_PACKED, (*first, crank, motor, part)).pack(
+        guide = (CLEARANCE,) if has_guide(v) else ()
+        n_g = N_GUIDE if guide else 0
+        vec, offsets = Assembly(N_PACKED, (*first, *guide, crank, motor, part)).pack(
             np.asarray(head, dtype=np.float64), _motor_values(v))  # fmt: skip
-        assert offsets["drive"] == N_PACKED + n_law  # literals in the glue
-        assert offsets["load"] == N_PACKED + n_law + N_CRANK + motor_size(v)
+        assert offsets["drive"] == N_PACKED + n_law + n_g  # literals in the glue
+        assert offsets["load"] == N_PACKED + n_law + n_g + N_CRANK + motor_size(v)
+        assert not guide or offsets["guide"] == N_PACKED + n_law
         return vec
     if has_guide(v):
         vec, offsets = Assembly(N_PACKED, (*first, CLEARANCE, part)).pack(
@@ -667,10 +676,6 @@ class CompressorContact(Model):
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
         if has_motor(values):
-            if has_guide(values):
-                raise ParameterError("drive = 'motor' with guide = 'clearance' is not "
-                                     "available yet; allowed with the guide clearance: drive "
-                                     "= 'prescribed'")  # fmt: skip
             check = _motor_parts(values)[1].check
             if check is not None:
                 check(values)
@@ -858,12 +863,15 @@ class CompressorContact(Model):
         k = self.kernels(values)
         names, units = zip(*self.states(values), strict=True)
         rigid = RIGID[values["clearance_joints"]]
+        # the guide's corners' phases (not its lateral position and tilt), a load's states
+        corners = range(G_GUIDE + 4, G_GUIDE + N_GUIDE_STATES) if has_guide(values) else ()
         return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
                          params=pack(values, self.load_part(values)), state_names=names,
                          state_units=units, period=None, name=self.name,
                          events=self.events(values), aux_states=1,
                          aux=tuple(i for i in (8, 9) if i not in rigid),
-                         passive=(*rigid, I_WIN, I_WLOSS, *range(G_GAS, len(names) - 3),
+                         passive=(*rigid, I_WIN, I_WLOSS, *corners,
+                                  *range(first_load_state(values), len(names) - 3),
                                   len(names) - 1))  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
@@ -976,10 +984,11 @@ class CompressorContact(Model):
         th1 = float(values["theta1_0"]) + w * t
         motor = has_motor(values)
         alpha = 0.0
-        if motor:  # the crank's angle, speed and acceleration: the observer's
-            th1, w, alpha = j[:, 21], j[:, 22], j[:, 23]
-        e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))
         guide = has_guide(values)
+        if motor:  # the crank's angle, speed and acceleration: the observer's (after the guide's)
+            mc = 30 if guide else 21
+            th1, w, alpha = j[:, mc], j[:, mc + 1], j[:, mc + 2]
+        e1x, e1y, e2x, e2y = (y[:, i] for i in range(4))
         e2ydd = j[:, 17]
         if guide:  # the small end follows the crosshead pin's lateral position
             e2y, e2ydd = e2y + y[:, G_GUIDE], e2ydd + j[:, 21]

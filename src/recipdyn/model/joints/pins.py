@@ -30,8 +30,12 @@ from .._compressor_contact import (
 )
 from .._compressor_contact_drive import (
     both_free_accelerations,
+    both_guide_free_accelerations,
     crank_free_accelerations,
+    crank_guide_free_accelerations,
     crosshead_free_accelerations,
+    crosshead_guide_free_accelerations,
+    ideal_guide_free_accelerations,
 )
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, compiled
 from ..components.guide import CLEARANCE
@@ -285,9 +289,15 @@ def _joints_guide(t, y, p, cfg, gy, friction, fo):
     """`_joints` with the guide's clearance (``cfg`` 3: both pins ideal): the rod's small end
     follows the crosshead pin's lateral position, and the crosshead pin's journal turns with
     the crosshead's tilt."""
-    _, c2, th2d, v3, s1, c1 = _kinematics(t, p, y[0], y[1], y[4], y[5], y[2], y[3] + y[gy],
-                                          y[6], y[7] + y[gy + 2])  # fmt: skip
     w = p[P_OMEGA]
+    return _joints_guide_at(p[P_TH10] + w * t, w, y, p, cfg, gy, friction, fo)
+
+
+@nb.njit(cache=True, inline="always")
+def _joints_guide_at(th1, w, y, p, cfg, gy, friction, fo):
+    """`_joints_guide` at the crank angle ``th1`` and speed ``w`` (a free crank's states)."""
+    _, c2, th2d, v3, s1, c1 = _kinematics_at(th1, w, p, y[0], y[1], y[4], y[5], y[2],
+                                             y[3] + y[gy], y[6], y[7] + y[gy + 2])  # fmt: skip
     z = 0.0 * y[0]
     p_crank = z
     f1 = (z, z, z, z, z, z, z)
@@ -372,6 +382,58 @@ def _accelerate_guide(t, y, p, out, cfg, gy, j3, j, fg, gf):
     out[9] = 0.0
     out[I_WIN] = p_in
     out[I_WLOSS] = p_loss + lost
+    return v3, c2
+
+
+@nb.njit(cache=True, inline="always")
+def _accelerate_guide_free(y, p, out, cfg, gy, j3, j, fg, gf, m, tm, co):
+    """`_accelerate_guide` with the crank angle free (a motor drive, as `_accelerate_free`):
+    the derivatives of the joints' twelve states, the guide's eight (``y[gy:gy + 8]``) and
+    the crank's ``y[m:m + 3]`` from the joints' forces ``j`` (`_joints_guide_at` at ``y[m],
+    y[m + 1]``), the gas force ``fg``, the guide's ``gf`` (`slice_forces`), the motor torque
+    ``tm``; ``j3`` the crosshead's tilt inertia, ``co`` the offset of the crank's slice. The
+    work of the gas and of the motor is ``W_in``, the motor's alone ``y[m + 2]``; the joints'
+    and the shoes' losses are ``W_loss``. Returns (crosshead velocity, cos theta2)."""
+    f1, f2, _, p_loss, _, v3, c2, s1, c1 = j
+    fx, fy, mz, lost, _ = gf
+    w1 = y[m + 1]
+    u = (fg + fx, f1[0], f1[1], f2[0], f2[1], f1[2] + f2[2], tm + f1[3], p[co], p[co + 1], fy,
+         s1, c1)  # fmt: skip
+    for i in range(4):
+        out[i] = y[4 + i]
+        out[4 + i] = 0.0 * y[0]
+    out[gy] = y[gy + 2]
+    out[gy + 1] = y[gy + 3]
+    if cfg == 0:
+        a = crank_guide_free_accelerations(0.0, (y[m], y[0], y[1], y[gy], w1, y[4], y[5],
+                                                 y[gy + 2]), p, u)  # fmt: skip
+        out[4], out[5], out[gy + 2] = a[1], a[2], a[3]
+        a0 = a[0]
+    elif cfg == 1:
+        a = crosshead_guide_free_accelerations(0.0, (y[m], y[2], y[3], y[gy], w1, y[6], y[7],
+                                                     y[gy + 2]), p, u)  # fmt: skip
+        out[6], out[7], out[gy + 2] = a[1], a[2], a[3]
+        a0 = a[0]
+    elif cfg == 2:
+        a5 = both_guide_free_accelerations(0.0, (y[m], y[0], y[1], y[2], y[3], y[gy], w1, y[4],
+                                                 y[5], y[6], y[7], y[gy + 2]), p, u)  # fmt: skip
+        out[4], out[5], out[6], out[7], out[gy + 2] = a5[1], a5[2], a5[3], a5[4], a5[5]
+        a0 = a5[0]
+    else:
+        a1 = ideal_guide_free_accelerations(0.0, (y[m], y[gy], w1, y[gy + 2]), p, u)
+        out[gy + 2] = a1[1]
+        a0 = a1[0]
+    # the tilt: the shoes' moment and the crosshead pin's friction torque on its journal
+    out[gy + 3] = (mz + f2[3]) / j3
+    for k in range(4):
+        out[gy + 4 + k] = 0.0
+    out[8] = 0.0
+    out[9] = 0.0
+    out[I_WIN] = fg * v3 + tm * w1
+    out[I_WLOSS] = p_loss + lost
+    out[m] = w1
+    out[m + 1] = a0
+    out[m + 2] = tm * w1
     return v3, c2
 
 
@@ -507,6 +569,7 @@ def law_source(law, offset: int) -> str:
         f"short_bearing_forces, {', '.join(names)})"
     )
     body = [pair] + [inspect.getsource(f.py_func) for f in (_joints_at, _joints,
+                                                             _joints_guide_at,
                                                              _joints_guide)]  # fmt: skip
     return "\n".join(head) + "\n\n\n" + "\n\n".join(body)
 
