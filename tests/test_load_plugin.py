@@ -55,10 +55,17 @@ CASES = {
     "guide clearance": (dict(guide="clearance", crank_joint="ideal", omega=150.0), SPRING,
                         dict(spring_rate=0.5), lambda th: _spring(th, 2e4, 0.5)),
 }  # fmt: skip
+#: ... and with the motor in the worn guide (ideal pins; not in CI: one more glue to compile)
+MORE = {
+    "guide clearance, motor": (dict(guide="clearance", crank_joint="ideal", drive="motor",
+                                    motor="constant", motor_torque=1000.0, omega=20.0),
+                               HARMONIC, {}, _harmonic),
+}  # fmt: skip
 
 
 @pytest.mark.filterwarnings("ignore::recipdyn.errors.LawRangeWarning")
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", [*CASES, *(pytest.param(k, marks=pytest.mark.exhaustive)
+                                            for k in MORE)])  # fmt: skip
 def test_a_users_load_runs_at_every_joint_and_in_the_worn_guide(case):
     """Hypothesis: the glue calls the user's compiled force at its own slice, on the crank
     angle the run integrates (with a motor, the crank's state, not omega t). The recorded gas
@@ -67,7 +74,7 @@ def test_a_users_load_runs_at_every_joint_and_in_the_worn_guide(case):
     differ in the last ulp: rel 1e-12 of the force's scale). The record holds the load's spec,
     absolute, and its parameters with units; the energy balance closes (test_contact's bound,
     1e-7 of the energy: the load's work enters W_in through the same force)."""
-    pins, spec, own, law = CASES[case]
+    pins, spec, own, law = {**CASES, **MORE}[case]
     kw = {**pins, "load": spec, **own}
     v = M.parameters(kw)
     assert M.route(v)[0] == "contact" and v["load"] == spec
