@@ -140,6 +140,40 @@ def _fd_columns(t, y, p, J, skip_passive):
 def fd_jac(t, y, p, J):
     _fd_columns(t, y, p, J, False)
 '''
+#: The glue's complex-step Jacobian, one text for the prescribed bodies: the columns of the
+#: ``{CS_N}`` states that move (the joints' twelve, then the guide's eight where it has
+#: clearance, the ``m``-th being state ``{CS_K}``), the work integrals' left 0; with
+#: ``skip_rigid`` a rigid pin's too (for the tangent flow, whose components along them stay 0).
+_CS_JAC = """@nb.njit(cache=True)
+def _cs_columns(t, y, p, f, J, skip_rigid):
+    n = y.shape[0]
+    yc = np.empty(n, np.complex128)
+    fc = np.empty(n, np.complex128)
+    for i in range(n):
+        yc[i] = y[i]
+    J[:, :] = 0.0
+    first = True
+    for m in range({CS_N}):
+        k = {CS_K}
+        if m < I_WIN and skip_rigid and _RIGID_MASK[{CFG}, k]:
+            continue
+        yc[k] = complex(y[k], CS_STEP)
+        _mechanism(t, yc, p, fc)
+        yc[k] = y[k]
+        for i in range(n):
+            J[i, k] = fc[i].imag / CS_STEP
+        if first:
+            for i in range(n):
+                f[i] = fc[i].real
+            first = False
+
+
+@nb.njit(cache=True)
+def cs_jac(t, y, p, J):
+    f = np.empty(y.shape[0])
+    _cs_columns(t, y, p, f, J, False)
+"""
+
 _PIN_C = "p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))"
 
 _BODY = (
@@ -163,36 +197,11 @@ def rhs(t, y, p, out):
 
 """
     + _FD_JAC.replace("{FD_C}", _PIN_C)
-    + '''
+    + """
 
-@nb.njit(cache=True)
-def _cs_columns(t, y, p, f, J, skip_rigid):
-    n = y.shape[0]
-    yc = np.empty(n, np.complex128)
-    fc = np.empty(n, np.complex128)
-    for i in range(n):
-        yc[i] = y[i]
-    J[:, :] = 0.0
-    first = True
-    for k in range(I_WIN):
-        if skip_rigid and _RIGID_MASK[{CFG}, k]:
-            continue
-        yc[k] = complex(y[k], CS_STEP)
-        _mechanism(t, yc, p, fc)
-        yc[k] = y[k]
-        for i in range(n):
-            J[i, k] = fc[i].imag / CS_STEP
-        if first:
-            for i in range(n):
-                f[i] = fc[i].real
-            first = False
-
-
-@nb.njit(cache=True)
-def cs_jac(t, y, p, J):
-    f = np.empty(y.shape[0])
-    _cs_columns(t, y, p, f, J, False)
-{JAC}
+"""
+    + _CS_JAC.replace("{CS_N}", "I_WIN").replace("{CS_K}", "m")
+    + '''{JAC}
 
 @nb.njit(cache=True)
 def observe(t, y, p):
@@ -325,37 +334,13 @@ def rhs(t, y, p, out):
 
 """
     + _FD_JAC.replace("{FD_C}", "min(p[P_C1], p[P_C2])")
-    + '''
+    + """
 
-@nb.njit(cache=True)
-def _cs_columns(t, y, p, f, J, skip_rigid):
-    n = y.shape[0]
-    yc = np.empty(n, np.complex128)
-    fc = np.empty(n, np.complex128)
-    for i in range(n):
-        yc[i] = y[i]
-    J[:, :] = 0.0
-    first = True
-    for m in range(I_WIN + 8):
-        k = m if m < I_WIN else m - I_WIN + {GY}  # then the guide's states
-        if m < I_WIN and skip_rigid and _RIGID_MASK[{CFG}, k]:
-            continue
-        yc[k] = complex(y[k], CS_STEP)
-        _mechanism(t, yc, p, fc)
-        yc[k] = y[k]
-        for i in range(n):
-            J[i, k] = fc[i].imag / CS_STEP
-        if first:
-            for i in range(n):
-                f[i] = fc[i].real
-            first = False
-
-
-@nb.njit(cache=True)
-def cs_jac(t, y, p, J):
-    f = np.empty(y.shape[0])
-    _cs_columns(t, y, p, f, J, False)
-{JAC}
+"""
+    + _CS_JAC.replace("{CS_N}", "I_WIN + 8").replace(
+        "{CS_K}", "m if m < I_WIN else m - I_WIN + {GY}  # then the guide's states"
+    )
+    + '''{JAC}
 
 @nb.njit(cache=True)
 def observe(t, y, p):
