@@ -353,3 +353,24 @@ def test_a_few_point_section_outweighs_the_zero_one_test_when_no_exponent_is_est
     assert v.verdict == "periodic", v.reasons
     assert any("sees the noise" in r for r in v.reasons)
     assert classify(**kw).verdict == "chaotic"
+
+
+def test_a_short_record_of_a_slow_signal_is_embedded_as_far_as_it_goes():
+    """A record shorter than Cao's test up to d = 10 needs at its delay ((10 + 1) tau + 2
+    samples: 552 for 500 samples of a slow two-tone signal, whose delay is 50) is tested up to
+    the dimension it embeds, and assessed (it raised a ValueError from inside Cao's test); at a
+    delay where it embeds fewer than 4 dimensions the embedding is "too_short" with its reason,
+    and the estimators then refuse."""
+    rng = np.random.default_rng(1)
+    t = np.arange(500)
+    x = (np.sin(2 * np.pi * t / 800) + 0.3 * np.sin(2 * np.pi * t / 258)
+         + 1e-3 * rng.standard_normal(t.size))  # fmt: skip
+    emb = choose_embedding(x)
+    fits = (x.size - 2) // emb.delay - 1
+    assert (10 + 1) * emb.delay + 2 > x.size  # (the case: too short for d = 10)
+    assert emb.status in ("ok", "not_saturated") and emb.e1.size == fits
+    assessed = assess_signal(x, 1000.0)  # two tones, 1e-3 noise: never chaotic
+    assert assessed.embedding.delay == emb.delay and assessed.embedding.status == emb.status
+    assert assessed.verdict.verdict != "chaotic"
+    short = choose_embedding(x, delay=200)  # 500 samples embed d = 1 at delay 200
+    assert short.status == "too_short" and "embed up to d = 1" in short.reason

@@ -151,9 +151,11 @@ class Embedding:
     """A delay embedding chosen from the data, with the evidence for it.
 
     ``status`` is ``"ok"``, or ``"not_saturated"`` when Cao's E1 was still changing at
-    ``max_dim`` and the false-nearest-neighbour fraction never fell below 1 % (the attractor,
-    if any, needs more dimensions than the record supports: the estimators refuse), or
-    ``"degenerate"`` for an exactly repeating record."""
+    ``max_dim`` (or the largest dimension the record embeds) and the false-nearest-neighbour
+    fraction never fell below 1 % (the attractor, if any, needs more dimensions than the record
+    supports: the estimators refuse), ``"too_short"`` when the record at its delay embeds fewer
+    than 4 dimensions (the estimators refuse), or ``"degenerate"`` for an exactly repeating
+    record."""
 
     delay: int
     dim: int
@@ -188,6 +190,15 @@ def choose_embedding(x, *, delay: int | None = None, dim: int | None = None,
     th = min(th, x.size // 10)
     if dim is not None:
         return Embedding(tau, int(dim), th, "ok", "dimension given", np.empty(0), np.empty(0))
+    # Cao's test of dimension d needs the record embedded in d + 1: at most `fits`
+    n = min(x.size, max_points)
+    fits = (n - 2) // tau - 1
+    if fits < 3:  # not even d = 1, 2 and 3 to compare: the dimension cannot be found
+        return Embedding(tau, 2, th, "too_short",
+                         f"{n} samples at delay {tau} embed up to d = {max(fits, 0)} only (a "
+                         "longer record, or a higher rate, is needed to find the embedding "
+                         "dimension)", np.empty(0), np.empty(0))  # fmt: skip
+    max_dim = min(max_dim, fits)
     e1, e2 = cao(x[:max_points], tau, max_dim=max_dim)
     if np.all(np.isnan(e1)):
         return Embedding(tau, 2, th, "degenerate", "no two distinct embedded points", e1, e2)
