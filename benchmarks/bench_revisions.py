@@ -5,10 +5,11 @@ The earlier revision (``--before``, default the last commit before the compresso
 assembled from components) is unpacked from git into a temporary folder with its own numba
 cache. Each tree runs in a worker process of its own that compiles every case first; then,
 round after round, the two workers time every case in turn, alternating, and the best round
-of each is kept. Interleaving keeps the ratios meaningful on a shared machine, where the
-absolute times are not (`_timing.py`). The cases are the four model names the earlier tree
-had, at their defaults, with their own events as a run hands them to the integrator: the
-presets of today's `compressor`.
+of each is kept. The time is the worker's CPU time: a shared machine's waits are left out,
+its contention for caches and cores is not, so on a loaded machine one run can err by tens
+of percent (run it on an idle one for the target). The cases are the four model names the
+earlier tree had, at their defaults, with their own events as a run hands them to the
+integrator: the presets of today's `compressor`.
 
 Target (the issue): every case within 1.05x of the earlier tree. Needs git and the
 repository (a checkout, not an installed package); without them it says so and measures
@@ -33,13 +34,13 @@ CASES = ("compressor", "compressor-contact", "compressor-valves", "compressor-co
 TARGET = 1.05
 
 
-def _worker(revs: float) -> None:
+def _worker(revs: float, cases: tuple[str, ...]) -> None:
     """In a tree's process: compile the cases, then time each once per line read."""
     from recipdyn.integrate import integrate
     from recipdyn.model.registry import get_model
 
     setups = {}
-    for name in CASES:
+    for name in cases:
         model = get_model(name)
         vals = model.parameters({})
         system = model.system(vals)
@@ -56,9 +57,9 @@ def _worker(revs: float) -> None:
     for _ in sys.stdin:
         out = {}
         for name, (system, y0, period, kw) in setups.items():
-            t0 = time.perf_counter()
+            t0 = time.process_time()  # CPU time: the waits of a shared machine left out
             run = integrate(system, y0, (0.0, revs * period), **kw)
-            out[name] = [(time.perf_counter() - t0) / revs, run.nsteps / revs]
+            out[name] = [(time.process_time() - t0) / revs, run.nsteps / revs]
         print(json.dumps(out), flush=True)
 
 
@@ -74,9 +75,10 @@ def _unpack(rev: str, into: Path) -> Path | None:
     return into / "src"
 
 
-def _start(src: Path, cache: Path, revs: float) -> subprocess.Popen:
+def _start(src: Path, cache: Path, revs: float, cases: tuple[str, ...]) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(src), "NUMBA_CACHE_DIR": str(cache)}
-    proc = subprocess.Popen([sys.executable, __file__, "--worker", "--revs", str(revs)],
+    proc = subprocess.Popen([sys.executable, __file__, "--worker", "--revs", str(revs),
+                             "--cases", *cases],
                             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                             text=True)  # fmt: skip
     return proc
@@ -93,13 +95,16 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--quick", action="store_true", help="1 revolution, 3 rounds")
     ap.add_argument("--before", default=BEFORE, help="the earlier revision (a git commit)")
     ap.add_argument("--rounds", type=int, default=None)
+    ap.add_argument("--revolutions", type=float, default=None, help="per timing (default 2)")
+    ap.add_argument("--cases", nargs="*", default=list(CASES), choices=CASES)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--revs", type=float, default=2.0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    cases = tuple(args.cases)
     if args.worker:
-        _worker(args.revs)
+        _worker(args.revs, cases)
         return {}
-    revs, rounds = (1.0, 3) if args.quick else (2.0, args.rounds or 7)
+    revs, rounds = (1.0, 3) if args.quick else (args.revolutions or 2.0, args.rounds or 7)
     here_src = Path(__file__).resolve().parent.parent / "src"
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -111,10 +116,10 @@ def main(argv: list[str] | None = None) -> dict:
         workers = {}
         for key, src in (("before", old_src), ("now", here_src)):
             (tmp / f"cache-{key}").mkdir()
-            workers[key] = _start(src, tmp / f"cache-{key}", revs)
+            workers[key] = _start(src, tmp / f"cache-{key}", revs, cases)
         for key, proc in workers.items():  # both compiled before any timing
             assert json.loads(proc.stdout.readline())["ready"], key
-        best = {k: dict.fromkeys(CASES, math.inf) for k in workers}
+        best = {k: dict.fromkeys(cases, math.inf) for k in workers}
         steps: dict[str, dict[str, float]] = {k: {} for k in workers}
         for r in range(rounds):
             order = ("before", "now") if r % 2 == 0 else ("now", "before")
@@ -128,7 +133,7 @@ def main(argv: list[str] | None = None) -> dict:
     print(f"per revolution, best of {rounds} alternating rounds ({revs:g} revolutions), "
           f"{args.before} against this tree:")  # fmt: skip
     rows = []
-    for name in CASES:
+    for name in cases:
         b, n = best["before"][name], best["now"][name]
         sb, sn = steps["before"][name], steps["now"][name]
         print(f"  {name:28s} {1e3 * b:9.2f} ms {1e3 * n:9.2f} ms  {n / b:5.2f}x  steps a "

@@ -117,19 +117,7 @@ def test_parameter_round_trips(model, tmp_path):
     assert model_values(model, read_config(cfg).params) == values
 
 
-#: Presets whose Jacobian is known to miss this test's tolerance, and why (strict: a fix shows).
-JACOBIAN_KNOWN = {
-    "compressor-contact[guide=clearance,guide_clearance=2e-4,drive=motor,motor=constant]": (
-        "the free crank's central-difference Jacobian (step 1e-5 of 1 mm for the guide's lateral "
-        "position) carries rounding noise ~1e-3 in d(alpha1)/d(yg) at this test's random "
-        "states, the crosshead up to ten guide clearances deep in the shoes (shoe forces "
-        "1e7-1e8 N), against an entry of ~1e-6 (that column's largest entries are ~1e11); "
-        "the prescribed guide's is the exact complex step"
-    ),
-}
-
-
-def test_kernels_deterministic_and_jacobian_exact(model, rng, request):
+def test_kernels_deterministic_and_jacobian_exact(model, rng):
     """rhs is deterministic (bit for bit); the Jacobian equals central differences within the
     difference's own error: truncation ~h^2 |f'''| (h = 1e-6 scaled, < 1e-6 relative for
     these smooth kernels; we allow 1e-5) plus rounding ~eps |f| / h (large for the stiff
@@ -139,9 +127,6 @@ def test_kernels_deterministic_and_jacobian_exact(model, rng, request):
     where a kink lies within the step: an entry is compared only where the central
     differences with h and h/4 agree (they do wherever f is smooth, whatever the Jacobian),
     and at most 2 % of the entries may be set aside so."""
-    known = JACOBIAN_KNOWN.get(request.node.callspec.id)
-    if known:
-        request.applymarker(pytest.mark.xfail(strict=True, reason=known))
     values = model.parameters()
     s = model.system(values)
     assert isinstance(s, (ODESystem, DiscreteMap)) and s.dim == len(model.states(values))

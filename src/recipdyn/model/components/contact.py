@@ -126,7 +126,7 @@ def _fd_columns(t, y, p, J, skip_passive):
             for i in range(n):
                 J[i, k] = 0.0
             continue
-        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else 1e-3))
+        scale = c if k < 4 else (c * p[P_OMEGA] if k < 10 else (1.0 if k < 12 else {FD_REST}))
         h = 1e-5 * max(abs(y[k]), scale)
         for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
             yp[k] = y[k] + step
@@ -174,6 +174,11 @@ def cs_jac(t, y, p, J):
     _cs_columns(t, y, p, f, J, False)
 """
 
+#: The steps of the states after the joints': 1e-3 of their unit, and 0.1 for the guide's
+#: lateral position and tilt and its corners' approach velocities (a step of 1 um, 1 urad,
+#: 1 um/s: with the shoes' forces at 1e7-1e8 N a step of 1e-8 drowned d(alpha1)/d(yg) in
+#: rounding, ~1e-3 against an entry of ~1e-6).
+_GUIDE_REST = "(0.1 if {GY} <= k < {GY} + 2 or {GY} + 4 <= k < {GY} + 8 else 1e-3)"
 _PIN_C = "p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))"
 
 _BODY = (
@@ -196,7 +201,7 @@ def rhs(t, y, p, out):
 
 
 """
-    + _FD_JAC.replace("{FD_C}", _PIN_C)
+    + _FD_JAC.replace("{FD_C}", _PIN_C).replace("{FD_REST}", "1e-3")
     + """
 
 """
@@ -333,7 +338,7 @@ def rhs(t, y, p, out):
 
 
 """
-    + _FD_JAC.replace("{FD_C}", "min(p[P_C1], p[P_C2])")
+    + _FD_JAC.replace("{FD_C}", "min(p[P_C1], p[P_C2])").replace("{FD_REST}", _GUIDE_REST)
     + """
 
 """
@@ -452,7 +457,7 @@ def rhs(t, y, p, out):
 
 
 """
-    + _FD_JAC.replace("{FD_C}", _PIN_C)
+    + _FD_JAC.replace("{FD_C}", _PIN_C).replace("{FD_REST}", "1e-3")
     + '''
 
 @compiled(JAC_SIGNATURE, allocates=True)
