@@ -204,6 +204,8 @@ REFUSED = [
     ({"crank_joint": "contact", "load": "valves", "load_table": TABLE},
      "not with load = 'valves'"),
     ({"load": "table"}, "load = 'table' needs load_table"),
+    ({"crank_joint": "contact", "drive": "motor", "motor": f"{PLUGIN}:LINEAR"},
+     "a torque law of your own file drives the massless link or ideal pins"),
     ({"crank_joint": "lubricated", "load": f"{PLUGIN}:NOT_A_COMPONENT"},
      "is int, not a load component"),
     ({"crank_joint": "ideal", "rc": 1e-3}, "the crank pin is ideal"),

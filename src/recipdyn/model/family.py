@@ -375,6 +375,13 @@ class Compressor(Model):
             mine["rc"] = 0.0
         if s["guide"] == "ideal" and raw.get("guide_clearance") not in (None, 0, 0.0):
             raise ParameterError("guide_clearance belongs to guide = 'clearance'")
+        if name.startswith("contact") and is_spec(raw.get("motor")):
+            raise ParameterError(
+                f"motor = {raw['motor']!r}: a torque law of your own file drives the massless "
+                "link or ideal pins in a rigid guide (crank_joint = 'link' or 'ideal', "
+                "crosshead_joint = 'ideal', guide = 'ideal'); with a contact or lubricated pin "
+                "or the guide's clearance: motor = 'constant' or 'induction'"
+            )
         ptab = mine.pop("pressure_table", None) if "pressure_table" not in impl.schema else None
         try:
             out = impl.parameters(mine)
