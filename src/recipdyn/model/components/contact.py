@@ -112,8 +112,8 @@ def _force(t, y, p, s1, c1):
 _FD_JAC = '''@nb.njit(cache=True)
 def _fd_columns(t, y, p, J, skip_passive):
     """Fourth-order central differences (truncation O(h^4)), steps scaled by the clearance
-    (positions), c omega (rates), work integrals 1 J, at least 1e-3 of their unit for the rest
-    (the guide's, the gas's and the plates', the crank's). With ``skip_passive`` the columns of
+    (positions), c omega (rates), work integrals 1 J, the states after the joints' by
+    {FD_REST} (of their unit, at least). With ``skip_passive`` the columns of
     the joints' work integrals (nothing depends on them) and of a rigid pin's states are left
     0: the tangent flow's components along them stay 0, so it never reads them."""
     n = y.shape[0]
