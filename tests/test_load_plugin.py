@@ -150,8 +150,8 @@ def test_a_constant_torques_default_is_the_users_loads_mean_torque():
 def test_a_users_load_is_refused_where_it_cannot_run():
     """One line each: a load with states but no initial states, one with states on the
     massless link (whose model holds no load states but the valves'), a load table beside a
-    load of one's own, an object that is not a load, a parameter of the load's out of its
-    range, and the guide's clearance with a motor (not available with any load)."""
+    load of one's own, an object that is not a load, and a parameter of the load's out of its
+    range. (The guide's clearance with a motor runs: `MORE`.)"""
     for kw, words in (
         (dict(crank_joint="contact", load=f"{FILE}:WITH_STATES"),
          "has states but provides no initial"),
@@ -162,8 +162,6 @@ def test_a_users_load_is_refused_where_it_cannot_run():
         (dict(crank_joint="contact", load=f"{FILE}:KELVIN_VOIGT"),
          "is a contact_law component, not a load component"),
         (dict(crank_joint="lubricated", load=SPRING, spring_rate=-1.0), "spring_rate"),
-        (dict(guide="clearance", crank_joint="ideal", drive="motor", load=SPRING),
-         "drive = 'motor' with guide"),
     ):  # fmt: skip
         with pytest.raises(ParameterError) as exc:
             M.parameters(kw)
