@@ -179,6 +179,19 @@ def cs_jac(t, y, p, J):
 #: 1 um/s: with the shoes' forces at 1e7-1e8 N a step of 1e-8 drowned d(alpha1)/d(yg) in
 #: rounding, ~1e-3 against an entry of ~1e-6).
 _GUIDE_REST = "(0.1 if {GY} <= k < {GY} + 2 or {GY} + 4 <= k < {GY} + 8 else 1e-3)"
+#: The glue's right-hand side, one text for every body: the mechanism's (the joints', the
+#: guide's, the crank's) derivatives, then a load's states' (``{STATE_RHS}``).
+_RHS = """@nb.njit(cache=True, inline="always")
+def _rhs(t, y, p, out):
+    v3, c2 = _mechanism(t, y, p, out)
+{STATE_RHS}
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+"""
 _PIN_C = "p[P_C1] if {CFG} == 0 else (p[P_C2] if {CFG} == 1 else min(p[P_C1], p[P_C2]))"
 
 _BODY = (
@@ -190,17 +203,8 @@ def _mechanism(t, y, p, out):
     return _accelerate(t, y, p, out, {CFG}, j, _force(t, y, p, j[7], j[8]))
 
 
-@nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out):
-    v3, c2 = _mechanism(t, y, p, out)
-{STATE_RHS}
-
-@compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
-    _rhs(t, y, p, out)
-
-
 """
+    + _RHS
     + _FD_JAC.replace("{FD_C}", _PIN_C).replace("{FD_REST}", "1e-3")
     + """
 
@@ -327,17 +331,8 @@ def _mechanism(t, y, p, out):
                              _force(t, y, p, j[7], j[8]), _guide(y, p, j[5]))
 
 
-@nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out):
-    v3, c2 = _mechanism(t, y, p, out)
-{STATE_RHS}
-
-@compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
-    _rhs(t, y, p, out)
-
-
 """
+    + _RHS
     + _FD_JAC.replace("{FD_C}", "min(p[P_C1], p[P_C2])").replace("{FD_REST}", _GUIDE_REST)
     + """
 
@@ -446,17 +441,8 @@ def _mechanism(t, y, p, out):
                             torque(y[{M} + 1], p, {MO}), {CO})
 
 
-@nb.njit(cache=True, inline="always")
-def _rhs(t, y, p, out):
-    v3, c2 = _mechanism(t, y, p, out)
-{STATE_RHS}
-
-@compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
-    _rhs(t, y, p, out)
-
-
 """
+    + _RHS
     + _FD_JAC.replace("{FD_C}", _PIN_C).replace("{FD_REST}", "1e-3")
     + '''
 
