@@ -2,7 +2,7 @@
 comparison with the previous run so that a regression shows (in the spirit of asv).
 
 Each ``bench_*.py`` module has ``main(argv) -> dict | None`` (``argv``: its command-line
-arguments, ``None`` for ``sys.argv``), a docstring whose first line says what it measures,
+arguments, ``None`` for ``sys.argv``), a docstring whose first paragraph says what it measures,
 and a ``--quick`` option (reduced sizes). A benchmark whose full run takes long (tens of
 minutes, or a data set to build) says so with ``RUN_ALL_ARGV = ["--quick"]``: this runner
 passes it that; ``--quick`` runs every benchmark quick, ``--full`` every one at full size.
@@ -128,8 +128,9 @@ def load(path: Path):
 
 
 def describe(mod) -> str:
-    """What a benchmark measures: the first line of its docstring."""
-    return ((mod.__doc__ or "").strip().splitlines() or ["(no description)"])[0]
+    """What a benchmark measures: the first paragraph of its docstring, on one line."""
+    first = (mod.__doc__ or "").strip().split("\n\n")[0]
+    return " ".join(first.split()) or "(no description)"
 
 
 def run_one(path: Path, mode: str) -> dict:
@@ -184,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
         for path in paths:
             mod = load(path)
             quick = " [run quick]" if getattr(mod, "RUN_ALL_ARGV", []) else ""
-            print(f"{path.stem.removeprefix('bench_'):24s} {describe(mod)}{quick}")
+            print(f"{path.stem.removeprefix('bench_')}{quick}: {describe(mod)}\n")
         return 0
     mode = "quick" if args.quick else "full" if args.full else "default"
     results: dict = {}
