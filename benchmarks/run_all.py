@@ -79,14 +79,15 @@ def summary_table(results: dict, previous: dict | None) -> str:
     for name, res in (previous or {}).get("benchmarks", {}).items():
         for row in res.get("summary", []) if isinstance(res, dict) else []:
             prev_rows[(name, row["metric"])] = row
-    lines = [f"{'benchmark':14s} {'metric':52s} {'value':>11s} {'target':>9s} {'':6s} "
+    w = max([14, *(len(n.removeprefix("bench_")) for n in results)])
+    lines = [f"{'benchmark':{w}s} {'metric':52s} {'value':>11s} {'target':>9s} {'':6s} "
              "vs previous"]  # fmt: skip
     lines.append("-" * len(lines[0]))
     for name, res in results.items():
         rows = res.get("summary", []) if isinstance(res, dict) else []
         short = name.removeprefix("bench_")
         if isinstance(res, dict) and "error" in res:
-            lines.append(f"{short:14s} FAILED: {res['error']}")
+            lines.append(f"{short:{w}s} FAILED: {res['error']}")
         for row in rows:
             v = row.get("value")
             unit = row.get("unit", "")
@@ -97,7 +98,7 @@ def summary_table(results: dict, previous: dict | None) -> str:
                 else (("≥ " if row.get("better") == "higher" else "≤ ") + f"{row['target']:g}")
             )
             lines.append(
-                f"{short:14s} {row['metric'][:52]:52s} {val:>11s} {tgt:>9s} "
+                f"{short:{w}s} {row['metric'][:52]:52s} {val:>11s} {tgt:>9s} "
                 f"{_ok(row):6s} {_change(row, prev_rows.get((name, row['metric'])))}"
             )
     return "\n".join(lines)
@@ -118,12 +119,19 @@ def status_table(results: dict) -> str:
 
 
 def load(path: Path):
-    """The benchmark module at ``path`` (its folder on ``sys.path``, for ``_timing``)."""
+    """The benchmark module at ``path``, under its own name in ``sys.modules`` and with its
+    folder on ``sys.path`` (for ``_timing``), so that a function of it sent to a process
+    pool pickles by name (bench_diagnosis_robustness's did not: "it's not the same object")."""
     if str(path.parent) not in sys.path:
         sys.path.insert(0, str(path.parent))
     spec = importlib.util.spec_from_file_location(path.stem, path)
     mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    sys.modules[path.stem] = mod
+    try:
+        spec.loader.exec_module(mod)
+    except BaseException:
+        sys.modules.pop(path.stem, None)
+        raise
     return mod
 
 
