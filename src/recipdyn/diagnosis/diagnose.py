@@ -210,7 +210,10 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     diag = _load(model)
     x = np.asarray(x, float)
     if tacho is not None:
-        edges = tacho_times(np.asarray(tacho, float), fs)
+        try:  # a channel that is no pulse train is refused with the tacho's reason
+            edges = tacho_times(np.asarray(tacho, float), fs)
+        except ValueError as exc:
+            raise ParameterError(str(exc)) from None
         if edges.size < 3:
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
