@@ -191,8 +191,9 @@ def test_tacho_edges_over_a_grid_of_widths_polarities_noise_jitter_and_speeds():
     mark (a step's crossing is interpolated between the two samples around it; noise below
     the trigger's 7.5 standard deviations never moves it to another sample). Up to 120 degrees
     the pulse is found as the minority level (polarity "auto"); wider, a record of a few
-    revolutions may hold more pulse than baseline, so the polarity is given. 2 speeds x 7 widths x 2 polarities x 3
-    noises x 2 jitters, fewer where a pulse would span under two samples."""
+    revolutions may hold more pulse than baseline, so the polarity is given. 2 speeds x 7
+    widths x 2 polarities x 3 noises x 2 jitters, fewer where a pulse would span under two
+    samples."""
     fs = 10_000.0
     failures, cases = [], 0
     for speed in (2.0, 30.0):

@@ -343,8 +343,9 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
 
 
 def _trained_snr(spec: dict[str, Any]) -> str:
-    r = spec.get("snr_range")
-    return f"{spec['snr_db']:g}" if r is None else f"{r[0]:g}..{r[1]:g}"
+    from .dataset import snr_text
+
+    return snr_text(spec).split(" ")[0]
 
 
 def _db(share: float) -> float:
