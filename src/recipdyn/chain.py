@@ -99,7 +99,8 @@ class Span:
         )
 
     def text(self) -> str:
-        r = f"{self.lo:g} .. {self.hi:g} {self.unit}".strip()
+        unit = "" if self.unit == "1" else self.unit
+        r = f"{self.lo:g} .. {self.hi:g} {unit}".strip()
         r += " (log-uniform)" if self.log else ""
         r += f"; absent with p = {self.p_none:g}" if self.p_none else ""
         return r + ("; one draw per chamber" if self.per_source else "")
@@ -121,7 +122,9 @@ class Choice:
         return value in self.values
 
     def text(self) -> str:
-        return " | ".join(map(str, self.values)) + (f" {self.unit}" if self.unit else "")
+        return ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in self.values) + (
+            f" {self.unit}" if self.unit else ""
+        )
 
 
 def _s(lo, hi, unit, meaning, source, **kw) -> Span:
@@ -140,7 +143,8 @@ DEFAULT_RANGES: Mapping[str, Span | Choice] = MappingProxyType({
         2500.0, 6000.0, "Hz", "dominant resonance of the path crosshead -> guide -> sensor "
         "(mounting and guide structure)", "serridge1987, endaq, prognost2025; "
         + _JUDGEMENT + ": the structure between crosshead and sensor is not modelled, so this "
-        "one resonance stands for mount and guide together, inside the record's band",
+        "one resonance stands for mount and guide together, in or near the record's band "
+        "(above its Nyquist frequency only the flank shows)",
         log=True),
     "accelerometer.damping": _s(0.02, 0.15, "1", "damping ratio of that resonance (Q 3 to 25)",
                                 "serridge1987 (lightly damped mounted resonances); issue42 "
