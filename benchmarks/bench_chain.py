@@ -119,13 +119,14 @@ def _shipped(args) -> list[dict]:
     spec = DatasetSpec.from_dict(diag.card["spec"])  # fixed: as it was built
     test = [t for t in design(spec) if t["split"] == "test"]
     conds = sorted({t["condition"] for t in test})[: args.conditions]
-    tasks = [t for t in test if t["condition"] in conds and t["level"] == 0
+    tasks = [t for t in test if t["condition"] in conds and t["level"] < args.per_class
              and (t["label"] == "healthy" or t["severity"] >= 0.5)]  # fmt: skip
     drawn_spec = DatasetSpec.from_dict({**diag.card["spec"], "chain": "drawn"})
     cache = Path(args.cache)
     cache.mkdir(parents=True, exist_ok=True)
     tally: dict[str, dict[str, int]] = {}
     wrong_rows = []
+    reasons: dict[str, dict[str, int]] = {}
     t_start = time.perf_counter()
     for t in tasks:
         t = dict(t, revolutions=args.revolutions)
@@ -155,6 +156,9 @@ def _shipped(args) -> list[dict]:
             c["n"] += 1
             if refused:
                 c["refused"] += 1
+                why = str(res.reason).split(";")[0].split("(")[0][:70]
+                reasons.setdefault(kind, {}).setdefault(why, 0)
+                reasons[kind][why] += 1
             elif label == t["label"]:
                 c["right"] += 1
             elif p >= 0.5:
@@ -177,6 +181,10 @@ def _shipped(args) -> list[dict]:
         out.append({"metric": f"shipped diagnoser, {kind} chain: wrong at p >= 0.5",
                     "value": c["wrong_hi"] / n, "unit": "1", "target": 0.01,
                     "better": "lower"})  # fmt: skip
+    for kind, rs in reasons.items():
+        print(f"\nrefusals, {kind} chain:")
+        for why, k in sorted(rs.items(), key=lambda x: -x[1]):
+            print(f"  {k} x {why}")
     if wrong_rows:
         print("\nconfidently wrong through drawn chains (truth -> answer, p; chain extremes):")
         for truth, label, p, ch in wrong_rows[:40]:
@@ -198,6 +206,7 @@ def main(argv=None) -> dict:
     ap.add_argument("--draws-cost", type=int, default=20)
     ap.add_argument("--conditions", type=int, default=2)
     ap.add_argument("--chains", type=int, default=3)
+    ap.add_argument("--per-class", type=int, default=1, help="records a class a condition")
     ap.add_argument("--revolutions", type=float, default=4.0)
     ap.add_argument("--model", default=None)
     ap.add_argument("--cache", default="bench-results/chain")

@@ -53,8 +53,9 @@ SOURCES: dict[str, str] = {
     "response of pressure measuring systems', NLR-TR F.238, 1965 (the tube-cavity "
     "resonance of a transducer behind a passage: quarter wave f = c / 4L)",
     "pipitone2007": "E. Pipitone, A. Beccari, S. Beccari, 'The experimental validation of a new "
-    "thermodynamic method for TDC determination', SAE 2007-24-0052 (a 1 degree error of the "
-    "dead-centre reference gives up to 10 % error in indicated mean pressure)",
+    "thermodynamic method for TDC determination', SAE technical paper (no. 2007-24-0052), "
+    "2007 (a 1 degree error of the dead-centre reference gives up to 10 % error in indicated "
+    "mean pressure)",
     "ni9234": "National Instruments, NI USB-9234 User Guide and Specifications: a delta-sigma "
     "acquisition module whose digital anti-alias filter is linear-phase with a passband to "
     "~0.45 fs and a group delay of many samples; IEPE inputs AC-coupled",
