@@ -905,3 +905,34 @@ def test_cli_dataset_refuses_a_fixed_snr_with_the_drawn_chain(capsys):
     assert main(["dataset", "--chain", "fixd", "-o", "unused-folder"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "--snr-range" in err[0] and "chain = 'fixd'" in err[1]
+
+
+def test_a_default_sensed_record_is_not_another_snr_for_a_default_data_sets_diagnoser(trained):
+    """Issue 44: `recipdyn dataset` drew at 20 dB while `recipdyn sense` recorded at 40 dB, so a
+    diagnoser of a default data set refused every default-sensed record as another SNR (the same
+    small data set with the fixed 20 dB chain refuses this record so, measured). Now the data
+    set draws its chains (SNR 10-40 dB) and sense records at 30 dB: the small data set's
+    diagnoser reads a new record (6 revolutions, other noise) of one of its training
+    conditions -- inside its speed range, which three conditions span narrowly -- sensed
+    through `SENSE_DEFAULT`, past the speed, sampling-rate and noise-floor gates, with its
+    noise floor inside the training range (FLOOR_SLACK 1.5)."""
+    from recipdyn import sensors
+    from recipdyn.chain import SENSE_DEFAULT
+    from recipdyn.diagnosis.dataset import simulate_record
+    from recipdyn.diagnosis.diagnose import diagnose_arrays
+
+    diag, _ = trained
+    task = next(t for t in design(SMALL) if t["split"] == "train" and t["label"] == "healthy")
+    task = {k: v for k, v in task.items() if k != "chain"}  # the exact outputs only
+    task["revolutions"] = 6.0
+    ds = simulate_record(task)
+    rec = sensors.record(ds, chain=SENSE_DEFAULT, seed=1)
+    res = diagnose_arrays(rec["accel_guide"].values, task["fs"], tacho=rec["tacho"].values,
+                          p_head=rec["p_head_sensor"].values,
+                          p_crank=rec["p_crank_sensor"].values, model=diag)  # fmt: skip
+    gates = ("crank speed", "sampling rate", "noise floor")
+    assert not (res.refused and any(g in res.reason for g in gates)), res.reason
+    if not res.refused:
+        q, (lo, hi) = res.evidence["noise_floor"]["share"], res.evidence["noise_floor"][
+            "training_range"]  # fmt: skip
+        assert lo / 1.5 <= q <= hi * 1.5
