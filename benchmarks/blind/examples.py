@@ -130,6 +130,13 @@ def examples() -> list[RecordSpec]:
         "0.346 mm, 90 % interval 0.298-0.401 mm", seed=60, **sense)  # fmt: skip
     add("E5.2", "0.5 mm crank pin, `recipdyn sense` defaults, accel + tacho", ph, "0.517 mm",
         seed=60, channels="accel+tacho", **sense)  # fmt: skip
+    # the same from a 10-revolution run at 10 kHz (`recipdyn simulate`'s default length and rate)
+    ph = class_physics(NOMINAL, "crank_pin_clearance", s05, revolutions=10.0, fs=10_000.0)
+    sense10 = dict(sense, fs=10_000.0)
+    add("E5.3", "0.5 mm crank pin, 10 revolutions at 10 kHz, `sense` defaults, all channels",
+        ph, "0.346 mm, 90 % interval 0.298-0.401 mm", seed=60, **sense10)  # fmt: skip
+    add("E5.4", "0.5 mm crank pin, 10 revolutions at 10 kHz, `sense` defaults, accel + tacho",
+        ph, "0.517 mm", seed=60, channels="accel+tacho", **sense10)  # fmt: skip
     # 6. no pressure channel
     add("E6.1", "healthy, accel + --speed only", healthy, "crosshead_guide_clearance p 0.88",
         seed=5, channels="accel+speed", **_own())  # fmt: skip

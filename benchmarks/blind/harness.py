@@ -151,6 +151,9 @@ def diagnose_channels(ch: dict, channels: str, model) -> dict:
             p=float(res.probabilities[res.label]),
             severity=float(res.severity),
             interval=[float(v) for v in res.severity_interval],
+            value=float(res.value),
+            value_interval=[float(v) for v in res.value_interval],
+            unit=res.unit,
             ood=dict(res.ood),
         )
     return ans

@@ -46,8 +46,11 @@ def examples_markdown(result: dict, before: dict | None) -> str:
         b = prev.get(r["id"])
         bcol = (f"{H.answer_text(b)} | " if b else "– | ") if before else ""
         fam = r["family"].removeprefix("issue: ")
-        L.append(f"| {r['id']} | {fam} | {truth} | {bcol}{H.answer_text(r)} | {r['outcome']} | "
-                 f"{r['note']} |")  # fmt: skip
+        ans = H.answer_text(r)
+        if r.get("unit") and r["label"] != "healthy":
+            lo, hi = sorted(r["value_interval"])
+            ans += f" = {r['value']:.3g} ({lo:.3g}..{hi:.3g}) {r['unit']}"
+        L.append(f"| {r['id']} | {fam} | {truth} | {bcol}{ans} | {r['outcome']} | {r['note']} |")
     return "\n".join(L)
 
 

@@ -47,10 +47,13 @@ class Physics:
     revolutions: float = 4.0
     transient: float = 1.0
     note: str = ""
+    fs: float = C.FS_PHYS  # sampling rate of the physics (recipdyn's own chain samples at it)
 
     @property
     def key(self) -> str:
         text = repr((self.source, self.params, self.revolutions, self.transient))
+        if self.fs != C.FS_PHYS:
+            text += repr(self.fs)
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def p(self) -> dict:
@@ -141,14 +144,14 @@ def _negative(p: dict, revolutions: float, fs: float) -> dict:
 def _compute(spec: Physics) -> dict:
     p = spec.p()
     if spec.source in ("recipdyn", "machine"):
-        return recipdyn_physics(p, spec.revolutions, spec.transient, C.FS_PHYS)
+        return recipdyn_physics(p, spec.revolutions, spec.transient, spec.fs)
     if spec.source == "other-model":
         from .other_model import Machine, simulate_other
 
         return simulate_other(Machine(**p), revolutions=spec.revolutions,
                               transient=spec.transient, fs=C.FS_PHYS)  # fmt: skip
     if spec.source == "negative":
-        return _negative(p, spec.revolutions, C.FS_PHYS)
+        return _negative(p, spec.revolutions, spec.fs)
     raise ValueError(f"source {spec.source!r}")
 
 
@@ -196,8 +199,8 @@ def _items(d: dict) -> tuple:
 
 
 def class_physics(cond: dict, name: str, severity: float, *, extra: dict | None = None,
-                  revolutions: float = 4.0, source: str = "recipdyn",
-                  note: str = "") -> Physics:  # fmt: skip
+                  revolutions: float = 4.0, source: str = "recipdyn", note: str = "",
+                  fs: float = C.FS_PHYS) -> Physics:  # fmt: skip
     """recipdyn's model at ``cond`` with class ``name`` at ``severity`` (and ``extra``
     parameters: another machine)."""
     from recipdyn.diagnosis.classes import BASELINE, get_class
@@ -208,7 +211,7 @@ def class_physics(cond: dict, name: str, severity: float, *, extra: dict | None 
     p.update(fc.overrides(severity))
     p.update(extra or {})
     return Physics(source, _items(p), name, severity if fc.parameter else None,
-                   revolutions=revolutions, note=note)  # fmt: skip
+                   revolutions=revolutions, note=note, fs=fs)  # fmt: skip
 
 
 def own(cond: dict) -> tuple:
@@ -339,6 +342,11 @@ def installation_errors(rng) -> dict[str, tuple[C.Chain, tuple]]:
     }
 
 
+#: The tacho's pulse settings (the neutral values keep the data set's pulse).
+TACHO_PULSE = ("mark_deg", "width_deg", "polarity", "baseline_v", "amplitude_v", "rise_s",
+               "jitter_deg", "noise_v")  # fmt: skip
+
+
 def blind_set(seed: int = 20240, *, quick: bool = False, severity_range=(0.5, 1.0)) -> list:
     """The blind set's records (`RecordSpec`), all drawn from ``seed``. ``quick``: one
     operating condition and a reduced set of each family (the benchmark's quick mode)."""
@@ -385,6 +393,9 @@ def blind_set(seed: int = 20240, *, quick: bool = False, severity_range=(0.5, 1.
     for _, ph in phys:
         for _ in range(n_all):
             add("A3 all effects drawn", ph, "chain", chain=C.draw_chain(rng))
+        ch = C.draw_chain(rng)  # all effects but the tacho's: what the rest does to an answer
+        ch = C.with_(ch, tacho={f: getattr(C.NEUTRAL.tacho, f) for f in TACHO_PULSE})
+        add("A3t all effects drawn but the tacho's", ph, "chain", chain=ch)
         add("A4 all effects drawn, accel + tacho", ph, "chain-reduced",
             chain=C.draw_chain(rng), channels="accel+tacho")  # fmt: skip
         add("A5 all effects drawn, accel + speed", ph, "chain-reduced",
