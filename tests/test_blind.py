@@ -206,7 +206,7 @@ def test_a_worn_crank_pin_through_the_data_sets_own_chain_is_named():
     operating point, through recipdyn's own chain at the middle of the data set's ranges,
     all channels: an in-domain record whose fault stands out by orders of magnitude
     (docs/diagnosis.md, separability); the harness must read the answer as right."""
-    ph = class_physics(NOMINAL, "crank_pin_clearance", 1.0, revolutions=3.0)
+    ph = class_physics(NOMINAL, "crank_pin_clearance", 1.0, revolutions=4.0)
     rec = RecordSpec(id="pin", family="A0", physics=ph, own=(("resonance_hz", 3750.0),
                      ("snr_db", 25.0)), group="control", seed=2)  # fmt: skip
     out = H.run_records([rec], say=lambda m: None)
