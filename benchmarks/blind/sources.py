@@ -26,7 +26,7 @@ from __future__ import annotations
 import hashlib
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -76,7 +76,6 @@ class RecordSpec:
     edits: tuple = ()  # applied to the channels after the chain (blind.edits)
     note: str = ""
     group: str = ""  # target group (blind.harness.TARGETS)
-    extra: dict = field(default_factory=dict, compare=False)
 
 
 # ------------------------------------------------------------------------------ physics
