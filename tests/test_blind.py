@@ -188,20 +188,27 @@ def test_the_second_model_moves_as_the_slider_crank_with_a_tight_pin():
 # ---------------------------------------------------- two records through the harness
 
 
-def test_a_record_of_no_compressor_at_1000_rpm_is_refused():
+@pytest.fixture(scope="module")
+def shipped():
+    from recipdyn.diagnosis import default_model_path, load
+
+    return load(default_model_path())
+
+
+def test_a_record_of_no_compressor_at_1000_rpm_is_refused(shipped):
     """White noise with a tacho at 1000 rpm, far outside any training speed range: whatever
     the diagnoser, it must withhold an answer, and the harness must read that as refused."""
     ph = Physics("negative", (("kind", "white"), ("rpm", 1000.0), ("seed", 1)), None, None,
                  revolutions=6.0)  # fmt: skip
     rec = RecordSpec(id="neg", family="D", physics=ph, chain=C.NEUTRAL, group="negative",
                      expect="refuse", seed=1)  # fmt: skip
-    out = H.run_records([rec], say=lambda m: None)
+    out = H.run_records([rec], model=shipped, say=lambda m: None)
     row = out["records"][0]
     assert row["outcome"] == "refused", row
     assert row["reason"]
 
 
-def test_a_worn_crank_pin_through_the_data_sets_own_chain_is_named():
+def test_a_worn_crank_pin_through_the_data_sets_own_chain_is_named(shipped):
     """The most severe worn crank pin (1 mm) of the data set's physics at its nominal
     operating point, through recipdyn's own chain at the middle of the data set's ranges,
     all channels: an in-domain record whose fault stands out by orders of magnitude
@@ -209,7 +216,7 @@ def test_a_worn_crank_pin_through_the_data_sets_own_chain_is_named():
     ph = class_physics(NOMINAL, "crank_pin_clearance", 1.0, revolutions=4.0)
     rec = RecordSpec(id="pin", family="A0", physics=ph, own=(("resonance_hz", 3750.0),
                      ("snr_db", 25.0)), group="control", seed=2)  # fmt: skip
-    out = H.run_records([rec], say=lambda m: None)
+    out = H.run_records([rec], model=shipped, say=lambda m: None)
     row = out["records"][0]
     assert row["outcome"] == "right", row
     assert row["truth"] == "crank_pin_clearance" and row["severity_true"] == 1.0

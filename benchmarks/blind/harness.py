@@ -191,13 +191,17 @@ def model_identity(model) -> dict:
 
 def run_records(records: list[RecordSpec], *, model=None, cache=None, workers: int = 1,
                 say=print) -> dict:  # fmt: skip
-    """Diagnose every record; returns ``{"records": [...], "timing": {...}}``."""
+    """Diagnose every record with ``model`` (a diagnoser file, a loaded diagnoser, or None:
+    the shipped one); returns ``{"records": [...], "timing": {...}}``."""
     from recipdyn.diagnosis import default_model_path, load
 
     t_all = time.perf_counter()
     phys, t_phys = _physics_all([r.physics for r in records], cache, workers, say)
     t0 = time.perf_counter()
-    diag = load(default_model_path() if model is None else model)
+    if hasattr(model, "predict_proba"):  # a diagnoser already loaded
+        diag = model
+    else:
+        diag = load(default_model_path() if model is None else model)
     t_load = time.perf_counter() - t0
     rows = []
     t_chain = t_diag = 0.0
