@@ -25,7 +25,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from .defaults import SIMULATION
-from .model.parameters import SCHEMA, CompressorParams, ParameterError, resolve_name
+from .model.parameters import (
+    PIN_SPELLINGS,
+    SCHEMA,
+    CompressorParams,
+    ParameterError,
+    resolve_name,
+)
 from .units import to_si
 
 if TYPE_CHECKING:
@@ -173,6 +179,9 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
     schema = model.schema_for(values)
     out: dict[str, Any] = {}
     for k, v in values.items():
+        if k in PIN_SPELLINGS and k not in schema.names:  # (the compressor's pins, spelt
+            out[k] = str(v)  # the older way: the model reads them into its selectors)
+            continue
         if k in ("load_table", "pressure_table") and k not in schema.names:
             # a table (rows) or its file beside the schema: the model's parameters() reads it
             # or refuses it

@@ -46,6 +46,7 @@ __all__ = [
     "SCHEMA",
     "SELECTORS",
     "configures",
+    "pin_joints",
 ]
 
 
@@ -188,6 +189,52 @@ SELECTORS = Schema((
 #: The contact joints' older way to name the pins (``clearance_joints``: where, ``joint``: dry
 #: or lubricated), which the selectors read too.
 PIN_SPELLINGS = ("clearance_joints", "joint")
+#: The older spelling's ``clearance_joints``: which pins (crank, crosshead) have clearance.
+_WHERE = {"crank": (True, False), "crosshead": (False, True), "both": (True, True),
+          "ideal": (False, False)}  # fmt: skip
+
+
+def pin_joints(values: Mapping[str, Any]) -> tuple[str | None, str | None]:
+    """The joints at the crank pin and at the crosshead pin that ``values`` (names, raw or
+    validated) ask for, None for a pin they say nothing of: ``crank_joint`` and
+    ``crosshead_joint`` where given, else the older spelling's where it is given
+    (``clearance_joints``: where the clearance is, default the crank pin; ``joint``: 'dry'
+    contact or 'lubricated' at those pins; the other pins ideal).
+
+    Where the two spellings contradict each other (``clearance_joints = 'crosshead'`` with
+    ``crank_joint = 'contact'``, or ``joint = 'lubricated'`` where no pin is lubricated), one
+    of the user's values would not be run as asked: [`ParameterError`][recipdyn.errors.
+    ParameterError] names both."""
+    crank, cross = values.get("crank_joint"), values.get("crosshead_joint")
+    where, joint = values.get("clearance_joints"), values.get("joint")
+    if where is None and joint is None:
+        return crank, cross
+    if where is not None and where not in _WHERE:
+        raise ParameterError(f"clearance_joints = {where!r}; allowed: {', '.join(_WHERE)}")
+    if joint is not None and joint not in ("dry", "lubricated"):
+        raise ParameterError(f"joint = {joint!r}; allowed: dry, lubricated")
+    kind = "lubricated" if joint == "lubricated" else "contact"
+    has = _WHERE[where or "crank"]
+    spelled = tuple(kind if h else "ideal" for h in has)
+    pins = []
+    for name, given, old, h in zip(("crank_joint", "crosshead_joint"), (crank, cross),
+                                   spelled, has, strict=True):  # fmt: skip
+        if given is not None and where is not None and (given != "ideal") != h:
+            pin = name.split("_")[0]
+            raise ParameterError(
+                f"{name} = {given!r} and clearance_joints = {where!r} contradict each other: "
+                f"clearance_joints = {where!r} makes the {pin} pin "
+                f"{'a clearance joint' if h else 'ideal'}; give one of them (crank_joint and "
+                "crosshead_joint name each pin)"
+            )
+        pins.append(old if given is None else given)
+    if joint == "lubricated" and "lubricated" not in pins:
+        raise ParameterError(
+            f"joint = 'lubricated' acts on no pin here (crank_joint = {pins[0]!r}, "
+            f"crosshead_joint = {pins[1]!r}): set crank_joint or crosshead_joint = "
+            "'lubricated' instead"
+        )
+    return pins[0], pins[1]
 
 
 def configures(values: Mapping[str, Any]) -> bool:
