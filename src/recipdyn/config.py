@@ -32,6 +32,7 @@ from .model.parameters import (
     ParameterError,
     resolve_name,
 )
+from .model.protocol import Derived
 from .units import to_si
 
 if TYPE_CHECKING:
@@ -224,6 +225,8 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any], *,
         comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
         if v is None:
             lines.append(f"# {p.name} = (derived by the model){comment}")
+        elif isinstance(v, Derived):  # (commented: it follows what it derives from)
+            lines.append(f"# {p.name} = {_toml_value(v)} (derived: {p.derive}){comment}")
         else:
             lines.append(f"{p.name} = {_toml_value(v)}{comment}")
     for name in model.schema.extras:  # values without a schema row: a table as rows

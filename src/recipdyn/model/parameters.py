@@ -30,7 +30,7 @@ from ..errors import ParameterError
 from .components.contract import resolve_component
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .gases import GASES
-from .protocol import Param, Schema
+from .protocol import Derived, Param, Schema, derive_value
 from .registry import is_spec
 
 __all__ = [
@@ -86,12 +86,12 @@ _INF = math.inf
 #: `CompressorParams.__post_init__`.
 SCHEMA = Schema((
     Param("r", "m", 0.12, "crank radius A-B (paper)", 0.0, _INF, True, True, group="mechanism"),
-    Param("rs", "m", 0.06, "main bearing to crank centroid (mid-length)", 0.0, _INF,
-          high_ref="r", group="mechanism"),
+    Param("rs", "m", 0.06, "main bearing to crank centroid (default: mid-length, r / 2)",
+          0.0, _INF, high_ref="r", group="mechanism", derive="r / 2"),
     Param("l", "m", 0.6, "connecting-rod length (paper)", 0.0, _INF, True, True,
           group="mechanism"),
-    Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (mid-length)", 0.0, _INF,
-          high_ref="l", group="mechanism"),
+    Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (default: mid-length, "
+          "l / 2)", 0.0, _INF, high_ref="l", group="mechanism", derive="l / 2"),
     Param("m1", "kg", 15.0, "crank mass", 0.0, _INF, high_open=True, assumed=ASSUMED["m1"],
           group="mechanism"),
     Param("m2", "kg", 20.0, "connecting-rod mass", 0.0, _INF, high_open=True,
@@ -100,8 +100,9 @@ SCHEMA = Schema((
           assumed=ASSUMED["m3"], group="mechanism"),
     Param("J1", "kg*m**2", 0.0012, "crank moment of inertia about its centroid", 0.0, _INF,
           high_open=True, assumed=ASSUMED["J1"], group="mechanism"),
-    Param("J2", "kg*m**2", 0.6, "rod moment of inertia about its centroid", 0.0, _INF,
-          high_open=True, assumed=ASSUMED["J2"], group="mechanism"),
+    Param("J2", "kg*m**2", 0.6, "rod moment of inertia about its centroid (default: a "
+          "slender uniform rod, m2 l^2 / 12)", 0.0, _INF, high_open=True, assumed=ASSUMED["J2"],
+          group="mechanism", derive="m2 * l**2 / 12"),
     Param("g", "m/s**2", 9.81, "gravitational acceleration (along -y)", 0.0, 100.0,
           group="mechanism"),
     Param("rc", "m", 1.0e-3, "radial clearance of the crank-pin joint (massless link length); "
@@ -342,14 +343,14 @@ class CompressorParams:
     """
 
     r: float = 0.12
-    rs: float = 0.06
+    rs: float = Derived(0.06)  # (r / 2 unless set: `SCHEMA`'s rules, derived again on replace)
     l: float = 0.6
-    ls: float = 0.3
+    ls: float = Derived(0.3)  # (l / 2)
     m1: float = 15.0
     m2: float = 20.0
     m3: float = 30.0
     J1: float = 0.0012
-    J2: float = 0.6
+    J2: float = Derived(0.6)  # (m2 l^2 / 12)
     g: float = 9.81
     rc: float = 1.0e-3
     d: float = 1.0e-3
@@ -383,10 +384,16 @@ class CompressorParams:
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        rules = [p for p in SCHEMA if p.derive]
         for p in SCHEMA:  # the static ranges, declared once in the schema
             if p.name in PLUGGABLE and is_spec(getattr(self, p.name)):
                 continue  # a component from a user's file (checked when it is loaded)
-            p.check(getattr(self, p.name))
+            if p not in rules or not isinstance(getattr(self, p.name), Derived):
+                p.check(getattr(self, p.name))
+        for p in rules:  # a default derived from the values it follows (unless set)
+            if isinstance(getattr(self, p.name), Derived) or getattr(self, p.name) is None:
+                object.__setattr__(self, p.name, derive_value(p, {
+                    k: getattr(self, k) for k in SCHEMA.names if k not in PLUGGABLE}))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
         _check("rc", self.rc, 0.0, self.r, hi_open=True)
@@ -397,6 +404,7 @@ class CompressorParams:
                 "needs millions of steps per revolution)"
             )
         # |d + r sin(theta1) + rc sin(theta_c)| < l must hold for every crank and link angle.
+        check_reach(self.l, self.r, self.rc, "rc")
         dmax = self.l - self.r - self.rc
         _check("d", self.d, -dmax, dmax, lo_open=True, hi_open=True)
         if self.m2 + self.m3 + self.J2 <= 0 and self.rc > 0:
@@ -459,6 +467,17 @@ class CompressorParams:
         for k, why in ASSUMED.items():
             out[f"{k}_note"] = why
         return out
+
+
+def check_reach(l: float, r: float, rc: float, rc_text: str) -> None:
+    """Refuse a connecting rod that cannot reach past the crank: the slider-crank exists for
+    ``l > r + rc`` (``rc_text``: what the clearance term is, e.g. ``"1.5 (rc + rc_crosshead)"``),
+    named by the lengths the user gives, not by a parameter whose range they make empty."""
+    if not l > r + rc:
+        raise ParameterError(
+            f"l = {l:g} m and r = {r:g} m: the connecting rod must be longer than the crank "
+            f"radius plus the clearance, l > r + {rc_text} = {r + rc:g} m"
+        )
 
 
 def _validate_table(table) -> None:

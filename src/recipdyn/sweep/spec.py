@@ -22,7 +22,7 @@ import numpy as np
 
 from ..defaults import SWEEP
 from ..errors import ParameterError, is_number
-from ..model.protocol import Model
+from ..model.protocol import Derived, Model, rule_inputs
 from ..model.registry import DEFAULT_MODEL, get_model
 from ..units import to_si
 
@@ -200,9 +200,20 @@ class SweepSpec:
                  continuation=self.continuation,
                  # (the default model is not named: the digests of stores made before
                  # sweeps took other models stay the same)
-                 **({} if self.model == DEFAULT_MODEL else {"model": self.model})),
+                 **({} if self.model == DEFAULT_MODEL else {"model": self.model}),
+                 **self._followers()),
             sort_keys=True, default=str,
         )  # fmt: skip
+
+    def _followers(self) -> dict[str, list[str]]:
+        """The base's derived values that follow a swept parameter (``ls = l / 2`` in a
+        sweep of ``l``), by their rules: part of the spec (a store made when they did not
+        follow differs; other specs keep their digests)."""
+        swept = {a.name for a in self.axes}
+        rules = sorted(f"{p.name} = {p.derive}" for p in self.get_model().schema_for(self.base)
+                       if p.derive and isinstance(self.base.get(p.name), Derived)
+                       and swept & set(rule_inputs(p.derive)))  # fmt: skip
+        return {"derived": rules} if rules else {}
 
     @property
     def digest(self) -> str:

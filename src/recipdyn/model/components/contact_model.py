@@ -42,6 +42,7 @@ from ..joints.pins import (
 )
 from ..load import CYCLE_PARAMS
 from ..parameters import SCHEMA as LINK_SCHEMA
+from ..parameters import check_reach
 from ..protocol import Model, Param, Schema
 from .guide import GUIDE_PARAMS, GUIDES
 from .load import cycle_outputs, cycle_summary
@@ -666,7 +667,9 @@ class CompressorContact(Model):
         if values["rc"] >= values["r"]:
             raise ParameterError(f"rc = {values['rc']!r} m is out of range; allowed: "
                                  f"(0, r = {values['r']!r}) m")  # fmt: skip
-        dmax = values["l"] - values["r"] - 1.5 * (values["rc"] + values["rc_crosshead"])
+        margin = 1.5 * (values["rc"] + values["rc_crosshead"])
+        check_reach(values["l"], values["r"], margin, "1.5 (rc + rc_crosshead)")
+        dmax = values["l"] - values["r"] - margin
         if not abs(values["d"]) < dmax:
             raise ParameterError(
                 f"d = {values['d']!r} m is out of range; allowed: "
