@@ -144,7 +144,7 @@ def test_process_pool_gives_the_serial_records_to_the_bit(small, tmp_path):
     features as the serial (interrupted and resumed) build."""
     out, *_ = small
     spec = DatasetSpec(
-        n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.5, seed=3
+        n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.25, seed=3
     )
     a = build_dataset(tmp_path / "p", spec, backend="processes", workers=2, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
@@ -611,8 +611,8 @@ def test_cli_refuses_bad_settings_in_one_line(capsys):
 
 def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
     pytest.importorskip("dask.distributed")
-    spec = DatasetSpec(n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"),
-                       test_fraction=0.5, seed=3)  # fmt: skip
+    spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"),
+                       test_fraction=0.25, seed=3)  # fmt: skip
     a = build_dataset(tmp_path / "d", spec, backend="dask", dask_local=1, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
     assert read_features(a)[0].equals(read_features(b)[0])
@@ -837,3 +837,73 @@ def test_a_diagnoser_with_a_baseline_reads_the_deviations_and_saves_them(
     assert np.array_equal(back.predict_proba(X), diag.predict_proba(X))
     c = diag.classes[1]
     assert np.array_equal(back.severity(X, c)[0], diag.severity(X, c)[0])
+
+
+# ---- data sets too small or unfinished (issue 44, item 3) -----------------------------------
+
+
+def test_a_data_set_too_small_to_train_on_is_refused_when_asked_for(tmp_path, capsys):
+    """``dataset --conditions 2``: one training condition, which `train` cannot both fit and
+    calibrate on (its split-conformal intervals and out-of-distribution threshold come from
+    conditions the fit has not seen; it crashed with a TypeError). Refused at once, with the
+    minimum for the test fraction; the minimum itself is accepted."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.dataset import min_conditions
+
+    with pytest.raises(ParameterError, match=r"n_conditions = 2 .*leaves 1 training condition"
+                                             r".*allowed: n_conditions >= 3"):  # fmt: skip
+        DatasetSpec(n_conditions=2, classes=("healthy", "crank_pin_clearance"))
+    out = tmp_path / "ds2"
+    assert main(["dataset", "-o", str(out), "--conditions", "2", "--classes",
+                 "healthy,crank_pin_clearance", "--backend", "serial"]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "n_conditions >= 3" in err[0] and not out.exists()
+    assert DatasetSpec(n_conditions=3).n_conditions == 3
+    assert (min_conditions(0.25), min_conditions(0.5), min_conditions(0.75)) == (3, 4, 6)
+
+
+def _table_only_data_set(folder, conditions, splits):
+    """A data set folder holding only a feature table and a data card (what `train` reads
+    before it fits anything)."""
+    import json
+
+    import pandas as pd
+
+    folder.mkdir()
+    rows = [dict(record=i, condition=c, split=s, label=lab, level=0, severity=0.5, f_x=1.0)
+            for i, (c, s, lab) in enumerate((c, s, lab) for c, s in zip(conditions, splits)
+                                            for lab in ("healthy", "ring_leak"))]  # fmt: skip
+    pd.DataFrame(rows).to_parquet(folder / "features.parquet")
+    spec = {"classes": ["healthy", "ring_leak"]}
+    (folder / "datacard.json").write_text(json.dumps({"spec": spec}))
+    return folder
+
+
+def test_train_refuses_a_data_set_with_one_training_condition(tmp_path, capsys):
+    """A data set of two conditions made before the refusal (one train, one test)."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.train import train
+
+    folder = _table_only_data_set(tmp_path / "old", (0, 1), ("train", "test"))
+    with pytest.raises(ParameterError, match=r"1 training condition\(s\); a diagnoser trains "
+                                             r"on 2 at least .* 3 conditions or more"):  # fmt: skip
+        train(folder)
+    assert main(["train", str(folder), "-o", str(tmp_path / "x.skops")]) == 2
+    assert "internal error" not in capsys.readouterr().err
+    assert not (tmp_path / "x.skops").exists()
+
+
+def test_train_on_a_missing_or_unfinished_data_set_says_so(tmp_path):
+    import zarr
+
+    from recipdyn.diagnosis.train import train
+
+    with pytest.raises(ParameterError, match="no such folder"):
+        train(tmp_path / "nowhere")
+    folder = tmp_path / "interrupted"
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="w")
+    g.create_array("done", shape=(6,), chunks=(1,), dtype=bool, fill_value=False)
+    g["done"][:2] = True
+    with pytest.raises(ParameterError, match=r"unfinished data set \(2 of 6 records\): "
+                                             r"finish it with .*--resume"):  # fmt: skip
+        train(folder)

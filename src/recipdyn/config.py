@@ -128,6 +128,8 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
                 kw[name] = read_load_table(v)
         elif _optional(name) and (v is None or str(v).lower() in ("default", "none")):
             kw[name] = None  # derived by the model (theta_c0, motor_torque)
+        elif isinstance(v, Derived):
+            kw[name] = v  # (a record's derived value, in SI: derived again)
         else:
             kw[name] = to_si(name, v)
     params = dataclasses.replace(base or CompressorParams(), **kw)
@@ -190,7 +192,8 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
             continue
         name = schema.resolve(k)
         p = schema[name]
-        out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
+        out[p.name] = (str(v) if p.choices is not None else v if isinstance(v, Derived)
+                       else to_si(p.name, v, unit=p.unit))  # fmt: skip
     return model.parameters(out)
 
 
