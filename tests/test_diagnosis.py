@@ -600,13 +600,53 @@ def test_shipped_diagnoser_matches_todays_physics():
         assert diag.predict_proba(x)[0] == pytest.approx(pin["proba"], abs=0.05)
 
 
-def test_cli_refuses_bad_settings_in_one_line(capsys):
+def test_cli_refuses_bad_settings_in_one_line(capsys, tmp_path):
     from recipdyn.cli import main
 
+    rec = tmp_path / "r.csv"
+    rec.write_text("time,accel_guide\n0,1\n0.001,2\n")
     assert main(["dataset", "--conditions", "1", "-o", "unused-folder"]) == 2
-    assert main(["diagnose", "missing.csv"]) == 2  # neither --speed nor --tacho
+    assert main(["diagnose", str(rec)]) == 2  # neither --speed nor --tacho
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "n_conditions" in err[0] and "speed and tacho" in err[1]
+
+
+def _simulated_record(path, sensed: bool = False):
+    """A file laid out as ``recipdyn simulate`` writes one: 108 outputs over time and the
+    record's title (with ``sensed``, as ``recipdyn sense`` leaves it)."""
+    import xarray as xr
+
+    t = np.arange(200) / 2000.0
+    ds = xr.Dataset({f"out{i}": ("time", np.sin((i + 1) * t)) for i in range(108)},
+                    coords={"time": t},
+                    attrs={"title": "recipdyn simulation: compressor", "model": "compressor"})  # fmt: skip
+    if sensed:
+        ds.attrs["sensor_channels"] = "out0"
+    ds.to_netcdf(path)
+    return path
+
+
+def test_diagnose_points_at_the_cause_of_a_bad_input(tmp_path, capsys):
+    """Issue 44, item 4: a file that is not there is said first (it was "speed and tacho:
+    give exactly one"); a simulated record without sensor channels says to run `recipdyn
+    sense` (it listed 108 column names); a record already sensed lists what it has, shortly."""
+    from recipdyn.cli import main
+
+    assert main(["diagnose", str(tmp_path / "nonexist.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "file not found" in err and "speed" not in err, err
+    sim = _simulated_record(tmp_path / "sim.nc")
+    for argv in (["diagnose", str(sim), "--speed", "20 rad/s"],
+                 ["analyze", str(sim), "-c", "accel_guide", "-o", str(tmp_path / "an")]):  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"recipdyn sense {sim}" in err, err
+        assert "out57" not in err and len(err) < 400, err
+    sensed = _simulated_record(tmp_path / "sensed.nc", sensed=True)
+    assert main(["diagnose", str(sensed), "--speed", "20 rad/s"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "recipdyn sense" not in err and "(108 variables in all)" in err and len(err) < 400
+    assert not (tmp_path / "an").exists()
 
 
 def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
