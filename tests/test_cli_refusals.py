@@ -195,6 +195,8 @@ def _fresh(args: list[str], tmp_path: Path) -> dict:
         ["compare", "a.nc", "b.nc"],
         ["reproduce", "--jobs", "0"],
         ["sweep", "-p", "rc=1mm,2mm", "--points", "0"],
+        ["sweep", "-p", "rc=1mm:2mm:0"],  # (issue 44, item 9: after numba, xarray, SciPy)
+        ["sweep", "-p", "rc=1mm,2mm", "-o", "x.csv/sweep"],  # an output it cannot make
     ],
     ids=lambda a: " ".join(a),
 )
@@ -206,6 +208,20 @@ def test_refused_before_heavy_imports(tmp_path, args):
     assert res["code"] == 2, res["err"]
     assert res["heavy"] == [], res["heavy"]
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0,
+                    reason="root writes into a read-only folder")  # fmt: skip
+def test_a_sweep_into_a_read_only_folder_is_refused_before_heavy_imports(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        res = _fresh(["sweep", "-p", "rc=1mm,2mm", "-o", "ro/sweep"], tmp_path)
+    finally:
+        ro.chmod(0o755)
+    assert res["code"] == 2 and ("not writable" in res["err"] or "cannot create" in res["err"])
+    assert res["heavy"] == [], res["heavy"]
 
 
 def test_light_lists_match_the_library():
