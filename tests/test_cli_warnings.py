@@ -40,8 +40,9 @@ def test_a_workers_warnings_come_back_to_the_command_once(capfd):
     assert sorted(results) == [0, 1, 4, 9]
     err = capfd.readouterr().err.splitlines()
     assert len(err) == 1, err
-    assert err[0].startswith("warning: the worker's warning, over two lines (UserWarning in "
-                             "tests/test_cli_warnings.py:"), err
+    assert err[0].startswith(
+        "warning: the worker's warning, over two lines (UserWarning in tests/test_cli_warnings.py:"
+    ), err
 
 
 def test_a_workers_warning_is_raised_again_in_the_library():

@@ -617,9 +617,9 @@ def _simulated_record(path, sensed: bool = False):
     import xarray as xr
 
     t = np.arange(200) / 2000.0
+    attrs = {"title": "recipdyn simulation: compressor", "model": "compressor"}
     ds = xr.Dataset({f"out{i}": ("time", np.sin((i + 1) * t)) for i in range(108)},
-                    coords={"time": t},
-                    attrs={"title": "recipdyn simulation: compressor", "model": "compressor"})  # fmt: skip
+                    coords={"time": t}, attrs=attrs)  # fmt: skip
     if sensed:
         ds.attrs["sensor_channels"] = "out0"
     ds.to_netcdf(path)
@@ -636,8 +636,9 @@ def test_diagnose_points_at_the_cause_of_a_bad_input(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "file not found" in err and "speed" not in err, err
     sim = _simulated_record(tmp_path / "sim.nc")
+    an = str(tmp_path / "an")
     for argv in (["diagnose", str(sim), "--speed", "20 rad/s"],
-                 ["analyze", str(sim), "-c", "accel_guide", "-o", str(tmp_path / "an")]):  # fmt: skip
+                 ["analyze", str(sim), "-c", "accel_guide", "-o", an]):  # fmt: skip
         assert main(argv) == 2
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and f"recipdyn sense {sim}" in err, err
@@ -910,9 +911,12 @@ def _table_only_data_set(folder, conditions, splits):
     import pandas as pd
 
     folder.mkdir()
-    rows = [dict(record=i, condition=c, split=s, label=lab, level=0, severity=0.5, f_x=1.0)
-            for i, (c, s, lab) in enumerate((c, s, lab) for c, s in zip(conditions, splits)
-                                            for lab in ("healthy", "ring_leak"))]  # fmt: skip
+    cells = [(c, s, lab) for c, s in zip(conditions, splits, strict=True)
+             for lab in ("healthy", "ring_leak")]  # fmt: skip
+    rows = [
+        dict(record=i, condition=c, split=s, label=lab, level=0, severity=0.5, f_x=1.0)
+        for i, (c, s, lab) in enumerate(cells)
+    ]
     pd.DataFrame(rows).to_parquet(folder / "features.parquet")
     spec = {"classes": ["healthy", "ring_leak"]}
     (folder / "datacard.json").write_text(json.dumps({"spec": spec}))

@@ -351,9 +351,7 @@ def test_sense_refuses_what_is_not_a_simulated_run(tmp_path, capsys):
     from recipdyn.cli import main
 
     foreign, csv = tmp_path / "measured.nc", tmp_path / "measured.csv"
-    xr.Dataset({"a": ("time", np.zeros(8))}, coords={"time": np.arange(8) / 1e3}).to_netcdf(
-        foreign
-    )
+    xr.Dataset({"a": ("time", np.zeros(8))}, coords={"time": np.arange(8) / 1e3}).to_netcdf(foreign)
     csv.write_text("time,a\n0,1\n0.001,2\n")
     for path, words in ((foreign, "not a run of 'recipdyn simulate'"),
                         (csv, "sense reads a run of 'recipdyn simulate' (.nc)")):  # fmt: skip

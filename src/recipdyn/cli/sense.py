@@ -113,8 +113,9 @@ def sense(
     if not run.exists():
         raise ParameterError(f"run file not found: {run}")
     if run.suffix.lower() != ".nc":
-        raise ParameterError(f"input {run}: sense reads a run of 'recipdyn simulate' (.nc); a "
-                             f"measured signal is analysed as it is: recipdyn analyze {run}")  # fmt: skip
+        raise ParameterError(f"input {run}: sense reads a run of 'recipdyn simulate' (.nc); "
+                             "a measured signal is analysed as it is: recipdyn analyze "
+                             f"{run}")  # fmt: skip
     if not (accel or pressure or tacho):
         raise ParameterError("sensors: --no-accel, --no-pressure and --no-tacho leave nothing "
                              "to record; allowed: at least one sensor")  # fmt: skip

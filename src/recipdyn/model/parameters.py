@@ -390,10 +390,10 @@ class CompressorParams:
                 continue  # a component from a user's file (checked when it is loaded)
             if p not in rules or not isinstance(getattr(self, p.name), Derived):
                 p.check(getattr(self, p.name))
+        given = {k: getattr(self, k) for k in SCHEMA.names if k not in PLUGGABLE}
         for p in rules:  # a default derived from the values it follows (unless set)
-            if isinstance(getattr(self, p.name), Derived) or getattr(self, p.name) is None:
-                object.__setattr__(self, p.name, derive_value(p, {
-                    k: getattr(self, k) for k in SCHEMA.names if k not in PLUGGABLE}))
+            if isinstance(given[p.name], Derived) or given[p.name] is None:
+                object.__setattr__(self, p.name, derive_value(p, given))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
         _check("rc", self.rc, 0.0, self.r, hi_open=True)
