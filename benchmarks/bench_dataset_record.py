@@ -149,7 +149,7 @@ def main(argv: list[str] | None = None) -> dict:
     a = ap.parse_args(argv)
     if a.quick:
         a.records = 1
-    spec = DatasetSpec(n_conditions=2, classes=("healthy",) + CLASSES[1:])
+    spec = DatasetSpec(n_conditions=3, classes=("healthy",) + CLASSES[1:])
     tasks = [t for t in design(spec) if t["condition"] == 0 and t["level"] == 3]
     with tempfile.TemporaryDirectory() as tmp:
         g, names = _open_store(Path(tmp) / "s.zarr", spec, design(spec), False, True)
