@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .channels import naming_table
 from .classes import get_class
 from .dataset import CONDITION_COLUMNS, read_features
 from .evidence import feature_groups
@@ -566,7 +567,10 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     state["fingerprints_json"] = json.dumps(
         _fingerprints(train_df, card, names, diag), default=float
     )
-    return diag, evaluate(diag, test_df, train_df, seed=seed)
+    ev = evaluate(diag, test_df, train_df, seed=seed)
+    # what each channel set can name, measured on the held-out conditions (channels.gate)
+    state["naming"] = {k: ev[k]["naming"] for k in AVAILABILITY}
+    return diag, ev
 
 
 def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
@@ -677,6 +681,14 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
                 bins=severity_bins(diag.card),
             ),
         }
+        # which classes this channel set can name (recipdyn.diagnosis.channels)
+        res[subset]["naming"] = naming_table(
+            test_df.label.to_numpy(),
+            np.array(classes)[pred],
+            test_df.severity.to_numpy(),
+            classes,
+            res[subset]["detection"],
+        )
         if subset == "full":
             res["predicted"] = np.array(classes)[pred].tolist()
             res["proba"] = proba.tolist()
