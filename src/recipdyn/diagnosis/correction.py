@@ -71,6 +71,7 @@ __all__ = [
     "ChainReference",
     "ChainCorrection",
     "reference_from",
+    "known_chain",
     "pressure_phase",
     "tacho_revolutions",
     "resonance",
@@ -196,6 +197,49 @@ class ChainReference:
             out.append((float(np.mean(r[f"{name}_{unit}"][i])), spread))
         inside = float(dist[0, -1]) <= REFERENCE_REACH * self.reach.get(chamber, math.inf)
         return out[0][0], out[1][0], out[0][1], out[1][1], inside
+
+
+def _column(row, name: str, k: int, default):
+    """A data set's chain column ``chain.<name>`` (one value, or per chamber ``.<k>``)."""
+    for key in (f"chain.{name}.{k}", f"chain.{name}"):
+        v = row.get(key) if hasattr(row, "get") else None
+        if v is not None and not (isinstance(v, float) and math.isnan(v)):
+            return v
+    return default
+
+
+def _lowpass_delay(fc, order, phase) -> float:
+    """Group delay (s) at low frequency of a causal Butterworth low-pass (0 if zero-phase)."""
+    from scipy.signal import butter, freqs
+
+    if fc is None or phase == "zero" or not fc or not order:
+        return 0.0
+    b, a = butter(int(order), 2 * math.pi * float(fc), analog=True)
+    w = 2 * math.pi * np.array([0.5, 1.5])  # rad/s: the polytropes' own frequencies
+    ph = np.unwrap(np.angle(freqs(b, a, worN=w)[1]))
+    return float(-(ph[1] - ph[0]) / (w[1] - w[0]))
+
+
+def known_chain(row, k: int, speed_hz: float) -> tuple[float, float, float]:
+    """``(phase_deg, offset_pa, gain)`` a data set's drawn chain gives pressure channel
+    ``k`` (0 head, 1 crank) of the record ``row`` (its ``chain.*`` columns: the tacho's
+    mark and delay, the channel's delay, causal low-pass, offset and gain); ``(0, 0, 1)``
+    for a data set of the fixed chain, which has no such columns. The phase is the one
+    `pressure_phase` reads: the mark's crank angle, plus the tacho's delay, less the
+    pressure's delays, as crank angle."""
+    mark = math.degrees(float(_column(row, "tacho.angle", k, 0.0)))
+    t_delay = float(_column(row, "tacho.delay_s", k, 0.0))
+    p_delay = float(_column(row, "pressure.delay_s", k, 0.0)) + _lowpass_delay(
+        _column(row, "pressure.lowpass_hz", k, None),
+        _column(row, "pressure.lowpass_order", k, None),
+        _column(row, "pressure.lowpass_phase", k, "causal"),
+    )
+    phase = mark + 360.0 * speed_hz * (t_delay - p_delay)
+    return (
+        phase,
+        float(_column(row, "pressure.offset", k, 0.0)),
+        float(_column(row, "pressure.gain", k, 1.0)),
+    )
 
 
 def reference_from(fits: list[dict[str, Any]], source: str = "") -> ChainReference:
@@ -535,13 +579,14 @@ def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
 # -- the accelerometer's mounting resonance ------------------------------------------------------
 
 
-def _resonance_fit(f, s, f0, fs):
+def _resonance_fit(f, s, f0, fs, response="analog"):
     """Fit ``log S = log(K f^b |H(f)|^2 |B(f)|^2 + N)`` over the band around ``f0``: ``H`` the
-    mounting resonance as `recipdyn.sensors.resonance_filter` discretises it (the closed
-    form at the bilinear transform's warped frequency), ``B`` a 4th-order Butterworth
-    anti-alias low-pass of free corner (the data set's sits at 0.4 fs, on the flank of a
-    3-4.5 kHz resonance sampled at 10-12.5 kHz), ``K f^b`` the impacts' sloping excitation,
-    ``N`` the white noise floor. Returns ``(fn, log zeta, ...)`` or None."""
+    mounting resonance, a base-excited single degree of freedom (``response="analog"``: a
+    real mount's; ``"bilinear"``: as `recipdyn.sensors.resonance_filter` discretises it, the
+    closed form at the bilinear transform's warped frequency), ``B`` a 4th-order Butterworth
+    anti-alias low-pass of free corner, analog or digital like ``H`` (the data set's sits at
+    0.4 fs, on the flank of a 3-4.5 kHz resonance sampled at 10-12.5 kHz), ``K f^b`` the
+    impacts' sloping excitation, ``N`` the white noise floor. Returns ``(fn, log zeta, ...)`` or None."""
     from scipy.optimize import least_squares
 
     band = (f >= 0.5 * f0) & (f <= min(1.8 * f0, 0.49 * fs))
@@ -549,13 +594,14 @@ def _resonance_fit(f, s, f0, fs):
     if fb.size < 12:
         return None
     tb = np.tan(np.pi * fb / fs)
+    warped = response == "bilinear"
 
     def model(x):
         fn, lz, lk, b, ln, fc = x
         z = math.exp(lz)
-        rr = tb / math.tan(math.pi * fn / fs)  # the warped frequency over fn
+        rr = tb / math.tan(math.pi * fn / fs) if warped else fb / fn
         h2 = 1.0 / ((1 - rr**2) ** 2 + (2 * z * rr) ** 2)
-        lp2 = 1.0 / (1.0 + (tb / math.tan(math.pi * fc / fs)) ** 8)
+        lp2 = 1.0 / (1.0 + ((tb / math.tan(math.pi * fc / fs)) if warped else fb / fc) ** 8)
         return np.logaddexp(lk + b * np.log(fb / f0) + np.log(h2 * lp2), ln)
 
     k0 = float(np.median(sb))
@@ -567,10 +613,13 @@ def _resonance_fit(f, s, f0, fs):
     return sol.x
 
 
-def resonance(x, fs: float, revs=None) -> dict[str, Estimate]:
+def resonance(x, fs: float, revs=None, response: str = "analog") -> dict[str, Estimate]:
     """The accelerometer's mounting resonance: frequency and damping ratio with their 95 %
-    half-widths from the spread of the fit over the record's parts (its revolutions, or four
-    equal parts without a crank angle)."""
+    half-widths, from the spread of the fit (`_resonance_fit`) over the record's parts (its
+    revolutions, or up to eight equal parts without a crank angle) and the fit's own
+    systematic error. ``response``: the resonance's form, ``"analog"`` (a real mount) or
+    ``"bilinear"`` (`recipdyn.sensors.resonance_filter`, whose warped flank makes an analog
+    fit read the damping low near the Nyquist frequency: 0.05 read as 0.014 at 0.4 fs)."""
     from scipy.signal import welch
 
     from .evidence import ringing_hz
@@ -582,7 +631,7 @@ def resonance(x, fs: float, revs=None) -> dict[str, Estimate]:
         return {"resonance_hz": nan, "damping": dataclass_replace(nan, unit="1")}
     nper = min(1024, x.size)
     f, s = welch(x, fs=fs, nperseg=nper)
-    best = _resonance_fit(f, s, f0, fs)
+    best = _resonance_fit(f, s, f0, fs, response)
     if best is None:
         return {"resonance_hz": nan, "damping": dataclass_replace(nan, unit="1")}
     # the spread over parts of the record
@@ -596,7 +645,7 @@ def resonance(x, fs: float, revs=None) -> dict[str, Estimate]:
     fits = []
     for q in parts:
         ff, sq = welch(q, fs=fs, nperseg=nper)
-        b = _resonance_fit(ff, sq, f0, fs)
+        b = _resonance_fit(ff, sq, f0, fs, response)
         if b is not None:
             fits.append((b[0], math.exp(b[1])))
     fn, z = float(best[0]), math.exp(float(best[1]))
@@ -824,10 +873,10 @@ def correct_chain(
             "corrected" if applied else "within its uncertainty: left",
             f"the {ch}-end transducer's offset against the diagnoser's chain",
         )
-        p = np.asarray(p_head if ch == "head" else p_crank, float)
+        p = p_head if ch == "head" else p_crank
         o_used = o if applied else 0.0
         g = gamma if ch == "crank" else 1.0
-        q = (p - o_used) / g
+        q = p if (o_used == 0.0 and g == 1.0) else (np.asarray(p, float) - o_used) / g
         lo, hi = (r["p_lo"] - o_used) / g, (r["p_hi"] - o_used) / g
         if not lo > 0 or not hi > lo:
             out.refused = (

@@ -285,7 +285,10 @@ def _diagnose_arrays(
             return _refuse(res, fix.refused, t0)
         revs, ph, pc = fix.revs, fix.p_head, fix.p_crank
     if correct:
-        chain.update(resonance(x, fs, revs if tacho is not None else None))
+        # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
+        # chain's exact (analog) one
+        form = "bilinear" if diag.card["spec"].get("chain") is None else "analog"
+        chain.update(resonance(x, fs, revs if tacho is not None else None, form))
         res.evidence["chain"] = _chain_summary(chain)
     row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
     names = diag.names
