@@ -586,7 +586,8 @@ def _resonance_fit(f, s, f0, fs, response="analog"):
     closed form at the bilinear transform's warped frequency), ``B`` a 4th-order Butterworth
     anti-alias low-pass of free corner, analog or digital like ``H`` (the data set's sits at
     0.4 fs, on the flank of a 3-4.5 kHz resonance sampled at 10-12.5 kHz), ``K f^b`` the
-    impacts' sloping excitation, ``N`` the white noise floor. Returns ``(fn, log zeta, ...)`` or None."""
+    impacts' sloping excitation, ``N`` the white noise floor. Returns ``(fn, log zeta,
+    ...)`` or None."""
     from scipy.optimize import least_squares
 
     band = (f >= 0.5 * f0) & (f <= min(1.8 * f0, 0.49 * fs))
