@@ -133,7 +133,9 @@ def gate(table: dict[str, Any] | None, subset: str, label: str) -> tuple[bool, s
             facts,
         )
     t = table[subset]
-    e = t["classes"].get(label, {})
+    e = dict(t["classes"].get(label, {}))
+    for k in ("precision", "recall"):  # NaN (no answers, no records) is null in JSON
+        e[k] = math.nan if e.get(k) is None else e[k]
     facts.update(
         measured=True,
         accuracy=t["accuracy"],

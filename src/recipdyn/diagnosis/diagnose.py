@@ -318,6 +318,7 @@ def _diagnose_arrays(
     if floor is not None:
         q, lo, hi = floor
         floor_ev = {"share": q, "training_range": [lo, hi]}
+        res.evidence["noise_floor"] = floor_ev
         if not lo / FLOOR_SLACK <= q <= hi * FLOOR_SLACK:
             return _refuse(
                 res,
@@ -379,8 +380,6 @@ def _diagnose_arrays(
             "deciding": _deciding(diag, X[0]),
         }
     )
-    if floor is not None:
-        res.evidence["noise_floor"] = floor_ev
     j = _closest(diag, X[0], res.label)
     if ph is not None and tacho is not None:
         from .train import curve
