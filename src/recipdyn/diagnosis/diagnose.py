@@ -244,7 +244,7 @@ def _diagnose_arrays(
     x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, correct=True
 ) -> Diagnosis:
     from ..analysis.vibration import crank_angle, tacho_times
-    from .correction import correct_chain, resonance, tacho_revolutions
+    from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
 
     t0 = time.perf_counter()
@@ -278,7 +278,13 @@ def _diagnose_arrays(
     if jitter is not None:
         chain["tacho_jitter"] = jitter
     if correct and tacho is not None and (ph is not None or pc is not None):
-        fix = correct_chain(revs, p_head=ph, p_crank=pc, reference=chain_reference(diag))
+        fix = correct_chain(
+            revs,
+            p_head=ph,
+            p_crank=pc,
+            reference=chain_reference(diag),
+            axis_sd_deg=axis_sd(jitter, edges.size) if jitter is not None else 0.0,
+        )
         chain.update(fix.estimates)
         res.evidence["chain"] = _chain_summary(chain)
         if fix.refused:
