@@ -46,7 +46,7 @@ def test_every_class_is_one_entry_with_a_meaning_and_a_valid_range():
 
 
 def test_design_is_seeded_balanced_and_split_by_condition():
-    spec = DatasetSpec(n_conditions=20, seed=7)
+    spec = DatasetSpec(n_conditions=20, seed=7, chain="fixed")  # the condition's resonance
     tasks = design(spec)
     assert tasks == design(spec)  # deterministic
     other = design(DatasetSpec(n_conditions=20, seed=8))
@@ -199,7 +199,7 @@ def test_a_fixed_level_store_keeps_its_identity():
     """A store is identified by its spec's JSON: the fixed-level spec of the shipped data set
     must give the string stored in its folder, or `--resume` refuses it as another spec.
     (The literal is the spec's JSON before the continuous-severity settings existed.)"""
-    spec = DatasetSpec(n_conditions=40, classes=SHIPPED_CLASSES)
+    spec = DatasetSpec(n_conditions=40, classes=SHIPPED_CLASSES, chain="fixed")
     assert spec.to_json() == (
         '{"classes": ["healthy", "crank_pin_clearance", "crosshead_pin_clearance", '
         '"suction_valve_leak", "discharge_valve_leak", "weak_valve_spring", "sticking_valve", '
@@ -474,9 +474,7 @@ def _record(tmp_path, name, **change):
     from recipdyn.diagnosis.train import load
 
     card = load(default_model_path()).card
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(card["spec"])  # its chain: fixed, as it was built
     task = next(
         t
         for t in design(spec)
@@ -570,9 +568,7 @@ def test_without_a_tacho_the_noise_floor_is_still_read(tmp_path, snr_db, answere
     i = diag.names.index("acc_quiet_share")
     assert all(i not in _cols(diag.names, k) for k in AVAILABILITY)
     path = _record(tmp_path, f"snr{snr_db:g}", snr_db=snr_db)
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in diag.card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(diag.card["spec"])
     omega = next(t for t in design(spec) if t["split"] == "test")["params"]["omega"]
     res = diagnose(path, speed=f"{omega} rad/s", model=diag)  # _record's condition
     if answered:  # past the noise floor; with a speed only no class is named (test_channels)
@@ -758,9 +754,10 @@ def test_drawn_snrs_are_seeded_in_range_and_leave_the_rest_of_the_design():
     in one line naming the setting."""
     from recipdyn.cli import main
 
-    fixed = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3)
+    fixed = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3,
+                        chain="fixed")  # fmt: skip
     drawn = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3,
-                        snr_range=(10.0, 40.0))  # fmt: skip
+                        snr_range=(10.0, 40.0), chain="fixed")  # fmt: skip
     a, b = design(fixed), design(drawn)
     snr = np.array([t["snr_db"] for t in b])
     assert {t["snr_db"] for t in a} == {20.0}
@@ -855,3 +852,105 @@ def test_a_diagnoser_with_a_baseline_reads_the_deviations_and_saves_them(
     assert np.array_equal(back.predict_proba(X), diag.predict_proba(X))
     c = diag.classes[1]
     assert np.array_equal(back.severity(X, c)[0], diag.severity(X, c)[0])
+
+
+# ---- the measurement chain drawn per record (issue 42, item 1) ------------------------------
+
+
+def test_drawn_chains_are_seeded_per_record_inside_the_ranges():
+    """The default data set draws each record's chain: seeded by (seed, condition, class,
+    record), so the same spec gives the same chains and a data set with fewer classes the
+    same chains for the classes it keeps; every chain inside the data set's ranges (with its
+    ``snr_range`` replacing the SNR's); the task's resonance and SNR are its chain's. The
+    fixed chain's tasks carry none (their records are those of earlier versions)."""
+    from recipdyn.chain import Chain
+
+    spec = DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11)
+    tasks = design(spec)
+    assert spec.chain == "drawn" and all("chain" in t for t in tasks)
+    chains = [Chain.from_dict(t["chain"]) for t in tasks]
+    for t, c in zip(tasks, chains, strict=True):
+        assert spec.chain_ranges.contains(c, t["fs"]) == []
+        assert t["resonance_hz"] == c.accelerometer.resonance_hz
+        assert t["snr_db"] == c.accelerometer.snr_db
+    assert len({c.accelerometer.gain for c in chains}) == len(chains)  # one draw a record
+    assert [t["chain"] for t in design(spec)] == [t["chain"] for t in tasks]
+    few = design(DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11,
+                             classes=("healthy", "ring_leak")))  # fmt: skip
+    keep = [t["chain"] for t in tasks if t["label"] in ("healthy", "ring_leak")]
+    assert [t["chain"] for t in few] == keep
+    narrow = design(DatasetSpec(n_conditions=3, levels=(1.0,), snr_range=(30.0, 31.0)))
+    assert all(30.0 <= t["snr_db"] <= 31.0 for t in narrow)
+    fixed = design(DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11, chain="fixed"))
+    assert not any("chain" in t for t in fixed)
+    assert {t["snr_db"] for t in fixed} == {20.0}
+    assert DatasetSpec.from_dict({"n_conditions": 3}).chain == "fixed"  # a spec from before
+
+
+def test_a_drawn_data_set_stores_every_records_chain_and_its_card_lists_the_ranges(small):
+    """The small data set (drawn chains, built, interrupted and resumed): the feature table
+    holds each record's chain (``chain.*`` columns equal to the design's), the store its JSON,
+    every record's features are finite (the tacho read whatever its polarity, width, noise
+    and filter), and the data card lists every range with its source."""
+    import json
+
+    import zarr
+
+    from recipdyn.chain import Chain, ChainRanges
+
+    out, *_ = small
+    df, card = read_features(out)
+    tasks = {t["index"]: t for t in design(SMALL)}
+    for _, row in df.iterrows():
+        want = Chain.from_dict(tasks[row.record]["chain"]).columns()
+        for k, v in want.items():
+            got = row[f"chain.{k}"]
+            assert (v is None and (got is None or got != got)) or got == v, k
+    g = zarr.open_group(str(out / "signals.zarr"), mode="r")
+    stored = json.loads(str(g["chain"][3]))
+    assert stored == tasks[3]["chain"]
+    assert np.isfinite(df.filter(like="f_").to_numpy()).all()
+    assert card["chain"]["kind"] == "drawn"
+    assert card["chain"]["ranges"] == ChainRanges().describe()
+    md = (out / "datacard.md").read_text()
+    assert "| tacho.angle_deg | -2 .. 2 deg |" in md and "`issue42`" in md
+
+
+def test_cli_dataset_refuses_a_fixed_snr_with_the_drawn_chain(capsys):
+    from recipdyn.cli import main
+
+    assert main(["dataset", "--snr", "30", "-o", "unused-folder"]) == 2
+    assert main(["dataset", "--chain", "fixd", "-o", "unused-folder"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "--snr-range" in err[0] and "chain = 'fixd'" in err[1]
+
+
+def test_a_default_sensed_record_is_not_another_snr_for_a_default_data_sets_diagnoser(trained):
+    """Issue 44: `recipdyn dataset` drew at 20 dB while `recipdyn sense` recorded at 40 dB, so a
+    diagnoser of a default data set refused every default-sensed record as another SNR (the same
+    small data set with the fixed 20 dB chain refuses this record so, measured). Now the data
+    set draws its chains (SNR 10-40 dB) and sense records at 30 dB: the small data set's
+    diagnoser reads a new record (6 revolutions, other noise) of one of its training
+    conditions -- inside its speed range, which three conditions span narrowly -- sensed
+    through `SENSE_DEFAULT`, past the speed, sampling-rate and noise-floor gates, with its
+    noise floor inside the training range (FLOOR_SLACK 1.5)."""
+    from recipdyn import sensors
+    from recipdyn.chain import SENSE_DEFAULT
+    from recipdyn.diagnosis.dataset import simulate_record
+    from recipdyn.diagnosis.diagnose import diagnose_arrays
+
+    diag, _ = trained
+    task = next(t for t in design(SMALL) if t["split"] == "train" and t["label"] == "healthy")
+    task = {k: v for k, v in task.items() if k != "chain"}  # the exact outputs only
+    task["revolutions"] = 6.0
+    ds = simulate_record(task)
+    rec = sensors.record(ds, chain=SENSE_DEFAULT, seed=1)
+    res = diagnose_arrays(rec["accel_guide"].values, task["fs"], tacho=rec["tacho"].values,
+                          p_head=rec["p_head_sensor"].values,
+                          p_crank=rec["p_crank_sensor"].values, model=diag)  # fmt: skip
+    gates = ("crank speed", "sampling rate", "noise floor")
+    assert not (res.refused and any(g in res.reason for g in gates)), res.reason
+    if not res.refused:
+        q, (lo, hi) = res.evidence["noise_floor"]["share"], res.evidence["noise_floor"][
+            "training_range"]  # fmt: skip
+        assert lo / 1.5 <= q <= hi * 1.5

@@ -236,17 +236,27 @@ def _lowpass_delay(fc, order, phase) -> float:
 def known_chain(row, k: int, speed_hz: float) -> tuple[float, float, float]:
     """``(phase_deg, offset_pa, gain)`` a data set's drawn chain gives pressure channel
     ``k`` (0 head, 1 crank) of the record ``row`` (its ``chain.*`` columns: the tacho's
-    mark and delay, the channel's delay, causal low-pass, offset and gain); ``(0, 0, 1)``
+    mark, delay and low-pass, the channel's delay, causal low-pass, passage resonance,
+    offset and gain); ``(0, 0, 1)``
     for a data set of the fixed chain, which has no such columns. The phase is the one
     `pressure_phase` reads: the mark's crank angle, plus the tacho's delay, less the
     pressure's delays, as crank angle."""
     mark = math.degrees(float(_column(row, "tacho.angle", k, 0.0)))
-    t_delay = float(_column(row, "tacho.delay_s", k, 0.0))
+    # the tacho's pulse delayed (its own delay; an analog input's low-pass moves the edge by
+    # about its group delay)
+    t_delay = float(_column(row, "tacho.delay_s", k, 0.0)) + _lowpass_delay(
+        _column(row, "tacho.lowpass_hz", k, None),
+        _column(row, "tacho.lowpass_order", k, 4),
+        "causal",
+    )
     p_delay = float(_column(row, "pressure.delay_s", k, 0.0)) + _lowpass_delay(
         _column(row, "pressure.lowpass_hz", k, None),
         _column(row, "pressure.lowpass_order", k, None),
         _column(row, "pressure.lowpass_phase", k, "causal"),
     )
+    fn = _column(row, "pressure.resonance_hz", k, None)
+    if fn:  # a passage resonance delays the slow content by 2 zeta / wn
+        p_delay += 2 * float(_column(row, "pressure.damping", k, 0.0)) / (2 * math.pi * float(fn))
     phase = mark + 360.0 * speed_hz * (t_delay - p_delay)
     return (
         phase,
@@ -659,7 +669,6 @@ def resonance(x, fs: float, revs=None, response: str = "analog") -> dict[str, Es
     ``"bilinear"`` (`recipdyn.sensors.resonance_filter`, whose warped flank makes an analog
     fit read the damping low near the Nyquist frequency: 0.05 read as 0.014 at 0.4 fs)."""
     from scipy.signal import find_peaks, welch
-
 
     x = np.asarray(x, float)
     nan = Estimate(math.nan, math.nan, "Hz", "not measured", "no resonance peak")

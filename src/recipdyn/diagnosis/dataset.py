@@ -63,6 +63,8 @@ __all__ = [
 #: The sensed channels stored per record.
 CHANNELS = ("accel_guide", "p_head_sensor", "p_crank_sensor", "tacho")
 BACKENDS = ("serial", "processes", "dask")
+#: How a data set's records are sensed (`DatasetSpec.chain`).
+CHAIN_KINDS = ("drawn", "fixed")
 
 
 @dataclass(frozen=True)
@@ -96,12 +98,21 @@ class DatasetSpec:
         Each record's accelerometer SNR drawn uniformly in ``[lo, hi]`` dB (seeded per
         condition, class and record) instead of ``snr_db`` for all, so that a diagnoser learns
         the machine apart from the sensor's noise floor (docs/diagnosis.md, robustness).
+        With the drawn chain it replaces the ranges' accelerometer SNR.
+    chain : {"drawn", "fixed"}
+        ``drawn`` (default): every record's measurement chain drawn from
+        `recipdyn.chain.DEFAULT_RANGES` (seeded per condition, class and record; domain
+        randomisation), its resonance and SNR in place of the condition's resonance and
+        ``snr_db``. ``fixed``: the one chain every data set used before
+        (`recipdyn.chain.legacy_chain`: the condition's resonance, ``snr_db`` or
+        ``snr_range``), its records those of earlier versions to the bit.
 
     Notes
     -----
-    A data set's store is identified by `to_json`, which leaves out the two continuous-
-    severity settings while they are None, so a store built with fixed levels keeps its
-    identity (and resumes) whatever settings are added here later.
+    A data set's store is identified by `to_json`, which leaves out the continuous-severity
+    and SNR-range settings while they are None and the chain while it is ``fixed``, so a
+    store built before keeps its identity (and resumes) whatever settings are added here
+    later; `from_dict` reads a spec without ``chain`` as the fixed chain it was built with.
     """
 
     n_conditions: int = 16
@@ -115,6 +126,7 @@ class DatasetSpec:
     severity_range: tuple[float, float] | None = None
     severity_draws: int | None = None
     snr_range: tuple[float, float] | None = None
+    chain: str = "drawn"
 
     def __post_init__(self):
         if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
@@ -146,6 +158,25 @@ class DatasetSpec:
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
+        if self.chain not in CHAIN_KINDS:
+            raise ParameterError(f"chain = {self.chain!r}; allowed: {', '.join(CHAIN_KINDS)}")
+
+    @property
+    def chain_ranges(self):
+        """The ranges a drawn chain comes from (`recipdyn.chain.ChainRanges`; ``snr_range``
+        replaces the accelerometer's SNR range)."""
+        from ..chain import DEFAULT_RANGES, ChainRanges, Span
+
+        ranges = ChainRanges()
+        if self.snr_range is not None:
+            old = DEFAULT_RANGES["accelerometer.snr_db"]
+            lo, hi = self.snr_range
+            ranges = ranges.with_spans(
+                accelerometer__snr_db=Span(
+                    lo, hi, old.unit, old.meaning, "the data set's snr_range"
+                )  # fmt: skip
+            )
+        return ranges
 
     @property
     def continuous(self) -> bool:
@@ -166,12 +197,16 @@ class DatasetSpec:
         for k in ("severity_range", "severity_draws", "snr_range"):
             if d[k] is None:
                 del d[k]
+        if d["chain"] == "fixed":
+            del d["chain"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
-        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples);
+        one without ``chain`` was built with the fixed chain."""
+        kw = {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+        return cls(**{"chain": "fixed", **kw})
 
 
 def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, float]:
@@ -227,9 +262,20 @@ def snrs(spec: DatasetSpec, condition: int, name: str, n: int) -> list[float]:
     return rng.uniform(lo, hi, n).tolist()
 
 
+def chain_draw(spec: DatasetSpec, condition: int, name: str, level: int, fs: float):
+    """The drawn measurement chain (`recipdyn.chain.Chain`) of record ``level`` of class
+    ``name`` at ``condition``: from a generator seeded by the data set's seed, the condition,
+    the class name and the record (as `severities`: adding a class, a condition or a record
+    leaves the other chains as they were)."""
+    rng = np.random.default_rng([spec.seed, 5, condition, zlib.crc32(name.encode()), level])
+    return spec.chain_ranges.draw(rng, fs)
+
+
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     """The records of ``spec``: one task per (condition, class, severity), in a fixed order
-    (``level`` numbers a class's records at a condition)."""
+    (``level`` numbers a class's records at a condition). With the drawn chain each task
+    holds its chain (``chain``, `recipdyn.chain.Chain.to_dict`), whose resonance and SNR are
+    the task's ``resonance_hz`` and ``snr_db``."""
     tasks = []
     splits = split_of(spec)
     for ci, cond in enumerate(_conditions(spec)):
@@ -264,12 +310,26 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                         "noise_seed": int(spec.seed * 1_000_003 + idx),
                     }
                 )
+                if spec.chain == "drawn":
+                    ch = chain_draw(spec, ci, name, li, cond["fs"])
+                    tasks[-1]["chain"] = ch.to_dict()
+                    tasks[-1]["resonance_hz"] = ch.accelerometer.resonance_hz
+                    tasks[-1]["snr_db"] = ch.accelerometer.snr_db
     return tasks
 
 
-def _snr_text(spec: dict[str, Any]) -> str:
+def snr_text(spec: dict[str, Any]) -> str:
+    """The accelerometer SNR (dB) a data set's spec (``asdict``) records at: one value, or
+    the range drawn in."""
     r = spec.get("snr_range")
-    return f"{spec['snr_db']}" if r is None else f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if r is not None:
+        return f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if spec.get("chain", "fixed") == "drawn":
+        from ..chain import DEFAULT_RANGES
+
+        a = DEFAULT_RANGES["accelerometer.snr_db"]
+        return f"{a.lo:g}..{a.hi:g} (drawn a record)"
+    return f"{spec['snr_db']:g}"
 
 
 def n_samples_max(tasks) -> int:
@@ -296,6 +356,10 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
             summary=summary,
             **task["params"],
         )
+    if "chain" in task:  # a drawn chain; a task without one has the fixed chain
+        from ..chain import Chain
+
+        return sensors.record(ds, chain=Chain.from_dict(task["chain"]), seed=task["noise_seed"])
     return sensors.record(
         ds,
         accelerometer=sensors.Accelerometer(
@@ -388,6 +452,9 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     g.create_array("done", shape=(n,), chunks=(1,), dtype=bool, fill_value=False)
     g.create_array("error", shape=(n,), chunks=(1,), dtype=str)
     g.create_array("seconds", shape=(n,), chunks=(1,), dtype="f8", fill_value=np.nan)
+    if spec.chain == "drawn":  # each record's drawn chain, as JSON
+        g.create_array("chain", shape=(n,), chunks=(n,), dtype=str)
+        g["chain"][:] = np.array([json.dumps(t["chain"]) for t in tasks])
     from .. import __version__
 
     g.attrs.update(
@@ -598,6 +665,10 @@ def _table(g, tasks, names: list[str]):
             "snr_db": t["snr_db"],
             "noise_seed": t["noise_seed"],
         }
+        if "chain" in t:
+            from ..chain import Chain
+
+            row.update({f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()})
         row.update({f"f_{k}": v for k, v in zip(names, feats[i], strict=True)})
         rows.append(row)
     return pd.DataFrame(rows)
@@ -663,18 +734,10 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "conditions": {
             k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
             for k, r in CONDITIONS.items()
+            if not (spec.chain == "drawn" and k == "resonance_hz")  # the chain's, below
         },
-        "sensors": {
-            "accelerometer": "recipdyn.sensors.Accelerometer(snr_db="
-            + (
-                f"{spec.snr_db}"
-                if spec.snr_range is None
-                else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
-            )
-            + ", resonance_hz=<condition>), other settings default",
-            "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
-            "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
-        },
+        "sensors": _sensors_card(spec),
+        "chain": _chain_card(spec),
         "seeds": {
             "conditions": [spec.seed, 0],
             "split": [spec.seed, 1],
@@ -692,6 +755,41 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "records": int(len(df)),
         "balance": balance,
         "throughput": throughput,
+    }
+
+
+def _sensors_card(spec: DatasetSpec) -> dict[str, str]:
+    if spec.chain == "drawn":
+        return {"all": "recipdyn.chain.ChainRanges().draw(rng, fs) per record (chain, below), "
+                "applied by recipdyn.sensors.record(..., chain=...)"}  # fmt: skip
+    snr = (
+        f"{spec.snr_db}"
+        if spec.snr_range is None
+        else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
+    )
+    return {
+        "accelerometer": f"recipdyn.sensors.Accelerometer(snr_db={snr}, "
+        "resonance_hz=<condition>), other settings default",
+        "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
+        "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
+    }
+
+
+def _chain_card(spec: DatasetSpec) -> dict[str, Any]:
+    """The data card's measurement chain: fixed, or the ranges drawn from with their
+    sources."""
+    if spec.chain == "fixed":
+        return {"kind": "fixed", "chain": "recipdyn.chain.legacy_chain(<condition's "
+                "resonance>, <snr>): the one chain of every record"}  # fmt: skip
+    from ..chain import SOURCES
+
+    return {
+        "kind": "drawn",
+        "seed": f"[{spec.seed}, 5, condition, crc32(class name), record]",
+        "response": "exact (the continuous-time response at every frequency of the record)",
+        "ranges": spec.chain_ranges.describe(),
+        "sources": SOURCES,
+        "per_record": "features.parquet columns chain.*; signals.zarr array chain (JSON)",
     }
 
 
@@ -715,7 +813,7 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
         f"{how}; {s['revolutions']} "
         f"revolutions after {s['transient']}; accelerometer SNR "
-        f"{_snr_text(s)} dB; "
+        f"{snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
         "",
         f"| class | parameter | {head} | meaning |",
@@ -729,6 +827,17 @@ def datacard_markdown(card: dict[str, Any]) -> str:
     lines += ["", "| condition | range | meaning |", "|---|---|---|"]
     for k, r in card["conditions"].items():
         lines.append(f"| {k} | {r['lo']:g} .. {r['hi']:g} {r['unit']} | {r['meaning']} |")
+    chain = card.get("chain", {"kind": "fixed"})
+    if chain["kind"] == "drawn":
+        lines += ["", f"Measurement chain: drawn per record (seed {chain['seed']}), applied "
+                  "with the exact response.", "", "| parameter | range | meaning | source |",
+                  "|---|---|---|---|"]  # fmt: skip
+        for r in chain["ranges"]:
+            lines.append(f"| {r['parameter']} | {r['range']} | {r['meaning']} | {r['source']} |")
+        lines += ["", "Sources:", ""]
+        lines += [f"- `{k}`: {v}" for k, v in chain["sources"].items()]
+    else:
+        lines += ["", "Measurement chain: fixed (recipdyn.chain.legacy_chain)."]
     lines += [
         "",
         "Class balance (records): " + json.dumps(card["balance"]),

@@ -252,7 +252,10 @@ def _diagnose_arrays(
     x = np.asarray(x, float)
     jitter = None
     if tacho is not None:
-        edges = tacho_times(np.asarray(tacho, float), fs)
+        try:  # a channel that is no pulse train is refused with the tacho's reason
+            edges = tacho_times(np.asarray(tacho, float), fs)
+        except ValueError as exc:
+            raise ParameterError(str(exc)) from None
         if edges.size < 3:
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
@@ -293,7 +296,8 @@ def _diagnose_arrays(
     if correct:
         # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
         # chain's exact (analog) one
-        form = "bilinear" if diag.card["spec"].get("chain") is None else "analog"
+        drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
+        form = "analog" if drawn else "bilinear"
         chain.update(resonance(x, fs, revs if tacho is not None else None, form))
         res.evidence["chain"] = _chain_summary(chain)
     row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
@@ -414,8 +418,9 @@ def _diagnose_arrays(
 
 
 def _trained_snr(spec: dict[str, Any]) -> str:
-    r = spec.get("snr_range")
-    return f"{spec['snr_db']:g}" if r is None else f"{r[0]:g}..{r[1]:g}"
+    from .dataset import snr_text
+
+    return snr_text(spec).split(" ")[0]
 
 
 def _db(share: float) -> float:
