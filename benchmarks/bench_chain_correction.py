@@ -59,9 +59,7 @@ def _shipped():
     from recipdyn.diagnosis.train import load
 
     diag = load(default_model_path())
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in diag.card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(diag.card["spec"])  # its chain: fixed, as it was built
     return diag, [t for t in design(spec) if t["split"] == "test"]
 
 

@@ -22,9 +22,7 @@ def healthy_run():
     from recipdyn.simulate import simulate
 
     card = load(default_model_path()).card
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(card["spec"])  # its chain: fixed, as it was built
     tasks = [t for t in design(spec) if t["split"] == "test" and t["label"] == "healthy"]
     cond = sorted({t["condition"] for t in tasks})[1]
     task = next(t for t in tasks if t["condition"] == cond)
