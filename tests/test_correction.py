@@ -326,3 +326,25 @@ def test_a_clean_record_is_answered_as_without_the_correction(healthy_run):
     off = diagnose_arrays(s["x"], s["fs"], correct=False, **kw)
     assert on.label == off.label == "healthy"
     assert "chain: phase" in on.text() and "channels used" in on.text()
+
+
+def test_undoing_a_known_chain_gives_the_frame_correct_chain_maps_to(reference):
+    """A data set of drawn chains can compute its features in the frame `correct_chain`
+    puts a record in, from each record's known chain (`undo_known_chain`): on the ideal
+    cycle with a mark of 1.2 deg, offsets +5 / -3 kPa and the crank end's gain 1 % low, the
+    two give the same crank angle (to the estimate's interval) and the same pressures (to
+    the offsets' intervals)."""
+    from recipdyn.diagnosis.correction import undo_known_chain
+
+    revs, ph, pc = _ideal_record(1.2, (5000.0, -3000.0), (1.0, 0.99), seed=21)
+    row = {"chain.tacho.angle": math.radians(1.2), "chain.pressure.offset.0": 5000.0,
+           "chain.pressure.offset.1": -3000.0, "chain.pressure.gain.0": 1.0,
+           "chain.pressure.gain.1": 0.99}  # fmt: skip
+    r_known, h_known, c_known = undo_known_chain(row, revs, ph, pc, 3.2)
+    fix = correct_chain(revs, p_head=ph, p_crank=pc, reference=reference)
+    e = fix.estimates
+    assert np.max(np.abs(fix.revs - r_known)) * 360 <= e["phase"].uncertainty
+    assert np.max(np.abs(fix.p_head - h_known)) <= e["offset_head"].uncertainty
+    # the crank end: its offset's interval, and the gain ratio's times the pressure it scales
+    bound = e["offset_crank"].uncertainty + e["gain_ratio"].uncertainty * np.max(np.abs(pc))
+    assert np.max(np.abs(fix.p_crank - c_known)) <= bound

@@ -72,6 +72,7 @@ __all__ = [
     "ChainCorrection",
     "reference_from",
     "known_chain",
+    "undo_known_chain",
     "pressure_phase",
     "tacho_revolutions",
     "resonance",
@@ -263,6 +264,23 @@ def known_chain(row, k: int, speed_hz: float) -> tuple[float, float, float]:
         float(_column(row, "pressure.offset", k, 0.0)),
         float(_column(row, "pressure.gain", k, 1.0)),
     )
+
+
+def undo_known_chain(row, revs, p_head, p_crank, speed_hz: float):
+    """A record of a data set's drawn chain, put in the frame `correct_chain` maps a record
+    to, from its *known* chain (``row``: its ``chain.*`` columns, `known_chain`): the crank
+    angle re-phased by the two pressure channels' mean phase, each offset removed, the crank
+    end's gain matched to the head end's; the common gain, the filters, the noise and the
+    mount left as drawn. Returns ``(revs, p_head, p_crank)``. A data set whose features are
+    computed so holds what `recipdyn diagnose` makes of a record when its estimates are
+    exact."""
+    (ph_h, o_h, g_h), (ph_c, o_c, g_c) = (known_chain(row, k, speed_hz) for k in (0, 1))
+    revs = np.asarray(revs, float) + 0.5 * (ph_h + ph_c) / 360.0
+    if p_head is not None:
+        p_head = np.asarray(p_head, float) - o_h
+    if p_crank is not None:
+        p_crank = (np.asarray(p_crank, float) - o_c) * (g_h / g_c)
+    return revs, p_head, p_crank
 
 
 def reference_from(fits: list[dict[str, Any]], source: str = "") -> ChainReference:

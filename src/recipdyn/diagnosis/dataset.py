@@ -371,10 +371,15 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
     )
 
 
-def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
+def features_of(
+    channels: dict[str, np.ndarray], fs: float, speed_hz: float, chain=None
+) -> dict[str, float]:
     """A record's features from its sensed channels: the crank angle from the tacho's first
     edge and the record's constant crank speed (a short record has too few pulses for
-    the speed to be read from them)."""
+    the speed to be read from them). ``chain`` (a drawn chain, `recipdyn.chain.Chain.to_dict`):
+    its known mark, delays, offsets and relative gain undone first
+    (`recipdyn.diagnosis.correction.undo_known_chain`: the frame `recipdyn diagnose` puts a
+    record in); None: the channels as sensed."""
     from ..analysis.vibration import tacho_times
     from .evidence import record_features
 
@@ -383,9 +388,14 @@ def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> 
     if edges.size == 0:
         raise ValueError("no tacho edge in the record")
     revs = (np.arange(x.size) / fs - edges[0]) * speed_hz
-    return record_features(
-        x, fs, revs, p_head=channels.get("p_head_sensor"), p_crank=channels.get("p_crank_sensor")
-    )
+    ph, pc = channels.get("p_head_sensor"), channels.get("p_crank_sensor")
+    if chain is not None:
+        from ..chain import Chain
+        from .correction import undo_known_chain
+
+        row = {f"chain.{k}": v for k, v in Chain.from_dict(chain).columns().items()}
+        revs, ph, pc = undo_known_chain(row, revs, ph, pc, speed_hz)
+    return record_features(x, fs, revs, p_head=ph, p_crank=pc)
 
 
 def make_record(task: dict[str, Any]) -> dict[str, Any]:
