@@ -880,11 +880,13 @@ def correct_chain(
             return out
     w = {ch: 1.0 / e["phase_sd"] ** 2 for ch, e in err.items()}
     phase = sum(err[ch]["phase"] * w[ch] for ch in err) / sum(w.values())
+    # the pressures' phase against the fitted crank angle: what the correction applies
+    core_sd = 1.0 / math.sqrt(sum(w.values()))
+    applied = _significant(phase, core_sd)
     # the fitted crank angle's own zero is uncertain by the tacho's jitter (`axis_sd`): the
     # correction aligns it to the pressures whatever it is, but as the mark's angle the
     # estimate carries that uncertainty too
-    phase_sd = math.hypot(1.0 / math.sqrt(sum(w.values())), axis_sd_deg)
-    applied = _significant(phase, phase_sd)
+    phase_sd = math.hypot(core_sd, axis_sd_deg)
     est["phase"] = Estimate(
         phase,
         K95 * phase_sd,
