@@ -187,15 +187,20 @@ class ChainReference:
         scale = np.std(X, axis=0)
         return X, np.where(scale > 0, scale, 1.0)
 
-    def bias(self, chamber: str, n_compression: float, n_expansion: float):
+    def bias(self, chamber: str, n_compression: float, n_expansion: float, exclude=None):
         """``(phase_deg, offset_pa, phase_spread, offset_spread, inside)`` that a record of
         the diagnoser's chain with these exponents shows, the spreads as standard
         uncertainties, and whether the exponents lie within `REFERENCE_REACH` of the
-        reference records'."""
+        reference records'. ``exclude``: an operating condition whose reference records are
+        left out (a data set correcting its own records reads each from the other
+        conditions', as a new record is read)."""
         from sklearn.neighbors import NearestNeighbors
 
         X, scale = self._space(chamber)
         r = {k: np.asarray(v, float) for k, v in self.rows[chamber].items()}
+        if exclude is not None and "condition" in r:
+            keep = r["condition"] != exclude
+            X, r = X[keep], {k: v[keep] for k, v in r.items()}
         k = min(REFERENCE_NEIGHBOURS, X.shape[0])
         nn = NearestNeighbors(n_neighbors=k).fit(X / scale)
         dist, idx = nn.kneighbors(np.array([[n_compression, n_expansion]]) / scale)
@@ -297,7 +302,7 @@ def reference_from(fits: list[dict[str, Any]], source: str = "") -> ChainReferen
     reach: dict[str, float] = {}
     for ch in ("head", "crank"):
         ok = [f for f in fits if f.get(ch, {}).get("ok")]
-        if len(ok) < 2 * REFERENCE_NEIGHBOURS:
+        if len(ok) < REFERENCE_NEIGHBOURS + 1:
             continue
         col = {
             k: np.array([f[ch][k] for f in ok], float)
@@ -322,6 +327,7 @@ def reference_from(fits: list[dict[str, Any]], source: str = "") -> ChainReferen
         dist, _ = nn.kneighbors(Z)
         reach[ch] = float(np.max(dist[:, -1]))
         rows[ch] = {name: v.tolist() for name, v in col.items()}
+        rows[ch]["condition"] = groups.astype(float).tolist()
         rows[ch]["phase_res"] = res["phase"].tolist()
         rows[ch]["offset_res"] = res["offset"].tolist()
     both = [f for f in fits if f.get("head", {}).get("ok") and f.get("crank", {}).get("ok")]
@@ -773,10 +779,16 @@ def correct_chain(
     p_crank=None,
     reference: ChainReference | None = None,
     axis_sd_deg: float = 0.0,
+    fits: dict[str, dict[str, Any]] | None = None,
+    exclude_condition=None,
 ) -> ChainCorrection:
     """Estimate the pressure channels' crank-angle phase, offsets and relative gain against
     the diagnoser's own chain (``reference``), check the two chambers against each other
-    and return the corrected crank angle and pressures.
+    and return the corrected crank angle and pressures. ``axis_sd_deg``: the standard error
+    of the crank angle's zero from the tacho's jitter (`axis_sd`); ``fits``: the chambers'
+    `pressure_phase` already computed on these ``revs`` (a data set stores them);
+    ``exclude_condition``: the record's operating condition, left out of the reference
+    (`ChainReference.bias`).
 
     For each chamber, `pressure_phase` gives the mark's crank angle and the offset; the
     reference's records with the same polytropic exponents give what the diagnoser's own
@@ -801,11 +813,12 @@ def correct_chain(
     revs = np.asarray(revs, float)
     out = ChainCorrection(revs=revs, p_head=p_head, p_crank=p_crank)
     est = out.estimates
-    fits: dict[str, dict[str, Any]] = {}
+    given = fits or {}
+    fits = {}
     for chamber, p in (("head", p_head), ("crank", p_crank)):
         if p is None:
             continue
-        r = pressure_phase(p, revs, chamber)
+        r = given.get(chamber) or pressure_phase(p, revs, chamber)
         if not r["ok"]:
             out.refused = (
                 f"p_{chamber}: no polytropic compression and re-expansion found in the "
@@ -825,7 +838,7 @@ def correct_chain(
         if ref is None or ch not in ref.rows:
             b = (0.0, 0.0, math.inf, math.inf, True)
         else:
-            b = ref.bias(ch, r["n_compression"], r["n_expansion"])
+            b = ref.bias(ch, r["n_compression"], r["n_expansion"], exclude_condition)
         if not b[4]:
             out.refused = (
                 f"p_{ch}: the {ch} end's polytropic exponents (compression "

@@ -475,6 +475,8 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     from .. import __version__
 
     df, card = read_features(folder)
+    if "chain_refused" in df.columns:  # records the chain correction refused: left out
+        df = df[df.chain_refused.fillna("") == ""].reset_index(drop=True)
     names = [c[2:] for c in df.columns if c.startswith("f_")]
     classes = list(card["spec"]["classes"])
     if only is not None:
@@ -529,7 +531,10 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         thresholds[subset] = float(np.quantile(d, 0.99) * OOD_MARGIN)
     speed = train_df.f_speed_hz.to_numpy()
     acc_curves, p_curves = _library(folder, train_df)
-    chain_ref = _chain_reference(folder, train_df, seed)
+    # the reference the data set's features were corrected against, or one built here
+    chain_ref = (card.get("chain_correction") or {}).get("reference") or _chain_reference(
+        folder, train_df, seed
+    )
     state = {
         "format": FORMAT,
         "recipdyn_version": __version__,
