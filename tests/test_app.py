@@ -635,7 +635,7 @@ def test_the_app_builds_with_every_callback(store):
 
 def _texts_of(component) -> str:
     """Every text and attribute value of a Dash component tree, as one string."""
-    return json.dumps(component, default=lambda c: c.to_plotly_json())
+    return json.dumps(component, default=lambda c: c.to_plotly_json(), ensure_ascii=False)
 
 
 def test_the_diagnosis_page_answers_a_dropped_record_and_shows_a_refusal(tmp_path):
@@ -697,6 +697,7 @@ def test_the_diagnosis_page_shows_what_it_has_no_words_for():
     layer adds them) is shown by its name and value, an item's own meaning with it; a
     known item whose value has another shape falls back to the generic rendering."""
     from recipdyn.app import DiagnosisView, result_children
+    from recipdyn.app.diagnosis import evidence_rows
 
     view = DiagnosisView(
         result=dict(refused=False, label="ring_leak", probabilities={"ring_leak": 0.7,
@@ -705,14 +706,24 @@ def test_the_diagnosis_page_shows_what_it_has_no_words_for():
                     evidence={"impacts_per_rev": 2.0,
                               "mounting_resonance_hz": {"value": 3812.0, "uncertainty": 40.0,
                                                         "meaning": "the accelerometer's own"},
-                              "deciding": "another shape"},
+                              "deciding": "another shape",
+                              "sensor_chain": {"offset": {"value": 600.0, "uncertainty": 3e2,
+                                                          "unit": "Pa", "status": "corrected",
+                                                          "note": "the transducer's offset"},
+                                               "gain": {"value": 1e-3, "unit": "1"}},
+                              "counts": {"knocks": 3, "quiet": [1, 2]}},
                     ood={"distance": 1.0, "threshold": 2.0, "features": "all"},
                     channel_set="acceleration + tacho", seconds=1.5),
         channels={"acceleration": "acc"})  # fmt: skip
     page = _texts_of(result_children(view))
+    rows = dict((r[0], r[1:]) for r in evidence_rows(view.result["evidence"]))
+    assert rows["sensor chain: offset"] == ("+600 ± 3e+02 Pa (corrected)",
+                                            "the transducer's offset")  # fmt: skip
+    assert rows["sensor chain: gain"] == ("+0.001", "")
+    assert rows["counts"] == ("knocks 3; quiet 1, 2", "")
     for part in (
         "mounting resonance (Hz)",
-        "value 3.81e+03; uncertainty 40",
+        "+3.81e+03 ± 40",
         "the accelerometer's own",
         "channel set",
         "acceleration + tacho",

@@ -85,6 +85,28 @@ EVIDENCE: dict[str, tuple[str, str, Any]] = {
         "the crank angle where it is",
         lambda v: f"{float(v['max']):.3f} of the range at {float(v['angle_deg']):.0f}°",
     ),
+    "channels": (
+        "channels the answer rests on",
+        "a class is named only from channels whose answers of it were right often enough "
+        "on held-out conditions (docs/diagnosis.md): how often, for the class named",
+        lambda v: (
+            v["channels"]
+            + (
+                f": right for {v['precision']:.0%} of its {v['answers']} answers on held-out "
+                f"conditions (recall {v['recall']:.0%}; all classes {v['accuracy']:.0%} of "
+                f"{v['n']} records)"
+                if v.get("measured")
+                else ""
+            )
+        ),
+    ),
+    "chain": (
+        "measurement chain",
+        "an error of the sensors or the acquisition estimated from the record itself, with "
+        "its 95 % half-width, and what was done with it (corrected before the features, "
+        "consistent with the diagnoser's chain, left, or not identified)",
+        None,
+    ),
     "closest_record": (
         "closest simulated record",
         "the training record of the named class nearest to this record in the diagnoser's "
@@ -244,6 +266,26 @@ def _unit(unit: str | None) -> str:
     return (unit or "").replace("**2", "²").replace("**3", "³").replace("*", "·")
 
 
+#: Keys of an evidence mapping that say what it means rather than what was measured.
+_SAYS = ("meaning", "description", "note")
+
+
+def _says(d: dict[str, Any]) -> str:
+    return next((str(d[k]) for k in _SAYS if d.get(k)), "")
+
+
+def _quantity_text(d: dict[str, Any]) -> str:
+    """A measured quantity (``value``, and ``uncertainty``, ``unit``, ``status`` if given)
+    as ``+623 ± 310 Pa (corrected)``."""
+    v, u = float(d["value"]), d.get("uncertainty")
+    unit = "" if d.get("unit") in (None, "", "1") else _unit(str(d["unit"]))
+    text = "—" if math.isnan(v) else f"{v:+.3g}"
+    if _is_number(u) and math.isfinite(u):
+        text += f" ± {u:.2g}"
+    text += f" {unit}" if unit else ""
+    return text + (f" ({d['status']})" if d.get("status") else "")
+
+
 def text_of(value: Any) -> str:
     """Any value of an answer as text: numbers to three digits, sequences joined, mappings
     as ``name value`` pairs."""
@@ -257,8 +299,10 @@ def text_of(value: Any) -> str:
     if isinstance(value, str):
         return value
     if isinstance(value, dict):
+        if _is_number(value.get("value")):  # a measured quantity: value, uncertainty, unit
+            return _quantity_text(value)
         return "; ".join(f"{_label(str(k))} {text_of(v)}" for k, v in value.items()
-                         if k not in ("meaning", "description"))  # fmt: skip
+                         if k not in _SAYS)  # fmt: skip
     if isinstance(value, (list, tuple)):
         if not value:
             return "none"
@@ -273,12 +317,18 @@ def text_of(value: Any) -> str:
 def evidence_rows(evidence: dict[str, Any]) -> list[tuple[str, str, str]]:
     """``(what was measured, value, what it means)`` for each evidence item, in the
     diagnoser's order: the page's words for the items it knows (`EVIDENCE`), else the item's
-    name, its value and its own ``meaning`` or ``description`` if it gives one."""
+    name, its value and its own ``meaning``, ``description`` or ``note`` if it gives one; a
+    mapping of mappings (the chain's estimates) a row each."""
     rows = []
     for key, value in (evidence or {}).items():
         name, meaning, show = EVIDENCE.get(key, (_label(key), "", None))
+        if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
+            for i, (k, v) in enumerate(value.items()):  # a group of items: a row each
+                rows.append((f"{name}: {_label(str(k))}", text_of(v),
+                             _says(v) or (meaning if i == 0 else "")))  # fmt: skip
+            continue
         if isinstance(value, dict):
-            meaning = str(value.get("meaning") or value.get("description") or meaning)
+            meaning = _says(value) or meaning
         text = None
         if show is not None:
             try:
