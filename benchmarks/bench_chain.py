@@ -75,7 +75,8 @@ def _cost(n: int) -> list[dict]:
     from recipdyn.chain import ChainRanges, legacy_chain
     from recipdyn.diagnosis.dataset import DatasetSpec, design
 
-    task = next(t for t in design(DatasetSpec(n_conditions=2, levels=(1.0,), chain="fixed"))
+    # the smallest data set a spec allows (3 conditions), for one healthy record's task
+    task = next(t for t in design(DatasetSpec(n_conditions=3, levels=(1.0,), chain="fixed"))
                 if t["label"] == "healthy")  # fmt: skip
     _simulate(task)  # loads the kernels
     t0 = time.perf_counter()

@@ -1,15 +1,16 @@
 """Where one data-set record's time goes (`recipdyn dataset`): simulate (the model's set-up
 and the integration), sense, featurise, store.
 
-    python benchmarks/bench_dataset_record.py [--records 3] [--profile]
+    python benchmarks/bench_dataset_record.py [--records 3] [--profile] [--quick]
     python benchmarks/bench_dataset_record.py --compare [--rounds 4]
 
 Runs, in one process, one record of each of a few classes at the first condition of the
 default design once to warm up (the first call loads or compiles the model's kernels, and the
 time of that is printed apart), then ``--records`` rounds over the same records, timing each
 phase with `time.perf_counter`, and prints the mean of each phase per record and its share.
-``--profile`` adds cProfile's 25 largest cumulative entries of one warm record. Times are of
-the machine it runs on (on a shared machine, compare the shares, not the seconds).
+``--profile`` adds cProfile's 25 largest cumulative entries of one warm record; ``--quick``
+is one round (``make bench``). Times are of the machine it runs on (on a shared machine,
+compare the shares, not the seconds).
 
 ``--compare`` times the records as the data set makes them now (no run summary; the event
 records built as one Dataset) against the way it made them before (the run summary computed
@@ -138,13 +139,16 @@ def compare(tasks, g, names, rounds: int) -> None:
     print("  stored channels and features identical to the bit: yes")
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--records", type=int, default=3, help="rounds over the classes")
+    ap.add_argument("--quick", action="store_true", help="one round (--records 1)")
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--compare", action="store_true", help="before/after, alternating")
     ap.add_argument("--rounds", type=int, default=4, help="rounds of --compare")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
+    if a.quick:
+        a.records = 1
     spec = DatasetSpec(n_conditions=3, classes=("healthy",) + CLASSES[1:])
     tasks = [t for t in design(spec) if t["condition"] == 0 and t["level"] == 3]
     with tempfile.TemporaryDirectory() as tmp:
@@ -156,7 +160,7 @@ def main() -> None:
             phases(t, g, names)
         if a.compare:
             compare(tasks, g, names, a.rounds)
-            return
+            return {}
         acc: dict[str, list[float]] = {}
         for _ in range(a.records):
             for t in tasks:
@@ -174,6 +178,12 @@ def main() -> None:
             phases(tasks[1], g, names)
             pr.disable()
             pstats.Stats(pr).sort_stats("cumulative").print_stats(25)
+    rows = [dict(metric="warm data-set records per second, one core", value=1 / total,
+                 unit="1/s", target=None, better="higher")]  # fmt: skip
+    rows += [dict(metric=f"share of a record's time: {k}", value=100 * np.mean(acc[k]) / total,
+                  unit="%", target=None, better="lower")
+             for k in ("simulate", "sense", "features", "store")]  # fmt: skip
+    return {"summary": rows, "seconds_per_record": {k: float(np.mean(v)) for k, v in acc.items()}}
 
 
 if __name__ == "__main__":

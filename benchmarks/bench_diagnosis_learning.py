@@ -2,12 +2,15 @@
 conditions and a feature-group ablation, both on a data set's held-out conditions
 (docs/diagnosis.md).
 
-    python benchmarks/bench_diagnosis_learning.py DATASET [--sizes 3,6,9] [--draws 3]
+    python benchmarks/bench_diagnosis_learning.py [DATASET] [--sizes 3,6,9] [--draws 3]
+    python benchmarks/bench_diagnosis_learning.py --quick
 
 Learning curve: classifiers (the one of ``recipdyn train``, all features) trained on ``n``
 training conditions drawn at random (``--draws`` draws, seeded) from the data set's training
 conditions, tested on its test conditions. Ablation: the same classifier on all training
-conditions with each feature group left out, and with each group alone.
+conditions with each feature group left out, and with each group alone. DATASET defaults to
+``make diagnoser``'s; ``--quick`` uses the small data set of ``_dataset.py`` with sizes 1,3
+(it checks that the benchmark runs, it does not measure a diagnoser).
 """
 
 from __future__ import annotations
@@ -15,6 +18,11 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+
+from _dataset import dataset_for
+
+#: ``make bench`` runs the quick mode (the full one needs ``make diagnoser``'s data set).
+RUN_ALL_ARGV = ["--quick"]
 
 
 def _fit_score(df_tr, df_te, cols, classes, seed=0):
@@ -30,19 +38,25 @@ def _fit_score(df_tr, df_te, cols, classes, seed=0):
     return ok.mean(), ok[ms].mean(), ok[healthy].mean()
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     from threadpoolctl import threadpool_limits
 
     from recipdyn.diagnosis.dataset import read_features
     from recipdyn.diagnosis.evidence import feature_groups
 
-    ap = argparse.ArgumentParser()
-    ap.add_argument("dataset")
-    ap.add_argument("--sizes", default="3,6,9")
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dataset", nargs="?", default=None)
+    ap.add_argument("--sizes", default=None, help="default 3,6,9 (--quick: 1,3)")
     ap.add_argument("--draws", type=int, default=3)
     ap.add_argument("--no-ablation", action="store_true")
-    args = ap.parse_args()
-    df, card = read_features(args.dataset)
+    ap.add_argument("--quick", action="store_true", help="the small data set of _dataset.py")
+    args = ap.parse_args(argv)
+    folder, quick = dataset_for(args.dataset, args.quick)
+    args.sizes = args.sizes or ("1,3" if quick else "3,6,9")
+    if quick:
+        print("(quick data set: the accuracies check that the benchmark runs, nothing more)")
+    df, card = read_features(folder)
+    curve: dict[str, float] = {}
     classes = list(card["spec"]["classes"])
     names = [c[2:] for c in df.columns if c.startswith("f_")]
     cols = [f"f_{n}" for n in names]
@@ -60,13 +74,14 @@ def main() -> None:
                 sub = tr[tr.condition.isin(pick)]
                 res.append(_fit_score(sub, te, cols, classes))
             a = np.array(res)
+            curve[str(n)] = float(a[:, 0].mean())
             print(
                 f"| {n} | {len(sub)} | {a[:, 0].mean():.3f} ± {a[:, 0].std():.3f} | "
                 f"{a[:, 1].mean():.3f} | {a[:, 2].mean():.3f} |",
                 flush=True,
             )
         if args.no_ablation:
-            return
+            return {"dataset": str(folder), "quick": quick, "accuracy_by_conditions": curve}
         groups = feature_groups(names)
         print("\n| features | columns | accuracy | s >= 0.5 | healthy recall |")
         print("|---|---|---|---|---|")
@@ -79,6 +94,7 @@ def main() -> None:
         for label, cs in rows:
             a, ms, h = _fit_score(tr, te, cs, classes)
             print(f"| {label} | {len(cs)} | {a:.3f} | {ms:.3f} | {h:.3f} |", flush=True)
+    return {"dataset": str(folder), "quick": quick, "accuracy_by_conditions": curve}
 
 
 if __name__ == "__main__":

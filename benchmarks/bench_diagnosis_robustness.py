@@ -21,6 +21,10 @@ The sensed channels are cached in ``--cache`` (one ``.npz`` a record), so the fe
 recomputed and another diagnoser evaluated without simulating again:
 
     python benchmarks/bench_diagnosis_robustness.py --workers 2 --cache out/robustness
+
+``--quick`` (``make bench``): one held-out condition, the variants ``as trained`` and
+``snr=5`` (an answer and a refusal), the classes of the data set's own configuration (the
+guide's clearance, which needs another compiled model, left out).
 """
 
 from __future__ import annotations
@@ -66,7 +70,11 @@ def simulate_channels(job):
     return key, {c: np.asarray(rec[c].values, np.float32) for c in CHANNELS}
 
 
-def main() -> None:
+#: ``make bench`` runs the quick mode (the full one simulates ~10^3 records).
+RUN_ALL_ARGV = ["--quick"]
+
+
+def main(argv: list[str] | None = None) -> dict:
     from recipdyn.diagnosis import default_model_path, load
     from recipdyn.diagnosis.dataset import DatasetSpec, design, features_of
     from recipdyn.diagnosis.diagnose import FLOOR_SLACK, RING_SLACK, noise_floor
@@ -90,7 +98,12 @@ def main() -> None:
         action="store_true",
         help="diagnose the cached records only (simulate nothing)",
     )
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true",
+                    help="1 condition, 2 variants, the base configuration's classes")  # fmt: skip
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.conditions = 1
+        args.variants = "as trained,snr=5"
     if args.simulate_only:
         import json
 
@@ -107,6 +120,10 @@ def main() -> None:
         for t in test
         if t["condition"] in conds and (t["label"] == "healthy" or t["severity"] >= 0.5)
     ]
+    if args.quick:  # the classes of the data set's own compiled configuration
+        from recipdyn.diagnosis.classes import get_class
+
+        tasks = [t for t in tasks if not get_class(t["label"]).requires]
     cache = Path(args.cache)
     cache.mkdir(parents=True, exist_ok=True)
     print(
@@ -114,6 +131,7 @@ def main() -> None:
     )
     print("| variant | records | accuracy (s >= 0.5) | healthy recall | refused (out of domain) |")
     print("|---|---|---|---|---|")
+    rows = []
     for name in args.variants.split(","):
         change = VARIANTS[name]
         jobs, skipped = [], 0
@@ -171,6 +189,12 @@ def main() -> None:
             f"  ({time.perf_counter() - t0:.0f} s)",
             flush=True,
         )
+        rows.append(dict(metric=f"accuracy (s >= 0.5), {name}", value=right / n, unit="",
+                         target=None, better="higher"))  # fmt: skip
+        outside = name == "snr=5"  # the one variant outside the training domain
+        rows.append(dict(metric=f"refused (out of domain), {name}", value=refused / n, unit="",
+                         target=None, better="higher" if outside else "lower"))  # fmt: skip
+    return {"summary": rows, "records_per_variant": len(tasks)}
 
 
 if __name__ == "__main__":

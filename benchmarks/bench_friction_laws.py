@@ -73,13 +73,16 @@ def _run(src: str | None, name: str, repeat: int) -> tuple[float, int]:
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", help="src folder of the code to compare with")
     ap.add_argument("--rounds", type=int, default=5, help="alternations (default 5)")
     ap.add_argument("--repeat", type=int, default=3, help="periods per measurement")
     ap.add_argument("--match", default="", help="only the cases whose name holds this")
     ap.add_argument("--case", help=argparse.SUPPRESS)
+    ap.add_argument("--quick", action="store_true", help="2 rounds of 1 period")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.rounds, args.repeat = 2, 1
     if args.case:  # one measurement, in its own process
         print(json.dumps(measure(args.case, args.repeat)))
         return {}

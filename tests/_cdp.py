@@ -31,7 +31,9 @@ class Page:
     def __init__(self, ws_url):
         import websocket
 
-        self.ws = websocket.create_connection(ws_url, timeout=120)
+        # no Origin header: Chromium 111+ refuses a DevTools connection from an origin it
+        # was not started to allow (403 "Rejected an incoming WebSocket connection")
+        self.ws = websocket.create_connection(ws_url, timeout=120, suppress_origin=True)
         self.n = 0
 
     def call(self, method, **params):
@@ -114,6 +116,7 @@ def served_page(app, tmp_path: Path) -> Iterator[tuple[Page, int, Path]]:
     server = make_server("127.0.0.1", port, app.server, threaded=True)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     profile, downloads = tmp_path / "profile", tmp_path / "downloads"
+    (profile / "DevToolsActivePort").unlink(missing_ok=True)  # a former browser's port
     proc = subprocess.Popen(
         [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",

@@ -7,6 +7,7 @@ click a fault-map cell; download the config and run it with the CLI)."""
 import base64
 import json
 import math
+import re
 import struct
 import time
 
@@ -20,6 +21,7 @@ from recipdyn.app import (
     click_query,
     config_text,
     fields,
+    format_value,
     from_query,
     log_ticks,
     panel_for,
@@ -82,7 +84,9 @@ def test_every_model_has_a_panel_whose_defaults_are_the_models(name):
 def test_fields_read_the_units_engineers_type():
     by = {f.key: f for f in fields("compressor", {"load": "cycle"})}
     assert by["rc"].unit == "mm" and by["suction_pressure"].unit == "bar"
-    assert by["omega"].unit == "rpm" and by["theta_c_offset"].unit == "deg"
+    assert by["theta_c_offset"].unit == "deg"
+    # the default 20 rad/s is 190.98593... rpm: the field is in rad/s, and rpm is typed
+    assert by["omega"].unit == "rad/s" and by["theta1_0"].unit == "rad"
     assert by["rc"].parse("0.5 mm") == pytest.approx(0.5e-3, rel=1e-15)
     assert by["rc"].parse("0.5") == pytest.approx(0.5e-3, rel=1e-15)  # a bare number: mm
     assert by["rc"].parse("500 um") == pytest.approx(0.5e-3, rel=1e-15)
@@ -91,9 +95,53 @@ def test_fields_read_the_units_engineers_type():
     assert by["suction_pressure"].parse("2 bar") == pytest.approx(2e5, rel=1e-15)
     assert by["theta_c_offset"].parse("90 deg") == pytest.approx(math.pi / 2, rel=1e-15)
     assert by["run.fs"].parse("5 kHz") == 5000.0
-    # written back in the display unit when six digits are exact, else in SI
+    # written in the display unit, exactly
     assert by["rc"].default_text == "1 mm" and by["omega"].default_text == "20 rad/s"
     assert by["suction_pressure"].range_text() == "(0, 10000] bar"
+    assert by["theta1_0"].range_text() == "[-1e+06, 1e+06] rad"  # not "±5.72958e+07 deg"
+    assert format_value(6.324555320336759e-4, by["rc"]) == "0.6324555320336759 mm"
+
+
+def _configurations():
+    """Every registered model at its defaults, and the compressor at each value of each of
+    its selectors and at the combinations of ``CONFIGURATIONS``."""
+    out = [(name, {}) for name in model_names()]
+    for name in model_names():
+        for p in get_model(name).selector_schema():
+            out += [(name, {p.name: v}) for v in p.choices if v != p.default]
+    return out + [("compressor", chosen) for chosen, _, _ in CONFIGURATIONS.values()]
+
+
+def _reads_back(text: str, si_unit: str) -> float:
+    from recipdyn.units import to_si
+
+    return float(text) if not si_unit else to_si("x", text, unit=si_unit)
+
+
+def test_every_field_shows_its_numbers_in_the_unit_beside_it():
+    """Every number field of every model's form, at every selector value: its default is
+    written in the unit shown beside it (not "20 rad/s" beside "rpm"), and the ends of the
+    range it states read back to the model's own bounds exactly (not 1e6 rad written as
+    "5.72958e+07 deg", which is 999999.6 rad). One helper, `display_unit`, decides."""
+    seen, wrong = 0, []
+    for name, chosen in _configurations():
+        for f in fields(name, chosen):
+            if f.choices is not None or f.param is None:
+                continue
+            seen += 1
+            text = f.default_text
+            if text and (text.split(" ", 1)[1] if " " in text else "") != f.unit:
+                wrong.append(f"{name} {chosen} {f.key}: {text!r} beside {f.unit!r}")
+            ends = re.fullmatch(r"[\[(](\S+), (\S+)[\])]( .+)?", f.range_text())
+            assert ends, f.range_text()
+            unit = (ends.group(3) or "").strip()
+            assert unit == f.unit, (f.key, f.range_text())
+            for end, bound in zip(ends.groups()[:2], (f.param.low, f.param.high), strict=True):
+                back = _reads_back(f"{end} {unit}".strip(), f.si_unit)
+                if back != bound:
+                    wrong.append(f"{name} {chosen} {f.key}: range end {end} {unit} is "
+                                 f"{back!r}, the model's bound {bound!r}")  # fmt: skip
+    assert seen > 300 and not wrong, "\n".join(wrong)
 
 
 def test_run_settings_are_the_command_lines():
@@ -585,11 +633,20 @@ def test_the_app_builds_with_every_callback(store):
 # --- the diagnosis section ----------------------------------------------------------------
 
 
+def _texts_of(component) -> str:
+    """Every text and attribute value of a Dash component tree, as one string."""
+    return json.dumps(component, default=lambda c: c.to_plotly_json(), ensure_ascii=False)
+
+
 def test_the_diagnosis_page_answers_a_dropped_record_and_shows_a_refusal(tmp_path):
     """A record of the shipped diagnoser's domain, dropped as a CSV (the page receives it
-    base64-encoded), is diagnosed: probabilities summing to 1, the evidence lines and the
-    overlay image; the same record read at another speed is refused with its reason; a
-    file of an unreadable type is told, not raised."""
+    base64-encoded), is diagnosed: probabilities summing to 1, shown in a table; the
+    severity; the evidence, one row an item; the channels named; the overlay image; and no
+    path of the server anywhere. The same record read at another speed is refused with its
+    reason; a file of an unreadable type, or without the channel named, is told by the
+    uploaded file's name, not the server's copy."""
+    import tempfile
+
     import pandas as pd
 
     from recipdyn.app import diagnose_upload
@@ -610,12 +667,73 @@ def test_the_diagnosis_page_answers_a_dropped_record_and_shows_a_refusal(tmp_pat
     assert sum(view.probabilities.values()) == pytest.approx(1.0)
     assert view.lines[0].startswith("diagnosis:") and any("impacts" in x for x in view.lines)
     assert min(_png_size(view.image)) > 100
-    assert len(result_children(view)) == 2  # the text and the overlay
+    assert view.channels == {"acceleration": "accel_guide", "tacho": "tacho",
+                             "head-end pressure": "p_head_sensor",
+                             "crank-end pressure": "p_crank_sensor",
+                             "sampling rate": f"{fs} Hz"}  # fmt: skip
+    page = _texts_of(result_children(view))
+    for part in ('"dx-probabilities"', '"dx-evidence"', '"dx-channels"', '"dx-overlay"',
+                 "impacts per revolution", "head-end pressure shape", "deciding features",
+                 "distance to the training records", view.result["label"]):  # fmt: skip
+        assert part in page, part
+    server = tempfile.gettempdir()
+    assert server not in page and server not in "\n".join(view.lines)
+    assert "figure" not in view.result  # the overlay's path: not kept
     fast = diagnose_upload(upload, "record.csv", tacho=None, speed="600 rpm", fs=f"{fs} Hz")
-    assert fast.refused and "crank speed" in fast.lines[0] and fast.image is None
+    assert fast.refused and "crank speed" in fast.result["reason"] and fast.image is None
+    refusal = _texts_of(result_children(fast))
+    assert '"dx-refusal"' in refusal and "Diagnosis withheld" in refusal
+    assert '"dx-probabilities"' not in refusal
     bad = diagnose_upload(upload, "record.xyz")
     assert "allowed" in bad.error and ".csv" in bad.error
     assert "drop a file" in diagnose_upload(None, None).error
+    missing = diagnose_upload(upload, "record.csv", channel="accel_crank", fs=f"{fs} Hz")
+    assert missing.error and "record.csv" in missing.error and server not in missing.error
+    assert '"dx-error"' in _texts_of(result_children(missing))
+
+
+def test_the_diagnosis_page_shows_what_it_has_no_words_for():
+    """A field of the answer or an evidence item the page does not know (the diagnosis
+    layer adds them) is shown by its name and value, an item's own meaning with it; a
+    known item whose value has another shape falls back to the generic rendering."""
+    from recipdyn.app import DiagnosisView, result_children
+    from recipdyn.app.diagnosis import evidence_rows
+
+    view = DiagnosisView(
+        result=dict(refused=False, label="ring_leak", probabilities={"ring_leak": 0.7,
+                    "healthy": 0.3}, severity=0.5, severity_interval=(0.3, 0.8),
+                    value=1e-6, value_interval=(5e-7, 2e-6), unit="m**2",
+                    evidence={"impacts_per_rev": 2.0,
+                              "mounting_resonance_hz": {"value": 3812.0, "uncertainty": 40.0,
+                                                        "meaning": "the accelerometer's own"},
+                              "deciding": "another shape",
+                              "sensor_chain": {"offset": {"value": 600.0, "uncertainty": 3e2,
+                                                          "unit": "Pa", "status": "corrected",
+                                                          "note": "the transducer's offset"},
+                                               "gain": {"value": 1e-3, "unit": "1"}},
+                              "counts": {"knocks": 3, "quiet": [1, 2]}},
+                    ood={"distance": 1.0, "threshold": 2.0, "features": "all"},
+                    channel_set="acceleration + tacho", seconds=1.5),
+        channels={"acceleration": "acc"})  # fmt: skip
+    page = _texts_of(result_children(view))
+    rows = dict((r[0], r[1:]) for r in evidence_rows(view.result["evidence"]))
+    assert rows["sensor chain: offset"] == ("+600 ± 3e+02 Pa (corrected)",
+                                            "the transducer's offset")  # fmt: skip
+    assert rows["sensor chain: gain"] == ("+0.001", "")
+    assert rows["counts"] == ("knocks 3; quiet 1, 2", "")
+    for part in (
+        "mounting resonance (Hz)",
+        "+3.81e+03 ± 40",
+        "the accelerometer's own",
+        "channel set",
+        "acceleration + tacho",
+        "another shape",
+        "More of the answer",
+        "severity 0.50",
+        "ring_leak_area",
+    ):
+        assert part in page, part
+    assert "inside the training domain" in page
 
 
 # --- a real browser -----------------------------------------------------------------------
@@ -626,6 +744,18 @@ _POINTS = ("(() => { const g = document.querySelector('#g-signal .js-plotly-plot
            " return g && g._fullData ? g._fullData.length && g._fullData[0].y.length : -1; })()")  # fmt: skip  # noqa: E501
 _IMAGE = ("(() => { const i = document.querySelector('#images img');"
           " return i && i.complete && i.naturalWidth; })()")  # fmt: skip
+#: The titles of the page's graphs that their toolbar (Plotly's mode bar) covers, and how
+#: many graphs have both.
+_COVERED = """(() => { const out = []; let n = 0;
+  for (const g of document.querySelectorAll('.js-plotly-plot')) {
+    const t = g.querySelector('.gtitle'), m = g.querySelector('.modebar');
+    if (!t || !m || !t.textContent) continue;
+    n += 1;
+    const a = t.getBoundingClientRect(), b = m.getBoundingClientRect();
+    if (a.left < b.right && b.left < a.right && a.top < b.bottom && b.top < a.bottom)
+      out.push(t.textContent);
+  }
+  return [out, n]; })()"""
 
 
 @pytest.mark.browser
@@ -647,6 +777,11 @@ def test_app_in_headless_chromium(store, tmp_path, monkeypatch):
         assert page_.wait(f"{_POINTS} > 100 && {_POINTS}") == 629  # decoded by plotly.js
         assert page_.wait(_IMAGE) > 500  # simulate's figure, decoded
         assert runs == ["compressor"]
+        page_.wait(
+            "(() => { const g = document.querySelector('#sweep .js-plotly-plot');"
+            " return g && g._fullData && g._fullData.length; })()"
+        )  # the map too
+        assert page_.js(_COVERED) == [[], 5]  # the four views and the map: no title covered
 
         # 1b. a selector, chosen with the mouse: the contact configuration's fields (its
         # contact law's restitution, not the massless link's equations), no run yet

@@ -191,7 +191,7 @@ def _lazy_dask_collection() -> None:
         return
 
     def is_dask_collection(x: object) -> bool:
-        if "dask" not in sys.modules and not hasattr(type(x), "__dask_graph__"):
+        if sys.modules.get("dask") is None and not hasattr(type(x), "__dask_graph__"):
             return False
         return real(x)
 
@@ -201,14 +201,18 @@ def _lazy_dask_collection() -> None:
 
 @contextlib.contextmanager
 def _no_unused_scheduler() -> Iterator[None]:
-    """While writing NetCDF, xarray asks dask which scheduler runs (to choose a lock), and
-    dask asks ``distributed`` for a client, importing it (~0.4 s). In a process that has not
-    imported ``distributed`` there is no client: this answers so (as if it were not
-    installed), then puts everything back."""
+    """While writing NetCDF or computing a dask-backed record, xarray asks dask which
+    scheduler runs (to choose a lock), and dask asks ``distributed`` for a client, importing
+    it (~0.4 s, 13 MB); before that, xarray imports dask itself to ask (6 MB and jinja2), even
+    for a record of numpy arrays. A package not imported yet cannot be in use: no array can
+    be a dask array before dask is imported, and no client can run before ``distributed``
+    is. So this answers as if they were not installed, then puts everything back."""
     import sys
 
     hidden = [n for n in ("distributed", "dask.distributed") if "distributed" not in sys.modules
               and n not in sys.modules]  # fmt: skip
+    if "dask" not in sys.modules:
+        hidden += ["dask", "dask.base"]
     for name in hidden:
         sys.modules[name] = None  # an import of it raises ImportError, which dask expects
     try:
@@ -217,6 +221,32 @@ def _no_unused_scheduler() -> Iterator[None]:
         for name in hidden:
             if sys.modules.get(name, 0) is None:
                 del sys.modules[name]
+
+
+no_unused_scheduler = _no_unused_scheduler
+
+
+def pandas_without_pyarrow() -> None:
+    """Import pandas (which xarray imports) as if pyarrow were not installed, for a command
+    that reads and writes no Parquet (``recipdyn simulate``: NetCDF, Zarr, CSV, MAT).
+
+    pandas imports pyarrow at its own import whenever it is installed (for its Arrow-backed
+    types; recipdyn installs it for the Parquet files of ``dataset``, ``features`` and
+    ``analyze``): 34 MB of resident memory and ~0.3 s in every process that imports xarray.
+    pandas then keeps its Python-backed string type, its default without pyarrow, which
+    nothing of such a command stores. pyarrow itself stays importable. Does nothing when
+    pandas or pyarrow is loaded already; never call it in a process that will read or write
+    Parquet (the library never does: only the commands that need neither)."""
+    import sys
+
+    if "pandas" in sys.modules or "pyarrow" in sys.modules:
+        return
+    sys.modules["pyarrow"] = None  # an import of it raises ImportError: "not installed"
+    try:
+        import pandas  # noqa: F401
+    finally:
+        if sys.modules.get("pyarrow", 0) is None:
+            del sys.modules["pyarrow"]
 
 
 def write_dataset(ds, path: str | Path) -> Path:

@@ -30,10 +30,15 @@ field of another configuration is named with the selector value that enables it;
 value that is a file, ``file.py:OBJ``, is never taken from a link); "Download config" writes
 the run's TOML config, which ``recipdyn simulate -c FILE`` runs. The sweep browser opens a
 sweep store and shows its fault map (2-D) or bifurcation diagram (1-D); clicking a point
-opens it in the panel and runs it. The diagnosis section takes a dropped record (or a
-simulated example) and its channel names and shows `recipdyn.diagnose`'s answer: the
-probabilities, the severity, the evidence and the overlay, or the refusal and its reason
-(`recipdyn.app.diagnosis`).
+opens it in the panel and runs it. Each field is shown in one unit (`display_unit`): the
+unit engineers type when the field's default and range are exact in it, else SI.
+
+The diagnosis has a page of its own (the tab "Diagnose a record", or ``#diagnose`` in the
+address): it takes a dropped record (or a simulated example) and its channel names and shows
+`recipdyn.diagnose`'s answer: the class probabilities, the severity and its interval, the
+evidence (what was measured, its value, what it means), the channels used and the closest
+simulated record overlaid at full width; or the refusal and its reason, prominently
+(`recipdyn.app.diagnosis`). No server path is shown.
 
 Why Dash: a plain Flask server with React components, so the app is one Python process and
 its callbacks are plain functions (tested without a browser, and in a real headless
@@ -42,24 +47,26 @@ Chromium); Plotly figures report clicks on map cells, which the sweep browser ne
 
 from __future__ import annotations
 
-from .diagnosis import DiagnosisView, diagnose_upload
+from .diagnosis import DiagnosisView, diagnose_upload, result_children
 from .figures import images, simulate_form, status_lines, views
 from .form import (
     MAX_SAMPLES,
     Field,
     config_text,
+    display_unit,
     fields,
     format_value,
     from_query,
     read_form,
     to_query,
 )
-from .page import GRAPHS, PageResult, build_app, click_query, panel_for, run_page
+from .page import GRAPHS, PAGES, PageResult, build_app, click_query, panel_for, run_page
 from .sweeps import log_ticks, point_from_click, sweep_figure
 
 __all__ = [
     "build_app", "run_page", "PageResult", "panel_for", "click_query", "GRAPHS", "fields",
     "Field", "read_form", "format_value", "to_query", "from_query", "config_text",
     "MAX_SAMPLES", "simulate_form", "views", "images", "status_lines", "sweep_figure",
-    "point_from_click", "log_ticks", "DiagnosisView", "diagnose_upload",
+    "point_from_click", "log_ticks", "DiagnosisView", "diagnose_upload", "result_children",
+    "display_unit", "PAGES",
 ]  # fmt: skip

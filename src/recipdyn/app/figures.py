@@ -17,12 +17,28 @@ from ..errors import ModelValidityWarning
 from ..plotting import section_times
 from .form import Form
 
-__all__ = ["simulate_form", "views", "images", "status_lines", "period_of", "POINTS"]
+__all__ = ["simulate_form", "views", "images", "status_lines", "period_of", "below_toolbar",
+           "POINTS", "TOOLBAR_BAND"]  # fmt: skip
 
 #: At most this many points per trace reach the browser.
 POINTS = 20_000
 #: matplotlib's pyplot is not thread-safe; the server answers requests in threads.
 _MPL_LOCK = threading.Lock()
+#: The band (px) at the top of a graph where Plotly draws its toolbar (the mode bar,
+#: right-aligned, about 25 px high); every graph of the app sets its title below it.
+TOOLBAR_BAND = 34
+
+
+def below_toolbar(fig):
+    """``fig`` with its title, whatever it says, below the toolbar's band and left-aligned,
+    and a top margin that holds both: a title in Plotly's default place, centred in the top
+    margin, runs under the toolbar as soon as it is longer than the room left of it (the
+    sweep browser's heading, the section's and the spectrum's titles were covered)."""
+    return fig.update_layout(
+        title=dict(x=0, xref="paper", xanchor="left", y=1, yref="container", yanchor="top",
+                   pad=dict(t=TOOLBAR_BAND)),
+        margin=dict(t=TOOLBAR_BAND + 36),
+    )  # fmt: skip
 
 
 def simulate_form(form: Form):
@@ -102,13 +118,13 @@ def views(ds, model) -> list[Any]:
         else:
             ts, once = section_times(ds, period)  # a motor's crank: once per turn
             sx, sy = np.interp(ts, t, xa), np.interp(ts, t, xb)
-            what = (f"{ts.size} points, {once}" if once != "none" else
+            what = (f"{ts.size} point{'s' if ts.size != 1 else ''}, {once}" if once != "none" else
                     "none: an autonomous system has no forcing period")  # fmt: skip
         sec.add_trace(go.Scatter(x=sx, y=sy, mode="markers", marker=dict(size=5)))
         sec.update_layout(title=f"section ({what})", xaxis_title=_label(ds, a),
                           yaxis_title=_label(ds, b))  # fmt: skip
     for fig in (sig, spc, ph, sec):
-        fig.update_layout(margin=dict(l=60, r=20, t=50, b=50), showlegend=False)
+        below_toolbar(fig.update_layout(margin=dict(l=60, r=20, b=50), showlegend=False))
     return [sig, spc, ph, sec]
 
 

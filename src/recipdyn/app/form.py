@@ -3,11 +3,15 @@ the units engineers type, with one error per field.
 
 A field holds text: a quantity with its unit (``"0.5 mm"``, ``"300 rpm"``, ``"3 bar"``), read
 by pint through `recipdyn.units.to_si`, or a bare number, read in the field's display
-unit (shown beside it). Values are written back in the display unit when that writes them
-exactly to six digits (``0.001 m`` -> ``"1 mm"``), else in SI (``20 rad/s`` stays
-``"20 rad/s"`` rather than an inexact ``"190.986 rpm"``), so the defaults of the form are the
-model's defaults to the bit. The same texts make the page's address (`to_query`) and the
-run's config file (`config_text`, read back by ``recipdyn simulate -c``).
+unit (shown beside it). One helper, `display_unit`, chooses that unit for every field: the
+unit engineers type for the quantity (mm, bar, rpm, deg) when every number the field shows,
+its default and the ends of its range, is written in it exactly to six digits
+(``0.001 m`` -> ``"1 mm"``), else the SI unit (the default crank speed ``20 rad/s`` is
+190.986... rpm: the field is in rad/s, and says so). So a default is never written in one
+unit beside another, a range is the model's own range (not ``1e6 rad`` rounded to
+``5.72958e+07 deg``), and the defaults of the form are the model's defaults to the bit. The
+same texts make the page's address (`to_query`) and the run's config file (`config_text`,
+read back by ``recipdyn simulate -c``).
 
 A model whose parameters choose its configuration (the compressor's joints, load, drive and
 guide: `Model.selector_schema`) gets those selectors first, as choice fields, then the fields
@@ -31,8 +35,9 @@ from ..model.protocol import Param
 from ..model.registry import DEFAULT_MODEL, get_model, is_spec, model_names
 from ..units import to_si
 
-__all__ = ["Field", "fields", "selected", "selector_errors", "read_form", "format_value",
-           "to_query", "from_query", "config_text", "MAX_SAMPLES", "RUN"]  # fmt: skip
+__all__ = ["Field", "fields", "display_unit", "selected", "selector_errors", "read_form",
+           "format_value", "to_query", "from_query", "config_text", "MAX_SAMPLES",
+           "RUN"]  # fmt: skip
 
 #: The longest run the app draws (samples, or iterations of a map); longer runs belong to
 #: ``recipdyn simulate``, which streams them to a file.
@@ -70,11 +75,9 @@ class Field:
             return "one of " + ", ".join(self.choices)
         if p is None:
             return ""
-        ends = []
-        for v in (p.low, p.high):
-            ends.append(f"{v / _factor(self.unit, self.si_unit):.6g}")
+        lo, hi = (_number(v, self.unit, self.si_unit) for v in (p.low, p.high))
         lb, rb = "(" if p.low_open else "[", ")" if p.high_open else "]"
-        return f"{lb}{ends[0]}, {ends[1]}{rb}" + (f" {self.unit}" if self.unit else "")
+        return f"{lb}{lo}, {hi}{rb}" + (f" {self.unit}" if self.unit else "")
 
     def parse(self, text: Any) -> Any:
         """The value of ``text`` in SI, checked against the range (`ParameterError`
@@ -115,10 +118,10 @@ def _factor(unit: str, si_unit: str) -> float:
     return float(_ureg().Quantity(1.0, unit).to(si_unit.replace("**", "^")).magnitude)
 
 
-def _display_unit(p: Param) -> str:
+def _engineers_unit(p: Param) -> str:
     """The unit engineers type for ``p``: mm for lengths below a metre, bar for pressures
     (GPa for elastic moduli), rpm for a crank speed, degrees for angles."""
-    d = abs(p.default) if isinstance(p.default, (int, float)) else 0.0
+    d = abs(p.default) if _is_number(p.default) else 0.0
     if p.unit == "m" and d < 1.0:
         return "mm"
     if p.unit == "Pa":
@@ -130,23 +133,51 @@ def _display_unit(p: Param) -> str:
     return p.unit
 
 
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _exact(value: float, factor: float) -> bool:
+    """Whether ``value`` (SI) written to six digits in a unit of ``factor`` reads back to it."""
+    return not math.isfinite(value) or float(f"{value / factor:.6g}") * factor == value
+
+
+def display_unit(p: Param, preferred: str | None = None) -> str:
+    """The unit a field of ``p`` is shown in, a sweep's axis drawn in and a bare number read
+    in: the unit engineers type (``preferred``, default `_engineers_unit`) when the field's
+    default and the ends of its range are each written in it exactly to six digits, else
+    the SI unit ``p.unit``. Every field takes its unit here, so that its default is never
+    written in one unit beside another (``20 rad/s`` beside ``rpm``) nor its range rounded
+    by a conversion (``1e6 rad`` as ``5.72958e+07 deg``, which is 999999.6 rad)."""
+    unit = preferred or _engineers_unit(p)
+    if unit == p.unit:
+        return unit
+    f = _factor(unit, p.unit)
+    shown = [v for v in (p.default, p.low, p.high) if _is_number(v)]
+    return unit if all(_exact(float(v), f) for v in shown) else p.unit
+
+
+def _number(value: float, unit: str, si_unit: str) -> str:
+    """A number (SI) as the field shows it: in ``unit`` to six digits when that is exact,
+    else its shortest exact text in ``unit``, else in SI with the SI unit written out."""
+    f = _factor(unit, si_unit)
+    for text in (f"{value / f:.6g}", repr(value / f)):
+        if not math.isfinite(value) or float(text) * f == value:
+            return text
+    return f"{value!r} {si_unit}"
+
+
 def format_value(value: Any, field: Field) -> str:
-    """``value`` (SI) as field text that reads back to it exactly: six digits in the display
-    unit when they are exact (``"1 mm"``), else six digits in SI (``"20 rad/s"``), else the
-    shortest exact text in the display unit, else in SI (``"2.6666666666666665"``)."""
+    """``value`` (SI) as field text that reads back to it exactly, in the field's display
+    unit (`display_unit`) wherever that can be exact: six digits (``"1 mm"``), else the
+    shortest exact text (``"0.6324555320336759 mm"``), else in SI (``"2.6666666666666665"``).
+    A default is always written in the display unit: `display_unit` chose it so."""
     if value is None:
         return ""
     if isinstance(value, str):
         return value
-    value = float(value)
-    units = list(dict.fromkeys((field.unit, field.si_unit)))
-    for digits in ("{:.6g}", "{!r}"):
-        for unit in units:
-            f = _factor(unit, field.si_unit)
-            text = digits.format(value / f)
-            if float(text) * f == value:
-                return f"{text} {unit}".strip()
-    return f"{value!r} {field.si_unit}".strip()
+    text = _number(float(value), field.unit, field.si_unit)
+    return text if text.endswith(f" {field.si_unit}") else f"{text} {field.unit}".strip()
 
 
 def _run_fields() -> list[Field]:
@@ -155,7 +186,8 @@ def _run_fields() -> list[Field]:
 
     def num(name, unit, disp, low, high, desc, low_open=True):
         p = Param(name, unit, SIMULATION[name], desc, low=low, high=high, low_open=low_open)
-        return Field(RUN + name, name, unit, disp, SIMULATION[name], desc, param=p)
+        return Field(RUN + name, name, unit, display_unit(p, disp or unit), SIMULATION[name],
+                     desc, param=p)  # fmt: skip
 
     return [
         num("revolutions", "", "", 0.0, math.inf,
@@ -225,7 +257,7 @@ def fields(model: Any = None, texts: dict[str, Any] | None = None) -> list[Field
             continue
         if p.choices is None and not isinstance(p.default, (int, float)) and not p.optional:
             continue
-        out.append(Field(p.name, p.name, p.unit, _display_unit(p), p.default, p.description,
+        out.append(Field(p.name, p.name, p.unit, display_unit(p), p.default, p.description,
                          p.group, p.choices, p.optional, p.assumed, p))  # fmt: skip
     return out + _run_fields()
 
@@ -390,7 +422,7 @@ def _elsewhere(m: Any, texts: dict[str, str], key: str, text: str) -> str | None
     p, where = rows[key]
     sel = selected(m, texts)
     where = _configuration(m, sel)[1].get(key) or where
-    f = Field(p.name, p.name, p.unit, _display_unit(p), p.default, param=p, choices=p.choices)
+    f = Field(p.name, p.name, p.unit, display_unit(p), p.default, param=p, choices=p.choices)
     try:
         m.parameters({**sel, key: f.parse(text)})
     except (ParameterError, TypeError, ValueError) as exc:

@@ -1,6 +1,11 @@
 """The page: layout and callbacks. Each callback is a thin wrapper around a plain function
 of this module (``panel_for``, ``run_page``, ...), which the tests call without a browser.
 
+Two pages under tabs: "Simulate" (the parameter panel, the run's views and figures, the sweep
+browser) and "Diagnose a record" (`recipdyn.app.diagnosis`). The address's fragment names the
+page (``#diagnose``), so a link opens it; the tabs hide one page and show the other, both
+stay on the page (a form's texts survive a visit to the other).
+
 State lives in the address: ``?model=compressor-contact&rc=0.5+mm&run.revolutions=2`` opens
 that model with those fields and runs it; ``?model=compressor&crank_joint=contact&rc=0.5+mm``
 opens the compressor's contact configuration. Changing a selector (crank_joint, load, ...)
@@ -18,8 +23,8 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model, model_names
-from .diagnosis import diagnosis_section
-from .figures import images, simulate_form, status_lines, views
+from .diagnosis import diagnosis_page
+from .figures import below_toolbar, images, simulate_form, status_lines, views
 from .form import (
     RUN,
     Field,
@@ -33,10 +38,12 @@ from .form import (
     to_query,
 )
 
-__all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "GRAPHS"]
+__all__ = ["build_app", "panel_for", "run_page", "PageResult", "click_query", "GRAPHS", "PAGES"]
 
 #: The interactive views, in the order `recipdyn.app.figures.views` returns them.
 GRAPHS = ("signal", "spectrum", "phase", "section")
+#: The pages (tab value -> label); the first opens by default, ``#<value>`` opens another.
+PAGES = {"simulate": "Simulate", "diagnose": "Diagnose a record"}
 _RED = "#B00020"
 _INPUT = {"width": "12em"}
 
@@ -105,12 +112,13 @@ class PageResult:
 def _empty() -> Any:
     import plotly.graph_objects as go
 
-    return go.Figure().update_layout(
+    fig = go.Figure().update_layout(
         xaxis_visible=False,
         yaxis_visible=False,
         plot_bgcolor="white",
-        margin=dict(l=10, r=10, t=10, b=10),
+        margin=dict(l=10, r=10, b=10),
     )
+    return below_toolbar(fig)
 
 
 def run_page(model: str, texts: dict[str, Any]) -> PageResult:
@@ -156,21 +164,53 @@ def _texts(ids: list[dict], values: list[Any]) -> dict[str, Any]:
     return {i["key"]: v for i, v in zip(ids, values, strict=True)}
 
 
+def page_of(fragment: str | None) -> str:
+    """The page an address's fragment names (``#diagnose``), the first page otherwise."""
+    name = (fragment or "").lstrip("#")
+    return name if name in PAGES else next(iter(PAGES))
+
+
+def _import_once() -> None:
+    """Import dask and pint here, in one thread, before the server answers requests in
+    threads: the first request of a page opens the sweep (dask) and draws the panel (pint,
+    which imports dask.base) at once, and dask's package and its ``dask.base`` import each
+    other, so two threads importing them at once could meet a half-imported ``dask.base``
+    (ImportError: cannot import name 'annotate' from partially initialized module)."""
+    import importlib.util
+
+    from ..units import _ureg
+
+    if importlib.util.find_spec("dask") is not None:
+        import dask  # noqa: F401
+    _ureg()
+
+
 def build_app(store: str | Path | None = None):
     """The Dash application (``app.run(port=...)`` serves it)."""
     from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
     from dash.exceptions import PreventUpdate
 
+    _import_once()
     app = Dash(__name__, title="recipdyn")
     options = [{"label": f"{n}" + (" (default)" if n == DEFAULT_MODEL else ""), "value": n}
                for n in model_names()]  # fmt: skip
     button = {"marginRight": "0.5em", "marginTop": "0.5em"}
+    tab = {"padding": "6px 18px", "fontWeight": "bold", "width": "auto", "flex": "0 0 auto"}
     app.layout = html.Div([
         dcc.Location(id="url", refresh=False),
         dcc.Location(id="nav", refresh="callback-nav"),
         dcc.Store(id="shown"), dcc.Store(id="go", data=0), dcc.Download(id="download"),
         dcc.Store(id="configuration"),
-        html.H2("recipdyn: reciprocating compressor dynamics", style={"margin": "4px 0"}),
+        html.Div([
+            html.H2("recipdyn: reciprocating compressor dynamics",
+                    style={"margin": "4px 1em 4px 0", "display": "inline-block"}),
+            dcc.Tabs(id="page", value=next(iter(PAGES)), children=[
+                dcc.Tab(label=label, value=value, id=f"tab-{value}", style=tab,
+                        selected_style=tab | {"borderTop": "3px solid #0072B2"})
+                for value, label in PAGES.items()],
+                parent_style={"display": "inline-block", "verticalAlign": "bottom"},
+                style={"height": "36px"}),
+        ], style={"borderBottom": "1px solid #d6d6d6", "marginBottom": "6px"}),
         html.Div([
             html.Div([
                 html.Label("model ", htmlFor="model", style={"fontWeight": "bold"}),
@@ -194,7 +234,6 @@ def build_app(store: str | Path | None = None):
                               placeholder="folder of a sweep", style={"width": "20em"}),
                     html.Button("Open", id="open", n_clicks=0),
                     dcc.Dropdown(id="sweep-var", options=[], value=None),
-                    diagnosis_section(),
                 ], id="panel-scroll", style={"maxHeight": "calc(100vh - 230px)",
                                              "overflowY": "auto", "marginTop": "6px",
                                              "borderTop": "1px solid #ccc"}),
@@ -211,7 +250,8 @@ def build_app(store: str | Path | None = None):
                 dcc.Graph(id="sweep", style={"height": "480px"}, figure=_empty().update_layout(
                     title="sweep browser: open a sweep folder to see its map")),
             ], style={"flex": "1", "minWidth": "0"}),
-        ], style={"display": "flex", "gap": "1em"}),
+        ], id="simulate-page", style={"display": "flex", "gap": "1em"}),
+        html.Div(diagnosis_page(), id="diagnose-tab", style={"display": "none"}),
     ], style={"fontFamily": "sans-serif"})  # fmt: skip
 
     fields_state = [State({"type": "field", "key": ALL}, "value"),
@@ -221,6 +261,25 @@ def build_app(store: str | Path | None = None):
 
     def form_texts(fv, fi, cv, ci) -> dict[str, Any]:
         return {**_texts(fi, fv), **_texts(ci, cv)}
+
+    @app.callback(Output("page", "value"), Input("url", "hash"))
+    def _open_page(fragment):
+        # a link's fragment (#diagnose) opens its page
+        return page_of(fragment)
+
+    @app.callback(
+        Output("simulate-page", "style"), Output("diagnose-tab", "style"),
+        Output("nav", "hash"), Input("page", "value"), State("url", "hash"),
+        State("simulate-page", "style"),
+    )  # fmt: skip
+    def _show_page(name, fragment, style):
+        # one page shown, the other hidden (both stay: their texts survive); the address
+        # names the page shown, so that a copied link opens it
+        shown = {**style, "display": "flex" if name == "simulate" else "none"}
+        other = {"display": "block" if name == "diagnose" else "none"}
+        first = next(iter(PAGES))
+        want = "" if name == first else f"#{name}"
+        return shown, other, no_update if (fragment or "") == want else want
 
     @app.callback(
         Output("model", "value"), Output("panel", "children"), Output("model-help", "children"),
@@ -357,7 +416,8 @@ def build_app(store: str | Path | None = None):
             with tempfile.TemporaryDirectory() as tmp:
                 kw.update(channel="accel_guide", tacho="tacho", speed=None,
                           p_head="p_head_sensor", p_crank="p_crank_sensor", fs=None)  # fmt: skip
-                view = diagnose_upload(None, None, path=example_record(Path(tmp)), **kw)
+                view = diagnose_upload(None, None, path=example_record(Path(tmp)),
+                                       name="the simulated example", **kw)  # fmt: skip
         else:
             view = diagnose_upload(contents, filename, **kw)
         return result_children(view)

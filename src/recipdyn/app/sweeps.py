@@ -11,7 +11,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.registry import DEFAULT_MODEL, configured_for_record, get_model
-from .form import _display_unit, _factor
+from .figures import below_toolbar
+from .form import _factor, display_unit
 
 __all__ = ["sweep_figure", "point_from_click", "log_ticks"]
 
@@ -38,7 +39,7 @@ def _axis_unit(ds, dim: str) -> tuple[str, float]:
     si = ds[dim].attrs.get("units", "")
     si = "" if si == "1" else si
     if dim in m.schema:
-        unit = _display_unit(m.schema[dim])
+        unit = display_unit(m.schema[dim])
         return unit, _factor(unit, si)
     return si, 1.0
 
@@ -100,7 +101,7 @@ def sweep_figure(store: str | Path, variable: str | None = None) -> tuple[Any, l
             title=f"{variable} ({units})" if units not in ("", "1") else variable)))  # fmt: skip
         fig.update_layout(xaxis=xaxis, yaxis=yaxis,
                           title=f"fault map: {variable} (click a cell to simulate it)")  # fmt: skip
-        return fig, options, variable
+        return below_toolbar(fig), options, variable
     dim = dims[0]
     options = [k for k in ds.data_vars if k.startswith("poincare_") and ds[k].ndim == 2]
     if not options:
@@ -112,7 +113,7 @@ def sweep_figure(store: str | Path, variable: str | None = None) -> tuple[Any, l
     fig = go.Figure(go.Scattergl(x=x, y=y, mode="markers", marker=dict(size=2, color="black")))
     fig.update_layout(title=f"bifurcation diagram: {variable} (click a value to simulate it)",
                       xaxis=xaxis, yaxis_title=variable)  # fmt: skip
-    return fig, options, variable
+    return below_toolbar(fig), options, variable
 
 
 def point_from_click(store: str | Path, click: dict) -> tuple[str, dict[str, Any]]:

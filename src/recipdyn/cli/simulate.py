@@ -316,6 +316,9 @@ def simulate(
         allowed = ", ".join(f"{k} ({v})" for k, v in DATASET_FORMATS.items())
         raise ParameterError(f"output {out}: unknown extension {out.suffix or '(none)'!r}; "
                              f"allowed: {allowed}")  # fmt: skip
+    from ..io import pandas_without_pyarrow
+
+    pandas_without_pyarrow()  # it writes no Parquet: 34 MB less (docs/reliability.md)
     from ..model.registry import get_model
 
     m = m or get_model()  # every input is valid: the model's module may load now
@@ -436,7 +439,10 @@ def _run(m, params, kw: dict, out: Path, stream: bool, extra: dict, max_memory, 
     if stream and ds.sizes[dim] > FIGURE_SAMPLES:  # the figure shows the last part
         ds = ds.isel({dim: slice(-FIGURE_SAMPLES, None)})
         typer.echo(f"figure and summary: the last {FIGURE_SAMPLES} samples")
-    ds = ds.load()
+    from ..io import no_unused_scheduler
+
+    with no_unused_scheduler():  # a streamed record's tail: read by dask, on no cluster
+        ds = ds.load()
     values = m.values_from_record(ds.attrs)
     m = m.configured(values)
     if figure:
