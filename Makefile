@@ -10,6 +10,7 @@ OUT ?= out
 $(STAMP): pyproject.toml requirements/constraints.txt
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) on PATH (set PYTHON=...)"; exit 2; }
 	$(PYTHON) -m venv $(VENV)
+	@echo "installing recipdyn and its dependencies into $(VENV) with pip (quiet; a few minutes on a fresh machine)..."
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c requirements/constraints.txt -e ".[dev]"
 	@touch $(STAMP)

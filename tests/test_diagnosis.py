@@ -144,7 +144,7 @@ def test_process_pool_gives_the_serial_records_to_the_bit(small, tmp_path):
     features as the serial (interrupted and resumed) build."""
     out, *_ = small
     spec = DatasetSpec(
-        n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.5, seed=3
+        n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.25, seed=3
     )
     a = build_dataset(tmp_path / "p", spec, backend="processes", workers=2, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
@@ -596,19 +596,60 @@ def test_shipped_diagnoser_matches_todays_physics():
         assert diag.predict_proba(x)[0] == pytest.approx(pin["proba"], abs=0.05)
 
 
-def test_cli_refuses_bad_settings_in_one_line(capsys):
+def test_cli_refuses_bad_settings_in_one_line(capsys, tmp_path):
     from recipdyn.cli import main
 
+    rec = tmp_path / "r.csv"
+    rec.write_text("time,accel_guide\n0,1\n0.001,2\n")
     assert main(["dataset", "--conditions", "1", "-o", "unused-folder"]) == 2
-    assert main(["diagnose", "missing.csv"]) == 2  # neither --speed nor --tacho
+    assert main(["diagnose", str(rec)]) == 2  # neither --speed nor --tacho
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "n_conditions" in err[0] and "speed and tacho" in err[1]
 
 
+def _simulated_record(path, sensed: bool = False):
+    """A file laid out as ``recipdyn simulate`` writes one: 108 outputs over time and the
+    record's title (with ``sensed``, as ``recipdyn sense`` leaves it)."""
+    import xarray as xr
+
+    t = np.arange(200) / 2000.0
+    attrs = {"title": "recipdyn simulation: compressor", "model": "compressor"}
+    ds = xr.Dataset({f"out{i}": ("time", np.sin((i + 1) * t)) for i in range(108)},
+                    coords={"time": t}, attrs=attrs)  # fmt: skip
+    if sensed:
+        ds.attrs["sensor_channels"] = "out0"
+    ds.to_netcdf(path)
+    return path
+
+
+def test_diagnose_points_at_the_cause_of_a_bad_input(tmp_path, capsys):
+    """Issue 44, item 4: a file that is not there is said first (it was "speed and tacho:
+    give exactly one"); a simulated record without sensor channels says to run `recipdyn
+    sense` (it listed 108 column names); a record already sensed lists what it has, shortly."""
+    from recipdyn.cli import main
+
+    assert main(["diagnose", str(tmp_path / "nonexist.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "file not found" in err and "speed" not in err, err
+    sim = _simulated_record(tmp_path / "sim.nc")
+    an = str(tmp_path / "an")
+    for argv in (["diagnose", str(sim), "--speed", "20 rad/s"],
+                 ["analyze", str(sim), "-c", "accel_guide", "-o", an]):  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"recipdyn sense {sim}" in err, err
+        assert "out57" not in err and len(err) < 400, err
+    sensed = _simulated_record(tmp_path / "sensed.nc", sensed=True)
+    assert main(["diagnose", str(sensed), "--speed", "20 rad/s"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "recipdyn sense" not in err and "(108 variables in all)" in err and len(err) < 400
+    assert not (tmp_path / "an").exists()
+
+
 def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
     pytest.importorskip("dask.distributed")
-    spec = DatasetSpec(n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"),
-                       test_fraction=0.5, seed=3)  # fmt: skip
+    spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"),
+                       test_fraction=0.25, seed=3)  # fmt: skip
     a = build_dataset(tmp_path / "d", spec, backend="dask", dask_local=1, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
     assert read_features(a)[0].equals(read_features(b)[0])
@@ -936,3 +977,76 @@ def test_a_default_sensed_record_is_not_another_snr_for_a_default_data_sets_diag
         q, (lo, hi) = res.evidence["noise_floor"]["share"], res.evidence["noise_floor"][
             "training_range"]  # fmt: skip
         assert lo / 1.5 <= q <= hi * 1.5
+
+
+# ---- data sets too small or unfinished (issue 44, item 3) -----------------------------------
+
+
+def test_a_data_set_too_small_to_train_on_is_refused_when_asked_for(tmp_path, capsys):
+    """``dataset --conditions 2``: one training condition, which `train` cannot both fit and
+    calibrate on (its split-conformal intervals and out-of-distribution threshold come from
+    conditions the fit has not seen; it crashed with a TypeError). Refused at once, with the
+    minimum for the test fraction; the minimum itself is accepted."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.dataset import min_conditions
+
+    with pytest.raises(ParameterError, match=r"n_conditions = 2 .*leaves 1 training condition"
+                                             r".*allowed: n_conditions >= 3"):  # fmt: skip
+        DatasetSpec(n_conditions=2, classes=("healthy", "crank_pin_clearance"))
+    out = tmp_path / "ds2"
+    assert main(["dataset", "-o", str(out), "--conditions", "2", "--classes",
+                 "healthy,crank_pin_clearance", "--backend", "serial"]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "n_conditions >= 3" in err[0] and not out.exists()
+    assert DatasetSpec(n_conditions=3).n_conditions == 3
+    assert (min_conditions(0.25), min_conditions(0.5), min_conditions(0.75)) == (3, 4, 6)
+
+
+def _table_only_data_set(folder, conditions, splits):
+    """A data set folder holding only a feature table and a data card (what `train` reads
+    before it fits anything)."""
+    import json
+
+    import pandas as pd
+
+    folder.mkdir()
+    cells = [(c, s, lab) for c, s in zip(conditions, splits, strict=True)
+             for lab in ("healthy", "ring_leak")]  # fmt: skip
+    rows = [
+        dict(record=i, condition=c, split=s, label=lab, level=0, severity=0.5, f_x=1.0)
+        for i, (c, s, lab) in enumerate(cells)
+    ]
+    pd.DataFrame(rows).to_parquet(folder / "features.parquet")
+    spec = {"classes": ["healthy", "ring_leak"]}
+    (folder / "datacard.json").write_text(json.dumps({"spec": spec}))
+    return folder
+
+
+def test_train_refuses_a_data_set_with_one_training_condition(tmp_path, capsys):
+    """A data set of two conditions made before the refusal (one train, one test)."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.train import train
+
+    folder = _table_only_data_set(tmp_path / "old", (0, 1), ("train", "test"))
+    with pytest.raises(ParameterError, match=r"1 training condition\(s\); a diagnoser trains "
+                                             r"on 2 at least .* 3 conditions or more"):  # fmt: skip
+        train(folder)
+    assert main(["train", str(folder), "-o", str(tmp_path / "x.skops")]) == 2
+    assert "internal error" not in capsys.readouterr().err
+    assert not (tmp_path / "x.skops").exists()
+
+
+def test_train_on_a_missing_or_unfinished_data_set_says_so(tmp_path):
+    import zarr
+
+    from recipdyn.diagnosis.train import train
+
+    with pytest.raises(ParameterError, match="no such folder"):
+        train(tmp_path / "nowhere")
+    folder = tmp_path / "interrupted"
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="w")
+    g.create_array("done", shape=(6,), chunks=(1,), dtype=bool, fill_value=False)
+    g["done"][:2] = True
+    with pytest.raises(ParameterError, match=r"unfinished data set \(2 of 6 records\): "
+                                             r"finish it with .*--resume"):  # fmt: skip
+        train(folder)

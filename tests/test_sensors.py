@@ -546,3 +546,21 @@ def test_tacho_polarity_baseline_jitter_and_noise(polarity):
     noisy = record(ds, accelerometer=None, tacho=Tacho(noise_std=0.05), seed=9)["tacho"].values
     quiet = noisy[np.mod(ds.theta1.values, 2 * np.pi) > 0.5]
     assert 1.4826 * np.median(np.abs(quiet - np.median(quiet))) == pytest.approx(0.05, rel=0.05)
+
+
+def test_sense_refuses_what_is_not_a_simulated_run(tmp_path, capsys):
+    """Issue 44, item 4 (its class of defect in `sense`): a NetCDF file that no simulation
+    wrote was refused naming the accelerometer's source, a CSV file as unreadable NetCDF;
+    both now say what sense reads and what to do with a measured signal."""
+    from recipdyn.cli import main
+
+    foreign, csv = tmp_path / "measured.nc", tmp_path / "measured.csv"
+    xr.Dataset({"a": ("time", np.zeros(8))}, coords={"time": np.arange(8) / 1e3}).to_netcdf(foreign)
+    csv.write_text("time,a\n0,1\n0.001,2\n")
+    for path, words in ((foreign, "not a run of 'recipdyn simulate'"),
+                        (csv, "sense reads a run of 'recipdyn simulate' (.nc)")):  # fmt: skip
+        out = tmp_path / "o" / "x.nc"
+        assert main(["sense", str(path), "-o", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert words in err and f"recipdyn analyze {path}" in err and "\n" not in err, err
+        assert not out.parent.exists()

@@ -225,7 +225,9 @@ def diagnose(
     closest simulated record overlaid; a record outside the training domain is refused."""
     from ..diagnosis.diagnose import diagnose as diagnose_fn
     from ..errors import ParameterError
+    from ..io_signal import check_signal_file
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     res = diagnose_fn(

@@ -119,6 +119,10 @@ def sense(
     # every option is checked before the record is read or anything is written
     if not run.exists():
         raise ParameterError(f"run file not found: {run}")
+    if run.suffix.lower() != ".nc":
+        raise ParameterError(f"input {run}: sense reads a run of 'recipdyn simulate' (.nc); "
+                             "a measured signal is analysed as it is: recipdyn analyze "
+                             f"{run}")  # fmt: skip
     if not (accel or pressure or tacho):
         raise ParameterError("sensors: --no-accel, --no-pressure and --no-tacho leave nothing "
                              "to record; allowed: at least one sensor")  # fmt: skip
@@ -144,7 +148,12 @@ def sense(
         from ..io import read_dataset, write_dataset
         from ..sensors import record
 
-        ds = read_dataset(run)
+        ds = read_dataset(run, expected="a recipdyn run (NetCDF from 'recipdyn simulate')")
+        if not str(ds.attrs.get("title", "")).startswith("recipdyn simulation"):
+            raise ParameterError(f"input {run}: not a run of 'recipdyn simulate' (no model "
+                                 "recorded); sense makes sensor channels from a simulated "
+                                 f"record; a measured signal is analysed as it is: recipdyn "
+                                 f"analyze {run}")  # fmt: skip
         has_p = any(n in ds.data_vars for n in pres.sources)
         res = record(ds, accelerometer=acc, pressure=pres if pressure and has_p else None,
                      tacho=Tacho() if tacho and "theta1" in ds.data_vars else None,

@@ -129,10 +129,18 @@ class DatasetSpec:
     chain: str = "drawn"
 
     def __post_init__(self):
-        if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
+        if not 0 < self.test_fraction < 1:
+            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
+        n, need = self.n_conditions, min_conditions(self.test_fraction)
+        if not (isinstance(n, int) and n >= 1):
+            raise ParameterError(f"n_conditions = {n!r}; allowed: an integer >= {need}")
+        if n - n_test_conditions(n, self.test_fraction) < MIN_TRAIN_CONDITIONS:
             raise ParameterError(
-                f"n_conditions = {self.n_conditions!r}; allowed: an integer "
-                ">= 2 (one for training, one for testing)"
+                f"n_conditions = {n} (test_fraction = {self.test_fraction:g}) leaves "
+                f"{max(0, n - n_test_conditions(n, self.test_fraction))} training "
+                f"condition(s); allowed: n_conditions >= {need} (a diagnoser trains on "
+                f"{MIN_TRAIN_CONDITIONS} conditions at least, one to fit and one to calibrate "
+                "its severity intervals and out-of-distribution threshold, and tests on 1)"
             )
         if not self.levels or not all(0 < s <= 1 for s in self.levels):
             raise ParameterError(f"levels = {self.levels!r}; allowed: severities in (0, 1]")
@@ -142,8 +150,6 @@ class DatasetSpec:
             raise ParameterError(f"revolutions = {self.revolutions!r}; allowed: [1, 100]")
         if not 0 <= self.transient <= 100:
             raise ParameterError(f"transient = {self.transient!r}; allowed: [0, 100]")
-        if not 0 < self.test_fraction < 1:
-            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
         if not (isinstance(self.seed, int) and 0 <= self.seed < 2**63):
             raise ParameterError(f"seed = {self.seed!r}; allowed: an integer >= 0")
         for c in self.classes:
@@ -231,9 +237,30 @@ def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
     return out
 
 
+#: Training conditions a diagnoser needs: one to fit on and one to calibrate on (its
+#: severity intervals' conformal quantiles and its out-of-distribution threshold come from
+#: whole conditions the fit has not seen: `recipdyn.diagnosis.train`).
+MIN_TRAIN_CONDITIONS = 2
+
+
+def n_test_conditions(n: int, test_fraction: float) -> int:
+    """Conditions held out for testing: ``test_fraction`` of ``n``, at least 1 (and at most
+    ``n - 1``)."""
+    return max(1, min(round(test_fraction * n), n - 1))
+
+
+def min_conditions(test_fraction: float) -> int:
+    """The fewest conditions that leave `MIN_TRAIN_CONDITIONS` for training and one for
+    testing at ``test_fraction``."""
+    n = MIN_TRAIN_CONDITIONS + 1
+    while n - n_test_conditions(n, test_fraction) < MIN_TRAIN_CONDITIONS:
+        n += 1
+    return n
+
+
 def split_of(spec: DatasetSpec) -> list[str]:
     """``"train"`` or ``"test"`` per condition (seeded; at least one of each)."""
-    n_test = min(max(1, round(spec.test_fraction * spec.n_conditions)), spec.n_conditions - 1)
+    n_test = n_test_conditions(spec.n_conditions, spec.test_fraction)
     perm = np.random.default_rng([spec.seed, 1]).permutation(spec.n_conditions)
     test = set(perm[:n_test].tolist())
     return ["test" if i in test else "train" for i in range(spec.n_conditions)]
@@ -854,6 +881,19 @@ def read_features(folder: str | Path):
 
     folder = Path(folder)
     table, card = folder / "features.parquet", folder / "datacard.json"
+    if not folder.is_dir():
+        raise ParameterError(f"{folder}: no such folder; build a data set there with "
+                             f"'recipdyn dataset -o {folder}'")  # fmt: skip
+    if (folder / "signals.zarr").is_dir() and not table.exists():
+        try:
+            done = records_done(folder)
+            count = f" ({int(done.sum())} of {done.size} records)"
+        except Exception:  # noqa: BLE001 - a store too damaged to count: said without
+            count = ""
+        raise ParameterError(
+            f"{folder}: an unfinished data set{count}: finish it with 'recipdyn dataset -o "
+            f"{folder} --resume' and the options that started it"
+        )
     if not table.exists() or not card.exists():
         raise ParameterError(
             f"{folder}: not a data set (no features.parquet/datacard.json); "

@@ -175,8 +175,9 @@ def diagnose(
     Diagnosis
         ``refused=True`` with ``reason`` for a record outside the training domain.
     """
-    from ..io_signal import speed_hz
+    from ..io_signal import check_signal_file, speed_hz
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     sig = _read(record, channel, fs)
