@@ -170,27 +170,27 @@ def train(
 
 @app.command()
 @with_json
-def calibrate(
+def recalibrate(
     model: Path = typer.Argument(..., help="A diagnoser file (.skops)."),
-    data: Path = typer.Argument(
-        ..., help="A data set of other conditions than the diagnoser's ('recipdyn dataset')."
+    data: list[Path] = typer.Argument(
+        ..., help="Data sets of other conditions than the diagnoser's ('recipdyn dataset')."
     ),
     out: Path = typer.Option(..., "--out", "-o", help="The calibrated diagnoser (.skops)."),
 ) -> None:
-    """Calibrate a diagnoser anew on a data set it was not trained on.
+    """Calibrate a diagnoser anew on data sets it was not trained on.
 
     Its out-of-domain refusal, physics consistency check and severity intervals are
-    calibrated on every record of DATA (other operating conditions, other drawn measurement
+    calibrated on every record of the DATA sets (other operating conditions, other drawn measurement
     chains), each cut to every channel set; its classifiers and regressors are kept. Reads
     an older diagnoser file too (format 3) and writes the current format."""
     from ..errors import ParameterError
 
     if out.suffix != ".skops":
         raise ParameterError(f"--out {out}: use a .skops file")
-    from ..diagnosis.train import calibrate as calibrate_fn
     from ..diagnosis.train import load, save
+    from ..diagnosis.train import recalibrate as recalibrate_fn
 
-    diag = calibrate_fn(load(model, any_format=True), data)
+    diag = recalibrate_fn(load(model, any_format=True), *data)
     with refused_leaves_nothing(out):
         save(diag, out)
     d = diag.state["domain"]

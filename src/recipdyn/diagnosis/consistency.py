@@ -89,7 +89,11 @@ def _per_revolution(y, revs, bins=BINS):
     """``(n_revs, bins)`` means of ``y`` in each crank-angle bin of each whole revolution."""
     r = np.asarray(revs, float)
     ok = np.isfinite(r)
-    start, stop = math.ceil(np.nanmin(r) - 1e-9), math.floor(np.nanmax(r) + 1e-9)
+    # whole revolutions as the features count them (`evidence._whole_revs`: a sample or two
+    # short still covers one)
+    fin = r[ok]
+    tol = 2.0 * abs(fin[1] - fin[0]) if fin.size > 1 else 0.0
+    start, stop = math.ceil(fin.min() - tol), math.floor(fin.max() + tol)
     n = stop - start
     if n < 1:
         return np.full((0, bins), np.nan)
@@ -145,12 +149,19 @@ def record_spread(channels: dict, fs: float, speed_hz: float) -> dict[str, np.nd
     )
 
 
+def _split(name: str) -> tuple[str, int]:
+    """A curve feature's prefix and crank angle: ``"ang_120"`` -> ``("ang_", 120)``."""
+    pre, _, deg = name.rpartition("_")
+    return pre + "_", int(deg)
+
+
 def _spread_vector(spread: dict, cols: list[str]) -> np.ndarray:
     out = np.full(len(cols), np.nan)
     for j, n in enumerate(cols):
-        s = spread.get(n[:3])
+        pre, deg = _split(n)
+        s = spread.get(pre)
         if s is not None:
-            out[j] = s[int(n[3:]) // 10]
+            out[j] = s[deg // 10]
     return out
 
 
@@ -312,11 +323,11 @@ class Consistency:
         z = (y - f) / sigma
         j = int(np.argmax(np.abs(z)))
         name = cols[j]
-        a0 = int(name[3:])
+        pre, a0 = _split(name)
         out = {
             "statistic": float(abs(z[j])),
             "worst": {
-                "curve": CURVES[name[:3]],
+                "curve": CURVES[pre],
                 "feature": name,
                 "angle_deg": (a0, a0 + 10),
                 "residual": float(y[j] - f[j]),

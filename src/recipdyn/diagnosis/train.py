@@ -14,7 +14,7 @@
   calibrate the absolute residuals, each record cut to every channel set, so the interval's
   coverage is that of a new operating condition and its drawn measurement chain, for the
   channels the record has (Vovk et al. 2005; Angelopoulos & Bates 2021, sec. 1;
-  `calibrate` adds or replaces the held-out records by another data set's).
+  `recalibrate` calibrates on another data set instead).
 * **Healthy baseline**: every pressure and cycle feature of the healthy training records is
   fitted by least squares as an affine function of the operating point the record itself
   shows (`OPERATING`: the crank speed, the suction and discharge levels), and the classifier
@@ -66,7 +66,7 @@ __all__ = [
     "Diagnoser",
     "save",
     "load",
-    "calibrate",
+    "recalibrate",
     "expected_calibration_error",
     "detection_limits",
     "severity_bins",
@@ -686,36 +686,42 @@ def _calibrate_state(state: dict, held: dict, *, fit_rows, source: str) -> None:
         diag.__dict__.pop(k, None)
 
 
-def calibrate(diag: Diagnoser, folder: str | Path) -> Diagnoser:
-    """``diag`` calibrated anew on every record of the data set in ``folder``: records its
+def recalibrate(diag: Diagnoser, *folders: str | Path) -> Diagnoser:
+    """``diag`` calibrated anew on every record of the data sets in ``folders``: records its
     training did not use (other operating conditions, other drawn measurement chains), each
     cut to every channel set. The detector and the consistency library are then fitted on
     all of ``diag``'s training records, the regressors and classifiers kept as they are.
-    The data set must be of ``diag``'s classes and features (else refused, naming it)."""
-    folder = Path(folder)
-    df, card = read_features(folder)
-    names = diag.names
-    missing = [n for n in names if f"f_{n}" not in df.columns]
-    if missing:
-        raise ParameterError(
-            f"{folder}: its features lack {missing[:3]} of the diagnoser's; build the "
-            "calibration data set with this recipdyn"
-        )
-    df = df[df.label.isin(diag.classes)].reset_index(drop=True)
-    if df.empty:
-        raise ParameterError(f"{folder}: no record of the diagnoser's classes")
+    A data set must be of ``diag``'s features and share a class with it (else refused,
+    naming it); its records of other classes are left out."""
     import copy
 
-    state = copy.copy(diag.state)
-    for old in ("ood_threshold", "conformal"):  # format 3's fixed threshold and half-widths
-        state.pop(old, None)
-    state["format"] = FORMAT
+    names = diag.names
+    parts, sources = [], []
     with one_thread():
-        held = held_out_rows(folder, df, names)
+        for folder in map(Path, folders):
+            df, card = read_features(folder)
+            missing = [n for n in names if f"f_{n}" not in df.columns]
+            if missing:
+                raise ParameterError(
+                    f"{folder}: its features lack {missing[:3]} of the diagnoser's; build "
+                    "the calibration data set with this recipdyn"
+                )
+            df = df[df.label.isin(diag.classes)].reset_index(drop=True)
+            if df.empty:
+                raise ParameterError(f"{folder}: no record of the diagnoser's classes")
+            parts.append(held_out_rows(folder, df, names))
+            sources.append(f"{len(df)} records of {df.condition.nunique()} conditions of "
+                           f"{folder.name} (seed {card['spec'].get('seed')})")  # fmt: skip
+        if not parts:
+            raise ParameterError("recalibrate: give at least one data set")
+        held = {k: np.concatenate([p[k] for p in parts]) for k in ("X", "labels", "severity")}
+        held["spreads"] = [s for p in parts for s in p["spreads"]]
+        state = copy.copy(diag.state)
+        for old in ("ood_threshold", "conformal"):  # format 3's threshold and half-widths
+            state.pop(old, None)
+        state["format"] = FORMAT
         n = len(state["train_labels"])
-        _calibrate_state(state, held, fit_rows=np.ones(n, bool),
-                         source=f"{len(df)} records of {df.condition.nunique()} conditions "
-                         f"of {folder.name} (seed {card['spec'].get('seed')})")  # fmt: skip
+        _calibrate_state(state, held, fit_rows=np.ones(n, bool), source="; ".join(sources))
     return Diagnoser(state)
 
 
@@ -1002,7 +1008,7 @@ def save(diag: Diagnoser, path: str | Path) -> Path:
 def load(path: str | Path, *, check_version: bool = True, any_format: bool = False) -> Diagnoser:
     """Read a diagnoser file; refuses one written by another recipdyn or scikit-learn version
     (its predictions would not be those evaluated) and one holding untrusted types.
-    ``any_format``: read an older file format too (for `calibrate`, which brings it to
+    ``any_format``: read an older file format too (for `recalibrate`, which brings it to
     `FORMAT`; such a diagnoser cannot diagnose until calibrated)."""
     import skops.io as sio
 
@@ -1027,8 +1033,8 @@ def load(path: str | Path, *, check_version: bool = True, any_format: bool = Fal
         raise ParameterError(
             f"diagnoser {path}: file format {state['format']}, this recipdyn reads format "
             f"{FORMAT} (its out-of-domain refusal and severity intervals are calibrated on "
-            "held-out records; format 3 held a fixed distance threshold); calibrate it with "
-            "'recipdyn calibrate FILE DATASET -o NEW' on a data set of other conditions, or "
+            "held-out records; format 3 held a fixed distance threshold); recalibrate it with "
+            "'recipdyn recalibrate FILE DATASET -o NEW' on a data set of other conditions, or "
             "rebuild it with 'recipdyn train DATASET -o FILE' ('make diagnoser' for the "
             "default one)"
         )
