@@ -767,7 +767,6 @@ def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
     with every channel, which printed intervals such as 1.00..1.00 for any machine). Its
     interval's half-width is at least half the levels' spacing. A diagnoser trained on drawn
     severities (the shipped one) keeps its conformal half-width."""
-    import copy
     import json
 
     from recipdyn.diagnosis.diagnose import default_model_path
@@ -779,16 +778,17 @@ def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
     assert shipped.severity_resolution == 0.0
     row = shipped.state["center"][None, :].copy()  # a full-channel row (every group finite)
     label = "ring_leak"
-    q = shipped.state["conformal"][label]["full"]
+    q = shipped.half_widths(label, "full")[0]
     s, lo, hi = shipped.severity(row, label)
     assert (lo[0], hi[0]) == (max(s[0] - q, 0.0), min(s[0] + q, 1.0))
     # the same diagnoser as if trained on four levels, with a collapsed conformal half-width
     levels = [0.25, 0.5, 0.75, 1.0]
     card["spec"].update(severity_range=None, levels=levels)
-    state = copy.deepcopy({k: shipped.state[k] for k in ("datacard_json", "conformal")})
-    state["datacard_json"] = json.dumps(card)
-    state["conformal"][label] = dict.fromkeys(state["conformal"][label], 1e-5)
+    sc = shipped.state["severity_calibration"]
+    tiny = dict(sc[label], residuals=np.full(len(sc[label]["residuals"]), 1e-5))
+    state = {"datacard_json": json.dumps(card), "severity_calibration": {**sc, label: tiny}}
     fixed = Diagnoser({**shipped.state, **state})
+    assert fixed.half_widths(label, "full")[0] == pytest.approx(1e-5)
     r = fixed.severity_resolution
     assert r == pytest.approx(0.125)
     s, lo, hi = fixed.severity(row, label)

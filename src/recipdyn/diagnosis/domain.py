@@ -11,8 +11,8 @@ score. The score decides only how many records *outside* the domain are caught.
 
 Scores (`DETECTORS`), each fitted per channel set (`recipdyn.diagnosis.train.AVAILABILITY`) on
 that set's columns of the training records, after a rank-based (quantile) transform of each
-feature to a standard normal fitted on the same records (a few heavy-tailed features, such as
-a knocking pin's peak, would otherwise dominate every distance):
+feature to a standard normal fitted on the same records (`TRANSFORM`; a few heavy-tailed
+features, such as a knocking pin's peak, would otherwise dominate every distance):
 
 * ``knn``: the distance to the `K_NEIGHBOURS`-th nearest training record (scikit-learn
   ``NearestNeighbors``), RMS per feature;
@@ -67,6 +67,12 @@ LOF_NEIGHBOURS = 20
 FOREST_TREES = 300
 #: Quantiles of the rank-based transform (at most the training records).
 QUANTILES = 200
+#: How the scaled features are transformed before a score: ``quantile`` (each to a standard
+#: normal by its rank among the training records) or ``robust`` (the median/IQR scaling
+#: alone, clipped at +-`CLIP`).
+TRANSFORM = "quantile"
+TRANSFORMS = ("quantile", "robust")
+CLIP = 50.0
 
 
 def _prep(Z: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -77,15 +83,21 @@ def _prep(Z: np.ndarray, cols: np.ndarray) -> np.ndarray:
 class _Scorer:
     """One channel set's detector, fitted on the training rows ``Zfit`` (columns ``cols``)."""
 
-    def __init__(self, method: str, Zfit: np.ndarray, labels: np.ndarray, cols, seed: int):
+    def __init__(self, method: str, Zfit: np.ndarray, labels: np.ndarray, cols, seed: int,
+                 transform: str = TRANSFORM):  # fmt: skip
         from sklearn.preprocessing import QuantileTransformer
 
         self.method, self.cols = method, np.asarray(cols, int)
         A = _prep(Zfit, self.cols)
-        self.qt = QuantileTransformer(
-            n_quantiles=min(QUANTILES, A.shape[0]), output_distribution="normal"
-        ).fit(A)
-        T = self.qt.transform(A)
+        if transform == "quantile":
+            self.qt = QuantileTransformer(
+                n_quantiles=min(QUANTILES, A.shape[0]), output_distribution="normal"
+            ).fit(A)
+        elif transform == "robust":
+            self.qt = None
+        else:
+            raise ValueError(f"transform {transform!r}; allowed: {', '.join(TRANSFORMS)}")
+        T = self._transform(A)
         self.labels = np.asarray(labels)
         if method in ("knn", "class"):
             from sklearn.neighbors import NearestNeighbors
@@ -109,10 +121,13 @@ class _Scorer:
         else:
             raise ValueError(f"method {method!r}; allowed: {', '.join(DETECTORS)}")
 
+    def _transform(self, A: np.ndarray) -> np.ndarray:
+        return np.clip(A, -CLIP, CLIP) if self.qt is None else self.qt.transform(A)
+
     def score(self, Z: np.ndarray, labels=None) -> np.ndarray:
         """Scores of the scaled rows ``Z`` (larger: less like the training records);
         ``labels``: the class each is given (the ``class`` score)."""
-        T = self.qt.transform(_prep(np.atleast_2d(Z), self.cols))
+        T = self._transform(_prep(np.atleast_2d(Z), self.cols))
         d = np.sqrt(T.shape[1])
         if self.method == "knn":
             return self.nn[None].kneighbors(T)[0][:, -1] / d
@@ -133,6 +148,7 @@ def fit_domain(
     *,
     fit_rows: np.ndarray,
     method: str = METHOD,
+    transform: str = TRANSFORM,
     alpha: float = ALPHA,
     seed: int = 0,
     source: str = "",
@@ -155,6 +171,7 @@ def fit_domain(
     """
     dom = {
         "method": method,
+        "transform": transform,
         "alpha": float(alpha),
         "seed": int(seed),
         "fit_rows": np.asarray(fit_rows, bool),
@@ -182,7 +199,9 @@ class Domain:
         Z = np.asarray(Z_fit, float)[rows]
         lab = np.asarray(labels_fit)[rows]
         self._scorers = {
-            k: _Scorer(state["method"], Z, lab, cols, state["seed"])
+            k: _Scorer(
+                state["method"], Z, lab, cols, state["seed"], state.get("transform", TRANSFORM)
+            )  # fmt: skip
             for k, cols in state["subsets"].items()
         }
         self._cc = None
