@@ -483,6 +483,34 @@ def test_a_diagnoser_of_another_version_is_refused(trained, tmp_path):
         load(path)
 
 
+def test_an_older_diagnoser_file_is_refused_with_the_remedy(trained, small, tmp_path):
+    """A format-3 file (a fixed kNN threshold, one severity half-width per channel set: no
+    held-out calibration to read) is refused in one line naming the two commands that make
+    a current one; `recalibrate` reads it and writes the current format, calibrated on every
+    record of another data set (here the small one's own, each cut to every channel set)."""
+    from recipdyn.diagnosis.train import AVAILABILITY, FORMAT, Diagnoser, load, save
+    from recipdyn.diagnosis.train import recalibrate
+
+    diag, _ = trained
+    old = {k: v for k, v in diag.state.items()
+           if k not in ("domain", "consistency", "severity_calibration")}  # fmt: skip
+    old.update(format=3, ood_threshold=dict.fromkeys(AVAILABILITY, 1.0))
+    path = save(Diagnoser(old), tmp_path / "old.skops")
+    with pytest.raises(ParameterError, match=r"format 3.*recipdyn recalibrate.*recipdyn train"):
+        load(path)
+    again = recalibrate(load(path, any_format=True), small[0])
+    df, _ = read_features(small[0])
+    n = len(df)
+    assert again.state["format"] == FORMAT and "ood_threshold" not in again.state
+    assert again.state["calibration_records"] == n
+    bins = list(again.state["domain"]["cal_bins"])
+    assert all(bins.count(k) == n for k in AVAILABILITY)
+    back = load(save(again, tmp_path / "new.skops"))
+    X = df[[f"f_{c}" for c in diag.names]].to_numpy(float)
+    o = back.ood(X[0], df.label.iloc[0])
+    assert 1 / (n + 1) <= o["p_value"] <= 1 and o["n_calibration"] == n
+
+
 # ---- diagnose --------------------------------------------------------------------------------
 
 
