@@ -488,8 +488,7 @@ def test_an_older_diagnoser_file_is_refused_with_the_remedy(trained, small, tmp_
     held-out calibration to read) is refused in one line naming the two commands that make
     a current one; `recalibrate` reads it and writes the current format, calibrated on every
     record of another data set (here the small one's own, each cut to every channel set)."""
-    from recipdyn.diagnosis.train import AVAILABILITY, FORMAT, Diagnoser, load, save
-    from recipdyn.diagnosis.train import recalibrate
+    from recipdyn.diagnosis.train import AVAILABILITY, FORMAT, Diagnoser, load, recalibrate, save
 
     diag, _ = trained
     old = {k: v for k, v in diag.state.items()
