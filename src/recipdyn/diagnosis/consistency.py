@@ -223,7 +223,8 @@ def _library(Z, center, scale, names, labels, severities, rows, label, subset):
     Y, U = X[:, idx], X[:, ops]
     sev = np.asarray(severities, float)[m]
     ok = np.isfinite(Y).all(axis=1) & np.isfinite(U).all(axis=1)
-    has_sev = bool(np.isfinite(sev[ok]).any())
+    s_ok = sev[ok][np.isfinite(sev[ok])]
+    has_sev = bool(s_ok.size and np.ptp(s_ok) > 0)  # the healthy machine: no severity
     sev = np.nan_to_num(sev, nan=0.0)
     return _Library(Y[ok], U[ok], sev[ok], has_sev), cols
 

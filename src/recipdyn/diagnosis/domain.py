@@ -212,6 +212,8 @@ class Domain:
 
     def score(self, Z: np.ndarray, subset: str, labels=None) -> np.ndarray:
         Z = np.atleast_2d(Z)
+        if self.state["method"] == "class" and labels is None:
+            raise ValueError("the class score needs the class each record is given (labels)")
         if labels is None or np.ndim(labels) == 0:
             labels = np.full(Z.shape[0], labels, dtype=object)
         return self._scorers[subset].score(Z, np.asarray(labels))
@@ -247,12 +249,14 @@ def refusal(diag, row: np.ndarray, label: str) -> tuple[dict[str, Any], str]:
     o = diag.ood(row, label)
     if o["p_value"] >= o["alpha"]:
         return o, ""
-    share = f"{o['p_value'] * (o['n_calibration'] + 1) - 1:.0f} of {o['n_calibration']}"
-    what = f" the {label} records" if o["method"] == "class" else ""
+    n = o["n_calibration"]
+    k = round(o["p_value"] * (n + 1)) - 1  # held-out records scoring at least as high
+    share = f"any of the {n}" if k == 0 else f"all but {k} of the {n}"
+    what = f"the {label} training records" if o["method"] == "class" else "the training records"
     return o, (
         f"the record lies outside the training domain: its features (channels: "
-        f"{o['features']}) are less like{what or ' the training records'} than {share} "
-        f"held-out in-domain records are (novelty p-value {o['p_value']:.3f} < "
+        f"{o['features']}) are less like {what} than {share} held-out in-domain records "
+        f"are (novelty p-value {o['p_value']:.3f} < "
         f"{o['alpha']:g}, score {o['score']:.2f}, {o['method']}): another measurement chain, "
         "another machine or a fault outside the data set; train or calibrate a diagnoser on "
         "records like it"
