@@ -551,6 +551,11 @@ def test_diagnose_a_ten_revolution_record(tmp_path):
         assert lo <= res.severity <= hi
     assert res.evidence["closest_record"]["label"] == res.label
     assert res.evidence["impacts_per_rev"] >= 0
+    # in the domain (its novelty p-value), and a simulated record of its class explains it
+    assert res.ood["p_value"] >= res.ood["alpha"] and res.ood["n_calibration"] > 0
+    c = res.evidence["consistency"]
+    assert c["fit"]["label"] == res.label and c["p_value"] >= c["alpha"]
+    assert np.isfinite(c["statistic"]) and c["worst"]["curve"]
     from matplotlib.image import imread
 
     img = imread(res.figure)
@@ -565,6 +570,24 @@ def test_diagnose_refuses_another_speed_range(tmp_path):
     res = diagnose(path, tacho="tacho")
     assert res.refused and "crank speed" in res.reason and "training range" in res.reason
     assert main(["diagnose", str(path), "--tacho", "tacho"]) == 2
+
+
+def test_diagnose_refuses_another_discharge_pressure_as_out_of_domain(tmp_path):
+    """The same held-out record at 6 bar discharge (the data set's 2.7-3.3 bar): its speed,
+    sampling rate, noise floor and sensor band are the training's, and the chain correction
+    passes it; the out-of-domain p-value refuses it (the old fixed margin answered such a
+    record `ring_leak` p 0.51), naming the p-value, the channels and the class's records."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.diagnose import diagnose
+
+    path = _record(tmp_path, "six", params={"discharge_pressure": 6e5})
+    kw = {"tacho": "tacho", "p_head": "p_head_sensor", "p_crank": "p_crank_sensor"}
+    res = diagnose(path, **kw)
+    assert res.refused and "outside the training domain" in res.reason, res.reason
+    assert res.ood["p_value"] < res.ood["alpha"] and "novelty p-value" in res.reason
+    argv = ["diagnose", str(path), "--tacho", "tacho", "--p-head", "p_head_sensor",
+            "--p-crank", "p_crank_sensor"]  # fmt: skip
+    assert main(argv) == 2
 
 
 def test_diagnose_refuses_another_sensor_band(tmp_path):
