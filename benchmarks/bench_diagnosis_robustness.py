@@ -172,11 +172,12 @@ def main(argv: list[str] | None = None) -> dict:
             f = features_of(ch, tt["fs"], tt["params"]["omega"] / (2 * math.pi))
             x = np.array([[f[k] for k in diag.names]])
             lo, hi = diag.state["ring_range"]
-            d, thr, _ = diag.ood(x[0])
+            lab = classes[int(np.argmax(diag.predict_proba(x)[0]))]
+            o = diag.ood(x[0], lab)
             ring_ok = lo * (1 - RING_SLACK) <= f["acc_ring_hz"] <= hi * (1 + RING_SLACK)
             floor = noise_floor(diag, x[0])
             floor_ok = floor is None or floor[1] / FLOOR_SLACK <= floor[0] <= floor[2] * FLOOR_SLACK
-            refused += (not ring_ok) or (not floor_ok) or d > thr
+            refused += (not ring_ok) or (not floor_ok) or o["p_value"] < o["alpha"]
             ok = classes[int(np.argmax(diag.predict_proba(x)[0]))] == t["label"]
             right += ok
             n += 1

@@ -348,3 +348,27 @@ def test_undoing_a_known_chain_gives_the_frame_correct_chain_maps_to(reference):
     # the crank end: its offset's interval, and the gain ratio's times the pressure it scales
     bound = e["offset_crank"].uncertainty + e["gain_ratio"].uncertainty * np.max(np.abs(pc))
     assert np.max(np.abs(fix.p_crank - c_known)) <= bound
+
+
+def test_a_flat_pressure_is_refused_naming_the_channel_not_crashed():
+    """A pressure channel of no compressor (flat at 1 bar, 50 Pa of noise: the blind set's
+    rolling-bearing record) has no polytropic compression or re-expansion: its exponents
+    cannot be fitted (the log of the pressure above the fitted offset is undefined), and the
+    correction refuses it naming the channel, where it crashed before in the reference's
+    neighbour search on NaN exponents."""
+    from recipdyn.diagnosis import default_model_path, load
+    from recipdyn.diagnosis.correction import correct_chain, pressure_phase
+    from recipdyn.diagnosis.diagnose import chain_reference
+
+    fs, f = 10240.0, 190 / 60
+    n = int(4 / f * fs)
+    revs = np.arange(n) / fs * f
+    ref = chain_reference(load(default_model_path()))
+    for seed in (0, 1):
+        rng = np.random.default_rng(seed)
+        ph = 1e5 + 50 * rng.standard_normal(n)
+        pc = 1e5 + 50 * rng.standard_normal(n)
+        r = pressure_phase(ph, revs, "head")
+        assert not r["ok"]
+        fix = correct_chain(revs, p_head=ph, p_crank=pc, reference=ref)
+        assert fix.refused.startswith("p_head: no polytropic compression and re-expansion")

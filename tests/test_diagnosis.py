@@ -483,6 +483,33 @@ def test_a_diagnoser_of_another_version_is_refused(trained, tmp_path):
         load(path)
 
 
+def test_an_older_diagnoser_file_is_refused_with_the_remedy(trained, small, tmp_path):
+    """A format-3 file (a fixed kNN threshold, one severity half-width per channel set: no
+    held-out calibration to read) is refused in one line naming the two commands that make
+    a current one; `recalibrate` reads it and writes the current format, calibrated on every
+    record of another data set (here the small one's own, each cut to every channel set)."""
+    from recipdyn.diagnosis.train import AVAILABILITY, FORMAT, Diagnoser, load, recalibrate, save
+
+    diag, _ = trained
+    old = {k: v for k, v in diag.state.items()
+           if k not in ("domain", "consistency", "severity_calibration")}  # fmt: skip
+    old.update(format=3, ood_threshold=dict.fromkeys(AVAILABILITY, 1.0))
+    path = save(Diagnoser(old), tmp_path / "old.skops")
+    with pytest.raises(ParameterError, match=r"format 3.*recipdyn recalibrate.*recipdyn train"):
+        load(path)
+    again = recalibrate(load(path, any_format=True), small[0])
+    df, _ = read_features(small[0])
+    n = len(df)
+    assert again.state["format"] == FORMAT and "ood_threshold" not in again.state
+    assert again.state["calibration_records"] == n
+    bins = list(again.state["domain"]["cal_bins"])
+    assert all(bins.count(k) == n for k in AVAILABILITY)
+    back = load(save(again, tmp_path / "new.skops"))
+    X = df[[f"f_{c}" for c in diag.names]].to_numpy(float)
+    o = back.ood(X[0], df.label.iloc[0])
+    assert 1 / (n + 1) <= o["p_value"] <= 1 and o["n_calibration"] == n
+
+
 # ---- diagnose --------------------------------------------------------------------------------
 
 
@@ -524,6 +551,11 @@ def test_diagnose_a_ten_revolution_record(tmp_path):
         assert lo <= res.severity <= hi
     assert res.evidence["closest_record"]["label"] == res.label
     assert res.evidence["impacts_per_rev"] >= 0
+    # in the domain (its novelty p-value), and a simulated record of its class explains it
+    assert res.ood["p_value"] >= res.ood["alpha"] and res.ood["n_calibration"] > 0
+    c = res.evidence["consistency"]
+    assert c["fit"]["label"] == res.label and c["p_value"] >= c["alpha"]
+    assert np.isfinite(c["statistic"]) and c["worst"]["curve"]
     from matplotlib.image import imread
 
     img = imread(res.figure)
@@ -538,6 +570,24 @@ def test_diagnose_refuses_another_speed_range(tmp_path):
     res = diagnose(path, tacho="tacho")
     assert res.refused and "crank speed" in res.reason and "training range" in res.reason
     assert main(["diagnose", str(path), "--tacho", "tacho"]) == 2
+
+
+def test_diagnose_refuses_another_discharge_pressure_as_out_of_domain(tmp_path):
+    """The same held-out record at 6 bar discharge (the data set's 2.7-3.3 bar): its speed,
+    sampling rate, noise floor and sensor band are the training's, and the chain correction
+    passes it; the out-of-domain p-value refuses it (the old fixed margin answered such a
+    record `ring_leak` p 0.51), naming the p-value, the channels and the class's records."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.diagnose import diagnose
+
+    path = _record(tmp_path, "six", params={"discharge_pressure": 6e5})
+    kw = {"tacho": "tacho", "p_head": "p_head_sensor", "p_crank": "p_crank_sensor"}
+    res = diagnose(path, **kw)
+    assert res.refused and "outside the training domain" in res.reason, res.reason
+    assert res.ood["p_value"] < res.ood["alpha"] and "novelty p-value" in res.reason
+    argv = ["diagnose", str(path), "--tacho", "tacho", "--p-head", "p_head_sensor",
+            "--p-crank", "p_crank_sensor"]  # fmt: skip
+    assert main(argv) == 2
 
 
 def test_diagnose_refuses_another_sensor_band(tmp_path):
@@ -767,7 +817,6 @@ def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
     with every channel, which printed intervals such as 1.00..1.00 for any machine). Its
     interval's half-width is at least half the levels' spacing. A diagnoser trained on drawn
     severities (the shipped one) keeps its conformal half-width."""
-    import copy
     import json
 
     from recipdyn.diagnosis.diagnose import default_model_path
@@ -779,16 +828,17 @@ def test_a_severity_interval_is_never_narrower_than_the_training_levels_allow():
     assert shipped.severity_resolution == 0.0
     row = shipped.state["center"][None, :].copy()  # a full-channel row (every group finite)
     label = "ring_leak"
-    q = shipped.state["conformal"][label]["full"]
+    q = shipped.half_widths(label, "full")[0]
     s, lo, hi = shipped.severity(row, label)
     assert (lo[0], hi[0]) == (max(s[0] - q, 0.0), min(s[0] + q, 1.0))
     # the same diagnoser as if trained on four levels, with a collapsed conformal half-width
     levels = [0.25, 0.5, 0.75, 1.0]
     card["spec"].update(severity_range=None, levels=levels)
-    state = copy.deepcopy({k: shipped.state[k] for k in ("datacard_json", "conformal")})
-    state["datacard_json"] = json.dumps(card)
-    state["conformal"][label] = dict.fromkeys(state["conformal"][label], 1e-5)
+    sc = shipped.state["severity_calibration"]
+    tiny = dict(sc[label], residuals=np.full(len(sc[label]["residuals"]), 1e-5))
+    state = {"datacard_json": json.dumps(card), "severity_calibration": {**sc, label: tiny}}
     fixed = Diagnoser({**shipped.state, **state})
+    assert fixed.half_widths(label, "full")[0] == pytest.approx(1e-5)
     r = fixed.severity_resolution
     assert r == pytest.approx(0.125)
     s, lo, hi = fixed.severity(row, label)

@@ -170,6 +170,38 @@ def train(
 
 @app.command()
 @with_json
+def recalibrate(
+    model: Path = typer.Argument(..., help="A diagnoser file (.skops)."),
+    data: list[Path] = typer.Argument(
+        ..., help="Data sets of other conditions than the diagnoser's ('recipdyn dataset')."
+    ),
+    out: Path = typer.Option(..., "--out", "-o", help="The calibrated diagnoser (.skops)."),
+) -> None:
+    """Calibrate a diagnoser anew on data sets it was not trained on.
+
+    Its out-of-domain refusal, physics consistency check and severity intervals are
+    calibrated on every record of the DATA sets (other operating conditions, other drawn measurement
+    chains), each cut to every channel set; its classifiers and regressors are kept. Reads
+    an older diagnoser file too (format 3) and writes the current format."""
+    from ..errors import ParameterError
+
+    if out.suffix != ".skops":
+        raise ParameterError(f"--out {out}: use a .skops file")
+    from ..diagnosis.train import load, save
+    from ..diagnosis.train import recalibrate as recalibrate_fn
+
+    diag = recalibrate_fn(load(model, any_format=True), *data)
+    with refused_leaves_nothing(out):
+        save(diag, out)
+    d = diag.state["domain"]
+    typer.echo(
+        f"calibrated on {diag.state['calibration_records']} records ({d['source']}); wrote {out}"
+    )
+    report(model=str(out), calibration=d["source"])
+
+
+@app.command()
+@with_json
 def diagnose(
     record: Path = typer.Argument(..., help="A record: CSV/TSV/WAV/MAT/NetCDF/Parquet."),
     channel: str = typer.Option(

@@ -565,7 +565,10 @@ def _fit_phase(p, phi, segs, chamber, a0=None):
     exps, noise = {}, []
     for kind, (q, f) in zip(segs, parts, strict=True):
         lv = np.log(chamber_volume(f + a, chamber))
-        exps[kind] = -float(np.polyfit(lv, np.log(q - o), 1)[0])
+        if np.all(q - o > 0):
+            exps[kind] = -float(np.polyfit(lv, np.log(q - o), 1)[0])
+        else:  # the segment dips below the fitted offset: no polytrope (not a chamber's)
+            exps[kind] = math.nan
     r = sol.fun
     noise = float(np.std(np.diff(r)) / math.sqrt(2.0))
     return sol.x, cov, math.sqrt(s2), exps, noise
@@ -610,6 +613,10 @@ def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
         out.update(p_lo=lo, p_hi=hi)
         return out
     x, cov, rms, exps, noise = _fit_phase(pp, phi, segs, chamber)
+    if not all(math.isfinite(v) for v in exps.values()):
+        # no exponent could be fitted (a flat or noisy channel): no polytropic segments
+        out.update(p_lo=float(lo), p_hi=float(hi))
+        return out
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     per_rev, per_off = [], []
     rev_of = np.floor(r[whole] - start).astype(int)

@@ -5,10 +5,11 @@ channels by name); the crank angle comes from a once-per-revolution tacho whose 
 outer dead centre, or from a constant speed (then the features that need the angle are left
 out and the diagnosis is less sharp). Before any answer, the record must lie in the
 diagnoser's training domain: its crank speed and sampling rate inside the training ranges,
-the frequency at which its impacts ring inside the training sensor band, its
-features no farther from the training records than the held-out conditions were
-(`recipdyn.diagnosis.train.Diagnoser.ood`). Otherwise the diagnosis is withheld, with the
-reason.
+the frequency at which its impacts ring inside the training sensor band, its features not
+less like the training records than all but a stated share of held-out records
+(`recipdyn.diagnosis.domain`: a conformal novelty p-value); and the best-fitting simulated
+record of the class named must explain it within its noise
+(`recipdyn.diagnosis.consistency`). Otherwise the diagnosis is withheld, with the reason.
 """
 
 from __future__ import annotations
@@ -118,10 +119,23 @@ class Diagnosis:
                 f"head-end pressure shape: largest deviation from the closest healthy "
                 f"simulated record {pd_['max']:.3f} (of its range) at {pd_['angle_deg']:.0f} deg"
             )
+        o = self.ood
         lines.append(
-            f"in domain: distance {self.ood['distance']:.2f} <= {self.ood['threshold']:.2f} "
-            f"({self.ood['features']})"
+            f"in domain: novelty p-value {o['p_value']:.3f} >= {o['alpha']:g} (score "
+            f"{o['score']:.2f} against {o['n_calibration']} held-out records, features: "
+            f"{o['features']})"
         )
+        c = ev.get("consistency") or {}
+        if c.get("fit"):
+            f, w = c["fit"], c["worst"]
+            sev = f" at severity {f['severity']:.2f}" if math.isfinite(f["severity"]) else ""
+            lines.append(
+                f"physics: the best-fitting simulated {f['label']}{sev} explains the record "
+                f"within {c['statistic']:.1f} standard deviations (largest: {w['curve']} at "
+                f"{w['angle_deg'][0]}-{w['angle_deg'][1]} deg; p-value {c['p_value']:.2f})"
+            )
+        elif c.get("reason"):
+            lines.append(f"physics: not checked ({c['reason']})")
         if self.figure:
             lines.append(f"closest simulated record overlaid: {self.figure}")
         lines.append(
@@ -352,25 +366,30 @@ def _diagnose_arrays(
             "resonance",
             t0,
         )
-    d, thr, subset = diag.ood(X[0])
-    res.ood = {"distance": d, "threshold": thr, "features": subset}
-    if d > thr:
-        return _refuse(
-            res,
-            f"the record's features lie {d / thr:.1f} times farther from the "
-            f"training records than the held-out conditions' (distance {d:.2f}, "
-            f"threshold {thr:.2f}, features: {subset}): another sensor band, "
-            "another machine or a fault outside the data set",
-            t0,
-        )
     proba = diag.predict_proba(X)[0]
     classes = diag.classes
     k = int(np.argmax(proba))
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
     # a class is named only with channels whose held-out answers of it were right
+    from .train import available
+
+    subset = available(X[0], diag.names)
     named, why, facts = gate(naming_of(diag), subset, classes[k])
     res.evidence["channels"] = facts
     if not named:
+        return _refuse(res, why, t0)
+    # out of the domain (domain.py), then not explained by the physics (consistency.py)
+    from .consistency import refusal as inconsistent
+    from .domain import refusal as out_of_domain
+
+    res.ood, why = out_of_domain(diag, X[0], classes[k])
+    if why:
+        return _refuse(res, why, t0)
+    s0 = diag.severity(X, classes[k])[0][0] if classes[k] != "healthy" else None
+    res.evidence["consistency"], why = inconsistent(
+        diag, X[0], classes[k], x, fs, revs, ph, pc, angle=tacho is not None, severity=s0
+    )
+    if why:
         return _refuse(res, why, t0)
     res.label = classes[k]
     if res.label != "healthy":
@@ -550,7 +569,7 @@ def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
 
 
 def _closest(diag, row, label: str) -> int:
-    from .train import K_NEIGHBOURS, _cols, available, knn_distance  # noqa: F401
+    from .train import _cols, available
 
     st = diag.state
     idx = np.array([i for i, lab in enumerate(st["train_labels"]) if lab == label])

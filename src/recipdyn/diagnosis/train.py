@@ -9,9 +9,12 @@
   missing features natively, is deterministic for a fixed ``random_state`` and persists
   with skops.
 * **Severity**: one `HistGradientBoostingRegressor` per fault class on the severity in [0, 1],
-  with **split-conformal** intervals: a quarter of the training conditions (whole conditions)
-  is held out to calibrate the absolute residuals, so the interval's coverage is that of a
-  new operating condition (Vovk et al. 2005; Angelopoulos & Bates 2021, sec. 1).
+  with **split-conformal** intervals (crepes' Mondrian ``ConformalRegressor``, one category
+  per channel set): a quarter of the training conditions (whole conditions) is held out to
+  calibrate the absolute residuals, each record cut to every channel set, so the interval's
+  coverage is that of a new operating condition and its drawn measurement chain, for the
+  channels the record has (Vovk et al. 2005; Angelopoulos & Bates 2021, sec. 1;
+  `recalibrate` calibrates on another data set instead).
 * **Healthy baseline**: every pressure and cycle feature of the healthy training records is
   fitted by least squares as an affine function of the operating point the record itself
   shows (`OPERATING`: the crank speed, the suction and discharge levels), and the classifier
@@ -22,11 +25,15 @@
   machine's recall on held-out conditions from 0.70 to about 0.9: a mildly sticking plate's
   extra suction dip is a few per mille of the span, as large as the dip's own change with
   speed and pressures, and stands out once those are taken off.
-* **Out of distribution**: the features are scaled by the training median and interquartile
-  range; a record's distance to its `K_NEIGHBOURS`-th nearest training record (over the
-  features the record has) is compared with the 99th percentile of the same distance for the
-  calibration conditions, times `OOD_MARGIN`; the crank speed and the sampling rate must lie
-  in the training ranges.
+* **Out of distribution** (`recipdyn.diagnosis.domain`): a detector fitted on the proper
+  training conditions' records, per channel set, scores a record; its conformal novelty
+  p-value against the held-out conditions' records (each cut to every channel set) below
+  `recipdyn.diagnosis.domain.ALPHA` refuses it. The crank speed and the sampling rate must
+  lie in the training ranges.
+* **Physics consistency** (`recipdyn.diagnosis.consistency`): the best-fitting record of
+  the named class, interpolated from the proper training records at the record's operating
+  point and best severity, must explain the record's curves over the revolution within
+  their uncertainty (p-value against the held-out records).
 
 Evaluation (on the held-out test conditions): accuracy, confusion matrix, per-class recall,
 the reliability diagram and expected calibration error of the top-class probability, the
@@ -60,8 +67,7 @@ __all__ = [
     "Diagnoser",
     "save",
     "load",
-    "K_NEIGHBOURS",
-    "OOD_MARGIN",
+    "recalibrate",
     "expected_calibration_error",
     "detection_limits",
     "severity_bins",
@@ -69,10 +75,6 @@ __all__ = [
     "deviations",
 ]
 
-#: Neighbours of the out-of-distribution distance.
-K_NEIGHBOURS = 3
-#: Margin on the calibration conditions' 99th percentile of that distance.
-OOD_MARGIN = 1.5
 #: Quantiles of the training records' ringing frequency that bound the sensor band accepted.
 RING_QUANTILES = (0.05, 0.95)
 #: Nominal coverage of the severity intervals.
@@ -83,8 +85,10 @@ AVAILABILITY = {
     "no_pressure": ("base", "angle"),
     "vibration_only": ("base",),
 }
-#: Layout version of a diagnoser file.
-FORMAT = 3
+#: Layout version of a diagnoser file (4: the out-of-domain detector, the consistency check
+#: and the severity's conformal residuals by channel set; 3 held a kNN threshold and one
+#: half-width per channel set, and is refused with the command that rebuilds it).
+FORMAT = 4
 #: The operating point the healthy baseline refers features to (`fit_baseline`).
 OPERATING = ("speed_hz", "cy_p_suction", "cy_p_discharge")
 #: Prefix of a feature's deviation from the healthy baseline.
@@ -239,14 +243,6 @@ def _scaler(X):
     return med, scale
 
 
-def knn_distance(Z_ref: np.ndarray, Z: np.ndarray, cols: np.ndarray, k: int) -> np.ndarray:
-    """RMS-per-feature distance of each row of ``Z`` to its ``k``-th nearest row of
-    ``Z_ref`` over the columns ``cols``."""
-    A, B = Z_ref[:, cols], Z[:, cols]
-    d = np.sqrt(np.maximum(((B[:, None, :] - A[None, :, :]) ** 2).mean(axis=2), 0.0))
-    return np.sort(d, axis=1)[:, min(k, A.shape[0]) - 1]
-
-
 def available(row: np.ndarray, names: list[str]) -> str:
     """Which availability subset a feature row has (`AVAILABILITY`)."""
     groups = feature_groups(names)
@@ -386,10 +382,34 @@ class Diagnoser:
         X = np.asarray(X, float)
         Xm, names = self.model_rows(X)
         s = np.clip(_predict_subsets(reg, Xm, names, proba=False), 0.0, 1.0)
-        subs = [available(row, self.names) for row in X]
-        q = np.array([self.state["conformal"][label][k] for k in subs])
-        q = np.maximum(q, self.severity_resolution)
+        subs = np.array([available(row, self.names) for row in X])
+        q = np.maximum(self.half_widths(label, subs), self.severity_resolution)
         return s, np.clip(s - q, 0, 1), np.clip(s + q, 0, 1)
+
+    def half_widths(self, label: str, subsets) -> np.ndarray:
+        """The conformal half-width of class ``label``'s severity interval for records of
+        each channel set in ``subsets``: crepes' Mondrian ``ConformalRegressor`` on the
+        held-out records' absolute residuals of that channel set (1, the whole range, where
+        they are too few for `COVERAGE`)."""
+        from crepes import ConformalRegressor
+
+        subsets = np.atleast_1d(np.asarray(subsets, dtype=str))
+        cal = self.state["severity_calibration"].get(label)
+        out = np.ones(subsets.size)
+        if cal is None or not len(cal["residuals"]):
+            return out
+        bins = np.asarray(cal["bins"], dtype=str)
+        known = np.isin(subsets, bins)
+        if known.any():
+            import warnings
+
+            cr = ConformalRegressor().fit(np.asarray(cal["residuals"], float), bins=bins)
+            with warnings.catch_warnings():  # too few records of a set: the whole range, as said
+                warnings.filterwarnings("ignore", "the no. of calibration examples")
+                iv = cr.predict_int(np.zeros(int(known.sum())), bins=subsets[known],
+                                    confidence=COVERAGE)  # fmt: skip
+            out[known] = np.minimum(np.asarray(iv, float)[:, 1], 1.0)
+        return out
 
     @property
     def severity_resolution(self) -> float:
@@ -404,14 +424,46 @@ class Diagnoser:
             return 0.0
         return 0.5 * float(np.min(np.diff(levels)))
 
-    def ood(self, row: np.ndarray) -> tuple[float, float, str]:
-        """(distance, threshold, subset) of one feature row."""
-        names = self.names
-        subset = available(row, names)
-        cols = _cols(names, subset)
+    @property
+    def domain(self):
+        """The out-of-domain detector (`recipdyn.diagnosis.domain.Domain`), refitted on the
+        training rows it was fitted on when first used."""
+        if getattr(self, "_domain", None) is None:
+            from .domain import Domain
+
+            self._domain = Domain(
+                self.state["domain"], self.state["Z_train"], self.state["train_labels"]
+            )
+        return self._domain
+
+    @property
+    def consistency(self):
+        """The physics consistency check (`recipdyn.diagnosis.consistency.Consistency`)."""
+        if getattr(self, "_consistency", None) is None:
+            from .consistency import Consistency
+
+            st = self.state
+            self._consistency = Consistency(
+                st["consistency"], st["Z_train"], st["center"], st["scale"], self.names,
+                st["train_labels"], st["train_severity"],
+            )  # fmt: skip
+        return self._consistency
+
+    def ood(self, row: np.ndarray, label: str | None = None) -> dict[str, Any]:
+        """The out-of-domain verdict of one feature row (the class named: ``label``):
+        ``score``, ``p_value``, ``alpha`` (refuse below), ``features`` (the channel set),
+        ``method``, ``n_calibration`` (held-out records of the set)."""
+        subset = available(row, self.names)
         z = (np.asarray(row, float) - self.state["center"]) / self.state["scale"]
-        d = knn_distance(self.state["Z_train"].astype(float), z[None, :], cols, K_NEIGHBOURS)
-        return float(d[0]), float(self.state["ood_threshold"][subset]), subset
+        d = self.domain
+        return {
+            "score": float(d.score(z[None, :], subset, label)[0]),
+            "p_value": float(d.p_value(z[None, :], subset, label)[0]),
+            "alpha": d.alpha,
+            "features": subset,
+            "method": d.state["method"],
+            "n_calibration": d.n_calibration(subset),
+        }
 
 
 def _split_train(df, seed: int):
@@ -509,34 +561,14 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     Xm, mnames = _with_baseline(X, names, baseline)
     clfs = _fit_subsets(lambda: _hgb_classifier(seed), Xm, y, mnames)
     proper, cal = _split_train(train_df, seed)
-    regs, conformal = {}, {}
+    regs = {}
     for c in classes:
         if c == "healthy":
             continue
         m = (train_df.label == c).to_numpy()
         s = train_df.severity.to_numpy()
-        reg = _fit_subsets(lambda: _hgb_regressor(seed), Xm[m & proper], s[m & proper], mnames)
-        Xcal, scal = _augment(X[m & cal], names)
-        Xcal, _ = _with_baseline(Xcal, names, baseline)
-        resid = np.abs(
-            np.clip(_predict_subsets(reg, Xcal, mnames, proba=False), 0, 1) - s[m & cal][scal]
-        )
-        n_cal = int((m & cal).sum())
-        conformal[c] = {}
-        for j, k in enumerate(AVAILABILITY):  # _augment stacks the subsets in this order
-            r = resid[j * n_cal : (j + 1) * n_cal]
-            n = r.size
-            qlev = min(1.0, math.ceil((n + 1) * COVERAGE) / n) if n else 1.0
-            conformal[c][k] = float(np.quantile(r, qlev, method="higher")) if n else 1.0
-        regs[c] = reg
+        regs[c] = _fit_subsets(lambda: _hgb_regressor(seed), Xm[m & proper], s[m & proper], mnames)
     center, scale = _scaler(X[proper])
-    Zp = (X[proper] - center) / scale
-    Zc = (X[cal] - center) / scale
-    thresholds = {}
-    for subset in AVAILABILITY:
-        cols = _cols(names, subset)
-        d = knn_distance(Zp, Zc, cols, K_NEIGHBOURS)
-        thresholds[subset] = float(np.quantile(d, 0.99) * OOD_MARGIN)
     speed = train_df.f_speed_hz.to_numpy()
     acc_curves, p_curves = _library(folder, train_df)
     # the reference the data set's features were corrected against, or one built here
@@ -553,12 +585,10 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         "baseline": baseline,
         "classifiers": clfs,
         "regressors": regs,
-        "conformal": conformal,
         "center": center,
         "scale": scale,
         # float16 (3 significant digits: the distances compare spreads of whole units)
         "Z_train": _half((X - center) / scale),
-        "ood_threshold": thresholds,
         "speed_range": [float(speed.min()), float(speed.max())],
         "fs_range": [float(train_df.fs.min()), float(train_df.fs.max())],
         # the central 90 % (a few records with few impacts peak elsewhere: RING_QUANTILES)
@@ -580,6 +610,12 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     for k in ("center", "scale"):
         state[k] = np.asarray(state[k], float)
     diag = Diagnoser(state)
+    # the held-out calibration: the quarter of the training conditions the regressors, the
+    # detector and the consistency library were not fitted on
+    held = held_out_rows(folder, train_df[cal].reset_index(drop=True), names)
+    _calibrate_state(state, held, fit_rows=proper,
+                     source=f"{int(cal.sum())} records of {int(train_df[cal].condition.nunique())} "
+                     f"held-out training conditions of {folder.name}")  # fmt: skip
     state["fingerprints_json"] = json.dumps(
         _fingerprints(train_df, card, names, diag), default=float
     )
@@ -587,6 +623,120 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     # what each channel set can name, measured on the held-out conditions (channels.gate)
     state["naming"] = {k: ev[k]["naming"] for k in AVAILABILITY}
     return diag, ev
+
+
+def held_out_rows(folder: Path, rows_df, names: list[str]) -> dict[str, Any]:
+    """The records of ``rows_df`` (rows of a data set's feature table in ``folder``) as the
+    calibration reads them: features ``X`` (columns ``names``), ``labels``, ``severity``,
+    and each record's revolution-to-revolution spread of its curves
+    (`recipdyn.diagnosis.consistency.record_spread`, from its stored channels)."""
+    import zarr
+
+    from .consistency import record_spread
+
+    g = zarr.open_group(str(Path(folder) / "signals.zarr"), mode="r")
+    spreads = []
+    for _, r in rows_df.iterrows():
+        i, n = int(r.record), int(g["n_samples"][int(r.record)])
+        ch = {c: np.asarray(g[c][i, :n], float) for c in
+              ("accel_guide", "tacho", "p_head_sensor", "p_crank_sensor") if c in g}  # fmt: skip
+        try:
+            spreads.append(record_spread(ch, float(r.fs), float(r.f_speed_hz)))
+        except (ValueError, IndexError):  # no tacho edge: no spread
+            spreads.append({})
+    return {
+        "X": rows_df[[f"f_{n}" for n in names]].to_numpy(float),
+        "labels": rows_df.label.to_numpy(str),
+        "severity": rows_df.severity.to_numpy(float),
+        "spreads": spreads,
+    }
+
+
+def _calibrate_state(state: dict, held: dict, *, fit_rows, source: str) -> None:
+    """The held-out calibration of a diagnoser's ``state`` (in place) from the records
+    ``held`` (`held_out_rows`): the severity's conformal residuals by channel set, the
+    out-of-domain detector's calibration scores and the consistency check's statistics.
+    ``fit_rows``: the training rows the detector and the consistency library use."""
+    from .consistency import fit_consistency
+    from .domain import fit_domain
+
+    diag = Diagnoser(state)
+    names, classes = diag.names, diag.classes
+    X, labels, sev = held["X"], held["labels"], held["severity"]
+    n = X.shape[0]
+    subsets = list(AVAILABILITY)
+    sevcal = {}
+    for c in classes:
+        if c == "healthy":
+            continue
+        m = labels == c
+        Xa, src = _augment(X[m], names)  # the subsets stacked in AVAILABILITY's order
+        if not m.any():
+            sevcal[c] = {"residuals": np.zeros(0), "bins": np.zeros(0, dtype=str)}
+            continue
+        Xm, mnames = _with_baseline(Xa, names, diag.baseline)
+        pred = np.clip(_predict_subsets(state["regressors"][c], Xm, mnames, proba=False), 0, 1)
+        sevcal[c] = {
+            "residuals": np.abs(pred - sev[m][src]),
+            "bins": np.repeat(subsets, int(m.sum())).astype(str),
+        }
+    state["severity_calibration"] = sevcal
+    Z = (X - state["center"]) / state["scale"]
+    cols = {k: _cols(names, k) for k in subsets}
+    state["domain"] = fit_domain(
+        state["Z_train"], np.asarray(state["train_labels"]), cols,
+        [(Z, labels, k) for k in subsets], fit_rows=fit_rows, source=source,
+    )  # fmt: skip
+    spreads = held["spreads"]
+    state["consistency"] = fit_consistency(
+        state["Z_train"], state["center"], state["scale"], names, state["train_labels"],
+        state["train_severity"], fit_rows=fit_rows, source=source,
+        calibration=[(X, labels, spreads, k) for k in ("full", "no_pressure")],
+    )  # fmt: skip
+    state["calibration_records"] = int(n)
+    for k in ("_domain", "_consistency"):
+        diag.__dict__.pop(k, None)
+
+
+def recalibrate(diag: Diagnoser, *folders: str | Path) -> Diagnoser:
+    """``diag`` calibrated anew on every record of the data sets in ``folders``: records its
+    training did not use (other operating conditions, other drawn measurement chains), each
+    cut to every channel set. The detector and the consistency library are then fitted on
+    all of ``diag``'s training records, the regressors and classifiers kept as they are.
+    A data set must be of ``diag``'s features and share a class with it (else refused,
+    naming it); its records of other classes are left out."""
+    import copy
+
+    names = diag.names
+    parts, sources = [], []
+    with one_thread():
+        for folder in map(Path, folders):
+            df, card = read_features(folder)
+            missing = [n for n in names if f"f_{n}" not in df.columns]
+            if missing:
+                raise ParameterError(
+                    f"{folder}: its features lack {missing[:3]} of the diagnoser's; build "
+                    "the calibration data set with this recipdyn"
+                )
+            df = df[df.label.isin(diag.classes)].reset_index(drop=True)
+            if "chain_refused" in df.columns:  # records the chain correction refused
+                df = df[df.chain_refused.fillna("") == ""].reset_index(drop=True)
+            if df.empty:
+                raise ParameterError(f"{folder}: no record of the diagnoser's classes")
+            parts.append(held_out_rows(folder, df, names))
+            sources.append(f"{len(df)} records of {df.condition.nunique()} conditions of "
+                           f"{folder.name} (seed {card['spec'].get('seed')})")  # fmt: skip
+        if not parts:
+            raise ParameterError("recalibrate: give at least one data set")
+        held = {k: np.concatenate([p[k] for p in parts]) for k in ("X", "labels", "severity")}
+        held["spreads"] = [s for p in parts for s in p["spreads"]]
+        state = copy.copy(diag.state)
+        for old in ("ood_threshold", "conformal"):  # format 3's threshold and half-widths
+            state.pop(old, None)
+        state["format"] = FORMAT
+        n = len(state["train_labels"])
+        _calibrate_state(state, held, fit_rows=np.ones(n, bool), source="; ".join(sources))
+    return Diagnoser(state)
 
 
 def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
@@ -774,7 +924,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
         sev[c] = {
             "median_relative_error": float(np.median(rel)),
             "coverage": float(cover.mean()),
-            "half_width": max(float(diag.state["conformal"][c]["full"]), diag.severity_resolution),
+            "half_width": max(float(diag.half_widths(c, "full")[0]), diag.severity_resolution),
             "n": int(m.sum()),
         }
         rel_all += rel.tolist()
@@ -789,7 +939,9 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
     lo, hi = diag.state["ring_range"]
     ring = X[:, names.index("acc_ring_hz")]
     out_band = ~((ring >= lo * (1 - RING_SLACK)) & (ring <= hi * (1 + RING_SLACK)))
-    far = np.array([diag.ood(row)[0] > diag.ood(row)[1] for row in X])
+    pred = np.array(classes)[np.asarray(res["proba"]).argmax(axis=1)]
+    far = np.array([(o := diag.ood(row, lab))["p_value"] < o["alpha"]
+                    for row, lab in zip(X, pred, strict=True)])  # fmt: skip
     res["ood_false_refusals"] = float(np.mean(out_band | far))
     return res
 
@@ -922,9 +1074,11 @@ def save(diag: Diagnoser, path: str | Path) -> Path:
     return path
 
 
-def load(path: str | Path, *, check_version: bool = True) -> Diagnoser:
+def load(path: str | Path, *, check_version: bool = True, any_format: bool = False) -> Diagnoser:
     """Read a diagnoser file; refuses one written by another recipdyn or scikit-learn version
-    (its predictions would not be those evaluated) and one holding untrusted types."""
+    (its predictions would not be those evaluated) and one holding untrusted types.
+    ``any_format``: read an older file format too (for `recalibrate`, which brings it to
+    `FORMAT`; such a diagnoser cannot diagnose until calibrated)."""
     import skops.io as sio
 
     from .. import __version__
@@ -942,8 +1096,17 @@ def load(path: str | Path, *, check_version: bool = True) -> Diagnoser:
     if bad:
         raise ParameterError(f"diagnoser {path}: holds untrusted types {bad}; refused")
     state = sio.load(path, trusted=untrusted)
-    if not isinstance(state, dict) or state.get("format") != FORMAT:
+    if not isinstance(state, dict) or not isinstance(state.get("format"), int):
         raise ParameterError(f"diagnoser {path}: not a recipdyn diagnoser")
+    if state["format"] != FORMAT and not (any_format and state["format"] >= 3):
+        raise ParameterError(
+            f"diagnoser {path}: file format {state['format']}, this recipdyn reads format "
+            f"{FORMAT} (its out-of-domain refusal and severity intervals are calibrated on "
+            "held-out records; format 3 held a fixed distance threshold); recalibrate it with "
+            "'recipdyn recalibrate FILE DATASET -o NEW' on a data set of other conditions, or "
+            "rebuild it with 'recipdyn train DATASET -o FILE' ('make diagnoser' for the "
+            "default one)"
+        )
     state = _unpack(state)
     if check_version:
         for what, have, want in (
