@@ -518,6 +518,8 @@ def params_from_attrs(attrs: Mapping[str, Any]) -> CompressorParams:
             if isinstance(v, np.generic):
                 v = v.item()
             kw[f.name] = None if v == "default" else v
+    if kw.get("load") == "table" and "load_table" in kw:
+        kw["load"] = "paper"  # records name the selector 'table'; the table itself is the load
     return CompressorParams(**kw)
 
 

@@ -98,7 +98,10 @@ def derive_value(p: Param, values: Mapping[str, Any]) -> Derived:
     """``p``'s value derived by its rule from ``values`` (validated numbers); a value out of
     ``p``'s range is refused naming the rule and the values it was derived from."""
     names = rule_inputs(p.derive)
-    v = float(eval(p.derive, {"__builtins__": {}}, {k: float(values[k]) for k in names}))  # noqa: S307 - a rule declared in recipdyn's code
+    try:
+        v = float(eval(p.derive, {"__builtins__": {}}, {k: float(values[k]) for k in names}))  # noqa: S307 - a rule declared in recipdyn's code
+    except (OverflowError, ZeroDivisionError):
+        v = float("inf")  # e.g. l = 1e154 squared: refused below as out of range, naming l
     try:
         p.check(v)
     except ParameterError:
