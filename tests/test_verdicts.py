@@ -418,3 +418,28 @@ def test_fast_link_ring_at_150_rad_s_is_not_an_exponent(tmp_path):
     s = analyze_signal(csv, tmp_path / "an", column="acc", speed="150 rad/s")
     for r in s["lyapunov_signal"].values():
         assert not (r["status"] == "ok" and r["exponent"] > 3 * 82), r
+
+
+def test_classify_withholds_ok_estimates_that_disagree():
+    """Three estimates with status ok, 18x apart (0.05, 0.3 and 0.9 per time unit), handed to
+    classify directly: docs/signal_analysis.md lists the disagreement rule among classify's
+    rules, but only assess_signal applied it, and classify said 'chaotic'. Now classify
+    applies the same rule (one implementation, `withhold_disagreeing`): every positive
+    estimate is withheld with the reason and the verdict is undetermined. Estimates that
+    agree (within their +-25 % accuracy: 1.5x apart) still make it chaotic."""
+    from recipdyn.analysis.lyapunov_signal import withhold_disagreeing
+
+    def est(m, v):
+        return SignalLyapunov(m, v, np.empty(0), np.empty(0), None)
+
+    apart = [est("wolf", 0.05), est("rosenstein", 0.3), est("kantz", 0.9)]
+    v = classify(k01=0.97, determinism=True, signal_lyapunov=apart, time_scale=0.1)
+    assert v.verdict == "undetermined", v.reasons
+    assert all(v.evidence[f"lambda1_{m}_status"] == "inconsistent" for m in
+               ("wolf", "rosenstein", "kantz"))  # fmt: skip
+    assert any("disagree" in r and "18x" in r for r in v.reasons), v.reasons
+    assert [e.status for e in withhold_disagreeing(apart)] == ["inconsistent"] * 3
+    assert [e.status for e in apart] == ["ok"] * 3  # the caller's estimates are not changed
+    close = [est("wolf", 0.6), est("rosenstein", 0.9), est("kantz", 0.75)]
+    v = classify(k01=0.97, determinism=True, signal_lyapunov=close, time_scale=0.1)
+    assert v.verdict == "chaotic", v.reasons

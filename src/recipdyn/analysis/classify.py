@@ -26,7 +26,10 @@ For a measured signal (no equations) two more pieces enter:
   is weakest), else **stochastic** (white noise, coloured noise and a noisy periodic signal land
   here).
 * ``signal_lyapunov``: estimates from the signal (Wolf, Rosenstein, Kantz); only those with a
-  usable status count (refusals are listed, never read as 0). They stand in for ``lambda1``
+  usable status count (refusals are listed, never read as 0), and usable positive ones that
+  disagree beyond their accuracy are withheld first (the rule of ``assess_signal``, one
+  implementation: ``withhold_disagreeing``), which makes the verdict **undetermined**. They
+  stand in for ``lambda1``
   when no equation-based exponent is given: positive when most usable estimates exceed
   ``signal_tol / time_scale`` (``time_scale``: the embedding delay, about one decorrelation
   time, in the exponents' time unit) and twice their fit error; flat when most do not
@@ -43,6 +46,7 @@ import numpy as np
 
 from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS, MAX_RMS_RATIO, MAX_SPEED_RATIO
 from .checks import as_signal
+from .lyapunov_signal import withhold_disagreeing
 from .poincare import count_distinct_points
 from .spectrum import Spectrum, find_spectral_peaks
 
@@ -149,7 +153,11 @@ def _grouped(estimates, what: str) -> list[str]:
 def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     """(lambda1, err, all_refused) from signal estimates; records the evidence. Estimates
     withheld as ``inconsistent`` are listed with their reason and never used; when they leave
-    no usable positive estimate, ``ev['signal_estimates_withheld']`` is set."""
+    no usable positive estimate, ``ev['signal_estimates_withheld']`` is set. Usable positive
+    estimates that disagree beyond their accuracy are withheld first
+    ([`withhold_disagreeing`][recipdyn.analysis.lyapunov_signal.withhold_disagreeing], the rule
+    `assess_signal` applies: a list from anywhere gets it too)."""
+    estimates = withhold_disagreeing(list(estimates))
     usable = [e for e in estimates if e.ok]
     withheld = [e for e in estimates if e.status == "inconsistent"]
     for e in estimates:

@@ -43,7 +43,8 @@ from ..defaults import MIN_SIGNAL_SAMPLES
 from .checks import as_signal, check_rate
 from .embedding import choose_embedding, delay_embed
 
-__all__ = ["SignalLyapunov", "lyap_wolf", "lyap_rosenstein", "lyap_kantz"]
+__all__ = ["SignalLyapunov", "lyap_wolf", "lyap_rosenstein", "lyap_kantz", "ESTIMATE_ACCURACY",
+           "withhold_disagreeing"]  # fmt: skip
 
 #: Fewest points of a divergence curve a slope is fitted to (else: refused, no scaling region).
 MIN_FIT_POINTS = 5
@@ -53,6 +54,11 @@ MIN_FIT_R2 = 0.95
 MIN_REFERENCES = 50
 #: Fewest Wolf evolutions (replacement intervals) an estimate is averaged over.
 MIN_EVOLUTIONS = 100
+#: Relative accuracy of an estimate with status ``ok`` (docs/signal_analysis.md, the
+#: calibration study ``benchmarks/bench_lyap_calibration.py``). Two positive estimates whose
+#: intervals lambda (1 +- ESTIMATE_ACCURACY) do not overlap -- a ratio above
+#: (1 + a) / (1 - a) -- disagree beyond it (`withhold_disagreeing`).
+ESTIMATE_ACCURACY = 0.25
 
 
 @dataclass
@@ -100,6 +106,27 @@ class SignalLyapunov:
         out.update({k: (v.item() if isinstance(v, np.generic) else v)
                     for k, v in self.params.items()})  # fmt: skip
         return out
+
+
+def withhold_disagreeing(estimates):
+    """The estimates with every usable positive one withheld (status ``inconsistent``, the
+    reason naming them all) when two of them disagree beyond ``ESTIMATE_ACCURACY``: their
+    intervals ``lambda (1 +- ESTIMATE_ACCURACY)`` do not overlap. The one implementation of
+    the rule, applied by `recipdyn.analysis.signal.assess_signal` and by
+    `recipdyn.analysis.classify.classify` to any list it is given. ``estimates``: a list or a
+    dict of `SignalLyapunov`; the same kind is returned (unchanged when they agree)."""
+    items = dict(estimates) if isinstance(estimates, dict) else dict(enumerate(estimates))
+    pos = {k: r for k, r in items.items() if r.status == "ok" and r.exponent > 0}
+    if len(pos) >= 2:
+        vals = np.array([r.exponent for r in pos.values()])
+        ratio = float(vals.max() / vals.min())
+        limit = (1 + ESTIMATE_ACCURACY) / (1 - ESTIMATE_ACCURACY)
+        if ratio > limit:
+            listed = ", ".join(f"{r.method} {r.exponent:.3g}" for r in pos.values())
+            why = (f"the estimators disagree ({listed}: {ratio:.2g}x apart, more than the "
+                   f"{limit:.2g}x their +-{ESTIMATE_ACCURACY:.0%} accuracy allows)")  # fmt: skip
+            items = {k: (r.withheld(why) if k in pos else r) for k, r in items.items()}
+    return items if isinstance(estimates, dict) else list(items.values())
 
 
 def _prepare(x, dim, delay, theiler, dt):

@@ -22,7 +22,14 @@ from .classify import (
     quarter_speed_ratio,
 )
 from .embedding import Embedding, choose_embedding
-from .lyapunov_signal import SignalLyapunov, _gate, lyap_kantz, lyap_rosenstein, lyap_wolf
+from .lyapunov_signal import (
+    SignalLyapunov,
+    _gate,
+    lyap_kantz,
+    lyap_rosenstein,
+    lyap_wolf,
+    withhold_disagreeing,
+)
 from .poincare import count_distinct_points
 from .spectrum import amplitude_spectrum
 from .surrogates import SurrogateTest, surrogate_test
@@ -97,11 +104,6 @@ MAX_SECTION_RTOL = 0.05
 #: (0.057 /s from the equations; the slopes 310 and 270 /s).
 PLATEAU_STEP = 2
 PLATEAU_TOL = 0.10
-#: Relative accuracy of one estimate where it was validated against published exponents
-#: (docs/signal_analysis.md: usable estimates within 25 %, Kantz on Rossler once -33 %). Two
-#: positive estimates whose intervals lambda (1 +- ESTIMATE_ACCURACY) do not overlap -- a
-#: ratio above 1.25 / 0.75 = 1.67 -- disagree beyond it.
-ESTIMATE_ACCURACY = 0.25
 
 
 def _fast_scale(spec, emb, dt) -> str:
@@ -120,19 +122,8 @@ def _reconcile(lyap, x, dt, emb, spec, section_periodic: str | None):
     Kantz slope is not on a plateau across embedding dimensions (Kantz 1994; the divergence
     then follows what the short embedding window sees, a fast ring, not the attractor); (3)
     the section says the orbit is periodic (``section_periodic``: the reason, or None)."""
-    out = dict(lyap)
+    out = withhold_disagreeing(dict(lyap))
     fast = _fast_scale(spec, emb, dt)
-    pos = {k: r for k, r in out.items() if r.status == "ok" and r.exponent > 0}
-    if len(pos) >= 2:
-        vals = np.array([r.exponent for r in pos.values()])
-        ratio = vals.max() / vals.min()
-        limit = (1 + ESTIMATE_ACCURACY) / (1 - ESTIMATE_ACCURACY)
-        if ratio > limit:
-            listed = ", ".join(f"{k} {r.exponent:.3g}" for k, r in pos.items())
-            for k, r in pos.items():
-                out[k] = r.withheld(f"the estimators disagree ({listed}: {ratio:.2g}x apart, "
-                                    f"more than the {limit:.2g}x their +-"
-                                    f"{ESTIMATE_ACCURACY:.0%} accuracy allows)")  # fmt: skip
     for name in ("rosenstein", "kantz"):
         r = out.get(name)
         if r is None or r.status != "ok" or not r.exponent > 0:
