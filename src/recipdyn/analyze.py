@@ -587,7 +587,8 @@ def _markdown(s: dict[str, Any]) -> str:
     for name, r in s["lyapunov_signal"].items():
         val = (r["exponent"] if r["status"] in ("ok", "flat")
                else f"{r['exponent']:.4g}, withheld ({r['reason']})"
-               if r["status"] == "inconsistent" else f"refused ({r['reason']})")  # fmt: skip
+               if r["status"] in ("inconsistent", "unconfirmed")
+               else f"refused ({r['reason']})")  # fmt: skip
         lines.append(f"- {name} (signal {s.get('signal', 'a')}): {val}")
     if s.get("zero_one_K") is not None:
         lines.append(f"- 0-1 test K (stroboscopic section): {s['zero_one_K']:.3f}")
