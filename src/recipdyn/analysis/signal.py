@@ -133,11 +133,14 @@ def _reconcile(lyap, x, dt, emb, spec, section_periodic: str | None):
             continue
         hi = ESTIMATORS[name](x, dt, delay=emb.delay, theiler=emb.theiler,
                               dim=emb.dim + PLATEAU_STEP)  # fmt: skip
-        r.params[f"exponent_dim_{emb.dim + PLATEAU_STEP}"] = hi.exponent
-        if hi.status == "refused":  # too few samples for the higher dimension: not checked
+        # a slope refused only for its curve's small rise is still a slope to compare (the
+        # plateau test asks whether the slope follows the dimension, not whether it is right)
+        slope = hi.exponent if hi.status == "ok" else hi.params.get("slope", float("nan"))
+        r.params[f"exponent_dim_{emb.dim + PLATEAU_STEP}"] = slope
+        if hi.status == "refused" and not np.isfinite(slope):  # too few samples: not checked
             r.params["plateau"] = f"not checked at d = {emb.dim + PLATEAU_STEP}: {hi.reason}"
             continue
-        change = hi.exponent / r.exponent - 1 if hi.status == "ok" else float("nan")
+        change = slope / r.exponent - 1 if hi.status != "flat" else float("nan")
         if not abs(change) <= PLATEAU_TOL:
             what = (f"changes {change:+.0%}" if np.isfinite(change)
                     else f"is {hi.status}")  # fmt: skip
