@@ -447,6 +447,70 @@ def summary(scores) -> str:
     return "\n".join(lines)
 
 
+def systems_table(truths_) -> str:
+    """The systems of the study (docs/signal_analysis.md)."""
+    import _lyap_systems as L
+
+    rows = ["| system | kind | parameters | λ1 (equations) | published | mean period | set |",
+            "|---|---|---|---|---|---|---|"]  # fmt: skip
+    higher = ("rossler-hyper", "logistic-lattice", "coupled-henon")
+    for name, s in L.catalogue().items():
+        t = truths_[name]
+        par = ", ".join(f"{k} = {v}" for k, v in s.params.items())
+        pub = "—"
+        if s.published:
+            pub = f"{s.published[0]:.4g} ({'ln 2' if s.published[1] == 'exact' else 'Sprott'})"
+        kind = s.kind + (" (higher-dim.)" if name.startswith("lorenz96") or name in higher
+                         else "")  # fmt: skip
+        period = "1 iteration" if s.kind == "map" else f"{t['mean_period']:.3g}"
+        group = "held-out" if name in HELD_OUT else "calibration"
+        rows.append(f"| {name} | {kind} | {par} | {t['lambda1']:.4g} ± {t['spread']:.1g} | "
+                    f"{pub} | {period} | {group} |")  # fmt: skip
+    for name, (lam, desc) in NEGATIVES.items():
+        group = "held-out" if name in HELD_OUT else "calibration"
+        kind = "regular" if lam == 0 else "stochastic"
+        rows.append(f"| {name} | {kind} | {desc} | {'0' if lam == 0 else '—'} | — | — | "
+                    f"{group} |")  # fmt: skip
+    return "\n".join(rows)
+
+
+def results_table(scores_by_tag: dict) -> str:
+    """Per set and estimator, for each run (``tag``): ok (share of all estimates), right
+    (share of the ok ones within TOLERANCE, or not positive for negatives), withheld
+    (inconsistent + unconfirmed), refused, the worst ok error."""
+    rows = ["| set | estimator | run | ok | ok within 25 % | withheld | refused | worst ok error |",
+            "|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    for group in ("calibration", "held-out"):
+        for name in ("wolf", "rosenstein", "kantz"):
+            for tag, sc in scores_by_tag.items():
+                e = sc[group]["estimators"][name]
+                n = e["ok"] + e["inconsistent"] + e["unconfirmed"] + e["refused"]
+                held = e["inconsistent"] + e["unconfirmed"]
+                worst = "—" if not e["ok"] else (
+                    "∞" if math.isinf(e["worst"]) else f"{100 * e['worst']:+.0f} %")  # fmt: skip
+                right = f"{e['right']}/{e['ok']}" + (
+                    f" ({e['right'] / e['ok']:.0%})" if e["ok"] else "")  # fmt: skip
+                rows.append(f"| {group} | {name} | {tag} | {e['ok']}/{n} ({e['ok'] / n:.0%}) "
+                            f"| {right} | {held} ({held / n:.0%}) | {e['refused']} "
+                            f"({e['refused'] / n:.0%}) | {worst} |")  # fmt: skip
+    return "\n".join(rows)
+
+
+def verdict_table(scores_by_tag: dict) -> str:
+    """Verdicts per set and kind of signal, for each run."""
+    kinds = sorted({k for sc in scores_by_tag.values() for g in sc.values()
+                    for k in g["verdicts"]})  # fmt: skip
+    tags = list(scores_by_tag)
+    rows = ["| set | signal -> verdict | " + " | ".join(tags) + " |",
+            "|---|---|" + "---|" * len(tags)]  # fmt: skip
+    for group in ("calibration", "held-out"):
+        for k in kinds:
+            vals = [scores_by_tag[t].get(group, {}).get("verdicts", {}).get(k, 0) for t in tags]
+            if any(vals):
+                rows.append(f"| {group} | {k} | " + " | ".join(map(str, vals)) + " |")
+    return "\n".join(rows)
+
+
 def crosscheck_nolds(records, truths_, max_cases=15) -> list[dict]:
     """Rosenstein's divergence curve from an independent implementation, ``nolds.lyap_r``
     (the ``bench`` extra), with recipdyn's embedding, Theiler window and length, on the
@@ -503,6 +567,8 @@ def main(argv=None) -> dict:
     ap.add_argument("--reuse", default=None, help="tag whose surrogate tests to reuse")
     ap.add_argument("--only", nargs="*", default=None, help="system names")
     ap.add_argument("--table", default=None, help="write the per-case table (markdown) here")
+    ap.add_argument("--docs", default=None,
+                    help="cached runs 'tag=label,...': print the docs' tables")  # fmt: skip
     args = ap.parse_args(argv)
     import _lyap_systems as L
 
@@ -511,6 +577,14 @@ def main(argv=None) -> dict:
     if worst_jac > 1e-6:
         raise RuntimeError(f"a Jacobian differs from central differences by {worst_jac:.2g}")
     tr = truths()
+    if args.docs:  # the tables of docs/signal_analysis.md from cached runs
+        by_tag = {}
+        for item in args.docs.split(","):  # tag or tag=label
+            tag, _, label = item.partition("=")
+            recs = [load(p) for p in sorted((OUT / tag).glob("*.pkl"))]
+            by_tag[label or tag] = score(recs, tr)
+        print(systems_table(tr), results_table(by_tag), verdict_table(by_tag), sep="\n\n")
+        return {"scores": by_tag}
     todo = [c for c in cases(args.full) if not args.only or c.system in args.only]
     print(f"{len(todo)} signals", flush=True)
     jobs = [(c, tr.get(c.system, {}), args.refresh, args.tag, args.reuse) for c in todo]

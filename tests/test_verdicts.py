@@ -451,6 +451,7 @@ def test_a_lone_positive_estimate_is_unconfirmed_and_gives_no_number():
     study a lone Wolf read 2x high on the Moore-Spiegel flow. The verdict counts its sign (a
     positive exponent, no value): chaotic with K = 0.97 and determinism; undetermined with
     K = 0.3 (conflicting evidence); stochastic without determinism."""
+    from recipdyn.analysis import amplitude_spectrum
     from recipdyn.analysis.lyapunov_signal import check_agreement
 
     def est(m, v, status="ok"):
@@ -471,3 +472,8 @@ def test_a_lone_positive_estimate_is_unconfirmed_and_gives_no_number():
     assert v.verdict == "undetermined", v.reasons
     v = classify(k01=0.97, determinism=False, signal_lyapunov=lone, time_scale=1.0)
     assert v.verdict == "stochastic", v.reasons
+    # below the positive limit (0.02 per delay: 0.2 here) an unconfirmed value is no evidence
+    # of "no divergence" either: harmonic lines alone do not make the signal periodic
+    spec = amplitude_spectrum(np.sin(2 * np.pi * 0.05 * np.arange(4000)), 1.0)
+    v = classify(determinism=True, signal_lyapunov=lone, time_scale=0.1, spectrum=spec)
+    assert v.verdict == "undetermined" and "lambda1" not in v.evidence, v.reasons

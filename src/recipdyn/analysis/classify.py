@@ -159,9 +159,10 @@ def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     `assess_signal` applies: a list from anywhere gets them too). Estimates withheld as
     ``inconsistent`` are listed with their reason and never used; when they leave no usable
     positive estimate, ``ev['signal_estimates_withheld']`` is set. An ``unconfirmed`` estimate
-    (a lone positive one) votes for a positive sign but gives no number: when it carries the
-    vote, lambda1 is None and ``ev['signal_exponent_unconfirmed']`` is set (the verdict counts
-    the exponent as positive, with no value). ``no_number``: every estimator refused."""
+    (a lone positive one) votes for a positive sign when above the positive limit, and is no
+    evidence otherwise; it gives no number: when it carries the vote, lambda1 is None and
+    ``ev['signal_exponent_unconfirmed']`` is set (the verdict counts the exponent as positive,
+    with no value). ``no_number``: no estimate is evidence either way."""
     estimates = check_agreement(list(estimates))
     usable = [e for e in estimates if e.ok]
     unconfirmed = [e for e in estimates if e.status == "unconfirmed"]
@@ -176,10 +177,13 @@ def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     reasons += _grouped(unconfirmed, "unconfirmed")
     if withheld and not any(e.exponent > 0 for e in usable):
         ev["signal_estimates_withheld"] = True
-    voters = usable + unconfirmed
+    lim = tol / time_scale
+    # an unconfirmed value votes only for a positive sign: below the positive limit it is no
+    # evidence of "no divergence" either (a lone Wolf of 58 1/s beside two refused slopes of
+    # a ringing machine signal would make its harmonic lines "periodic")
+    voters = usable + [e for e in unconfirmed if e.exponent > max(lim, 2 * e.stderr)]
     if not voters:
         return None, 0.0, not withheld
-    lim = tol / time_scale
     pos = [e for e in voters if e.exponent > max(lim, 2 * e.stderr)]
     if usable:
         ev["lambda1_signal_median"] = float(np.median([e.exponent for e in usable]))
