@@ -2,6 +2,8 @@
 
 import json
 
+import numpy as np
+
 from recipdyn.cli import main
 
 
@@ -159,3 +161,43 @@ def test_signal_verdict_names_its_threshold():
     assert lam == 292.9
     assert "median 292.9 > 100, the smallest exponent counted as positive: 0.01 per " \
         "embedding delay of 0.0001" in reasons[0]  # fmt: skip
+
+
+def test_lines_between_crank_orders_are_named_by_frequency_only(tmp_path):
+    """A 3.2 Hz machine (192 rpm) with lines at orders 1, 2 and 5 and three lines between
+    orders (1.8, 11.6 and 36.9 Hz, the issue's): the orders are labelled 1, 2, 5; the others
+    have no crank order (``None`` in summary.json, a dash in summary.md). Before, each was
+    "crank order 0". The record is 20 s long, a bin of 0.05 Hz: the harmonic tolerance of
+    1.5 bins (0.075 Hz) is far from the 0.4-1.2 Hz between those lines and the nearest order."""
+    import json
+
+    import pandas as pd
+
+    from recipdyn.analyze import analyze_signal
+
+    fs, f0 = 100.0, 3.2
+    t = np.arange(int(20 * fs)) / fs
+    orders = {1: 1.0, 2: 0.6, 5: 0.4}
+    others = {1.8: 0.5, 11.6: 0.45, 36.9: 0.35}
+    x = sum(a * np.sin(2 * np.pi * k * f0 * t) for k, a in orders.items())
+    x = x + sum(a * np.sin(2 * np.pi * f * t + 1.0) for f, a in others.items())
+    x = x + 0.01 * np.random.default_rng(3).standard_normal(t.size)
+    path = tmp_path / "machine.csv"
+    pd.DataFrame({"time": t, "acc": x}).to_csv(path, index=False)
+    s = analyze_signal(path, tmp_path / "an", column="acc", speed="192 rpm")
+    peaks = json.loads((tmp_path / "an" / "summary.json").read_text())["spectrum"]["peaks"]
+
+    def label(f):
+        p = min(peaks, key=lambda p: abs(p["frequency_hz"] - f))
+        assert abs(p["frequency_hz"] - f) < 0.1, (f, peaks)
+        return p["crank_order"]
+
+    assert [label(k * f0) for k in orders] == list(orders)
+    assert [label(f) for f in others] == [None, None, None]
+    assert s["spectrum"]["peaks"] == peaks
+    md = (tmp_path / "an" / "summary.md").read_text()
+    rows = [r for r in md.splitlines() if r.startswith("| ") and r.count("|") == 4]
+    assert not any(r.rstrip().endswith("| 0 |") for r in rows), rows
+    for f in others:
+        assert any(r.startswith(f"| {f:.4g} ") and r.rstrip().endswith("| — |")
+                   for r in rows), (f, rows)  # fmt: skip

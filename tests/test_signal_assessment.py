@@ -112,41 +112,45 @@ FLOW_SAMPLES = 6
 
 @pytest.mark.parametrize("name", CHAOTIC)
 def test_chaotic_signals_within_25_percent_or_refused(name):
-    """Every estimator either refuses with a reason or is usable, at least two of the three
-    are usable, each usable one within 40 %, the surrogates show determinism and the verdict
-    is chaotic, on every trajectory; the median of the usable estimates, averaged over the
-    trajectories, is within 25 % of the published lambda1 (the issue's criterion).
+    """On every trajectory: each estimate with status ok is within 25 % of the published
+    lambda1 (the stated accuracy, ESTIMATE_ACCURACY); every other one is refused (NaN),
+    withheld as inconsistent or unconfirmed (the number kept), with the reason; the
+    surrogates show determinism and the verdict is chaotic. Where numbers are reported, the
+    median of the ok estimates averaged over the trajectories is within 10 % (below).
 
     Measured 2026-11-25 over trajectories from starts 1e-6 apart (another CPU's rounding draws
     one such sample; 12 per flow, 8 per map), the median's relative error: Rossler -0.17
     +- 0.039 (-0.12 ... -0.27: Rosenstein and Kantz read low on this slowly rotating flow, a
-    bias of the methods; one trajectory in 12 failed the former single-trajectory bound of
-    20 %), Rossler hyperchaos -0.05 +- 0.03, Ueda -0.02 +- 0.06, Ikeda -0.08, Lozi -0.045,
-    logistic 0.00; the worst single estimate -0.335 (Kantz, Rossler). The mean of 6 Rossler
-    trajectories has sigma 0.016: -0.25 is 5 sigma away."""
+    bias of the methods), Rossler hyperchaos -0.05 +- 0.03, Ueda -0.02 +- 0.06, Ikeda -0.08,
+    Lozi -0.045, logistic 0.00; the worst single estimate -0.335 (Kantz, Rossler). Since issue
+    44 those biased slopes are refused (their divergence curves rise by 1.2-1.7 log units,
+    below MIN_DIVERGENCE_RISE) and a lone Wolf estimate is unconfirmed: on Rossler and Ueda no
+    number is reported, and the verdict counts the sign (chaotic). Ok estimates on the maps
+    (Rosenstein, Kantz, Wolf agreeing within 1.25x) scatter by < 1 % between trajectories;
+    the mean of the medians is held to 15 %: Ikeda's is -10 % (Rosenstein and Kantz read
+    10-25 % low on this map, a bias of the methods; -8 % over 8 trajectories before), the
+    others within 5 %."""
+    from recipdyn.analysis.lyapunov_signal import ESTIMATE_ACCURACY
+
     _, _, lam = signal(name)
     medians = []
     for start in range(FLOW_SAMPLES if name in FLOWS else 1):
         a = assessed(name, start=start)
         usable = [r for r in a.lyapunov.values() if r.ok]
         for r in a.lyapunov.values():
-            # usable, refused (NaN) or withheld as inconsistent with the other evidence; both
-            # with the reason (issue 31: Kantz on Ikeda, 0.42 against 0.51, has no plateau
-            # across embedding dimensions and is withheld)
             assert (
                 r.ok
                 or (r.status == "refused" and r.reason and np.isnan(r.exponent))
-                or (r.status == "inconsistent" and r.reason)
+                or (r.status in ("inconsistent", "unconfirmed") and r.reason)
             )
-        # at least one usable: since issue 31 an estimate whose slope is not on a plateau
-        # across embedding dimensions is withheld (Kantz on the hyperchaotic Rossler flow)
-        assert len(usable) >= 1, {k: r.reason for k, r in a.lyapunov.items()}
         vals = np.array([r.exponent for r in usable])
-        assert np.all(np.abs(vals / lam - 1) < 0.40), (start, vals)
+        assert np.all(np.abs(vals / lam - 1) <= ESTIMATE_ACCURACY), (start, vals)
         assert a.surrogates.nonlinear
         assert a.verdict.verdict == "chaotic", a.verdict.reasons
-        medians.append(np.median(vals))
-    assert np.mean(medians) == pytest.approx(lam, rel=0.25), medians
+        if vals.size:
+            medians.append(np.median(vals))
+    if medians:
+        assert np.mean(medians) == pytest.approx(lam, rel=0.15), medians
 
 
 def test_high_dimensional_flow_is_refused_not_misestimated():

@@ -386,7 +386,10 @@ def test_ring_dominated_compressor_signal_is_not_called_chaotic(tmp_path):
         assert not (r["status"] == "ok" and r["exponent"] > 1.0), r
         if r["status"] == "inconsistent":
             assert r["reason"]
-    assert len("; ".join(s["verdict"]["reasons"])) < 900
+    # one reason per estimator and check, each a sentence a user reads (the calibrated rules
+    # say why a slope is refused and how far off such slopes were: ~320 characters)
+    reasons = s["verdict"]["reasons"]
+    assert len(reasons) <= 8 and all(len(r) < 400 for r in reasons), reasons
 
 
 @pytest.mark.slow
@@ -418,3 +421,62 @@ def test_fast_link_ring_at_150_rad_s_is_not_an_exponent(tmp_path):
     s = analyze_signal(csv, tmp_path / "an", column="acc", speed="150 rad/s")
     for r in s["lyapunov_signal"].values():
         assert not (r["status"] == "ok" and r["exponent"] > 3 * 82), r
+
+
+def test_classify_withholds_ok_estimates_that_disagree():
+    """Three estimates with status ok, 18x apart (0.05, 0.3 and 0.9 per time unit), handed to
+    classify directly: docs/signal_analysis.md lists the disagreement rule among classify's
+    rules, but only assess_signal applied it, and classify said 'chaotic'. Now classify
+    applies the same rules (one implementation, `check_agreement`): every positive
+    estimate is withheld with the reason and the verdict is undetermined. Estimates that
+    agree (within AGREEMENT_RATIO = 1.25x) still make it chaotic."""
+    from recipdyn.analysis.lyapunov_signal import withhold_disagreeing
+
+    def est(m, v):
+        return SignalLyapunov(m, v, np.empty(0), np.empty(0), None)
+
+    apart = [est("wolf", 0.05), est("rosenstein", 0.3), est("kantz", 0.9)]
+    v = classify(k01=0.97, determinism=True, signal_lyapunov=apart, time_scale=0.1)
+    assert v.verdict == "undetermined", v.reasons
+    assert all(v.evidence[f"lambda1_{m}_status"] == "inconsistent" for m in
+               ("wolf", "rosenstein", "kantz"))  # fmt: skip
+    assert any("disagree" in r and "18x" in r for r in v.reasons), v.reasons
+    assert [e.status for e in withhold_disagreeing(apart)] == ["inconsistent"] * 3
+    assert [e.status for e in apart] == ["ok"] * 3  # the caller's estimates are not changed
+    close = [est("wolf", 0.8), est("rosenstein", 0.95), est("kantz", 0.9)]
+    v = classify(k01=0.97, determinism=True, signal_lyapunov=close, time_scale=0.1)
+    assert v.verdict == "chaotic", v.reasons
+
+
+def test_a_lone_positive_estimate_is_unconfirmed_and_gives_no_number():
+    """One positive estimate with status ok, the other two refused: its number is not
+    reported (status 'unconfirmed', the reason names the refused ones); in the calibration
+    study a lone Wolf read 2x high on the Moore-Spiegel flow. The verdict counts its sign (a
+    positive exponent, no value): chaotic with K = 0.97 and determinism; undetermined with
+    K = 0.3 (conflicting evidence); stochastic without determinism."""
+    from recipdyn.analysis import amplitude_spectrum
+    from recipdyn.analysis.lyapunov_signal import check_agreement
+
+    def est(m, v, status="ok"):
+        return SignalLyapunov(m, v, np.empty(0), np.empty(0), None, status=status,
+                              reason="" if status == "ok" else "no scaling region")  # fmt: skip
+
+    lone = [est("wolf", 0.19), est("rosenstein", float("nan"), "refused"),
+            est("kantz", float("nan"), "refused")]  # fmt: skip
+    checked = check_agreement(lone)
+    assert [e.status for e in checked] == ["unconfirmed", "refused", "refused"]
+    assert "rosenstein, kantz not usable" in checked[0].reason
+    assert check_agreement(checked) == checked  # a second application changes nothing
+    v = classify(k01=0.97, determinism=True, signal_lyapunov=lone, time_scale=1.0)
+    assert v.verdict == "chaotic" and "lambda1" not in v.evidence, v.reasons
+    assert v.evidence["lambda1_wolf_status"] == "unconfirmed"
+    assert any("value unconfirmed" in r for r in v.reasons), v.reasons
+    v = classify(k01=0.3, determinism=True, signal_lyapunov=lone, time_scale=1.0)
+    assert v.verdict == "undetermined", v.reasons
+    v = classify(k01=0.97, determinism=False, signal_lyapunov=lone, time_scale=1.0)
+    assert v.verdict == "stochastic", v.reasons
+    # below the positive limit (0.02 per delay: 0.2 here) an unconfirmed value is no evidence
+    # of "no divergence" either: harmonic lines alone do not make the signal periodic
+    spec = amplitude_spectrum(np.sin(2 * np.pi * 0.05 * np.arange(4000)), 1.0)
+    v = classify(determinism=True, signal_lyapunov=lone, time_scale=0.1, spectrum=spec)
+    assert v.verdict == "undetermined" and "lambda1" not in v.evidence, v.reasons

@@ -90,8 +90,7 @@ def analyze_run(path: str | Path, out: str | Path, *, section_points: int = 200,
         peaks = find_spectral_peaks(spec, n=8, fundamental=fc, min_separation=PEAK_SEPARATION)
         summary["spectrum"] = {
             "resolution_hz": spec.resolution,
-            "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude, crank_order=p.order)
-                      for p in peaks],
+            "peaks": [_peak_row(p) for p in peaks],
         }  # fmt: skip
         fmax = min(fs / 2, 1.5 * max(p.frequency for p in peaks)) if peaks else None
         what = ds[vib].attrs.get("long_name") or vib
@@ -326,8 +325,7 @@ def analyze_signal(path: str | Path, out: str | Path, *, column=None, fs=None,
         "input": path.name, "signal": sig.name, "units": sig.units, "samples": int(n_total),
         "fs_hz": rate, "notes": sig.notes + a.notes, "model": "none (measured signal)",
         "spectrum": {"resolution_hz": spec.resolution,
-                     "peaks": [dict(frequency_hz=p.frequency, amplitude=p.amplitude,
-                                    crank_order=p.order) for p in peaks]},
+                     "peaks": [_peak_row(p) for p in peaks]},
         "lyapunov_signal": {k: r.diagnostics() for k, r in a.lyapunov.items()},
         "signal_assessment": a.to_dict(),
         "verdict": a.verdict.to_dict() | {"headline": _headline(a.verdict, vib)},
@@ -522,6 +520,13 @@ def _equations_any_model(m, ds, dim, out, summary, section_points, lyap_revoluti
     return lam, lam_err, section, k01
 
 
+def _peak_row(p) -> dict[str, Any]:
+    """A spectral peak for the summary: its crank order only when it is one (within the
+    harmonic tolerance of `find_spectral_peaks`, 1.5 bins), else ``None``: a line between
+    orders is named by its frequency alone (it said "crank order 0")."""
+    return dict(frequency_hz=p.frequency, amplitude=p.amplitude, crank_order=p.order or None)
+
+
 def _markdown(s: dict[str, Any]) -> str:
     v = s["verdict"]
     measured = s.get("model") == "none (measured signal)"
@@ -533,8 +538,8 @@ def _markdown(s: dict[str, Any]) -> str:
              " — " + "; ".join(v["reasons"]), "", f"## Spectrum peaks ({what})", "",
              f"| f (Hz) | amplitude ({unit}) |" + (" crank order |" if orders else ""),
              "|---|---|" + ("---|" if orders else "")]  # fmt: skip
-    for p in peaks:
-        order = f" {p['crank_order']} |" if orders else ""
+    for p in peaks:  # a line between orders: its frequency alone
+        order = f" {p['crank_order'] or '—'} |" if orders else ""
         lines.append(f"| {p['frequency_hz']:.4g} | {p['amplitude']:.4g} |{order}")
     vib = s.get("vibration")
     if vib:
@@ -582,7 +587,8 @@ def _markdown(s: dict[str, Any]) -> str:
     for name, r in s["lyapunov_signal"].items():
         val = (r["exponent"] if r["status"] in ("ok", "flat")
                else f"{r['exponent']:.4g}, withheld ({r['reason']})"
-               if r["status"] == "inconsistent" else f"refused ({r['reason']})")  # fmt: skip
+               if r["status"] in ("inconsistent", "unconfirmed")
+               else f"refused ({r['reason']})")  # fmt: skip
         lines.append(f"- {name} (signal {s.get('signal', 'a')}): {val}")
     if s.get("zero_one_K") is not None:
         lines.append(f"- 0-1 test K (stroboscopic section): {s['zero_one_K']:.3f}")

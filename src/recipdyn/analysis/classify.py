@@ -26,7 +26,12 @@ For a measured signal (no equations) two more pieces enter:
   is weakest), else **stochastic** (white noise, coloured noise and a noisy periodic signal land
   here).
 * ``signal_lyapunov``: estimates from the signal (Wolf, Rosenstein, Kantz); only those with a
-  usable status count (refusals are listed, never read as 0). They stand in for ``lambda1``
+  usable status count (refusals are listed, never read as 0). The estimates are compared with
+  each other first (the rules of ``assess_signal``, one implementation: ``check_agreement``):
+  usable positive ones that disagree are withheld, which makes the verdict **undetermined**;
+  a lone positive one is ``unconfirmed``: it votes for a positive sign but gives no number
+  (the verdict counts the exponent as positive, with no value). They stand in for
+  ``lambda1``
   when no equation-based exponent is given: positive when most usable estimates exceed
   ``signal_tol / time_scale`` (``time_scale``: the embedding delay, about one decorrelation
   time, in the exponents' time unit) and twice their fit error; flat when most do not
@@ -43,6 +48,7 @@ import numpy as np
 
 from ..defaults import LYAP_TOL, MAX_PERIODIC_POINTS, MAX_RMS_RATIO, MAX_SPEED_RATIO
 from .checks import as_signal
+from .lyapunov_signal import check_agreement
 from .poincare import count_distinct_points
 from .spectrum import Spectrum, find_spectral_peaks
 
@@ -147,40 +153,60 @@ def _grouped(estimates, what: str) -> list[str]:
 
 
 def _signal_exponent(estimates, time_scale, tol, ev, reasons):
-    """(lambda1, err, all_refused) from signal estimates; records the evidence. Estimates
-    withheld as ``inconsistent`` are listed with their reason and never used; when they leave
-    no usable positive estimate, ``ev['signal_estimates_withheld']`` is set."""
+    """(lambda1, err, no_number) from signal estimates; records the evidence. The estimates
+    are first compared with each other
+    ([`check_agreement`][recipdyn.analysis.lyapunov_signal.check_agreement], the rules
+    `assess_signal` applies: a list from anywhere gets them too). Estimates withheld as
+    ``inconsistent`` are listed with their reason and never used; when they leave no usable
+    positive estimate, ``ev['signal_estimates_withheld']`` is set. An ``unconfirmed`` estimate
+    (a lone positive one) votes for a positive sign when above the positive limit, and is no
+    evidence otherwise; it gives no number: when it carries the vote, lambda1 is None and
+    ``ev['signal_exponent_unconfirmed']`` is set (the verdict counts the exponent as positive,
+    with no value). ``no_number``: no estimate is evidence either way."""
+    estimates = check_agreement(list(estimates))
     usable = [e for e in estimates if e.ok]
+    unconfirmed = [e for e in estimates if e.status == "unconfirmed"]
     withheld = [e for e in estimates if e.status == "inconsistent"]
     for e in estimates:
         ev[f"lambda1_{e.method}"] = e.exponent if e.ok else None
         ev[f"lambda1_{e.method}_status"] = e.status
-        if e.status == "inconsistent":
+        if e.status in ("inconsistent", "unconfirmed"):
             ev[f"lambda1_{e.method}_withheld"] = e.exponent
     reasons += _grouped([e for e in estimates if e.status == "refused"], "refused")
     reasons += _grouped(withheld, "withheld")
+    reasons += _grouped(unconfirmed, "unconfirmed")
     if withheld and not any(e.exponent > 0 for e in usable):
         ev["signal_estimates_withheld"] = True
-    if not usable:
-        return None, 0.0, not withheld
     lim = tol / time_scale
-    pos = [e for e in usable if e.exponent > max(lim, 2 * e.stderr)]
-    vals = np.array([e.exponent for e in usable])
-    ev["lambda1_signal_median"] = float(np.median(vals))
+    # an unconfirmed value votes only for a positive sign: below the positive limit it is no
+    # evidence of "no divergence" either (a lone Wolf of 58 1/s beside two refused slopes of
+    # a ringing machine signal would make its harmonic lines "periodic")
+    voters = usable + [e for e in unconfirmed if e.exponent > max(lim, 2 * e.stderr)]
+    if not voters:
+        return None, 0.0, not withheld
+    pos = [e for e in voters if e.exponent > max(lim, 2 * e.stderr)]
+    if usable:
+        ev["lambda1_signal_median"] = float(np.median([e.exponent for e in usable]))
     ev["lambda1_signal_tolerance"] = lim
-    if len(pos) * 2 > len(usable):  # a majority positive
-        lam = float(np.median([e.exponent for e in pos]))
-        reasons.append(f"{len(pos)} of {len(usable)} signal estimates positive "
+    if len(pos) * 2 > len(voters):  # a majority positive
+        confirmed = [e for e in pos if e.ok]
+        if not confirmed:
+            ev["signal_exponent_unconfirmed"] = True
+            names = ", ".join(e.method for e in pos)
+            reasons.append(f"{names}: positive, its value unconfirmed (no number is reported)")
+            return None, 0.0, False
+        lam = float(np.median([e.exponent for e in confirmed]))
+        reasons.append(f"{len(pos)} of {len(voters)} signal estimates positive "
                        f"(median {lam:.4g} > {lim:.3g}, the smallest exponent counted as "
                        f"positive: {tol:g} per embedding delay of {time_scale:.3g})")  # fmt: skip
         return lam, 0.0, False
-    if pos and len(pos) * 2 == len(usable):  # a tie
-        reasons.append(f"signal estimates disagree: {len(pos)} of {len(usable)} positive")
+    if pos and len(pos) * 2 == len(voters):  # a tie
+        reasons.append(f"signal estimates disagree: {len(pos)} of {len(voters)} positive")
         ev["signal_estimates_conflict"] = True
         return None, 0.0, False
     if pos:
         names = ", ".join(e.method for e in pos)
-        reasons.append(f"{len(usable) - len(pos)} of {len(usable)} signal estimates show no "
+        reasons.append(f"{len(voters) - len(pos)} of {len(voters)} signal estimates show no "
                        f"divergence ({names} dissents)")  # fmt: skip
     return 0.0, 0.0, False
 
@@ -285,7 +311,9 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
                 "test, the surrogates and the section all assume a stationary record",
             )
             return Verdict("undetermined", ev, reasons)
-    pos = lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err)
+    # a lone positive signal estimate (unconfirmed) counts as a positive sign without a value
+    unconfirmed = lambda1 is None and ev.get("signal_exponent_unconfirmed", False)
+    pos = unconfirmed or (lambda1 is not None and lambda1 > max(lyap_tol, 2 * lambda1_err))
     flat = lambda1 == 0.0 and (k01 is None or k01 < 0.5)  # no divergence: noise never is
     if deterministic is False and not flat:
         regular = n_distinct is not None and n_distinct <= max_periodic_points
@@ -323,7 +351,9 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
             reasons.append(f"0-1 test K = {k01:.2f} on a section of {n_distinct} point(s): "
                            "the test sees the noise around them")  # fmt: skip
     if pos and (k01 is None or k01 > 0.5):
-        reasons.append("largest Lyapunov exponent positive beyond its uncertainty")
+        reasons.append("largest Lyapunov exponent positive" + (
+            " (the sign of a lone estimate; its value unconfirmed)" if unconfirmed
+            else " beyond its uncertainty"))  # fmt: skip
         if k01 is not None:
             reasons.append(f"0-1 test K = {k01:.2f} > 0.5")
         return Verdict("chaotic", ev, reasons)

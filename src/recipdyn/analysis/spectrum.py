@@ -114,6 +114,11 @@ def find_spectral_peaks(
     harmonics under a structural ring excited once a revolution, or the ripples of one broad
     line, is then one entry, while low harmonics (further apart than the window) stay
     separate. 0: every local maximum of the raw spectrum.
+
+    A peak is harmonic ``k`` of ``fundamental`` (``order = k``) when it lies within
+    ``tol_bins`` frequency bins of ``k * fundamental``: the largest bin of a windowed line is
+    within half a bin of the line's frequency, and one more bin allows for the leakage of a
+    neighbouring line shifting that maximum. Any other peak has ``order = 0``: not an order.
     """
     amp = spec.amplitude
     if amp.size < 3 or amp.max() <= 0:
