@@ -63,8 +63,8 @@ _DEFAULTS = SELECTORS.defaults()
 
 #: The implementations, by route: where each lives (imported when first asked for).
 ROUTES = {
-    "link": "recipdyn.model.compressor:COMPRESSOR",
-    "link-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
+    "link": "recipdyn.model.assembler.model:LINK",
+    "link-valves": "recipdyn.model.assembler.model:LINK_VALVES",
     "contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
     "contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",
     "guide": "recipdyn.model.compressor_guide:COMPRESSOR_GUIDE",

@@ -58,9 +58,14 @@ def __getattr__(name: str):
 def close_matches(word: str, candidates) -> list[str]:
     """The candidates ``word`` may be a misspelling of, closest first: difflib's similarity
     ratio (without case) at least 0.6 and within 0.1 of the best one's (so that
-    ``discharge_presure`` suggests ``discharge_pressure`` alone, not every ``*_pressure``)."""
+    ``discharge_presure`` suggests ``discharge_pressure`` alone, not every ``*_pressure``);
+    for a name that a machine holds per part, the namespaced ones (``rc``: ``throw1.rc``,
+    ``throw2.rc``)."""
     from difflib import SequenceMatcher
 
+    spaced = sorted(c for c in set(candidates) if c.rpartition(".")[2] == word and c != word)
+    if spaced:  # a machine's namespaced parameter (throw1.rc for rc): every part's
+        return spaced[:4]
     scored = []
     for c in set(candidates):
         m = SequenceMatcher(None, word.lower(), c.lower())

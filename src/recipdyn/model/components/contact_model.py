@@ -908,8 +908,8 @@ class CompressorContact(Model):
         pin's the other way), at rest relative to the journals; a rigid joint's are 0."""
         ang = values["e0_angle"]
         if ang is None:
+            from ..mechanism.link import equilibrium_theta_c
             from ..parameters import CompressorParams
-            from .mechanism import equilibrium_theta_c
 
             keys = (
                 *MECH,
