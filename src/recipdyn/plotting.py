@@ -313,7 +313,7 @@ def throws_figure(ds: xr.Dataset, *, title: str | None = None, max_throws: int =
     a = ds.attrs
     rcs = ", ".join(f"{t}.rc={1e3 * a[f'param_{t}.rc']:g} mm" for t in throws
                     if f"param_{t}.rc" in a)  # fmt: skip
-    add_footer(fig, f"{len(throws)} throws; {rcs} | {a['solver_method']} rtol="
+    add_footer(fig, f"{len(throws)} throws{'; ' + rcs if rcs else ''} | {a['solver_method']} rtol="
                     f"{a['solver_rtol']:g} | recipdyn {a['recipdyn_version']}")  # fmt: skip
     return fig
 

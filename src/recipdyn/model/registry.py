@@ -126,6 +126,9 @@ def load_object(spec: str, what: str = "object") -> object:
         raise ParameterError(str(exc).replace("model ", f"{what} ", 1)) from None
 
 
+#: The model of a machine file (a routing entry like `_BUILTIN`'s: imported when a file is
+#: first asked for).
+MACHINE_MODEL = "recipdyn.model.assembler.model:MachineModel"
 _MACHINES: dict[tuple[str, int], Model] = {}
 
 
@@ -137,7 +140,6 @@ def is_machine_file(spec: object) -> bool:
 def machine_model(path: str) -> Model:
     """The model of the machine file ``path`` (one per file and version of it in a process,
     so its systems are assembled once)."""
-    from .assembler.model import MachineModel
     from .machine import read_machine
 
     p = Path(path).resolve()
@@ -146,7 +148,7 @@ def machine_model(path: str) -> Model:
     except OSError:
         raise ParameterError(f"machine: file not found: {path}") from None
     if key not in _MACHINES:
-        _MACHINES[key] = MachineModel(read_machine(p))
+        _MACHINES[key] = _load_path(MACHINE_MODEL)(read_machine(p))
     return _MACHINES[key]
 
 
