@@ -2,11 +2,12 @@
 against N times one throw, measured side by side in one run.
 
 Each case integrates the machine of N identical throws of the paper's compressor (the
-paper's load; in phase, or with ``--phases spread`` evenly spread over a turn), with a prescribed crank and with the induction motor, for
-``--revolutions`` revolutions at the default tolerances, in alternating rounds in one process
-(CPU time, the best of the rounds). The steps a run takes depend on the fastest throw's
-motion, not on N, so the ratio measures the cost of one right-hand side of N throws against N
-of one throw. Target: at most 1.1.
+paper's load; in phase, or with ``--phases spread`` evenly spread over a turn), with a
+prescribed crank and with the induction motor, for ``--revolutions`` revolutions at the
+default tolerances, in alternating rounds in one process (CPU time, the best of the rounds).
+In phase, the throws take the steps one throw takes, and the ratio measures the cost of one
+right-hand side of N throws against N of one throw; spread, each throw's fast motion comes at
+its own time and the runs take more steps (printed). Target: at most 1.1.
 
     python benchmarks/bench_throws.py [--throws 1 2 4] [--rounds 5] [--revolutions 1]
 """
@@ -33,9 +34,13 @@ def main() -> None:
     ap.add_argument("--throws", type=int, nargs="*", default=[1, 2, 4])
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--revolutions", type=float, default=1.0)
-    ap.add_argument("--phases", choices=("same", "spread"), default="same",
-                    help="the throws in phase (the same steps as one throw) or spread evenly "
-                    "over a turn (each throw's fast motion at its own time: more steps)")
+    ap.add_argument(
+        "--phases",
+        choices=("same", "spread"),
+        default="same",
+        help="the throws in phase (the same steps as one throw) or spread evenly "
+        "over a turn (each throw's fast motion at its own time: more steps)",
+    )
     args = ap.parse_args()
 
     from recipdyn.integrate import integrate

@@ -360,3 +360,21 @@ def test_a_machine_file_is_read_with_its_structure_and_refuses_what_it_cannot_ho
         with pytest.raises(ParameterError) as exc:
             read_machine(f)
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
+
+
+@pytest.mark.parametrize("case", ["value", "structure"])
+def test_a_bad_machine_is_refused_before_the_compiled_code_loads(tmp_path, case):
+    """A machine file's bad value (``--set throw2.rc=-1mm``) or bad structure is answered in
+    one line with exit status 2 before numba, xarray, SciPy or the kernels load (a fresh
+    interpreter: the model of a machine is built and validated without compiled code)."""
+    from test_cli_refusals import _fresh
+
+    f = tmp_path / "bad.toml"
+    f.write_text('[[throw]]\nload = "cycle"\n[[throw]]\nload = "paper"\n')
+    args = (["simulate", "--machine", str(TWO_THROW), "--set", "throw2.rc=-1 mm"]
+            if case == "value" else ["simulate", "--machine", str(f)])  # fmt: skip
+    res = _fresh([*args, "-o", "o/x.nc"], tmp_path)
+    assert res["code"] == 2, res["err"]
+    assert res["heavy"] == [], res["heavy"]
+    assert len(res["err"].strip().splitlines()) == 1, res["err"]
+    assert ("throw2.rc" if case == "value" else "one kind of load") in res["err"]

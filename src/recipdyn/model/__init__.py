@@ -11,7 +11,7 @@ import importlib
 
 _LAZY = {
     "ODESystem": "base", "DiscreteMap": "base", "Signal": "base",
-    "AssembledSystem": "assembler.model", "compressor_model": "assembler.model",
+    "AssembledSystem": "assembler.system", "compressor_model": "assembler.model",
     "equilibrium_theta_c": "mechanism.link",
     "ideal_slider_crank": "kinematics", "ideal_mechanism": "kinematics",
     "joint_forces": "kinematics", "kinematics": "kinematics",

@@ -18,15 +18,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
 from dataclasses import fields as dataclass_fields
+from dataclasses import replace
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...errors import ParameterError
-from ..base import Event, ODESystem, Signal, rhs_series
 from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
 from ..mechanism.link import (
     PHASE,
@@ -40,8 +39,19 @@ from ..protocol import Model, Param, Schema
 from ..registry import absolute_spec, is_spec
 from .assemble import Configuration, assemble, load_of, throw_values
 
-__all__ = ["MachineModel", "OneThrow", "LINK", "LINK_VALVES", "VALVES_SCHEMA",
-           "machine_schema", "compressor_model", "AssembledSystem"]  # fmt: skip
+if TYPE_CHECKING:
+    from ..base import Event, Signal
+    from .system import AssembledSystem
+
+__all__ = [
+    "MachineModel",
+    "OneThrow",
+    "LINK",
+    "LINK_VALVES",  # noqa: F822 (built on first use, __getattr__)
+    "VALVES_SCHEMA",  # noqa: F822
+    "machine_schema",
+    "compressor_model",
+]
 
 _FIELDS = frozenset(f.name for f in dataclass_fields(CompressorParams))
 
@@ -50,14 +60,16 @@ _FIELDS = frozenset(f.name for f in dataclass_fields(CompressorParams))
 _DROP = {"load", "load_amplitude", "load_sign", "equations", "gas"}
 
 
+@lru_cache(maxsize=1)
 def _valves_schema() -> Schema:
+    """`VALVES_SCHEMA` (the valves' parameters live beside their compiled code: built when
+    first asked for, so a machine without valves is validated before numba loads)."""
     from .. import valves as va
 
     return Schema((*(p for p in SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
                   aliases=dict(SCHEMA.aliases))  # fmt: skip
 
 
-VALVES_SCHEMA = _valves_schema()
 #: The structure's keys, which a machine file gives as parts, not parameters.
 _SELECTORS = ("load", "drive", "motor", "equations")
 #: The cycle's parameters, which a throw with the paper's load does not have.
@@ -68,16 +80,15 @@ def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
     adds its own) without the shaft's, the stages' and the selectors, with its ``phase``."""
-    from ..components.load import LOADS
-
     if throw.load == "valves":
-        base = list(VALVES_SCHEMA)
+        base = list(_valves_schema())
     else:
         base = [p for p in SCHEMA if not (throw.load != "cycle" and p.group == _CYCLE_GROUP)]
         if throw.load != "paper":
             base = [p for p in base if p.name not in ("load_amplitude", "load_sign")]
         if is_spec(throw.load):
             from ..components.contract import resolve_component
+            from ..components.load import LOADS
 
             base += list(resolve_component("load", throw.load, LOADS).params)
     skip = {*SHAFT_NAMES, *STAGE_NAMES, *_SELECTORS}
@@ -163,11 +174,6 @@ class MachineModel(Model):
         if machine.source:
             self.spec = machine.source
         self.schema = schema if schema is not None else machine_schema(machine)
-        defaults = self.parameters() if schema is None else None
-        if defaults is not None:
-            names = self.states(defaults)
-            self.state_names = tuple(n for n, _ in names)
-            self.state_units = tuple(u for _, u in names)
         pre = [machine.prefix(t.name) for t in machine.throws]
         self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
             ("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
@@ -187,6 +193,21 @@ class MachineModel(Model):
                 "load=cycle (ideal valves)"
             )
             self.event_example = {}
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The states at the defaults (assembled when first asked for: building the model
+        loads no compiled code, so a bad value is refused before numba loads)."""
+        return tuple(n for n, _ in self._default_states())
+
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        return tuple(u for _, u in self._default_states())
+
+    def _default_states(self) -> tuple[tuple[str, str], ...]:
+        if "_states0" not in self.__dict__:
+            self.__dict__["_states0"] = self.states(self.parameters())
+        return self.__dict__["_states0"]
 
     # -- what the values choose --------------------------------------------------------
     def structure(self, values: Mapping[str, Any]) -> Machine:
@@ -233,12 +254,12 @@ class MachineModel(Model):
         or a CSV file relative to the machine file), as ``throwK.load_table``."""
         from pathlib import Path
 
-        from ..load import read_load_table
-
         out = {}
         for t in self.machine.throws:
             table = t.values.get("load_table")
             if isinstance(table, str):
+                from ..load import read_load_table
+
                 path = Path(table)
                 if not path.is_absolute() and self.machine.source:
                     path = Path(self.machine.source).parent / path
@@ -262,9 +283,10 @@ class MachineModel(Model):
         for t, local in zip(machine.throws, self.throws(values), strict=True):
             try:
                 self.throw_params(local)
-                load = load_of(local)
-                if load.check is not None:
-                    load.check(local)
+                if is_spec(local.get("load")):  # a user's component's own checks
+                    load = load_of(local)
+                    if load.check is not None:
+                        load.check(local)
             except ParameterError as exc:
                 raise _prefixed_message(machine.prefix(t.name), exc) from None
 
@@ -298,6 +320,8 @@ class MachineModel(Model):
         return self.configuration(values).layout.state.named()
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        from ..base import Event
+
         c = self.configuration(values)
         if not c.has_states:
             return ()
@@ -306,6 +330,8 @@ class MachineModel(Model):
                       "guard: rebound with the restitution, or rest"),)  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> AssembledSystem:
+        from .system import AssembledSystem, Frozen
+
         c = self.configuration(values)
         machine = c.machine
         motor = c.motor is not None
@@ -325,7 +351,7 @@ class MachineModel(Model):
             aux_states=c.aux_states,
             passive=c.passive(self.throws(values)),
             model=self,
-            values=_Frozen(values),
+            values=Frozen(values),
         )
 
     def system_name(self, values: Mapping[str, Any]) -> str:
@@ -394,6 +420,7 @@ class MachineModel(Model):
         and the machine's energy. The crank angle, speed and gas forces come from the
         compiled observer: the functions that were integrated."""
         from .. import valves as va
+        from ..base import Signal, rhs_series
         from ..components.load import cycle_outputs
         from ..kinematics import kinematics
 
@@ -497,41 +524,6 @@ def _n_cycle() -> int:
     return N_CYCLE
 
 
-@dataclass(frozen=True)
-class _Frozen:
-    """Values held by a system (compared by identity: a system is built per values)."""
-
-    values: Mapping[str, Any]
-
-    def __hash__(self) -> int:
-        return id(self)
-
-
-@dataclass(frozen=True)
-class AssembledSystem(ODESystem):
-    """An assembled machine's [`ODESystem`][recipdyn.model.base.ODESystem] with the model
-    and values it was built from: ``initial_state()``, ``outputs(t, y)`` and
-    ``accelerations(t, y)`` without repeating them."""
-
-    model: Any = None
-    values: Any = field(default=None, repr=False)
-
-    def initial_state(self) -> np.ndarray:
-        return self.model.initial_state(self.values.values)
-
-    def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, Signal]:
-        return self.model.outputs(self.values.values, t, y)
-
-    def accelerations(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """The first throw's clearance-angle acceleration at each sample."""
-        return rhs_series(self.rhs, self.params, t, y)[:, 1]
-
-    @property
-    def cparams(self) -> CompressorParams:
-        """The first throw's parameters."""
-        return self.model.throw_params(self.model.throws(self.values.values)[0])
-
-
 # -- the compressor of one throw: the compressor's names and selectors ----------------------
 
 
@@ -573,10 +565,6 @@ class OneThrow(MachineModel):
         self.valves = valves
         self.validity_bounds_instead = instead
         super().__init__(Machine(name=name, description=description), schema=schema)
-        defaults = self.parameters()
-        names = self.states(defaults)
-        self.state_names = tuple(n for n, _ in names)
-        self.state_units = tuple(u for _, u in names)
         self.section_signals = (("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"),
                                 ("v", "m/s"), ("a", "m/s**2"))  # fmt: skip
         self.vibration_signal = ("a", "m/s**2")
@@ -701,16 +689,28 @@ LINK = OneThrow(
     "crosshead subsidence (Xiao et al. 2017)",
     SCHEMA,
 )
-#: The same mechanism with the cylinder gas and dynamic plate valves as states (route
-#: ``link-valves``, the preset ``compressor-valves``).
-LINK_VALVES = OneThrow(
-    "compressor-valves",
-    "the compressor (massless-link clearance) driven by the compression cycle with dynamic "
-    "plate valves: cylinder pressures and valves as states",
-    VALVES_SCHEMA,
-    valves=True,
-    instead="the contact-impact joint with dynamic valves (--model compressor-contact-valves)",
-)
+
+
+def _link_valves() -> OneThrow:
+    """The same mechanism with the cylinder gas and dynamic plate valves as states (route
+    ``link-valves``, the preset ``compressor-valves``), built when first asked for."""
+    return OneThrow(
+        "compressor-valves",
+        "the compressor (massless-link clearance) driven by the compression cycle with dynamic "
+        "plate valves: cylinder pressures and valves as states",
+        _valves_schema(),
+        valves=True,
+        instead="the contact-impact joint with dynamic valves (--model compressor-contact-valves)",
+    )
+
+
+def __getattr__(name: str):
+    if name == "VALVES_SCHEMA":
+        return _valves_schema()
+    if name == "LINK_VALVES":
+        globals()[name] = _link_valves()
+        return globals()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def compressor_model(p: CompressorParams | None = None,

@@ -192,6 +192,15 @@ class Machine:
             if t.stage not in [s.name for s in self.stages]:
                 raise ParameterError(f"{where}.stage = {t.stage!r}; the machine's stages: "
                                      f"{', '.join(s.name for s in self.stages)}")  # fmt: skip
+        first = self.throws[0]
+        for t in self.throws[1:]:
+            if (t.load, t.equations) != (first.load, first.equations):
+                raise ParameterError(
+                    f"machine {self.name!r}: {t.name}.load = {t.load!r} ({t.equations}) beside "
+                    f"{first.name}.load = {first.load!r} ({first.equations}): the throws of a "
+                    "machine carry one kind of load and one set of equations today (their "
+                    "parameters differ freely)"
+                )
         if len(set(names)) != len(names):
             raise ParameterError(f"machine {self.name!r}: two throws named alike: {names}")
         if len({s.name for s in self.stages}) != len(self.stages):

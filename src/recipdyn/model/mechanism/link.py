@@ -19,12 +19,14 @@ states, independent of the sympy derivation the kernels come from.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..base import Signal
-from ..kinematics import joint_forces
 from ..protocol import Param
+
+if TYPE_CHECKING:
+    from ..base import Signal
 
 __all__ = ["MECHANISM", "HEAD", "N_HEAD", "STATES", "PHASE", "equilibrium_theta_c",
            "mechanism_outputs", "mechanism_energy", "SIGN_CONVENTION"]  # fmt: skip
@@ -87,6 +89,9 @@ def mechanism_outputs(p, k, thc, thcd, thcdd, fg) -> dict[str, Signal]:
     ([`kinematics`][recipdyn.model.kinematics.kinematics]) and the gas force ``fg`` on the
     crosshead, whatever load gives it (``p``: the throw's
     [`CompressorParams`][recipdyn.model.parameters.CompressorParams])."""
+    from ..base import Signal
+    from ..kinematics import joint_forces
+
     jf = joint_forces(p, k, thc, fg)
     return {
         "x": Signal(k.x3, "m", "crosshead displacement x3"),
