@@ -40,6 +40,27 @@ CASES = {
     "valves": ("compressor-valves", {}),
     "valves-fault": ("compressor-valves", {"leak_area_discharge_head": 2e-5}),
     "valves-motor": ("compressor-valves", {"drive": "motor"}),
+    "contact": ("compressor-contact", {}),
+    "contact-cycle": ("compressor-contact", {"load": "cycle"}),
+    "lubricated-contact": ("compressor-contact", {"crank_joint": "lubricated",
+                                                  "crosshead_joint": "contact", "omega": 150.0,
+                                                  "load_amplitude": 2e4}),
+    "contact-both-tanh": ("compressor-contact", {"crosshead_joint": "contact",
+                                                 "friction_law": "tanh", "friction": 0.1}),
+    "contact-law-file": ("compressor-contact", {"contact_law": f"{PLUGIN}:KELVIN_VOIGT"}),
+    "contact-load-file": ("compressor-contact", {"load": f"{PLUGIN}:HARMONIC"}),
+    "contact-motor": ("compressor-contact", {"drive": "motor", "motor": "constant",
+                                             "omega": 150.0, "load_amplitude": 2e4}),
+    "contact-valves": ("compressor-contact-valves", {}),
+    "contact-valves-motor": ("compressor-contact-valves", {"drive": "motor"}),
+    "guide-ideal-pins": ("compressor-contact", {"guide": "clearance", "crank_joint": "ideal",
+                                                "guide_clearance": 2e-4}),
+    "guide-contact": ("compressor-contact", {"guide": "clearance", "guide_clearance": 2e-4}),
+    "guide-motor": ("compressor-contact", {"guide": "clearance", "crank_joint": "ideal",
+                                           "guide_clearance": 2e-4, "drive": "motor",
+                                           "motor": "constant"}),
+    "guide-valves": ("compressor-contact-valves", {"guide": "clearance",
+                                                   "guide_clearance": 2e-4}),
 }  # fmt: skip
 
 
@@ -76,6 +97,8 @@ def main() -> None:
         "--before-cache",
         help="the earlier tree's numba cache folder (kept between runs; default: a temporary one)",
     )
+    ap.add_argument("--before-records", help="a folder for the earlier tree's records, kept "
+                    "between runs (a case found there is not run again)")  # fmt: skip
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -89,7 +112,13 @@ def main() -> None:
         outs = {}
         for label, src in (("before", old_src), ("now", new_src)):
             out = tmp / label
-            out.mkdir()
+            if label == "before" and args.before_records:
+                out = Path(args.before_records)
+            out.mkdir(parents=True, exist_ok=True)
+            cases = [c for c in args.cases if not (out / f"{c}.npz").exists()]
+            if not cases:
+                outs[label] = out
+                continue
             env = {**os.environ, "PYTHONPATH": str(src),
                    "NUMBA_CACHE_DIR": str(tmp / f"cache_{label}")}  # fmt: skip
             if label == "now" and "NUMBA_CACHE_DIR" in os.environ:
@@ -98,7 +127,7 @@ def main() -> None:
                 env["NUMBA_CACHE_DIR"] = args.before_cache
             subprocess.run([sys.executable, __file__, "--worker", "--before", args.before,
                             "--revolutions", str(args.revolutions), "--out", str(out),
-                            "--cases", *args.cases], env=env, check=True)  # fmt: skip
+                            "--cases", *cases], env=env, check=True)  # fmt: skip
             outs[label] = out
         report = {}
         for name in args.cases:

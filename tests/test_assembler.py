@@ -97,26 +97,60 @@ def test_a_templates_own_block_binds_its_reference_configuration(drive):
     configuration (one throw of the paper's compressor; the induction motor), exactly the
     roles and constants the assembler binds for it, so the template that is linted and read
     is the code a configuration runs."""
-    import ast
-
-    from recipdyn.model.assembler import generate
     from recipdyn.model.registry import get_model
 
     m = get_model("compressor")
     v = m.parameters({"drive": drive})
     template, roles, constants, _, _ = m.configuration(v).bindings()
+    got_roles, got_consts = _block(template)
+    assert got_roles == roles
+    _same_constants(got_consts, constants)
+
+
+def _block(template: str) -> tuple[dict, dict]:
+    """The roles ``name -> (module, function)`` and the constants a template's own block
+    binds."""
+    import ast
+
+    from recipdyn.model.assembler import generate
+
     text = (generate.TEMPLATES / f"{template}.py").read_text()
     block = text[text.index(generate.BEGIN) : text.index(generate.END)]
-    got_roles, got_consts = {}, {}
+    roles, consts = {}, {}
     for node in ast.parse(block).body:
         if isinstance(node, ast.ImportFrom):
-            got_roles.update({a.asname or a.name: (node.module, a.name) for a in node.names})
+            roles.update({a.asname or a.name: (node.module, a.name) for a in node.names})
         else:
-            got_consts[node.targets[0].id] = eval(ast.unparse(node.value), {"np": np})
+            consts[node.targets[0].id] = eval(ast.unparse(node.value), {"np": np})
+    return roles, consts
+
+
+def _same_constants(got: dict, want: dict) -> None:
+    assert got.keys() == want.keys()
+    for k, v in want.items():
+        assert np.array_equal(np.asarray(got[k]), np.asarray(v)), k
+
+
+def test_the_contact_templates_bind_their_reference_configuration():
+    """The joints' and the contact kernels' templates as they stand bind the reference
+    configuration of `compressor-contact` (the crank pin worn, the built-in law, Ambrósio's
+    friction, the paper's load, the crank prescribed, the guide rigid): the names and
+    constants the model binds for it (the joints' functions from the template of the joints
+    itself, where the model writes a module per law)."""
+    from recipdyn.model.components import contact_model as cm
+    from recipdyn.model.components.load import PAPER
+    from recipdyn.model.registry import get_model
+
+    v = get_model("compressor-contact").parameters()
+    roles, consts, _, _ = cm.joints_bindings(None, cm.friction_part(v), "ambrosio_friction")
+    got_roles, got_consts = _block("joints")
     assert got_roles == roles
-    assert got_consts.keys() == constants.keys()
-    for k, want in constants.items():
-        assert np.array_equal(np.asarray(got_consts[k]), np.asarray(want)), k
+    _same_constants(got_consts, consts)
+    jm = "recipdyn.model.assembler.templates.joints"
+    roles, consts, _ = cm.contact_bindings(jm, v["clearance_joints"], PAPER, False, 0, None, 0)
+    got_roles, got_consts = _block("contact")
+    assert got_roles == roles
+    _same_constants(got_consts, consts)
 
 
 def test_a_one_throw_machine_file_is_the_compressor(tmp_path):

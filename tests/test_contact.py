@@ -12,6 +12,7 @@ import pytest
 
 import recipdyn
 from recipdyn.integrate import integrate
+from recipdyn.model.assembler.templates.joints import _pair  # the built-in law's joints
 from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem
 from recipdyn.model.components import contact_model as cm
 from recipdyn.model.joints import pins as jp
@@ -19,7 +20,6 @@ from recipdyn.model.joints.contact import (
     FRICTION_LAWS,
     FRICTION_ROLES,
     LAWS,
-    ambrosio_friction,
     delivered_restitution,
     hysteresis_factor,
     normal_force,
@@ -166,8 +166,8 @@ def _newton_euler_rhs(t, y, p, out):  # y = (theta2, x3, theta2', x3', v_impact)
     u = -r * w * math.sin(th1) - l * s2 * w2 - v3
     v = r * w * math.cos(th1) + l * c2 * w2
     # (no friction in this case: any friction law gives 0)
-    f = jp._pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
-                 p, ambrosio_friction, jp.P_MU)  # fmt: skip
+    f = _pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
+              p)  # fmt: skip
     aax, aay = -r * w * w * math.cos(th1), -r * w * w * math.sin(th1)
     # moments about the crank pin A: (J2 + m2 ls^2) theta2'' = -m2 ls (rGA x aA) + rPA x F2
     #   + rGA x m2 g + T_b

@@ -181,7 +181,7 @@ def _model_edges(graph: dict[str, set[str]], models: set[str]) -> set[tuple[str,
 
 #: The model modules of the compressor (the registry's and family's tables must name them).
 MODEL_MODULES = {"family", "assembler.model", "compressor_contact", "compressor_contact_valves",
-                 "compressor_guide"}  # fmt: skip
+                 "reference.compressor_guide"}  # fmt: skip
 
 
 def test_no_model_module_imports_another():

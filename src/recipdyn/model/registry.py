@@ -42,6 +42,7 @@ _BUILTIN = {
     "compressor-valves": "recipdyn.model.family:COMPRESSOR_VALVES",
     "compressor-contact-valves": "recipdyn.model.family:COMPRESSOR_CONTACT_VALVES",
     "compressor-guide": "recipdyn.model.family:COMPRESSOR_GUIDE",
+    "compressor-guide-reference": "recipdyn.model.reference.compressor_guide:COMPRESSOR_GUIDE",
 }
 _REGISTERED: dict[str, Model] = {}
 

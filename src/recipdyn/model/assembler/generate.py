@@ -26,7 +26,7 @@ from types import ModuleType
 
 import numpy as np
 
-__all__ = ["absent", "template_names", "bindings", "module", "TEMPLATES"]
+__all__ = ["absent", "template_names", "bindings", "module", "Literal", "TEMPLATES"]
 
 TEMPLATES = Path(__file__).with_name("templates")
 BEGIN, END = "# <bindings>", "# </bindings>"
@@ -61,7 +61,16 @@ def template_names(template: str) -> tuple[frozenset[str], frozenset[str]]:
     return frozenset(roles), frozenset(constants)
 
 
+class Literal(int):
+    """An integer constant written as a plain literal (``CFG = 2``): numba types it as
+    ``Literal[int]``, so a function it is passed to compiles once per value and prunes the
+    branches on it (a configuration code); `_constant` writes other integers as ``np.int64``,
+    one compilation for every value (an offset)."""
+
+
 def _constant(value) -> str:
+    if isinstance(value, Literal):
+        return str(int(value))
     if isinstance(value, (bool, np.bool_)):
         return "True" if value else "False"
     if isinstance(value, (int, np.integer)):
