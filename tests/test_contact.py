@@ -4,6 +4,7 @@ closed form, the limits of the compressor model with it, its energy balance and 
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numba as nb
@@ -767,9 +768,9 @@ FRICTION = dict(crank_joint="contact", omega=150.0, load_amplitude=2e4, friction
 @pytest.mark.parametrize("drive", ["prescribed", "motor"])
 @pytest.mark.parametrize("law", FRICTION_LAWS)
 def test_the_glue_calls_the_friction_law_it_names(law, drive):
-    """The friction law is chosen when the glue is written: the glue imports the function
-    ``friction_law`` names and reads no law code (the packed vector holds none); at a state in
-    contact the observed ``F_t / F_n`` is that law's closed form at the sliding velocity
+    """The friction law is chosen when the kernels are written: the joints' module binds the
+    function ``friction_law`` names and reads no law code (the packed vector holds none); at a
+    state in contact the observed ``F_t / F_n`` is that law's closed form at the sliding velocity
     ``v_t = omega R_j - theta2' (R_j + c)`` (journal on the crank, bearing on the rod), to
     rounding, and the two laws differ there by far more (0.5 against tanh(1.5) = 0.905 of
     mu at v_t = 7.5 m/s). The same with a motor (the free crank's glue: its initial state
@@ -778,7 +779,8 @@ def test_the_glue_calls_the_friction_law_it_names(law, drive):
     motor = {"drive": "motor", "motor": "constant"} if drive == "motor" else {}
     v = m.parameters(FRICTION, friction_law=law, **motor)
     k = m.kernels(v)
-    src = Path(k.__file__).read_text(encoding="utf-8")
+    joints = sys.modules[k.joints.py_func.__module__]  # the joints' forces of the laws
+    src = Path(joints.__file__).read_text(encoding="utf-8")
     assert f"import {FRICTION_ROLES[law]} as friction" in src
     assert ("_motor_" in k.__name__) == (drive == "motor")
     assert "P_FLAW" not in src and "int(p[" not in src and not hasattr(jp, "P_FLAW")

@@ -8,6 +8,7 @@ zero-clearance limit, the energy balance with every worn part at once, and the k
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -197,11 +198,12 @@ SHOES = {**IDEAL_PINS, "guide_clearance": 2e-4, "load_amplitude": 2e4, "guide_fr
 
 @pytest.mark.parametrize("law", FRICTION_LAWS)
 def test_the_shoes_friction_law_is_chosen_by_name(law):
-    """The guide's friction law is a function chosen when the kernel is built: the glue's
-    guide imports the one ``guide_friction_law`` names and reads no law code (its slice holds
-    none), and `compressor-guide` runs the compiled kernel of that law."""
+    """The guide's friction law is a function chosen when the kernels are built: the joints'
+    module binds the one ``guide_friction_law`` names and reads no law code (its slice holds
+    none), and `compressor-guide-reference` runs the compiled kernel of that law."""
     v = CC.parameters({**SHOES, "guide_friction_law": law})
-    src = Path(CC.kernels(v).__file__).read_text(encoding="utf-8")
+    k = CC.kernels(v)
+    src = Path(sys.modules[k.joints.py_func.__module__].__file__).read_text(encoding="utf-8")
     assert f"import {FRICTION_ROLES[law]} as guide_friction" in src
     assert "FLAW" not in src and "int(p[" not in src
     g = recipdyn.get_model("compressor-guide-reference")

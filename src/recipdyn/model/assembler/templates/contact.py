@@ -69,32 +69,34 @@ from recipdyn.model.joints.pins import (
 
 # isort: split
 # <bindings>
-from recipdyn.model.assembler.generate import absent as guide_corner
-from recipdyn.model.assembler.generate import absent as guide_forces
-from recipdyn.model.assembler.generate import absent as joints_at
-from recipdyn.model.assembler.generate import absent as joints_guide
-from recipdyn.model.assembler.generate import absent as joints_guide_at
 from recipdyn.model.assembler.generate import absent as load_event
 from recipdyn.model.assembler.generate import absent as load_force
 from recipdyn.model.assembler.generate import absent as load_reset
 from recipdyn.model.assembler.generate import absent as load_rhs
 from recipdyn.model.assembler.generate import absent as load_state_force
 from recipdyn.model.assembler.generate import absent as torque
-from recipdyn.model.assembler.templates.joints import joints
+from recipdyn.model.assembler.templates.joints import (
+    guide_corner,
+    guide_forces,
+    joints,
+    joints_at,
+    joints_guide,
+    joints_guide_at,
+)
 from recipdyn.model.components.load import paper_force_sc as load_force_sc
 
 A = np.int64(12)
 CFG = 0
-CO = np.int64(0)
+CO = np.int64(31)
 G = np.int64(12)
-GO = np.int64(0)
-GY = np.int64(0)
+GO = np.int64(31)
+GY = np.int64(12)
 HAS_GUIDE = False
 LO = np.int64(31)
 LOAD_SC = True
 LOAD_STATES = False
-M = np.int64(0)
-MO = np.int64(0)
+M = np.int64(12)
+MO = np.int64(33)
 MOTOR = False
 N_OBS = np.int64(21)
 # </bindings>
