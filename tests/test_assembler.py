@@ -412,3 +412,20 @@ def test_a_bad_machine_is_refused_before_the_compiled_code_loads(tmp_path, case)
     assert res["heavy"] == [], res["heavy"]
     assert len(res["err"].strip().splitlines()) == 1, res["err"]
     assert ("throw2.rc" if case == "value" else "one kind of load") in res["err"]
+
+
+def test_a_throws_derived_defaults_follow_its_own_values():
+    """The compressor's derived defaults (``ls = l / 2``, ``J2 = m2 l**2 / 12``) hold per
+    throw: ``throw2.ls`` follows ``throw2.l``, not ``throw1.l``; a value the machine file
+    gives is kept (the file's, not the rule's)."""
+    from recipdyn.model.protocol import Derived
+
+    m = _model(_two())
+    v = m.parameters({"throw2.l": 0.5, "throw1.l": 0.7})
+    assert v["throw2.ls"] == pytest.approx(0.25) and isinstance(v["throw2.ls"], Derived)
+    assert v["throw1.ls"] == pytest.approx(0.35)
+    assert v["throw1.J2"] == pytest.approx(v["throw1.m2"] * 0.7**2 / 12)
+    assert v["throw2.J2"] == 0.7  # (the file's value: _two gives it)
+    f = Machine("m", throws=(Throw("throw1", params=(("ls", 0.2),)), Throw("throw2")))
+    w = _model(f).parameters()
+    assert w["throw1.ls"] == 0.2 and w["throw2.ls"] == pytest.approx(w["throw2.l"] / 2)

@@ -48,7 +48,15 @@ def dataset(
         help="With --severity-range: records of each class per condition (default: "
         "as many as --levels).",
     ),
-    snr: float = typer.Option(20.0, "--snr", help="Accelerometer SNR, dB."),
+    chain: str = typer.Option(
+        "drawn",
+        "--chain",
+        help="drawn (default): every record's measurement chain drawn from the stated ranges "
+        "(docs/sensors.md); fixed: the one chain of earlier versions (for comparisons).",
+    ),
+    snr: float = typer.Option(
+        None, "--snr", help="Accelerometer SNR, dB, with --chain fixed (default 20)."
+    ),
     snr_range: str = typer.Option(
         None,
         "--snr-range",
@@ -81,10 +89,18 @@ def dataset(
         kw["severity_draws"] = draws
     if snr_range is not None:
         kw["snr_range"] = _snrs(snr_range)
+    if snr is not None and chain != "fixed":
+        from ..errors import ParameterError
+
+        raise ParameterError(
+            "snr: sets the fixed chain's accelerometer SNR; allowed with --chain fixed, or "
+            "give the drawn chain's range with --snr-range LO,HI"
+        )
     spec = DatasetSpec(
         n_conditions=conditions,
         levels=_levels(levels),
-        snr_db=snr,
+        snr_db=20.0 if snr is None else snr,
+        chain=chain,
         revolutions=revolutions,
         transient=transient,
         test_fraction=test_fraction,
@@ -170,14 +186,26 @@ def diagnose(
         None, "--model", "-m", help="Diagnoser file (default: the one shipped with recipdyn)."
     ),
     out: Path = typer.Option(None, "--out", "-o", help="Folder for the overlay figure."),
+    no_correction: bool = typer.Option(
+        False,
+        "--no-correction",
+        help="Trust the tacho's mark, the pressures' zero and alignment (no chain correction).",
+    ),
 ) -> None:
     """Diagnose a record: fault class, severity and evidence, or a refusal with its reason.
 
-    Class probabilities, the severity with its interval, impacts and deciding features, the
-    closest simulated record overlaid; a record outside the training domain is refused."""
+    The measurement chain's errors read from the record (the tacho mark's crank angle and
+    the pressures' offsets from the polytropes, their relative gain, the tacho's jitter, the
+    mount's resonance) and corrected; class probabilities, the severity with its interval,
+    the channels used and how often their answer was right on held-out conditions, impacts
+    and deciding features, the closest simulated record overlaid. A record outside the
+    training domain, whose chain cannot be made consistent, or whose channels cannot tell
+    its class apart is refused."""
     from ..diagnosis.diagnose import diagnose as diagnose_fn
     from ..errors import ParameterError
+    from ..io_signal import check_signal_file
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     res = diagnose_fn(
@@ -190,6 +218,7 @@ def diagnose(
         p_crank=p_crank,
         model=model,
         out=out,
+        correct=not no_correction,
     )
     if res.refused:
         raise ParameterError(f"diagnose {record.name}: refused: {res.reason}")

@@ -63,6 +63,8 @@ __all__ = [
 #: The sensed channels stored per record.
 CHANNELS = ("accel_guide", "p_head_sensor", "p_crank_sensor", "tacho")
 BACKENDS = ("serial", "processes", "dask")
+#: How a data set's records are sensed (`DatasetSpec.chain`).
+CHAIN_KINDS = ("drawn", "fixed")
 
 
 @dataclass(frozen=True)
@@ -96,12 +98,21 @@ class DatasetSpec:
         Each record's accelerometer SNR drawn uniformly in ``[lo, hi]`` dB (seeded per
         condition, class and record) instead of ``snr_db`` for all, so that a diagnoser learns
         the machine apart from the sensor's noise floor (docs/diagnosis.md, robustness).
+        With the drawn chain it replaces the ranges' accelerometer SNR.
+    chain : {"drawn", "fixed"}
+        ``drawn`` (default): every record's measurement chain drawn from
+        `recipdyn.chain.DEFAULT_RANGES` (seeded per condition, class and record; domain
+        randomisation), its resonance and SNR in place of the condition's resonance and
+        ``snr_db``. ``fixed``: the one chain every data set used before
+        (`recipdyn.chain.legacy_chain`: the condition's resonance, ``snr_db`` or
+        ``snr_range``), its records those of earlier versions to the bit.
 
     Notes
     -----
-    A data set's store is identified by `to_json`, which leaves out the two continuous-
-    severity settings while they are None, so a store built with fixed levels keeps its
-    identity (and resumes) whatever settings are added here later.
+    A data set's store is identified by `to_json`, which leaves out the continuous-severity
+    and SNR-range settings while they are None and the chain while it is ``fixed``, so a
+    store built before keeps its identity (and resumes) whatever settings are added here
+    later; `from_dict` reads a spec without ``chain`` as the fixed chain it was built with.
     """
 
     n_conditions: int = 16
@@ -115,12 +126,21 @@ class DatasetSpec:
     severity_range: tuple[float, float] | None = None
     severity_draws: int | None = None
     snr_range: tuple[float, float] | None = None
+    chain: str = "drawn"
 
     def __post_init__(self):
-        if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
+        if not 0 < self.test_fraction < 1:
+            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
+        n, need = self.n_conditions, min_conditions(self.test_fraction)
+        if not (isinstance(n, int) and n >= 1):
+            raise ParameterError(f"n_conditions = {n!r}; allowed: an integer >= {need}")
+        if n - n_test_conditions(n, self.test_fraction) < MIN_TRAIN_CONDITIONS:
             raise ParameterError(
-                f"n_conditions = {self.n_conditions!r}; allowed: an integer "
-                ">= 2 (one for training, one for testing)"
+                f"n_conditions = {n} (test_fraction = {self.test_fraction:g}) leaves "
+                f"{max(0, n - n_test_conditions(n, self.test_fraction))} training "
+                f"condition(s); allowed: n_conditions >= {need} (a diagnoser trains on "
+                f"{MIN_TRAIN_CONDITIONS} conditions at least, one to fit and one to calibrate "
+                "its severity intervals and out-of-distribution threshold, and tests on 1)"
             )
         if not self.levels or not all(0 < s <= 1 for s in self.levels):
             raise ParameterError(f"levels = {self.levels!r}; allowed: severities in (0, 1]")
@@ -130,8 +150,6 @@ class DatasetSpec:
             raise ParameterError(f"revolutions = {self.revolutions!r}; allowed: [1, 100]")
         if not 0 <= self.transient <= 100:
             raise ParameterError(f"transient = {self.transient!r}; allowed: [0, 100]")
-        if not 0 < self.test_fraction < 1:
-            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
         if not (isinstance(self.seed, int) and 0 <= self.seed < 2**63):
             raise ParameterError(f"seed = {self.seed!r}; allowed: an integer >= 0")
         for c in self.classes:
@@ -146,6 +164,25 @@ class DatasetSpec:
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
+        if self.chain not in CHAIN_KINDS:
+            raise ParameterError(f"chain = {self.chain!r}; allowed: {', '.join(CHAIN_KINDS)}")
+
+    @property
+    def chain_ranges(self):
+        """The ranges a drawn chain comes from (`recipdyn.chain.ChainRanges`; ``snr_range``
+        replaces the accelerometer's SNR range)."""
+        from ..chain import DEFAULT_RANGES, ChainRanges, Span
+
+        ranges = ChainRanges()
+        if self.snr_range is not None:
+            old = DEFAULT_RANGES["accelerometer.snr_db"]
+            lo, hi = self.snr_range
+            ranges = ranges.with_spans(
+                accelerometer__snr_db=Span(
+                    lo, hi, old.unit, old.meaning, "the data set's snr_range"
+                )  # fmt: skip
+            )
+        return ranges
 
     @property
     def continuous(self) -> bool:
@@ -166,12 +203,16 @@ class DatasetSpec:
         for k in ("severity_range", "severity_draws", "snr_range"):
             if d[k] is None:
                 del d[k]
+        if d["chain"] == "fixed":
+            del d["chain"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
-        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples);
+        one without ``chain`` was built with the fixed chain."""
+        kw = {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+        return cls(**{"chain": "fixed", **kw})
 
 
 def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, float]:
@@ -196,9 +237,30 @@ def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
     return out
 
 
+#: Training conditions a diagnoser needs: one to fit on and one to calibrate on (its
+#: severity intervals' conformal quantiles and its out-of-distribution threshold come from
+#: whole conditions the fit has not seen: `recipdyn.diagnosis.train`).
+MIN_TRAIN_CONDITIONS = 2
+
+
+def n_test_conditions(n: int, test_fraction: float) -> int:
+    """Conditions held out for testing: ``test_fraction`` of ``n``, at least 1 (and at most
+    ``n - 1``)."""
+    return max(1, min(round(test_fraction * n), n - 1))
+
+
+def min_conditions(test_fraction: float) -> int:
+    """The fewest conditions that leave `MIN_TRAIN_CONDITIONS` for training and one for
+    testing at ``test_fraction``."""
+    n = MIN_TRAIN_CONDITIONS + 1
+    while n - n_test_conditions(n, test_fraction) < MIN_TRAIN_CONDITIONS:
+        n += 1
+    return n
+
+
 def split_of(spec: DatasetSpec) -> list[str]:
     """``"train"`` or ``"test"`` per condition (seeded; at least one of each)."""
-    n_test = min(max(1, round(spec.test_fraction * spec.n_conditions)), spec.n_conditions - 1)
+    n_test = n_test_conditions(spec.n_conditions, spec.test_fraction)
     perm = np.random.default_rng([spec.seed, 1]).permutation(spec.n_conditions)
     test = set(perm[:n_test].tolist())
     return ["test" if i in test else "train" for i in range(spec.n_conditions)]
@@ -227,9 +289,20 @@ def snrs(spec: DatasetSpec, condition: int, name: str, n: int) -> list[float]:
     return rng.uniform(lo, hi, n).tolist()
 
 
+def chain_draw(spec: DatasetSpec, condition: int, name: str, level: int, fs: float):
+    """The drawn measurement chain (`recipdyn.chain.Chain`) of record ``level`` of class
+    ``name`` at ``condition``: from a generator seeded by the data set's seed, the condition,
+    the class name and the record (as `severities`: adding a class, a condition or a record
+    leaves the other chains as they were)."""
+    rng = np.random.default_rng([spec.seed, 5, condition, zlib.crc32(name.encode()), level])
+    return spec.chain_ranges.draw(rng, fs)
+
+
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     """The records of ``spec``: one task per (condition, class, severity), in a fixed order
-    (``level`` numbers a class's records at a condition)."""
+    (``level`` numbers a class's records at a condition). With the drawn chain each task
+    holds its chain (``chain``, `recipdyn.chain.Chain.to_dict`), whose resonance and SNR are
+    the task's ``resonance_hz`` and ``snr_db``."""
     tasks = []
     splits = split_of(spec)
     for ci, cond in enumerate(_conditions(spec)):
@@ -264,12 +337,26 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                         "noise_seed": int(spec.seed * 1_000_003 + idx),
                     }
                 )
+                if spec.chain == "drawn":
+                    ch = chain_draw(spec, ci, name, li, cond["fs"])
+                    tasks[-1]["chain"] = ch.to_dict()
+                    tasks[-1]["resonance_hz"] = ch.accelerometer.resonance_hz
+                    tasks[-1]["snr_db"] = ch.accelerometer.snr_db
     return tasks
 
 
-def _snr_text(spec: dict[str, Any]) -> str:
+def snr_text(spec: dict[str, Any]) -> str:
+    """The accelerometer SNR (dB) a data set's spec (``asdict``) records at: one value, or
+    the range drawn in."""
     r = spec.get("snr_range")
-    return f"{spec['snr_db']}" if r is None else f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if r is not None:
+        return f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if spec.get("chain", "fixed") == "drawn":
+        from ..chain import DEFAULT_RANGES
+
+        a = DEFAULT_RANGES["accelerometer.snr_db"]
+        return f"{a.lo:g}..{a.hi:g} (drawn a record)"
+    return f"{spec['snr_db']:g}"
 
 
 def n_samples_max(tasks) -> int:
@@ -296,6 +383,10 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
             summary=summary,
             **task["params"],
         )
+    if "chain" in task:  # a drawn chain; a task without one has the fixed chain
+        from ..chain import Chain
+
+        return sensors.record(ds, chain=Chain.from_dict(task["chain"]), seed=task["noise_seed"])
     return sensors.record(
         ds,
         accelerometer=sensors.Accelerometer(
@@ -307,21 +398,68 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
     )
 
 
-def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
-    """A record's features from its sensed channels: the crank angle from the tacho's first
-    edge and the record's constant crank speed (a short record has too few pulses for
-    the speed to be read from them)."""
+def _revs(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> np.ndarray:
+    """The crank angle a data set's features read: from the tacho's first edge at the
+    record's constant crank speed (a short record has too few pulses for the speed to be
+    read from them)."""
     from ..analysis.vibration import tacho_times
-    from .evidence import record_features
 
-    x = channels["accel_guide"]
     edges = tacho_times(channels["tacho"], fs)
     if edges.size == 0:
         raise ValueError("no tacho edge in the record")
-    revs = (np.arange(x.size) / fs - edges[0]) * speed_hz
+    return (np.arange(channels["accel_guide"].size) / fs - edges[0]) * speed_hz
+
+
+def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
+    """A record's features from its sensed channels (the crank angle: `_revs`)."""
+    from .evidence import record_features
+
+    revs = _revs(channels, fs, speed_hz)
     return record_features(
-        x, fs, revs, p_head=channels.get("p_head_sensor"), p_crank=channels.get("p_crank_sensor")
+        channels["accel_guide"], fs, revs, p_head=channels.get("p_head_sensor"),
+        p_crank=channels.get("p_crank_sensor"),
+    )  # fmt: skip
+
+
+def chamber_fits(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict:
+    """Each chamber's `recipdyn.diagnosis.correction.pressure_phase` on the record's crank
+    angle (`_revs`), JSON-able: what the chain correction of a drawn-chain data set reads."""
+    from .correction import pressure_phase
+
+    revs = _revs(channels, fs, speed_hz)
+    revs = np.where(revs >= 0, revs, np.nan)
+    out = {}
+    for ch in ("head", "crank"):
+        p = channels.get(f"p_{ch}_sensor")
+        if p is not None:
+            out[ch] = {k: (float(v) if isinstance(v, (float, np.floating)) else v)
+                       for k, v in pressure_phase(p, revs, ch).items()}  # fmt: skip
+    return out
+
+
+def corrected_features(channels, fs: float, speed_hz: float, reference, fits, condition=None):
+    """``(features or None, correction)``: the record's chain estimated and corrected as
+    `recipdyn diagnose` does (`recipdyn.diagnosis.correction.correct_chain`, against
+    ``reference``, from its stored ``fits``, its own ``condition`` left out of the
+    reference), then its features; None where the correction refuses the record."""
+    from .correction import correct_chain
+    from .evidence import record_features
+
+    revs = _revs(channels, fs, speed_hz)
+    fix = correct_chain(
+        revs,
+        p_head=channels.get("p_head_sensor"),
+        p_crank=channels.get("p_crank_sensor"),
+        reference=reference,
+        fits=fits,
+        exclude_condition=condition,
     )
+    if fix.refused:
+        return None, fix
+    feats = record_features(
+        channels["accel_guide"], fs, fix.revs, p_head=fix.p_head, p_crank=fix.p_crank
+    )
+    return feats, fix
 
 
 def make_record(task: dict[str, Any]) -> dict[str, Any]:
@@ -336,9 +474,10 @@ def make_record(task: dict[str, Any]) -> dict[str, Any]:
         ch = {c: np.asarray(rec[c].values, dtype=np.float32) for c in CHANNELS}
         out["channels"] = ch
         speed = task["params"]["omega"] / (2 * math.pi)
-        out["features"] = features_of(
-            {k: v.astype(float) for k, v in ch.items()}, task["fs"], speed
-        )
+        chd = {k: v.astype(float) for k, v in ch.items()}
+        out["features"] = features_of(chd, task["fs"], speed)
+        if "chain" in task:  # a drawn chain: what its correction reads (_correct_records)
+            out["fits"] = chamber_fits(chd, task["fs"], speed)
     except Exception as exc:  # noqa: BLE001 - recorded; the data set goes on
         out["error"] = f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)}"
     out["seconds"] = time.perf_counter() - t0
@@ -376,6 +515,8 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
             raise ParameterError(
                 f"{path.parent}: a data set exists; --resume to continue it, --force to start over"
             )
+        if spec.chain == "drawn":
+            _chain_arrays(g, len(tasks))
         return g, names
     g = zarr.open_group(str(path), mode="w")
     chunk = (1, m)
@@ -388,6 +529,10 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     g.create_array("done", shape=(n,), chunks=(1,), dtype=bool, fill_value=False)
     g.create_array("error", shape=(n,), chunks=(1,), dtype=str)
     g.create_array("seconds", shape=(n,), chunks=(1,), dtype="f8", fill_value=np.nan)
+    if spec.chain == "drawn":  # each record's drawn chain, as JSON
+        g.create_array("chain", shape=(n,), chunks=(n,), dtype=str)
+        g["chain"][:] = np.array([json.dumps(t["chain"]) for t in tasks])
+        _chain_arrays(g, n)
     from .. import __version__
 
     g.attrs.update(
@@ -401,8 +546,18 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     return g, names
 
 
+def _chain_arrays(g, n: int) -> None:
+    """A drawn-chain store's per-record chain correction (JSON strings): the chambers' fits
+    (`chamber_fits`), the estimates and the refusal (`_correct_records`)."""
+    for name in ("chain_fits", "chain_estimates", "chain_refused"):
+        if name not in g:
+            g.create_array(name, shape=(n,), chunks=(n,), dtype=str)
+
+
 def _write(g, res: dict[str, Any], names: list[str]) -> None:
     i = res["index"]
+    if "fits" in res:
+        g["chain_fits"][i] = json.dumps(res["fits"])
     if not res["error"]:
         for c, y in res["channels"].items():
             row = np.full(g[c].shape[1], np.nan, np.float32)
@@ -536,6 +691,10 @@ def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
         ch = {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
         f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
         g["features"][i, :] = np.array([f[k] for k in names], float)
+        if spec.chain == "drawn":  # the fits the correction reads (_finish corrects)
+            _chain_arrays(g, len(tasks))
+            fit = chamber_fits(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
+            g["chain_fits"][i] = json.dumps(fit)
     g.attrs["feature_names"] = names
     card = json.loads((folder / "datacard.json").read_text(encoding="utf-8"))
     _finish(folder, g, spec, tasks, names, card["throughput"])
@@ -598,6 +757,15 @@ def _table(g, tasks, names: list[str]):
             "snr_db": t["snr_db"],
             "noise_seed": t["noise_seed"],
         }
+        if "chain" in t:
+            from ..chain import Chain
+
+            row.update({f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()})
+            if "chain_refused" in g:  # the correction's estimates and refusal (_correct_records)
+                row["chain_refused"] = str(g["chain_refused"][i])
+                raw = str(g["chain_estimates"][i])
+                for k, (v, u, _) in (json.loads(raw) if raw else {}).items():
+                    row[f"est.{k}"], row[f"est.{k}.u95"] = v, u
         row.update({f"f_{k}": v for k, v in zip(names, feats[i], strict=True)})
         rows.append(row)
     return pd.DataFrame(rows)
@@ -615,14 +783,94 @@ CONDITION_COLUMNS = (
 )
 
 
+def _correct_records(g, tasks, names) -> dict[str, Any]:
+    """A drawn-chain data set's records, put through the chain correction `recipdyn
+    diagnose` runs (issue 42): the reference is built from the training records' fits with
+    each one's drawn chain taken off (`recipdyn.diagnosis.correction.known_chain`); every
+    record is then corrected against it (its own condition left out, as a new record's
+    would be) and its features recomputed from the corrected channels, so the training
+    features carry the estimator's real errors; a record the correction refuses keeps its
+    reason (``chain_refused``) and is left out of training. Each record's estimates are
+    stored beside its drawn chain, and their coverage is measured here."""
+    from ..chain import Chain
+    from .correction import known_chain, reference_from
+
+    done, err = np.asarray(g["done"][:]), np.asarray(g["error"][:])
+    ok = [t for t in tasks if done[t["index"]] and not err[t["index"]]]
+    t0 = time.perf_counter()
+
+    def channels(i):
+        n = int(g["n_samples"][i])
+        return {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
+
+    fits, truth = {}, {}
+    for t in ok:
+        i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
+        raw = str(g["chain_fits"][i])
+        fits[i] = json.loads(raw) if raw else chamber_fits(channels(i), t["fs"], speed)
+        row = {f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()}
+        truth[i] = [known_chain(row, k, speed) for k in (0, 1)]
+    ref_fits = []
+    for t in ok:
+        if t["split"] != "train":
+            continue
+        i = t["index"]
+        f = {"condition": t["condition"]}
+        for k, ch in enumerate(("head", "crank")):
+            r = dict(fits[i].get(ch, {"ok": False}))
+            if r.get("ok"):
+                phase, offset, gain = truth[i][k]
+                r["phase_deg"] -= phase
+                r["offset_pa"] -= offset
+                r["p_lo"] = (r["p_lo"] - offset) / gain
+                r["p_hi"] = (r["p_hi"] - offset) / gain
+            f[ch] = r
+        ref_fits.append(f)
+    ref = reference_from(ref_fits, source=f"{len(ref_fits)} training records, drawn chains")
+    if not ref.rows:
+        return {"reference": None, "refused": 0, "records": len(ok),
+                "note": "too few training records for a reference: not corrected"}  # fmt: skip
+    hits: dict[str, list[int]] = {}
+    refused = 0
+    for t in ok:
+        i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
+        feats, fix = corrected_features(channels(i), t["fs"], speed, ref, fits[i], t["condition"])
+        est = {k: [e.value, e.uncertainty, e.status] for k, e in fix.estimates.items()}
+        g["chain_estimates"][i] = json.dumps(est)
+        g["chain_refused"][i] = fix.refused[:500]
+        if feats is None:
+            refused += 1
+            continue
+        g["features"][i, :] = np.array([feats[k] for k in names], float)
+        (ph, oh, gh), (pc, oc, gc) = truth[i]
+        want = {"phase_head": ph, "phase_crank": pc, "offset_head": oh,
+                "offset_crank": oc, "gain_ratio": gh / gc - 1.0}  # fmt: skip
+        for k, w in want.items():
+            e = fix.estimates.get(k)
+            if e is not None and math.isfinite(e.value) and math.isfinite(e.uncertainty):
+                h = hits.setdefault(k, [0, 0])
+                h[0] += abs(e.value - w) <= e.uncertainty
+                h[1] += 1
+    return {
+        "reference": ref.to_dict(),
+        "records": len(ok),
+        "refused": refused,
+        "coverage": {k: {"within": h[0], "of": h[1]} for k, h in hits.items()},
+        "seconds": time.perf_counter() - t0,
+    }
+
+
 def _finish(out: Path, g, spec: DatasetSpec, tasks, names, throughput) -> None:
     from .. import __version__
     from ..io import atomic_path
 
+    correction = _correct_records(g, tasks, names) if spec.chain == "drawn" else None
     df = _table(g, tasks, names)
     with atomic_path(out / "features.parquet") as tmp:
         df.to_parquet(tmp, index=False)
     card = datacard(spec, df, throughput, __version__)
+    if correction is not None:
+        card["chain_correction"] = correction
     with atomic_path(out / "datacard.json") as tmp:
         Path(tmp).write_text(json.dumps(card, indent=1, default=float), encoding="utf-8")
     with atomic_path(out / "datacard.md") as tmp:
@@ -663,18 +911,10 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "conditions": {
             k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
             for k, r in CONDITIONS.items()
+            if not (spec.chain == "drawn" and k == "resonance_hz")  # the chain's, below
         },
-        "sensors": {
-            "accelerometer": "recipdyn.sensors.Accelerometer(snr_db="
-            + (
-                f"{spec.snr_db}"
-                if spec.snr_range is None
-                else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
-            )
-            + ", resonance_hz=<condition>), other settings default",
-            "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
-            "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
-        },
+        "sensors": _sensors_card(spec),
+        "chain": _chain_card(spec),
         "seeds": {
             "conditions": [spec.seed, 0],
             "split": [spec.seed, 1],
@@ -692,6 +932,41 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "records": int(len(df)),
         "balance": balance,
         "throughput": throughput,
+    }
+
+
+def _sensors_card(spec: DatasetSpec) -> dict[str, str]:
+    if spec.chain == "drawn":
+        return {"all": "recipdyn.chain.ChainRanges().draw(rng, fs) per record (chain, below), "
+                "applied by recipdyn.sensors.record(..., chain=...)"}  # fmt: skip
+    snr = (
+        f"{spec.snr_db}"
+        if spec.snr_range is None
+        else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
+    )
+    return {
+        "accelerometer": f"recipdyn.sensors.Accelerometer(snr_db={snr}, "
+        "resonance_hz=<condition>), other settings default",
+        "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
+        "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
+    }
+
+
+def _chain_card(spec: DatasetSpec) -> dict[str, Any]:
+    """The data card's measurement chain: fixed, or the ranges drawn from with their
+    sources."""
+    if spec.chain == "fixed":
+        return {"kind": "fixed", "chain": "recipdyn.chain.legacy_chain(<condition's "
+                "resonance>, <snr>): the one chain of every record"}  # fmt: skip
+    from ..chain import SOURCES
+
+    return {
+        "kind": "drawn",
+        "seed": f"[{spec.seed}, 5, condition, crc32(class name), record]",
+        "response": "exact (the continuous-time response at every frequency of the record)",
+        "ranges": spec.chain_ranges.describe(),
+        "sources": SOURCES,
+        "per_record": "features.parquet columns chain.*; signals.zarr array chain (JSON)",
     }
 
 
@@ -715,7 +990,7 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
         f"{how}; {s['revolutions']} "
         f"revolutions after {s['transient']}; accelerometer SNR "
-        f"{_snr_text(s)} dB; "
+        f"{snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
         "",
         f"| class | parameter | {head} | meaning |",
@@ -729,6 +1004,30 @@ def datacard_markdown(card: dict[str, Any]) -> str:
     lines += ["", "| condition | range | meaning |", "|---|---|---|"]
     for k, r in card["conditions"].items():
         lines.append(f"| {k} | {r['lo']:g} .. {r['hi']:g} {r['unit']} | {r['meaning']} |")
+    chain = card.get("chain", {"kind": "fixed"})
+    if chain["kind"] == "drawn":
+        lines += ["", f"Measurement chain: drawn per record (seed {chain['seed']}), applied "
+                  "with the exact response.", "", "| parameter | range | meaning | source |",
+                  "|---|---|---|---|"]  # fmt: skip
+        for r in chain["ranges"]:
+            lines.append(f"| {r['parameter']} | {r['range']} | {r['meaning']} | {r['source']} |")
+        lines += ["", "Sources:", ""]
+        lines += [f"- `{k}`: {v}" for k, v in chain["sources"].items()]
+    else:
+        lines += ["", "Measurement chain: fixed (recipdyn.chain.legacy_chain)."]
+    cc = card.get("chain_correction")
+    if cc:
+        cov = ", ".join(
+            f"{k} {v['within']}/{v['of']}" for k, v in (cc.get("coverage") or {}).items()
+        )
+        lines += [
+            "",
+            f"Chain correction (as `recipdyn diagnose` runs it, before the features): "
+            f"{cc['refused']} of {cc['records']} records refused (left out of training); "
+            f"estimates within their 95 % intervals of the drawn chain: {cov or 'none'}"
+            + (f"; {cc['note']}" if cc.get("note") else "")
+            + ".",
+        ]
     lines += [
         "",
         "Class balance (records): " + json.dumps(card["balance"]),
@@ -745,6 +1044,19 @@ def read_features(folder: str | Path):
 
     folder = Path(folder)
     table, card = folder / "features.parquet", folder / "datacard.json"
+    if not folder.is_dir():
+        raise ParameterError(f"{folder}: no such folder; build a data set there with "
+                             f"'recipdyn dataset -o {folder}'")  # fmt: skip
+    if (folder / "signals.zarr").is_dir() and not table.exists():
+        try:
+            done = records_done(folder)
+            count = f" ({int(done.sum())} of {done.size} records)"
+        except Exception:  # noqa: BLE001 - a store too damaged to count: said without
+            count = ""
+        raise ParameterError(
+            f"{folder}: an unfinished data set{count}: finish it with 'recipdyn dataset -o "
+            f"{folder} --resume' and the options that started it"
+        )
     if not table.exists() or not card.exists():
         raise ParameterError(
             f"{folder}: not a data set (no features.parquet/datacard.json); "

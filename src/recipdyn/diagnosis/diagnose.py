@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .channels import gate
 from .classes import get_class
 
 __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
@@ -80,6 +81,18 @@ class Diagnosis:
                 f"{self.value:.3g} {self.unit} ({min(lo, hi):.3g}..{max(lo, hi):.3g})"
             )
         ev = self.evidence
+        ch = ev.get("channels", {})
+        if ch:
+            line = f"channels used: {ch['channels']}"
+            if ch.get("measured"):
+                line += (
+                    f"; on held-out conditions '{self.label}' from them was right for "
+                    f"{ch['precision']:.0%} of its {ch['answers']} answers (recall "
+                    f"{ch['recall']:.0%}; all classes {ch['accuracy']:.0%} of {ch['n']} records)"
+                )
+            lines.append(line)
+        for name, e in ev.get("chain", {}).items():
+            lines.append(f"chain: {name.replace('_', ' ')} {_estimate_text(e)}")
         lines.append(
             f"impacts: {ev['impacts_per_rev']:.1f} per revolution"
             + (
@@ -117,6 +130,15 @@ class Diagnosis:
         return "\n".join(lines)
 
 
+def _estimate_text(e: dict[str, Any]) -> str:
+    """One chain estimate (`recipdyn.diagnosis.correction.Estimate` as a dict) in words."""
+    v, u = e["value"], e["uncertainty"]
+    if not math.isfinite(v):
+        return e["status"] + (f" ({e['note']})" if e["note"] else "")
+    unc = f" +- {u:.2g}" if math.isfinite(u) else ""
+    return f"{v:+.3g}{unc} {e['unit']} ({e['status']})"
+
+
 def _read(path, column, fs):
     from ..io_signal import read_signal
 
@@ -134,6 +156,7 @@ def diagnose(
     p_crank: str | None = None,
     model=None,
     out: str | Path | None = None,
+    correct: bool = True,
 ) -> Diagnosis:
     """Diagnose the record in the file ``record``.
 
@@ -155,14 +178,20 @@ def diagnose(
         Default: the diagnoser shipped with recipdyn.
     out : path, optional
         Folder for the overlay figure (none without it).
+    correct : bool
+        Estimate the measurement chain's errors from the record and correct them before the
+        features (`recipdyn.diagnosis.correction`); False: trust the tacho's mark, the
+        pressures' zero and the channels' alignment, and interpolate the crank angle
+        through every tacho pulse, as recipdyn did before (for comparison).
 
     Returns
     -------
     Diagnosis
         ``refused=True`` with ``reason`` for a record outside the training domain.
     """
-    from ..io_signal import speed_hz
+    from ..io_signal import check_signal_file, speed_hz
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     sig = _read(record, channel, fs)
@@ -171,7 +200,15 @@ def diagnose(
     ph = _read(record, p_head, rate).x if p_head is not None else None
     pc = _read(record, p_crank, rate).x if p_crank is not None else None
     return diagnose_arrays(
-        x, rate, tacho=tach, speed_hz=speed_hz(speed), p_head=ph, p_crank=pc, model=model, out=out
+        x,
+        rate,
+        tacho=tach,
+        speed_hz=speed_hz(speed),
+        p_head=ph,
+        p_crank=pc,
+        model=model,
+        out=out,
+        correct=correct,
     )
 
 
@@ -193,29 +230,41 @@ def diagnose_arrays(
     p_crank=None,
     model=None,
     out=None,
+    correct: bool = True,
 ) -> Diagnosis:
     """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed)."""
     from .train import one_thread
 
     with one_thread():
         return _diagnose_arrays(x, fs, tacho=tacho, speed_hz=speed_hz, p_head=p_head,
-                                p_crank=p_crank, model=model, out=out)  # fmt: skip
+                                p_crank=p_crank, model=model, out=out,
+                                correct=correct)  # fmt: skip
 
 
-def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> Diagnosis:
+def _diagnose_arrays(
+    x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, correct=True
+) -> Diagnosis:
     from ..analysis.vibration import crank_angle, tacho_times
+    from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
 
     t0 = time.perf_counter()
     diag = _load(model)
     x = np.asarray(x, float)
+    jitter = None
     if tacho is not None:
-        edges = tacho_times(np.asarray(tacho, float), fs)
+        try:  # a channel that is no pulse train is refused with the tacho's reason
+            edges = tacho_times(np.asarray(tacho, float), fs)
+        except ValueError as exc:
+            raise ParameterError(str(exc)) from None
         if edges.size < 3:
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
             )
-        revs = crank_angle(x.size, fs, pulses=edges)
+        if correct:  # a fit through the pulses (their jitter averaged), not an interpolation
+            revs, jitter = tacho_revolutions(edges, x.size, fs)
+        else:
+            revs = crank_angle(x.size, fs, pulses=edges)
         keep = np.isfinite(revs)
     else:
         if speed_hz is None:
@@ -227,12 +276,36 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     x, revs = x[sl], revs[sl]
     ph = None if p_head is None else np.asarray(p_head, float)[sl]
     pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
+    res = Diagnosis(refused=False)
+    # the measurement chain, estimated from the record and corrected before any feature
+    chain: dict[str, Any] = {}
+    if jitter is not None:
+        chain["tacho_jitter"] = jitter
+    if correct and tacho is not None and (ph is not None or pc is not None):
+        fix = correct_chain(
+            revs,
+            p_head=ph,
+            p_crank=pc,
+            reference=chain_reference(diag),
+            axis_sd_deg=axis_sd(jitter, edges.size) if jitter is not None else 0.0,
+        )
+        chain.update(fix.estimates)
+        res.evidence["chain"] = _chain_summary(chain)
+        if fix.refused:
+            return _refuse(res, fix.refused, t0)
+        revs, ph, pc = fix.revs, fix.p_head, fix.p_crank
+    if correct:
+        # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
+        # chain's exact (analog) one
+        drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
+        form = "analog" if drawn else "bilinear"
+        chain.update(resonance(x, fs, revs if tacho is not None else None, form))
+        res.evidence["chain"] = _chain_summary(chain)
     row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
     names = diag.names
     X = np.array([[row[n] for n in names]], float)
     st = diag.state
     f_rev = row["speed_hz"]
-    res = Diagnosis(refused=False)
     lo, hi = st["speed_range"]
     if not lo * (1 - RANGE_SLACK) <= f_rev <= hi * (1 + RANGE_SLACK):
         return _refuse(
@@ -256,6 +329,7 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     if floor is not None:
         q, lo, hi = floor
         floor_ev = {"share": q, "training_range": [lo, hi]}
+        res.evidence["noise_floor"] = floor_ev
         if not lo / FLOOR_SLACK <= q <= hi * FLOOR_SLACK:
             return _refuse(
                 res,
@@ -293,6 +367,11 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     classes = diag.classes
     k = int(np.argmax(proba))
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
+    # a class is named only with channels whose held-out answers of it were right
+    named, why, facts = gate(naming_of(diag), subset, classes[k])
+    res.evidence["channels"] = facts
+    if not named:
+        return _refuse(res, why, t0)
     res.label = classes[k]
     if res.label != "healthy":
         s, slo, shi = diag.severity(X, res.label)
@@ -305,13 +384,13 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
         )
         res.unit = fc.unit
     imp = impacts(x, fs, revs)
-    res.evidence = {
-        "impacts_per_rev": imp["per_rev"],
-        "impact_angles_deg": _top_angles(imp) if tacho is not None else [],
-        "deciding": _deciding(diag, X[0]),
-    }
-    if floor is not None:
-        res.evidence["noise_floor"] = floor_ev
+    res.evidence.update(
+        {
+            "impacts_per_rev": imp["per_rev"],
+            "impact_angles_deg": _top_angles(imp) if tacho is not None else [],
+            "deciding": _deciding(diag, X[0]),
+        }
+    )
     j = _closest(diag, X[0], res.label)
     if ph is not None and tacho is not None:
         from .train import curve
@@ -340,12 +419,58 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
 
 
 def _trained_snr(spec: dict[str, Any]) -> str:
-    r = spec.get("snr_range")
-    return f"{spec['snr_db']:g}" if r is None else f"{r[0]:g}..{r[1]:g}"
+    from .dataset import snr_text
+
+    return snr_text(spec).split(" ")[0]
 
 
 def _db(share: float) -> float:
     return -10.0 * math.log10(max(share, 1e-30))
+
+
+def _chain_summary(chain: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """The chain's estimates as plain dicts (value, uncertainty, unit, status, note)."""
+    from dataclasses import asdict
+
+    return {k: asdict(v) for k, v in chain.items()}
+
+
+def naming_of(diag) -> dict | None:
+    """What each channel set of ``diag`` can name (`recipdyn.diagnosis.channels`): stored in
+    the diagnoser when it was trained, or, for the shipped one trained before that, in the
+    file measured on its held-out conditions beside it (`held_out_file`), if it is this
+    diagnoser's."""
+    t = diag.state.get("naming")
+    return t if t else held_out(diag).get("naming")
+
+
+def chain_reference(diag):
+    """The `recipdyn.diagnosis.correction.ChainReference` of ``diag``'s own chain: stored
+    in it, or the shipped diagnoser's measured one (`held_out_file`), else the default."""
+    from .correction import ChainReference
+
+    d = diag.state.get("chain_reference") or held_out(diag).get("chain_reference")
+    return ChainReference.from_dict(d)
+
+
+def held_out_file() -> Path:
+    """Measurements of the shipped diagnoser made on its held-out conditions after it was
+    built (``benchmarks/bench_chain_correction.py --held-out``): what each channel set can
+    name and its chain's reference. Read only while they belong to the diagnoser loaded
+    (its pinned records' fingerprint)."""
+    return default_model_path().with_name("default.heldout.json")
+
+
+def held_out(diag) -> dict[str, Any]:
+    import hashlib
+    import json
+
+    path = held_out_file()
+    if not path.is_file():
+        return {}
+    d = json.loads(path.read_text(encoding="utf-8"))
+    mine = hashlib.sha256(str(diag.state.get("fingerprints_json", "")).encode()).hexdigest()
+    return d if d.get("fingerprint") == mine else {}
 
 
 def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:

@@ -109,14 +109,16 @@ def _shaft_params(shaft: Shaft) -> tuple[Param, ...]:
 
 
 def _with_default(p: Param, name: str, raw: Any) -> Param:
-    """``p`` under ``name`` with the default ``raw`` (a machine file's value, with units)."""
+    """``p`` under ``name`` with the default ``raw`` (a machine file's value, with units); a
+    derivation rule reads the names of its own namespace (`protocol.derive_value`), and a
+    value the file gives replaces it."""
     from ...quantity import to_unit
 
     q = replace(p, name=name)
     if raw is None:
         return q
     value = str(raw) if p.choices is not None else to_unit(name, raw, p.unit)
-    return replace(q, default=q.check(value))
+    return replace(q, default=q.check(value), derive="")  # (the file's value, not the rule's)
 
 
 def machine_schema(machine: Machine) -> Schema:
