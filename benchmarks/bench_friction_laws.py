@@ -32,8 +32,9 @@ CASES = {
         "friction": 0.1, "friction_law": "tanh", "v0": 0.01, "v1": 0.02}),
     "crank pin with a motor, tanh": ("compressor-contact", {
         **_IMPACTS, "friction_law": "tanh", "drive": "motor", "motor": "constant"}),
-    "compressor-guide kernel, ambrosio": ("compressor-guide", {**_SHOES}),
-    "compressor-guide kernel, tanh": ("compressor-guide", {**_SHOES, "guide_friction_law": "tanh"}),
+    "compressor-guide kernel, ambrosio": ("compressor-guide-reference", {**_SHOES}),
+    "compressor-guide kernel, tanh": ("compressor-guide-reference",
+                                      {**_SHOES, "guide_friction_law": "tanh"}),
     "glue's guide (ideal pins), tanh": ("compressor", {
         **_SHOES, "guide": "clearance", "crank_joint": "ideal", "guide_friction_law": "tanh"}),
 }  # fmt: skip

@@ -16,11 +16,11 @@ import argparse
 from _timing import best_per_revolution, setup
 
 CASES = {
-    "healthy guide (c = 0)": ("compressor-guide", {}),
-    "worn guide, c = 0.1 mm": ("compressor-guide", {"guide_clearance": 1e-4}),
-    "worn guide, c = 0.2 mm": ("compressor-guide", {"guide_clearance": 2e-4}),
-    "worn guide, c = 0.5 mm": ("compressor-guide", {"guide_clearance": 5e-4}),
-    "worn guide, c = 0.2 mm, gas cycle": ("compressor-guide",
+    "healthy guide (c = 0)": ("compressor-guide-reference", {}),
+    "worn guide, c = 0.1 mm": ("compressor-guide-reference", {"guide_clearance": 1e-4}),
+    "worn guide, c = 0.2 mm": ("compressor-guide-reference", {"guide_clearance": 2e-4}),
+    "worn guide, c = 0.5 mm": ("compressor-guide-reference", {"guide_clearance": 5e-4}),
+    "worn guide, c = 0.2 mm, gas cycle": ("compressor-guide-reference",
                                           {"guide_clearance": 2e-4, "load": "cycle"}),
     "rigid guide (compressor, rc = 0)": ("compressor", {"rc": 0.0}),
 }  # fmt: skip

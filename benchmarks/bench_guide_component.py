@@ -14,9 +14,9 @@ from _timing import best_per_revolution, setup
 
 _IDEAL = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}
 CASES = {
-    "compressor-guide, c = 0.2 mm": ("compressor-guide", {"guide_clearance": 2e-4}),
+    "compressor-guide, c = 0.2 mm": ("compressor-guide-reference", {"guide_clearance": 2e-4}),
     "glue, ideal pins, c = 0.2 mm": ("compressor-contact", {**_IDEAL, "guide_clearance": 2e-4}),
-    "compressor-guide, c = 0.2 mm, cycle": ("compressor-guide",
+    "compressor-guide, c = 0.2 mm, cycle": ("compressor-guide-reference",
                                             {"guide_clearance": 2e-4, "load": "cycle"}),
     "glue, ideal pins, c = 0.2 mm, cycle": ("compressor-contact",
                                             {**_IDEAL, "guide_clearance": 2e-4,

@@ -1,11 +1,11 @@
 """The crosshead knock's signature next to the healthy machine (docs/faults.md).
 
-Runs ``compressor-guide`` at 20 rad/s under the paper's load, one revolution after one: the
-healthy guide (no clearance) and a worn one (0.2 mm radial clearance), and draws over crank
-angle the crosshead's lateral acceleration (what an accelerometer on the guide sees), its
-lateral position in the clearance, and the side force of the shoes with the ideal mechanism's
-side-force reversals marked. Usage: ``python examples/crosshead_knock_figure.py [OUTDIR]``
-(default ``docs/img``).
+Runs ``compressor-guide-reference`` (the guide's kernel of its own) at 20 rad/s under the
+paper's load, one revolution after one: the healthy guide (no clearance) and a worn one
+(0.2 mm radial clearance), and draws over crank angle the crosshead's lateral acceleration
+(what an accelerometer on the guide sees), its lateral position in the clearance, and the
+side force of the shoes with the ideal mechanism's side-force reversals marked. Usage:
+``python examples/crosshead_knock_figure.py [OUTDIR]`` (default ``docs/img``).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from recipdyn.model.compressor_guide import COMPRESSOR_GUIDE, ideal_crosshead  # noqa: E402
+from recipdyn.model.reference.compressor_guide import COMPRESSOR_GUIDE, ideal_crosshead  # noqa: E402
 from recipdyn.simulate import simulate  # noqa: E402
 
 CLEARANCE = 2e-4
@@ -28,7 +28,7 @@ CLEARANCE = 2e-4
 def main(out: Path) -> dict[str, float]:
     runs = {}
     for c in (0.0, CLEARANCE):
-        runs[c] = simulate(model="compressor-guide", params={"guide_clearance": c},
+        runs[c] = simulate(model="compressor-guide-reference", params={"guide_clearance": c},
                            revolutions=1, transient=1, fs=40000.0)  # fmt: skip
     v = COMPRESSOR_GUIDE.parameters({"guide_clearance": CLEARANCE})
     fig, ax = plt.subplots(3, 1, figsize=(9, 8.5), sharex=True, constrained_layout=True)

@@ -67,8 +67,7 @@ def test_finite_time_exponent_of_a_regular_orbit_is_extrapolated_away():
     (mean 30, over 24 of the starts). Bounds: ratio > 0.25 (4 sigma), limit > 5 errors. The
     base case's torus gives the same numbers from every start tried (4)."""
     from recipdyn.analysis import lyapunov_spectrum
-    from recipdyn.model import CompressorParams
-    from recipdyn.model.compressor import compressor_model
+    from recipdyn.model import CompressorParams, compressor_model
 
     p = CompressorParams()
     m = compressor_model(p)
@@ -94,8 +93,7 @@ def test_finite_time_exponent_of_a_heavier_regular_orbit_is_not_positive():
     stays far above its own bound (0.60)."""
     from recipdyn.analysis import lyapunov_spectrum
     from recipdyn.defaults import LYAP_TOL
-    from recipdyn.model import CompressorParams
-    from recipdyn.model.compressor import compressor_model
+    from recipdyn.model import CompressorParams, compressor_model
 
     p = CompressorParams(m2=30.0, m3=50.0, J2=0.9)
     m = compressor_model(p)

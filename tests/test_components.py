@@ -186,7 +186,7 @@ def test_outputs_are_what_was_integrated(kw):
     with the recorded values gives the recorded accelerations, to rounding (rel 1e-9: the
     accelerations reach ~1e5 and are formed from the same numbers). A force or crank angle
     recomputed by a second copy of the physics could drift from the dynamics unseen."""
-    from recipdyn.model.components.mechanism import HEAD
+    from recipdyn.model.mechanism.link import HEAD
 
     p = CompressorParams(rc=2e-3, **kw)
     ds = recipdyn.simulate(p, revolutions=1, fs=500.0)

@@ -1,5 +1,6 @@
-"""The compressor with clearance in the crosshead guide (`compressor-guide`): the ideal-guide
-limit, the energy balance, and the knock at the side-load reversals."""
+"""The compressor with clearance in the crosshead guide, its own kernel
+(`compressor-guide-reference`, the independent check of the contact joints' guide): the
+ideal-guide limit, the energy balance, and the knock at the side-load reversals."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 import recipdyn
-from recipdyn.model.compressor_guide import COMPRESSOR_GUIDE, ideal_crosshead
+from recipdyn.model.reference.compressor_guide import COMPRESSOR_GUIDE, ideal_crosshead
 from recipdyn.sensors import Accelerometer, record
 
 
@@ -40,8 +41,8 @@ def test_no_clearance_and_stiff_shoes_give_the_ideal_guide():
     3 % of its peak (measured 1 %, the same contact vibration). A sign error in a generalised
     force, a wrong gas-force input or a missing gravity term would show in one of them."""
     v = COMPRESSOR_GUIDE.parameters({"guide_clearance": 0.0})
-    ds = recipdyn.simulate(model="compressor-guide", params=v, revolutions=1, transient=0.5,
-                           fs=2000.0)  # fmt: skip
+    ds = recipdyn.simulate(model="compressor-guide-reference", params=v, revolutions=1,
+                           transient=0.5, fs=2000.0)  # fmt: skip
     ref = recipdyn.simulate(model="compressor", params={"rc": 0.0}, revolutions=1,
                             transient=0.5, fs=2000.0)  # fmt: skip
     ide = ideal_crosshead(v, ds.theta1.values)
@@ -68,7 +69,7 @@ def test_the_crosshead_knocks_after_each_side_load_reversal(load_amplitude):
     energy balance closes to 1e-8 (measured 4e-11 - 2e-10)."""
     params = {"guide_clearance": 2e-4, "load_amplitude": load_amplitude}
     v = COMPRESSOR_GUIDE.parameters(params)
-    ds = recipdyn.simulate(model="compressor-guide", params=v, revolutions=1, transient=1,
+    ds = recipdyn.simulate(model="compressor-guide-reference", params=v, revolutions=1, transient=1,
                            fs=20000.0)  # fmt: skip
     assert ds.attrs["energy_balance_residual"] < 1e-8
     th = np.radians(np.linspace(0, 720, 72001))
@@ -103,7 +104,9 @@ def test_an_elastic_frictionless_guide_loses_nothing():
     errors of ~1e-10 accumulate over ~1e5 steps; measured 4.7e-8; the drive's torque is the
     first row of the same Lagrange equations, so this checks it too)."""
     params = {"guide_clearance": 2e-4, "guide_restitution": 1.0, "guide_friction": 0.0}
-    ds = recipdyn.simulate(model="compressor-guide", params=params, revolutions=1, fs=2000.0)
+    ds = recipdyn.simulate(
+        model="compressor-guide-reference", params=params, revolutions=1, fs=2000.0
+    )
     assert ds.attrs["impacts"] >= 2
     assert ds.attrs["energy_lost_in_guide_J"] == 0.0
     assert ds.attrs["energy_balance_residual"] < 1e-6
@@ -120,7 +123,7 @@ def test_the_knock_s_speed_grows_as_the_clearance_to_the_two_thirds():
     clearance-independent bounce, a wrong mass) would not scale so."""
     v = {}
     for c in (1e-4, 5e-4):
-        ds = recipdyn.simulate(model="compressor-guide", params={"guide_clearance": c},
+        ds = recipdyn.simulate(model="compressor-guide-reference", params={"guide_clearance": c},
                                revolutions=1, transient=1, fs=2000.0)  # fmt: skip
         v[c] = ds.attrs["impact_velocity_max_m_s"]
     assert v[5e-4] / v[1e-4] == pytest.approx(5 ** (2 / 3), rel=0.15)

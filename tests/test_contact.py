@@ -4,6 +4,7 @@ closed form, the limits of the compressor model with it, its energy balance and 
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numba as nb
@@ -12,6 +13,7 @@ import pytest
 
 import recipdyn
 from recipdyn.integrate import integrate
+from recipdyn.model.assembler.templates.joints import _pair  # the built-in law's joints
 from recipdyn.model.base import EVENT_SIGNATURE, RHS_SIGNATURE, Event, ODESystem
 from recipdyn.model.components import contact_model as cm
 from recipdyn.model.joints import pins as jp
@@ -19,7 +21,6 @@ from recipdyn.model.joints.contact import (
     FRICTION_LAWS,
     FRICTION_ROLES,
     LAWS,
-    ambrosio_friction,
     delivered_restitution,
     hysteresis_factor,
     normal_force,
@@ -166,8 +167,8 @@ def _newton_euler_rhs(t, y, p, out):  # y = (theta2, x3, theta2', x3', v_impact)
     u = -r * w * math.sin(th1) - l * s2 * w2 - v3
     v = r * w * math.cos(th1) + l * c2 * w2
     # (no friction in this case: any friction law gives 0)
-    f = jp._pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
-                 p, ambrosio_friction, jp.P_MU)  # fmt: skip
+    f = _pair(ex, ey, u, v, 0.0, w2, p[jp.P_C2], p[jp.P_K2], p[jp.P_RJ2], y[4], p[jp.P_OIL2],
+              p)  # fmt: skip
     aax, aay = -r * w * w * math.cos(th1), -r * w * w * math.sin(th1)
     # moments about the crank pin A: (J2 + m2 ls^2) theta2'' = -m2 ls (rGA x aA) + rPA x F2
     #   + rGA x m2 g + T_b
@@ -771,9 +772,9 @@ FRICTION = dict(crank_joint="contact", omega=150.0, load_amplitude=2e4, friction
 @pytest.mark.parametrize("drive", ["prescribed", "motor"])
 @pytest.mark.parametrize("law", FRICTION_LAWS)
 def test_the_glue_calls_the_friction_law_it_names(law, drive):
-    """The friction law is chosen when the glue is written: the glue imports the function
-    ``friction_law`` names and reads no law code (the packed vector holds none); at a state in
-    contact the observed ``F_t / F_n`` is that law's closed form at the sliding velocity
+    """The friction law is chosen when the kernels are written: the joints' module binds the
+    function ``friction_law`` names and reads no law code (the packed vector holds none); at a
+    state in contact the observed ``F_t / F_n`` is that law's closed form at the sliding velocity
     ``v_t = omega R_j - theta2' (R_j + c)`` (journal on the crank, bearing on the rod), to
     rounding, and the two laws differ there by far more (0.5 against tanh(1.5) = 0.905 of
     mu at v_t = 7.5 m/s). The same with a motor (the free crank's glue: its initial state
@@ -782,7 +783,8 @@ def test_the_glue_calls_the_friction_law_it_names(law, drive):
     motor = {"drive": "motor", "motor": "constant"} if drive == "motor" else {}
     v = m.parameters(FRICTION, friction_law=law, **motor)
     k = m.kernels(v)
-    src = Path(k.__file__).read_text(encoding="utf-8")
+    joints = sys.modules[k.joints.py_func.__module__]  # the joints' forces of the laws
+    src = Path(joints.__file__).read_text(encoding="utf-8")
     assert f"import {FRICTION_ROLES[law]} as friction" in src
     assert ("_motor_" in k.__name__) == (drive == "motor")
     assert "P_FLAW" not in src and "int(p[" not in src and not hasattr(jp, "P_FLAW")

@@ -69,8 +69,9 @@ def test_lankarani_nikravesh_from_a_file_gives_the_builtins_trajectory_to_the_bi
 @pytest.mark.filterwarnings("ignore::recipdyn.errors.LawRangeWarning")
 def test_a_users_law_acts_with_a_motor_too():
     """Hypothesis: with a motor (the crank free) the glue runs the file's law, not the
-    built-in one: the glue's joints' forces (`_joints_at`, called with the crank's state) are
-    the ones written with the law, not the built-in ones imported after them, and a run with
+    built-in one: the kernels' joints' forces (``joints_at``, called with the crank's state)
+    are those of the joints' module written for the law (its ``law_normal`` the file's), and a
+    run with
     the Kelvin-Voigt law (a spring-dashpot: another normal force at every contact) differs
     from the built-in law's run through the same impacts by a large part of the crank-pin
     eccentricity's swing (a model that ignored the law would give the same run to the
@@ -83,7 +84,8 @@ def test_a_users_law_acts_with_a_motor_too():
     _, a = _run(v0, 0.25 * T, 201)
     s1, b = _run(v1, 0.25 * T, 201)
     glue = sys.modules[s1.rhs.py_func.__module__]
-    assert glue._joints_at.py_func.__module__ == glue.__name__  # the law's own, not rebound
+    joints = sys.modules[glue.joints_at.py_func.__module__]  # the module of the law's joints
+    assert joints.law_normal.py_func.__name__ == "kv_normal"  # the file's law, not the built-in
     assert a.t_events.size >= 2  # impacts happen (or the law would not be exercised)
     ex0, ex1 = a.y[:, 0], b.y[:, 0]
     assert np.abs(ex1 - ex0).max() > 0.01 * np.ptp(ex0) > 0.0

@@ -40,6 +40,49 @@ def test_generated_drive_code_is_up_to_date():
     assert committed == derivation.generate_drive_code()
 
 
+def test_generated_throw_code_is_up_to_date():
+    """The committed mechanism/_generated_throw.py (one throw's share of a free crank's
+    equations, for machines of several throws) is exactly what the derivation prints now."""
+    from pathlib import Path
+
+    committed = Path(derivation.__file__).parent / "mechanism" / "_generated_throw.py"
+    assert committed.read_text() == derivation.generate_throw_code()
+
+
+def test_a_throws_share_solved_alone_is_the_one_throw_free_crank(rng):
+    """The throw's own ``M`` and ``b`` (without the drive) with the drive's inertia and torque
+    added to its crank row, solved, give the free-crank accelerations of the one-throw
+    derivation (`_generated_drive`), at 30 random states and geometries: the two printed
+    forms of one Lagrangian agree to rounding (1e-9 relative)."""
+    from recipdyn.model._generated_drive import free_crank_accelerations
+    from recipdyn.model.mechanism._generated_throw import link_throw_system
+
+    for c in _random_states(rng, 30):
+        p = np.array(
+            [
+                c["r"],
+                c["r"] * rng.uniform(0, 1),
+                c["l"],
+                c["ls"],
+                rng.uniform(1, 30),
+                c["m2"],
+                c["m3"],
+                rng.uniform(0, 1),
+                c["J2"],
+                c["g"],
+                c["rc"],
+                c["d"],
+            ]
+        )
+        y = (rng.uniform(0, 6.3), rng.uniform(0, 6.3), rng.uniform(5, 30), rng.normal(0, 50))
+        F, Jd, Tm = rng.normal(0, 1e5), rng.uniform(1, 1e4), rng.normal(0, 1e4)
+        m00, m10, m11, b0, b1 = link_throw_system(y, p, 0, (F,))
+        M = np.array([[m00 + Jd, m10], [m10, m11]])
+        want = np.linalg.solve(M, [b0 + Tm, b1])
+        got = free_crank_accelerations(0.0, y, p, (Jd, F, Tm))
+        assert np.allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max()), (got, want)
+
+
 def test_structured_equals_brute_force_lagrangian(rng):
     """Hypothesis: the paper-structured derivation (exact partials, Eq. 38-42 form) and a
     brute-force Lagrangian with theta2 = -asin(...) substituted give the same theta_c''."""

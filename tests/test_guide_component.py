@@ -1,12 +1,14 @@
 """The crosshead guide's clearance as a component of the contact joints' glue
 (`compressor-contact` and `compressor-contact-valves` with ``guide = clearance``): the rigid
-guide untouched, agreement with `compressor-guide` (an independent implementation), the stiff
+guide untouched, agreement with `compressor-guide-reference` (an independent implementation:
+the preset compressor-guide's kernel before the assembler), the stiff
 zero-clearance limit, the energy balance with every worn part at once, and the knock's timing.
 """
 
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,13 +16,12 @@ import pytest
 
 import recipdyn
 from recipdyn.errors import ParameterError
-from recipdyn.model.components.contact import glue_source
 from recipdyn.model.components.contact_model import pack
 from recipdyn.model.components.load import PAPER
 from recipdyn.model.compressor_contact import COMPRESSOR_CONTACT as CC
-from recipdyn.model.compressor_guide import KERNELS, ideal_crosshead
 from recipdyn.model.joints.contact import FRICTION_LAWS, FRICTION_ROLES
 from recipdyn.model.joints.pins import N_PACKED
+from recipdyn.model.reference.compressor_guide import KERNELS, ideal_crosshead
 
 #: Both pins ideal, the guide worn: the configuration `compressor-guide` integrates.
 IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}
@@ -28,7 +29,7 @@ IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "
 
 def test_a_rigid_guide_leaves_the_contact_model_as_it_was():
     """With ``guide = ideal`` (the default) the guide's parameters are inert: the parameter
-    vector is the joints' and the load's only, the generated glue holds no guide code, and a
+    vector is the joints' and the load's only, the generated kernels bind no guide, and a
     run with every guide parameter changed is the default run to the bit (same trajectory,
     same steps). A guide parameter leaking into the rigid kernel would change one of them."""
     v = CC.parameters({})
@@ -37,8 +38,8 @@ def test_a_rigid_guide_leaves_the_contact_model_as_it_was():
     w = CC.parameters(odd)
     assert pack(v).size == N_PACKED + PAPER.pack(v).size
     np.testing.assert_array_equal(pack(v), pack(w))
-    src = glue_source(cfg=0, joints="crank", load=PAPER, offset=N_PACKED, first_state=12)
-    assert "guide" not in src.replace("guide=", "")
+    src = Path(CC.kernels(v).__file__).read_text()
+    assert "HAS_GUIDE = False" in src  # the guide's branches removed before typing
     a = recipdyn.simulate(model=CC, params=v, revolutions=0.25, fs=2000.0)
     b = recipdyn.simulate(model=CC, params=w, revolutions=0.25, fs=2000.0)
     for k in ("ex", "ey", "a", "joint_force", "W_in", "W_loss"):
@@ -65,8 +66,8 @@ def _pair(c: float, load: dict, revolutions: float):
     params = {"guide_clearance": c, **load}
     new = recipdyn.simulate(model="compressor-contact", params={**IDEAL_PINS, **params},
                             revolutions=revolutions, transient=0.0, fs=4000.0)  # fmt: skip
-    ref = recipdyn.simulate(model="compressor-guide", params=params, revolutions=revolutions,
-                            transient=0.0, fs=4000.0)  # fmt: skip
+    ref = recipdyn.simulate(model="compressor-guide-reference", params=params,
+                            revolutions=revolutions, transient=0.0, fs=4000.0)  # fmt: skip
     return new, ref
 
 
@@ -197,14 +198,15 @@ SHOES = {**IDEAL_PINS, "guide_clearance": 2e-4, "load_amplitude": 2e4, "guide_fr
 
 @pytest.mark.parametrize("law", FRICTION_LAWS)
 def test_the_shoes_friction_law_is_chosen_by_name(law):
-    """The guide's friction law is a function chosen when the kernel is built: the glue's
-    guide imports the one ``guide_friction_law`` names and reads no law code (its slice holds
-    none), and `compressor-guide` runs the compiled kernel of that law."""
+    """The guide's friction law is a function chosen when the kernels are built: the joints'
+    module binds the one ``guide_friction_law`` names and reads no law code (its slice holds
+    none), and `compressor-guide-reference` runs the compiled kernel of that law."""
     v = CC.parameters({**SHOES, "guide_friction_law": law})
-    src = Path(CC.kernels(v).__file__).read_text(encoding="utf-8")
+    k = CC.kernels(v)
+    src = Path(sys.modules[k.joints.py_func.__module__].__file__).read_text(encoding="utf-8")
     assert f"import {FRICTION_ROLES[law]} as guide_friction" in src
     assert "FLAW" not in src and "int(p[" not in src
-    g = recipdyn.get_model("compressor-guide")
+    g = recipdyn.get_model("compressor-guide-reference")
     gv = g.parameters(guide_friction_law=law)
     assert g.system(gv).rhs is KERNELS[law][0] and g.system(gv).jac is KERNELS[law][1]
 

@@ -72,17 +72,17 @@ def test_a_torn_unit_cache_file_is_parsed_again(tmp_path, monkeypatch):
     """pint writes its cache of parsed unit definitions in place, so a process can find a file
     another one is still writing (two test workers, two sweeps starting on a fresh machine).
     Such a file is ignored: the units are parsed again and the value is right."""
-    from recipdyn import units
+    from recipdyn import quantity, units
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    units._ureg.cache_clear()
+    quantity._ureg.cache_clear()
     try:
         assert units.to_si("rc", "1 mm") == 1e-3  # fills the cache
         files = [p for p in (tmp_path / "recipdyn" / "pint").rglob("*.pickle")]
         assert files
         for p in files:
             p.write_bytes(p.read_bytes()[:20])  # torn halfway
-        units._ureg.cache_clear()
+        quantity._ureg.cache_clear()
         assert units.to_si("omega", "191 rpm") == 191 * 2 * 3.141592653589793 / 60
     finally:
-        units._ureg.cache_clear()
+        quantity._ureg.cache_clear()

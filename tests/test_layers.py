@@ -14,7 +14,8 @@ SRC = Path(recipdyn.__file__).parent
 
 #: Layers from the floor up; a module may import its own layer and any lower one.
 LAYERS = [
-    {"errors", "defaults", "io", "locking", "resources", "parallel", "progress", "mplstyle"},
+    {"errors", "defaults", "io", "locking", "resources", "parallel", "progress", "mplstyle",
+     "quantity"},
     {"model"},
     {"units", "config"},  # read the model's parameter schema
     {"integrate"},
@@ -156,7 +157,7 @@ def _model_modules() -> set[str]:
     built-in table names, and the implementations ``compressor`` routes to."""
     from recipdyn.model import family, registry
 
-    tables = [*registry._BUILTIN.values(), *family.ROUTES.values()]
+    tables = [*registry._BUILTIN.values(), registry.MACHINE_MODEL, *family.ROUTES.values()]
     return {t.partition(":")[0].removeprefix("recipdyn.model.") for t in tables}
 
 
@@ -179,8 +180,8 @@ def _model_edges(graph: dict[str, set[str]], models: set[str]) -> set[tuple[str,
 
 
 #: The model modules of the compressor (the registry's and family's tables must name them).
-MODEL_MODULES = {"family", "compressor", "compressor_contact", "compressor_valves",
-                 "compressor_contact_valves", "compressor_guide"}  # fmt: skip
+MODEL_MODULES = {"family", "assembler.model", "compressor_contact", "compressor_contact_valves",
+                 "reference.compressor_guide"}  # fmt: skip
 
 
 def test_no_model_module_imports_another():
@@ -203,13 +204,15 @@ def test_no_model_module_imports_another():
 
 def test_only_the_routing_tables_name_models():
     """Import strings of models appear in the two routing tables only: the registry's
-    (model name -> model) and family's ``ROUTES`` (selectors -> implementation), each naming
-    exactly its table's modules; no other module of the model package holds one."""
+    (model name -> model, and machine file -> the machines' model) and family's ``ROUTES``
+    (selectors -> implementation), each naming exactly its table's modules; no other module
+    of the model package holds one."""
     from recipdyn.model import family, registry
 
     found = {_node(p.relative_to(MODEL).with_suffix("").parts): _routes(p)
              for p in MODEL.rglob("*.py")}  # fmt: skip
-    tables = {"registry": registry._BUILTIN, "family": family.ROUTES}
+    tables = {"registry": {**registry._BUILTIN, "machine files": registry.MACHINE_MODEL},
+              "family": family.ROUTES}  # fmt: skip
     for name, table in tables.items():
         want = {t.partition(":")[0].removeprefix("recipdyn.model.") for t in table.values()}
         assert found.pop(name) == want, name

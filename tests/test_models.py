@@ -17,7 +17,7 @@ import recipdyn
 from recipdyn.cli import main
 from recipdyn.errors import ParameterError
 from recipdyn.model.base import DiscreteMap, ODESystem
-from recipdyn.model.registry import get_model, model_names
+from recipdyn.model.registry import get_model, model_names, model_spec
 
 EXAMPLE = str(Path(__file__).parents[1] / "examples" / "pendulum.py") + ":PENDULUM"
 #: Component combinations (model/components) that pass the same tests as the registered
@@ -46,11 +46,17 @@ PRESETS = {
 # Not in the list yet: the dynamic valves with a lubricated pin fail the Jacobian check in a
 # rate column (their central-difference Jacobian). An ideal crank pin's sweep is checked in
 # tests/test_contact.py (its section signals name the crank pin's ``ex``: zero there).
-MODELS = [*model_names(), EXAMPLE, *PRESETS]
+#: Machines of several throws (`recipdyn.model.machine`, by their files): the motor coupling
+#: two throws through the crank, and two throws with dynamic valves and a fault on one.
+MACHINES = [
+    str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw.toml"),
+    str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
+]
+MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 
 
 def _ids(x):
-    return Path(x.split(":")[0]).stem if ":" in x else x
+    return Path(x.split(":")[0]).stem if ":" in x or x.endswith(".toml") else x
 
 
 def _preset(name, over):
@@ -171,7 +177,7 @@ def test_simulate_records_outputs_with_units_and_inputs(model, tmp_path):
 
 
 def test_cli_simulate_and_models(model, tmp_path, capsys):
-    spec = EXAMPLE if model.name == "pendulum" else model.name
+    spec = model_spec(model)
     out = tmp_path / "r.nc"
     assert main(["simulate", "--model", spec, "-n", "2", "--fs", "100 Hz", "-o", str(out),
                  "--no-progress", *_set_args(model)]) == 0  # fmt: skip
@@ -226,7 +232,7 @@ def test_sweep_any_model(model, tmp_path):
     records the model and units, and draws its figures."""
     from recipdyn.sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
 
-    spec_name = EXAMPLE if model.name == "pendulum" else model.name
+    spec_name = model_spec(model)
     p = next(p for p in model.schema if p.choices is None and p.default not in (None, 0.0))
     lo, hi = sorted((p.default, p.default * 1.01))
     axis = parse_axis(f"{p.name}={lo}:{hi}:2", spec_name)

@@ -198,11 +198,12 @@ def test_the_command_line_runs_and_analyses_a_motor_with_the_guide(tmp_path, cap
 
 
 def test_the_compressor_guide_preset_with_a_motor_runs_on_the_contact_joints_glue():
-    """`compressor-guide` (ideal pins in a worn guide) runs its own kernel, whose crank is
-    prescribed; with ``drive = motor`` it routes to the contact joints' glue, which carries
-    the same guide with the crank free (routing and states only: the runs are above)."""
+    """`compressor-guide` (ideal pins in a worn guide) runs on the contact joints' kernels
+    with the crank prescribed and with ``drive = motor`` (the crank free) alike (routing and
+    states only: the runs are above; its former kernel of its own is the reference model
+    ``compressor-guide-reference``)."""
     m = get_model("compressor-guide")
-    assert m.route(m.parameters())[0] == "guide"
+    assert m.route(m.parameters())[0] == "contact"
     values = m.parameters({"drive": "motor"})
     assert m.route(values)[0] == "contact"
     assert (values["guide"], values["drive"]) == ("clearance", "motor")

@@ -168,12 +168,26 @@ def read_config(path: str | Path) -> RunConfig:
         raise ParameterError(f"config {path}: permission denied") from None
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"config {path}: malformed TOML ({exc})") from None
+    if isinstance(raw.get("params"), dict):  # dotted names (throw2.rc) are nested tables
+        raw["params"] = _flatten(raw["params"])
     try:
         return _config_classes()[1].model_validate(raw)
     except ValidationError as exc:
         first = exc.errors()[0]
         loc = ".".join(str(x) for x in first["loc"])
         raise ParameterError(f"config {path}: {loc}: {first['msg']}") from None
+
+
+def _flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``{"throw2": {"rc": 1e-3}}`` as ``{"throw2.rc": 1e-3}``: a machine's namespaced
+    parameters (a TOML dotted key ``throw2.rc = ...`` is a table of its own)."""
+    out: dict[str, Any] = {}
+    for k, v in table.items():
+        if isinstance(v, dict):
+            out.update(_flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
 
 
 def model_values(model, values: dict[str, Any]) -> dict[str, Any]:

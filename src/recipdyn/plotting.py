@@ -14,6 +14,7 @@ __all__ = [
     "provenance_footer",
     "add_footer",
     "model_figure",
+    "throws_figure",
     "axis_label",
     "contact_figure",
     "plot_signal",
@@ -234,6 +235,8 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
     of the first two (points for a map). The contact-impact compressor gets
     [`contact_figure`][recipdyn.plotting.contact_figure]."""
     names = set(ds.data_vars)
+    if "theta1" in names and len(throw_names(ds)) > 1:
+        return throws_figure(ds, title=title)  # a machine of several throws
     if {"ex", "delta", "x", "v", "a"} <= names or {"ex_crosshead", "delta_crosshead"} <= names:
         return contact_figure(ds, title=title)  # the contact-impact joint, any load
     if {"theta_c", "contact_force", "gas_force", "x", "v", "a"} <= names:
@@ -266,6 +269,52 @@ def model_figure(ds: xr.Dataset, *, title: str | None = None):
     else:
         axes[1].set_axis_off()
     fig.suptitle(title or ds.attrs.get("title", ds.attrs.get("model", "model")))
+    return fig
+
+
+def throw_names(ds: xr.Dataset) -> list[str]:
+    """The throws of a machine's record: the namespaces of its signals ``throwK.a``."""
+    return sorted({str(k).rpartition(".")[0] for k in ds.data_vars
+                   if str(k).endswith(".a") and f"{str(k)[:-2]}.x" in ds},
+                  key=lambda n: (len(n), n))  # fmt: skip
+
+
+def throws_figure(ds: xr.Dataset, *, title: str | None = None, max_throws: int = 6):
+    """A machine of several throws: each throw's crosshead displacement, velocity,
+    acceleration and gas force (rows) by the shaft's crank angle over the last recorded
+    revolution, one line per throw (its phase shows as a shift along the angle)."""
+    plt = _mpl()
+    throws = throw_names(ds)[:max_throws]
+    th = np.asarray(ds["theta1"].values, dtype=float)
+    last = th >= th[-1] - 2.0 * np.pi
+    deg = np.degrees(np.mod(th[last], 2.0 * np.pi))
+    order = np.argsort(deg, kind="stable")
+    rows = [
+        ("x", "crosshead displacement"),
+        ("v", "crosshead velocity"),
+        ("a", "crosshead acceleration"),
+        ("gas_force", "gas force on the crosshead"),
+    ]
+    fig, axes = plt.subplots(len(rows), 1, figsize=(10, 9), sharex=True, constrained_layout=True)
+    for ax, (name, what) in zip(axes, rows, strict=True):
+        unit = ""
+        for t in throws:
+            da = ds.get(f"{t}.{name}")
+            if da is None:
+                continue
+            unit = da.attrs.get("units", "")
+            ax.plot(deg[order], np.asarray(da.values)[last][order], lw=0.8, label=t)
+        ax.set_ylabel(f"{what} ({unit})" if unit else what)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="upper right", ncols=min(len(throws), 3))
+    axes[-1].set_xlabel("crank angle of the shaft (deg), last revolution")
+    axes[-1].set_xlim(0, 360)
+    fig.suptitle(title or f"{ds.attrs.get('model', 'machine')}: each throw by crank angle")
+    a = ds.attrs
+    rcs = ", ".join(f"{t}.rc={1e3 * a[f'param_{t}.rc']:g} mm" for t in throws
+                    if f"param_{t}.rc" in a)  # fmt: skip
+    add_footer(fig, f"{len(throws)} throws{'; ' + rcs if rcs else ''} | {a['solver_method']} rtol="
+                    f"{a['solver_rtol']:g} | recipdyn {a['recipdyn_version']}")  # fmt: skip
     return fig
 
 

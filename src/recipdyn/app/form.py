@@ -113,7 +113,7 @@ def _factor(unit: str, si_unit: str) -> float:
     """SI value of one display ``unit`` (1.0 when they are the same)."""
     if unit == si_unit:
         return 1.0
-    from ..units import _ureg
+    from ..quantity import _ureg
 
     return float(_ureg().Quantity(1.0, unit).to(si_unit.replace("**", "^")).magnitude)
 

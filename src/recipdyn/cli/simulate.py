@@ -277,6 +277,12 @@ def simulate(
         help="A registered model (see 'recipdyn models') or module:object; "
         "default: the paper's compressor.",
     ),  # fmt: skip
+    machine: Path = typer.Option(
+        None,
+        "--machine",
+        help="A machine file (TOML: its shaft and drive, throws at their phase angles, stages, "
+        "sensors; docs/machines.md): assembled into the model that runs.",
+    ),
     dump_config: Path = typer.Option(
         None,
         "--dump-config",
@@ -290,6 +296,11 @@ def simulate(
     from ..errors import ParameterError
     from ..units import to_si
 
+    if machine is not None:
+        if model is not None:
+            raise ParameterError("--machine and --model: give one of them (a machine file is "
+                                 "the model it describes)")  # fmt: skip
+        model = str(machine)
     # everything is validated before anything heavy is imported or any file written
     m, params, settings = _collect_model(model, rc, d, omega, sets, config, load=False)
     kw = {**SIMULATION, **settings}

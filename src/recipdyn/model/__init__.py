@@ -11,8 +11,8 @@ import importlib
 
 _LAZY = {
     "ODESystem": "base", "DiscreteMap": "base", "Signal": "base",
-    "CompressorModel": "compressor", "compressor_model": "compressor",
-    "equilibrium_theta_c": "compressor",
+    "AssembledSystem": "assembler.system", "compressor_model": "assembler.model",
+    "equilibrium_theta_c": "mechanism.link",
     "ideal_slider_crank": "kinematics", "ideal_mechanism": "kinematics",
     "joint_forces": "kinematics", "kinematics": "kinematics",
     "gas_force": "components.load", "mu_paper": "load", "read_load_table": "load",

@@ -2,8 +2,8 @@
 
 Exact clearance-angle acceleration and its partial derivatives for the single-DOF massless-link
 clearance model (see [`recipdyn.model.derivation`][recipdyn.model.derivation] for the derivation).
-Parameter vector layout: see [`recipdyn.model.compressor`][recipdyn.model.compressor] (``P_*``
-indices).
+The arguments are scalars; the assembler reads them from a throw's mechanism slice
+(`recipdyn.model.mechanism.link_kernels`).
 """
 
 import math

@@ -29,7 +29,7 @@ For a map the same convention holds with the step index ``n`` (a float) in place
 Derived outputs (e.g. crosshead displacement from the clearance angle) are *not* part of the
 compiled rule: a model may implement [`ODESystem.outputs`][recipdyn.model.base.ODESystem.outputs] to
 turn a trajectory into named, unit-labelled signals. Nothing here knows about cranks; the compressor
-model ([`recipdyn.model.compressor`][recipdyn.model.compressor]) is one implementation, the Lorenz
+model ([`recipdyn.model.assembler`][recipdyn.model.assembler]) is one implementation, the Lorenz
 system in the tests another.
 """
 

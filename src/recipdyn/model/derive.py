@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
-__all__ = ["Lagrangian", "derive", "kernel_source", "accelerations_source", "KernelPrinter"]
+__all__ = ["Lagrangian", "derive", "kernel_source", "accelerations_source", "system_source",
+           "KernelPrinter"]  # fmt: skip
 
 
 class KernelPrinter(PythonCodePrinter):
@@ -190,6 +191,37 @@ def accelerations_source(lag: Lagrangian, name: str, inputs: int, given=()) -> s
     lines += [f"    b{i} = {vals[len(low) + i]}" for i in range(n)]
     lines += _ldl_solve(n)
     lines.append("    return (" + ", ".join(f"a{i}" for i in range(n)) + (",)" if n == 1 else ")"))
+    return "\n".join(lines + [""])
+
+
+def system_source(lag: Lagrangian, name: str, reads: dict, doc: str) -> str:
+    """Python source of ``{name}_system(y, p, m, u)``: the lower triangle of the mass matrix
+    and the right-hand side of ``M qdd = b`` as one tuple, ``(m00, m10, m11, ..., b0, b1,
+    ...)``, allocating nothing: the parts of a body that an assembly combines with other
+    bodies' (a throw's contribution to the crank's equation) before it solves.
+
+    ``y`` holds ``(q, qd)`` (a tuple or an array); ``reads`` maps each parameter symbol to
+    the text that reads it (``"p[m + 3]"``: the body's slice at offset ``m``; ``"u[0]"``: an
+    input computed per call; ``"0.0"``: left out of this body, such as an inertia another
+    body carries). No imports: the caller's module provides ``nb`` and ``math``."""
+    n = lag.n
+    low = [(i, j) for i in range(n) for j in range(i + 1)]
+    zero = {s: sp.S.Zero for s, text in reads.items() if text == "0.0"}
+    exprs = [lag.M[i, j].subs(zero) for i, j in low] + [lag.b[i].subs(zero) for i in range(n)]
+    head, vals = _body(lag, exprs)
+    used = set().union(*(e.free_symbols for e in exprs))
+    for i, sym in enumerate(lag.params):
+        line = f"    _p{i} = p[{i}]"
+        if sym in zero or sym not in used:
+            head.remove(line)
+        else:
+            head[head.index(line)] = f"    _p{i} = {reads[sym]}"
+    lines = ["@nb.njit(cache=True)", f"def {name}_system(y, p, m, u):", f'    """{doc}"""',
+             *head]  # fmt: skip
+    lines += [f"    m{i}{j} = {vals[k]}" for k, (i, j) in enumerate(low)]
+    lines += [f"    b{i} = {vals[len(low) + i]}" for i in range(n)]
+    names = [f"m{i}{j}" for i, j in low] + [f"b{i}" for i in range(n)]
+    lines.append("    return (" + ", ".join(names) + ")")
     return "\n".join(lines + [""])
 
 

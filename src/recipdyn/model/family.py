@@ -24,7 +24,8 @@ enables it (`owner`).
 The old model names are *presets*: ``compressor-contact`` is this model with
 ``crank_joint = contact`` as its default, ``compressor-valves`` with ``load = valves``,
 ``compressor-contact-valves`` with both, ``compressor-guide`` with ``guide = clearance`` and
-ideal pins (`PRESETS`).
+ideal pins (`PRESETS`; its former kernel of its own is the reference model
+``compressor-guide-reference``).
 
 **Values and records.** A configuration's validated values are its implementation's values
 plus each selector the implementation does not itself have whose value differs from the
@@ -64,11 +65,10 @@ _DEFAULTS = SELECTORS.defaults()
 
 #: The implementations, by route: where each lives (imported when first asked for).
 ROUTES = {
-    "link": "recipdyn.model.compressor:COMPRESSOR",
-    "link-valves": "recipdyn.model.compressor_valves:COMPRESSOR_VALVES",
+    "link": "recipdyn.model.assembler.model:LINK",
+    "link-valves": "recipdyn.model.assembler.model:LINK_VALVES",
     "contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
     "contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",
-    "guide": "recipdyn.model.compressor_guide:COMPRESSOR_GUIDE",
 }
 _LOADED: dict[str, Model] = {}
 
@@ -81,11 +81,9 @@ def implementation(name: str) -> Model:
     return _LOADED[name]
 
 
-def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False) -> str:
+def route(s: Mapping[str, Any], table: bool = False) -> str:
     """The implementation (a key of `ROUTES`) for the selector values ``s`` (``table``: a
-    load or pressure table is given; ``guide_kernel``: ideal pins in a worn guide with the
-    paper's load or the cycle run `compressor-guide`'s own kernel, as the preset of that name
-    does, instead of the contact joints' glue); a combination that none covers raises
+    load or pressure table is given); a combination that none covers raises
     [`ParameterError`][recipdyn.errors.ParameterError] in one line that says why and what is
     allowed."""
     crank, cross, load, drive, guide = (s[k] for k in SELECTORS.names)
@@ -97,11 +95,9 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
                 "link's equations hold the crosshead on its line; allowed with the guide "
                 "clearance: crank_joint = 'ideal', 'contact' or 'lubricated'"
             )
-        if (guide_kernel and rigid_pins and load in ("paper", "cycle") and not table
-                and drive == "prescribed"):  # fmt: skip
-            return "guide"  # compressor-guide: its own kernel, the Flores benchmark's
-        # the contact joints' glue with its own guide (any pin joint, ideal pins included;
-        # with a motor, the crank's states after the guide's)
+        # the contact joints' kernels with the guide (any pin joint, ideal pins included; with
+        # a motor, the crank's states after the guide's); the preset compressor-guide's own
+        # kernel is the reference model compressor-guide-reference, its independent check
         return "contact-valves" if load == "valves" else "contact"
     if crank == "link" and cross != "ideal":
         raise ParameterError(
@@ -233,10 +229,7 @@ class Compressor(Model):
         self.choosable = choosable
         self._selectors = _chosen(self.defaults, _DEFAULTS)
         self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
-        #: A preset whose defaults choose the guide clearance (compressor-guide) runs its own
-        #: kernel where it applies; the model otherwise runs the contact joints' glue.
-        self._guide_kernel = self._selectors["guide"] == "clearance"
-        impl = implementation(route(self._selectors, guide_kernel=self._guide_kernel))
+        impl = implementation(route(self._selectors))
         self.description = description or impl.description
         self._adopt(impl)
         others = {k: v for k, v in self.defaults.items() if k not in SELECTORS.names}
@@ -275,7 +268,7 @@ class Compressor(Model):
 
     def _route0(self, s: Mapping[str, Any] | None = None) -> str:
         """The route at the selector values ``s`` (default: this preset's)."""
-        return route(self._selectors if s is None else s, guide_kernel=self._guide_kernel)
+        return route(self._selectors if s is None else s)
 
     def with_defaults(self, **defaults: Any) -> Compressor:
         """This model with other defaults (selectors or any parameter), under its name."""
@@ -298,12 +291,12 @@ class Compressor(Model):
             name, s = self._routes[key]
         except KeyError:
             s = self.selectors(values)
-            name = route(s, table, self._guide_kernel)
+            name = route(s, table)
             if len(self._routes) < 256:
                 self._routes[key] = name, s
         except TypeError:  # an unhashable value
             s = self.selectors(values)
-            name = route(s, table, self._guide_kernel)
+            name = route(s, table)
         return name, implementation(name), dict(s)
 
     def _split(self, values: Mapping[str, Any]) -> tuple[Model, dict[str, Any]]:

@@ -312,7 +312,7 @@ class CompressorParams:
     theta_c0 : float or None
         Initial clearance angle, rad. ``None`` (default) = the link aligned with the force the
         rod transmits at t = 0, i.e. the static equilibrium of the link under the gas load
-        (`recipdyn.model.compressor.equilibrium_theta_c`), plus ``theta_c_offset``.
+        (`recipdyn.model.mechanism.link.equilibrium_theta_c`), plus ``theta_c_offset``.
     theta_c_offset : float
         Offset added to the default initial clearance angle, rad. The motion is very sensitive
         to it: offsets of ~0.2 rad and more excite large free oscillations of the link.

@@ -63,9 +63,14 @@ def __getattr__(name: str):
 def close_matches(word: str, candidates) -> list[str]:
     """The candidates ``word`` may be a misspelling of, closest first: difflib's similarity
     ratio (without case) at least 0.6 and within 0.1 of the best one's (so that
-    ``discharge_presure`` suggests ``discharge_pressure`` alone, not every ``*_pressure``)."""
+    ``discharge_presure`` suggests ``discharge_pressure`` alone, not every ``*_pressure``);
+    for a name that a machine holds per part, the namespaced ones (``rc``: ``throw1.rc``,
+    ``throw2.rc``)."""
     from difflib import SequenceMatcher
 
+    spaced = sorted(c for c in set(candidates) if c.rpartition(".")[2] == word and c != word)
+    if spaced:  # a machine's namespaced parameter (throw1.rc for rc): every part's
+        return spaced[:4]
     scored = []
     for c in set(candidates):
         m = SequenceMatcher(None, word.lower(), c.lower())
@@ -96,19 +101,24 @@ def rule_inputs(rule: str) -> tuple[str, ...]:
 
 def derive_value(p: Param, values: Mapping[str, Any]) -> Derived:
     """``p``'s value derived by its rule from ``values`` (validated numbers); a value out of
-    ``p``'s range is refused naming the rule and the values it was derived from."""
+    ``p``'s range is refused naming the rule and the values it was derived from. The rule
+    reads the names of ``p``'s own namespace: a machine's ``throw2.ls = l / 2`` follows
+    ``throw2.l``."""
     names = rule_inputs(p.derive)
+    scope = p.name.rpartition(".")[0]
+    inputs = {k: f"{scope}.{k}" if scope else k for k in names}
+    numbers = {k: float(values[n]) for k, n in inputs.items()}
     try:
-        v = float(eval(p.derive, {"__builtins__": {}}, {k: float(values[k]) for k in names}))  # noqa: S307 - a rule declared in recipdyn's code
+        v = float(eval(p.derive, {"__builtins__": {}}, numbers))  # noqa: S307 - recipdyn's own rule
     except (OverflowError, ZeroDivisionError):
         v = float("inf")  # e.g. l = 1e154 squared: refused below as out of range, naming l
     try:
         p.check(v)
     except ParameterError:
-        given = ", ".join(f"{k} = {float(values[k]):g}" for k in names)
+        given = ", ".join(f"{n} = {float(values[n]):g}" for n in inputs.values())
         raise ParameterError(
             f"{p.name} = {p.derive} = {v:g} {p.unit} (derived from {given}) is out of range; "
-            f"allowed: {p.range_text()}: set {p.name} or change {', '.join(names)}"
+            f"allowed: {p.range_text()}: set {p.name} or change {', '.join(inputs.values())}"
         ) from None
     return Derived(v)
 

@@ -7,6 +7,8 @@
 * A path: ``"my_models:PENDULUM"`` (an importable module) or ``"path/to/file.py:PENDULUM"``
   (a file of the user's own), naming a [`Model`][recipdyn.model.protocol.Model] instance or
   class.
+* A machine file: ``"path/to/machine.toml"`` (`recipdyn.model.machine`), assembled into a
+  model of its throws (``recipdyn simulate --machine FILE``).
 
 Modules are imported only when a model is asked for, so listing names costs nothing.
 """
@@ -24,7 +26,7 @@ from .protocol import Model, close_matches
 
 __all__ = ["get_model", "model_names", "register", "models_with_parameter", "model_spec",
            "load_object", "is_spec", "absolute_spec", "configured_for_record", "DEFAULT_MODEL",
-           "ENTRY_POINT_GROUP"]  # fmt: skip
+           "ENTRY_POINT_GROUP", "is_machine_file", "machine_model"]  # fmt: skip
 
 DEFAULT_MODEL = "compressor"
 ENTRY_POINT_GROUP = "recipdyn.models"
@@ -40,6 +42,7 @@ _BUILTIN = {
     "compressor-valves": "recipdyn.model.family:COMPRESSOR_VALVES",
     "compressor-contact-valves": "recipdyn.model.family:COMPRESSOR_CONTACT_VALVES",
     "compressor-guide": "recipdyn.model.family:COMPRESSOR_GUIDE",
+    "compressor-guide-reference": "recipdyn.model.reference.compressor_guide:COMPRESSOR_GUIDE",
 }
 _REGISTERED: dict[str, Model] = {}
 
@@ -124,6 +127,32 @@ def load_object(spec: str, what: str = "object") -> object:
         raise ParameterError(str(exc).replace("model ", f"{what} ", 1)) from None
 
 
+#: The model of a machine file (a routing entry like `_BUILTIN`'s: imported when a file is
+#: first asked for).
+MACHINE_MODEL = "recipdyn.model.assembler.model:MachineModel"
+_MACHINES: dict[tuple[str, int], Model] = {}
+
+
+def is_machine_file(spec: object) -> bool:
+    """Whether ``spec`` names a machine file (``*.toml``)."""
+    return isinstance(spec, str) and spec.strip().lower().endswith(".toml")
+
+
+def machine_model(path: str) -> Model:
+    """The model of the machine file ``path`` (one per file and version of it in a process,
+    so its systems are assembled once)."""
+    from .machine import read_machine
+
+    p = Path(path).resolve()
+    try:
+        key = (str(p), p.stat().st_mtime_ns)
+    except OSError:
+        raise ParameterError(f"machine: file not found: {path}") from None
+    if key not in _MACHINES:
+        _MACHINES[key] = _load_path(MACHINE_MODEL)(read_machine(p))
+    return _MACHINES[key]
+
+
 def get_model(spec: str | Model | None = None) -> Model:
     """The model named ``spec`` (default `DEFAULT_MODEL`); see the module docstring."""
     if isinstance(spec, Model):
@@ -131,6 +160,8 @@ def get_model(spec: str | Model | None = None) -> Model:
     spec = DEFAULT_MODEL if spec is None else str(spec).strip()
     if spec in _REGISTERED:
         return _REGISTERED[spec]
+    if is_machine_file(spec):
+        return machine_model(spec)
     target = _BUILTIN.get(spec)
     if target is None:
         target = _entry_points().get(spec)

@@ -11,7 +11,7 @@ import xarray as xr
 from ..analysis.poincare import count_distinct_points, stroboscopic_section
 from ..errors import ModelValidityWarning
 from ..integrate import IntegrationError
-from ..model.compressor import compressor_model
+from ..model.assembler.model import compressor_model
 from ..simulate import clean_attrs, simulate
 
 __all__ = ["measure_run", "spectral_peaks", "F_MAX_STORED"]

@@ -5,7 +5,8 @@ r"""The contact-impact joints at the pins as a model: what its models share.
 with dynamic valves as states) are the same joints with the same parameters, packing,
 generated glue, outputs and summaries: `CompressorContact` holds them (the second model
 overrides what its load's states change). The compiled parts are
-`recipdyn.model.joints.pins`, the glue's source `recipdyn.model.components.contact`.
+`recipdyn.model.joints.pins`, the kernels' templates `recipdyn.model.assembler.templates.joints`
+(the joints' forces, one module per contact law) and `.contact` (one per configuration).
 """
 
 from __future__ import annotations
@@ -34,11 +35,11 @@ from ..joints.pins import (
     N_GUIDE,
     N_GUIDE_STATES,
     N_PACKED,
+    P_CHI,
     P_MU,
     RIGID,
     STATE_NAMES,
     STATE_UNITS,
-    law_source,
 )
 from ..load import CYCLE_PARAMS
 from ..parameters import SCHEMA as LINK_SCHEMA
@@ -300,58 +301,116 @@ def friction_part(values: Mapping[str, Any]) -> tuple[str, str, int]:
     return "recipdyn.model.joints.contact", FRICTION_ROLES[values["friction_law"]], P_MU
 
 
+def joints_bindings(law: str | None, friction: tuple[str, str, int], guide_friction: str
+                    ) -> tuple[dict, dict, str, str]:  # fmt: skip
+    """The joints' forces for one contact law and one friction law at the pins and at the
+    guide's shoes: the roles and constants of the template ``joints``
+    (`recipdyn.model.assembler.templates.joints`), its stem and note. ``law``: a contact law of
+    a user's file (its absolute spec; its slice after the joints' part), or None for the
+    built-in law (its hysteresis factor at `P_CHI`)."""
+    from .contract import resolve_component, source_digest
+
+    builtin = "recipdyn.model.joints.contact"
+    roles = {"friction": friction[:2], "guide_friction": (builtin, guide_friction)}
+    note, stem = "", f"{friction[1]}_{guide_friction}"
+    if law is None:
+        roles.update(law_normal=(builtin, "power_law_normal"),
+                     law_elastic=(builtin, "power_law_elastic"))  # fmt: skip
+        lo = P_CHI
+    else:
+        law_c = resolve_component("contact_law", law, {})
+        roles.update(law_normal=(law_c.module, law_c.kernel("normal")),
+                     law_elastic=(law_c.module, law_c.kernel("elastic")))  # fmt: skip
+        lo = N_PACKED
+        # its edits give a new module, never stale machine code
+        note = f"contact_law = {law_c.module}: {source_digest(law_c.module)}"
+        stem = f"{law_c.name}_{stem}".replace("-", "_")
+    return roles, {"FO": friction[2], "LO": lo}, stem, note
+
+
+@lru_cache(maxsize=16)
+def _joints_module(law: str | None, friction: tuple[str, str, int], guide_friction: str):
+    """The module of the joints' forces (`joints_bindings`), compiled once for every
+    configuration of the joints that holds those laws."""
+    from ..assembler import generate
+
+    return generate.module("joints", *joints_bindings(law, friction, guide_friction))
+
+
+def contact_bindings(joints_module: str, joints: str, load, guide: bool, n_law: int,
+                     motor: str | None, n_motor: int) -> tuple[dict, dict, str]:  # fmt: skip
+    """The roles, constants and stem of the template ``contact``
+    (`recipdyn.model.assembler.templates.contact`) for one configuration of the joints: the
+    joints' forces from ``joints_module``, the load component ``load``'s roles, the motor's
+    torque law, and the offsets of the layout (the joints' part, the law's slice of
+    ``n_law``, the guide's, with a motor the crank's and the torque law's of ``n_motor``, the
+    load's; the states: the joints', the guide's, the load's, the crank's)."""
+    from ..assembler import generate
+
+    absent = ("recipdyn.model.assembler.generate", "absent")
+    roles = {name: (joints_module, name) for name in (
+        "joints", "joints_at", "joints_guide", "joints_guide_at", "guide_forces",
+        "guide_corner")}  # fmt: skip
+    roles.update(dict.fromkeys(("load_force", "load_force_sc", "load_state_force", "load_rhs",
+                                "load_event", "load_reset", "torque"), absent))  # fmt: skip
+    stateful = bool(load.states)
+    if stateful:
+        for role, kernel in (
+            ("load_state_force", "state_force"),
+            ("load_rhs", "state_rhs"),
+            ("load_event", "event"),
+            ("load_reset", "reset"),
+        ):
+            roles[role] = (load.module, load.kernel(kernel))
+    elif "force_sc" in load.kernels:
+        roles["load_force_sc"] = (load.module, load.kernel("force_sc"))
+    else:
+        roles["load_force"] = (load.module, load.kernel("force"))
+    n_guide, first = (N_GUIDE, G_GAS + N_GUIDE_STATES) if guide else (0, G_GAS)
+    n_drive = N_CRANK + n_motor if motor is not None else 0
+    constants = dict(
+        A=first + len(load.states), CFG=generate.Literal(CFG[joints]),
+        CO=N_PACKED + n_law + n_guide, G=first, GO=N_PACKED + n_law, GY=G_GUIDE,
+        HAS_GUIDE=guide, LO=N_PACKED + n_law + n_guide + n_drive,
+        LOAD_SC="force_sc" in load.kernels, LOAD_STATES=stateful,
+        M=first + len(load.states) + len(load.aux_states),
+        MO=N_PACKED + n_law + n_guide + N_CRANK, MOTOR=motor is not None,
+        N_OBS=(30 if guide else 21) + (3 if motor is not None else 0),
+    )  # fmt: skip
+    stem = f"{joints}_{load.name}" + ("_guide" if guide else "")
+    if motor is not None:
+        from .drive import MOTORS
+
+        roles["torque"] = (MOTORS[motor].module, MOTORS[motor].kernel("torque"))
+        stem += f"_motor_{motor}"
+    return roles, constants, stem.replace("-", "_")
+
+
 @lru_cache(maxsize=32)
 def _glue(joints: str, load: str, guide: bool = False, law: str | None = None,
           n_law: int = 0, friction: tuple[str, str, int] = (), guide_friction: str = "",
           motor: str | None = None, n_motor: int = 0):  # fmt: skip
-    from .contact import glue_source
-    from .contract import glue_module, resolve_component, source_digest
+    """The kernels of one configuration of the joints: a module generated from the template
+    ``contact`` (`contact_bindings`), calling the joints' module of its laws
+    (`_joints_module`)."""
+    from ..assembler import generate
+    from .contract import resolve_component, source_digest
     from .load import LOADS, VALVES
 
     part = VALVES if load == VALVES.name else resolve_component("load", load, LOADS)
-    block, stem = "", f"contact_{joints}_{part.name}_{friction[1]}".replace("-", "_")
-    # a load of a user's file (``load`` its absolute spec): its edits give a new glue file
-    tail = "" if load in LOADS or part is VALVES else (
-        f"\n# load = {part.module}: {source_digest(part.module)}\n")  # fmt: skip
-    if law is not None:  # a contact law of a user's file: its slice first, after the joints'
-        law_c = resolve_component("contact_law", law, {})
-        block = law_source(law_c, N_PACKED)
-        # its edits give a new glue file, never stale machine code
-        block += f"\n# contact_law = {law_c.module}: {source_digest(law_c.module)}\n"
-        stem += f"_{law_c.name}".replace("-", "_")
-    if motor is not None:  # the crank's slice and the torque law's before the load's
-        from .drive import MOTORS
-
-        # with the guide's clearance, its states follow the joints' and its slice the law's
-        n_g, first = (N_GUIDE, G_GAS + N_GUIDE_STATES) if guide else (0, G_GAS)
-        src = glue_source(cfg=CFG[joints], joints=joints, load=part,
-                          offset=N_PACKED + n_law + n_g + N_CRANK + n_motor, first_state=first,
-                          law=block, motor=MOTORS[motor],
-                          motor_state=first + len(part.states) + len(part.aux_states),
-                          motor_offset=N_PACKED + n_law + n_g + N_CRANK,
-                          crank_offset=N_PACKED + n_law + n_g, friction=friction,
-                          guide=N_PACKED + n_law if guide else None,
-                          guide_state=G_GUIDE if guide else None,
-                          guide_friction=guide_friction)  # fmt: skip
-        if guide:
-            stem += f"_guide_{guide_friction}"
-        return glue_module(src + tail, f"{stem}_motor_{motor}")
-    if not guide:
-        src = glue_source(cfg=CFG[joints], joints=joints, load=part, offset=N_PACKED + n_law,
-                          first_state=G_GAS, law=block, friction=friction)  # fmt: skip
-        return glue_module(src + tail, stem)
-    src = glue_source(cfg=CFG[joints], joints=joints, load=part,
-                      offset=N_PACKED + n_law + N_GUIDE, first_state=G_GAS + N_GUIDE_STATES,
-                      guide=N_PACKED + n_law, guide_state=G_GUIDE, law=block,
-                      friction=friction, guide_friction=guide_friction)  # fmt: skip
-    return glue_module(src + tail, f"{stem}_guide_{guide_friction}")
+    jm = _joints_module(law, friction, guide_friction or "ambrosio_friction").__name__
+    roles, constants, stem = contact_bindings(jm, joints, part, guide, n_law, motor, n_motor)
+    # a load of a user's file (``load`` its absolute spec): its edits give a new module
+    note = "" if load in LOADS or part is VALVES else (
+        f"load = {part.module}: {source_digest(part.module)}")  # fmt: skip
+    return generate.module("contact", roles, constants, stem, note)
 
 
 def kernels(values: Mapping[str, Any], load=None):
-    """The generated glue of the joints, the guide, the load ``values`` choose (or ``load``)
-    and the contact law of a user's file if one is chosen: a module with ``rhs``, ``jac``,
-    ``rhs_jac``, ``event``, ``reset``, ``observe`` and ``fd_jac``
-    (`recipdyn.model.components.contact`)."""
+    """The generated kernels of the joints, the guide, the load ``values`` choose (or
+    ``load``) and the contact law of a user's file if one is chosen: a module with ``rhs``,
+    ``jac``, ``rhs_jac``, ``event``, ``reset``, ``observe``, ``fd_jac`` and ``cs_jac``
+    (`recipdyn.model.assembler.templates.contact`)."""
     part = load_part(values) if load is None else load
     name = _load_key(values, part)
     spec = law_spec(values)
@@ -911,8 +970,8 @@ class CompressorContact(Model):
         pin's the other way), at rest relative to the journals; a rigid joint's are 0."""
         ang = values["e0_angle"]
         if ang is None:
+            from ..mechanism.link import equilibrium_theta_c
             from ..parameters import CompressorParams
-            from .mechanism import equilibrium_theta_c
 
             keys = (
                 *MECH,

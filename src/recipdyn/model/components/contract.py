@@ -85,6 +85,10 @@ class Component:
         ``values -> ndarray``: a load with states, its states then its auxiliary states at
         ``t = 0`` (a load of a user's file with states needs it; the dynamic valves' model
         computes its own).
+    steps : callable, optional
+        ``values -> ndarray``: a load with states, the step of the Jacobian's central
+        differences for each of its states as a pair ``(rel, abs)``, ``h = 1e-7 (|y| (1 +
+        rel) + abs)`` (default ``(0, 1)``: steps of 1e-7 relative to 1).
     """
 
     family: str
@@ -98,6 +102,7 @@ class Component:
     aux_states: tuple[tuple[str, str], ...] = ()
     check: Callable[[Mapping[str, Any]], None] | None = None
     initial: Callable[[Mapping[str, Any]], np.ndarray] | None = None
+    steps: Callable[[Mapping[str, Any]], np.ndarray] | None = None
 
     def kernel(self, role: str) -> str:
         """``from MODULE import FUNCTION as ALIAS`` target for ``role``."""

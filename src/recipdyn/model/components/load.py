@@ -12,6 +12,8 @@ r"""Load components: the force of the gas on the crosshead along +x, ``F(theta1)
   (auxiliary); slice `recipdyn.model.cycle.cycle_data`, then
   `recipdyn.model.valves.pack_valves`.
 
+Each role is a compiled function, called (not inlined) by the kernels that use it, so it is
+compiled once for every configuration (docs/architecture.md, Composing compiled components).
 A load without states is one compiled function ``force(theta1, p, o)`` reading its slice at
 offset ``o``; a load may add ``force_sc(sin theta1, cos theta1, p, o)``, the same force from
 the sine and cosine of the crank angle, for a joint that has them (the contact joint's
@@ -66,13 +68,13 @@ __all__ = [
 _TWO_PI = 2.0 * math.pi
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def paper_force(th1, p, o):
     """The paper's load (slice ``amplitude, sign``)."""
     return p[o + 1] * p[o] * mu_kernel(th1)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def paper_force_sc(s1, c1, p, o):
     """The paper's load from ``sin theta1`` and ``cos theta1`` (`recipdyn.model.load.mu_sincos`:
     equal to `paper_force` to rounding, without reducing the angle)."""
@@ -98,35 +100,46 @@ def table_force(th1, p, o):
     return f0 + (f1 - f0) * (phi - a0) / (a1 - a0)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def cycle_force(th1, p, o):
     """The ideal-valve compression cycle (slice `recipdyn.model.cycle.cycle_data`)."""
     return cycle_force_kernel(th1, p[o:])
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def valves_force(y, g, p, o):
     """The gas force of the chamber pressures ``y[g]``, ``y[g + 6]``."""
     return va.state_force(y, g, p[o:])
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def valves_rhs(x, xdot, y, g, a, p, o, out):
     """The chambers' and plates' derivatives (`recipdyn.model.valves.gas_rhs`)."""
     c = p[o:]
     va.gas_rhs(x, xdot, y, g, a, c, c[N_CYCLE:], out)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def valves_event(y, g, p, o):
     """The smallest plate factor (`recipdyn.model.valves.valve_event`)."""
     return va.valve_event(y, g, p[o + N_CYCLE :])
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def valves_reset(y, g, p, o, out):
     """A plate's impact (`recipdyn.model.valves.valve_reset`)."""
     va.valve_reset(y, g, p[o + N_CYCLE :], out)
+
+
+def _valves_steps(values: Mapping[str, Any]) -> np.ndarray:
+    """The Jacobian's central-difference steps of the valves' states, ``(rel, abs)`` per
+    state (`recipdyn.model.components.contract.Component.steps`): a pressure by 1e-7 of
+    itself plus the suction pressure, a gas mass by 1e-7 of twice itself, a plate's lift by
+    1e-7 of itself plus its full lift, a plate's velocity by 1e-7 of itself plus 1 m/s."""
+    lift = float(values["valve_lift"])
+    chamber = [0.0, float(values["suction_pressure"]), 1.0, 1e-12, 0.0, lift, 0.0, 1.0, 0.0,
+               lift, 0.0, 1.0]  # fmt: skip
+    return np.array(chamber * 2, dtype=np.float64)
 
 
 def _valves(values: Mapping[str, Any]) -> np.ndarray:
@@ -158,7 +171,7 @@ CYCLE = Component("load", "cycle", "the compression cycle, ideal valves, polytro
 
 VALVES = Component(
     "load", "valves", "the cylinder gas with dynamic plate valves (pressures, plates as states)",
-    module=__name__, pack=_valves, params=va.SCHEMA_PARAMS,
+    module=__name__, pack=_valves, params=va.SCHEMA_PARAMS, steps=_valves_steps,
     kernels={"state_force": "valves_force", "state_rhs": "valves_rhs",
              "event": "valves_event", "reset": "valves_reset"},
     states=tuple(zip(va.GAS_STATE_NAMES, va.GAS_STATE_UNITS, strict=True)),

@@ -76,7 +76,8 @@ import numpy as np
 
 __all__ = [
     "LAWS", "FRICTION_LAWS", "hysteresis_factor", "delivered_restitution", "hertz_stiffness",
-    "normal_force", "ambrosio_friction", "tanh_friction", "FRICTION_ROLES",
+    "normal_force", "ambrosio_friction", "tanh_friction", "FRICTION_ROLES", "power_law_normal",
+    "power_law_elastic",
     "short_bearing_forces",
 ]  # fmt: skip
 
@@ -137,6 +138,23 @@ def normal_force(delta, ddelta, v_impact, K, chi):
         return 0.0
     f = K * delta * np.sqrt(delta) * (1.0 + chi * ddelta / v_impact)
     return f if f.real > 0.0 else 0.0
+
+
+# The built-in law as a contact law's roles (docs/components.md, a new contact law): the
+# joints' module of the built-in law binds them (`recipdyn.model.assembler.templates.joints`).
+
+
+@nb.njit(cache=True)
+def power_law_normal(delta, ddelta, v_impact, K, p, o):
+    """The ``normal`` role of the built-in law: `normal_force` with its hysteresis factor
+    ``chi`` at ``p[o]``."""
+    return normal_force(delta, ddelta, v_impact, K, p[o])
+
+
+@nb.njit(cache=True)
+def power_law_elastic(delta, K, p, o):
+    """The ``elastic`` role of the built-in law: ``K delta^1.5``."""
+    return K * delta * np.sqrt(delta)
 
 
 # The built-in friction laws as the contact law's ``friction(vt, p, o)`` role: ``F_t / F_n``

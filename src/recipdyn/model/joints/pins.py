@@ -2,13 +2,14 @@ r"""The contact-impact joints at the pins: their layout and compiled parts.
 
 What every model with contact or lubricated pin joints shares (`compressor-contact`, with
 the dynamic valves `compressor-contact-valves`, and the guide's clearance on the same
-glue): the packed parameter vector of the joints (the ``P_*`` constants, `N_PACKED`) and
-their state (`STATE_NAMES`), the kinematics, the force of one joint (`_pair`: contact,
-friction, oil film), both joints (`_joints`), the mechanism's accelerations given the gas
-force (`_accelerate`, from the generated ``_compressor_contact``), the same with the guide's
-clearance, and the contact events and their resets. They do not depend on the load: the
-generated glue (`recipdyn.model.components.contact`) joins them with one load component.
-The laws themselves (normal force, friction, oil film) are `recipdyn.model.joints.contact`.
+kernels): the packed parameter vector of the joints (the ``P_*`` constants, `N_PACKED`) and
+their state (`STATE_NAMES`), the kinematics, the mechanism's accelerations given the joints'
+and the gas force (`_accelerate`, from the generated ``_compressor_contact``), the same with
+the guide's clearance and with the crank free, and the contact events and their resets. The
+joints' forces (`recipdyn.model.assembler.templates.joints`: one module per contact law and
+friction law) and the kernels of a configuration (`recipdyn.model.assembler.templates.contact`)
+are written by the assembler; the laws themselves (normal force, friction, oil film) are
+`recipdyn.model.joints.contact`.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from .._compressor_contact_drive import (
 )
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, compiled
 from ..components.guide import CLEARANCE
-from .contact import normal_force, short_bearing_forces
+from .contact import short_bearing_forces  # noqa: F401 (the joints' template reads it here)
 
 #: Where the clearance is: the crank pin, the crosshead pin, or both (``clearance_joints``).
 JOINTS = ("crank", "crosshead", "both")
@@ -84,10 +85,11 @@ GUIDE_JOINTS = (*JOINTS, "ideal")
 GUIDE_INPUTS = ("F3_y",)
 
 
-# The right-hand side's helpers below, down to _rhs, are inlined into the compiled rhs: a call
-# between numba functions that pass arrays costs ~30 ns, as much as a quarter of the whole
-# evaluation here (189 -> 126 ns per call, 12-state crank-pin case; the same arithmetic, so
-# bit-identical results). Cost: ~3 s more compilation on first use, once per machine (cached).
+# The joints' forces (the contact law, the friction law, the oil film) are the module the
+# assembler writes per choice of laws (`recipdyn.model.assembler.templates.joints`); the
+# accelerations below are compiled once and called, not inlined, by every configuration's
+# kernels (`recipdyn.model.assembler.templates.contact`): with numba's reference counting off,
+# a call that passes arrays costs ~1 ns (docs/architecture.md, Composing compiled components).
 
 
 @nb.njit(cache=True, inline="always")
@@ -117,80 +119,6 @@ def _kinematics_at(th1, w, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
     return s2, c2, th2d, v3, s1, c1
 
 
-@nb.njit(cache=True, inline="always")
-def _pair(ex, ey, u, v, w_j, w_b, c, K, Rj, v_imp, oil, p, friction, fo):
-    """Forces of one clearance joint, e = (ex, ey) from the journal centre to the bearing
-    centre, journal and bearing turning at w_j and w_b: the tuple (F_x, F_y (on the bearing),
-    T_b (on the bearing, about its centre), T_j (on the journal), F_n, F_t, power lost).
-    ``friction(vt, p, fo)``: the friction law (a contact law's ``friction`` role, e.g.
-    `recipdyn.model.joints.contact.ambrosio_friction` with ``fo = P_MU``), a compiled
-    function the caller names: each law compiles its own kernel."""
-    z = 0.0 * ex  # zero of the state's type (real, or complex for the complex step)
-    fx, fy, tb, tj, fnn, ftt, lost = z, z, z, z, z, z, z
-    rho = np.sqrt(ex * ex + ey * ey)
-    if rho.real == 0.0:
-        return fx, fy, tb, tj, fnn, ftt, lost
-    delta = rho - c
-    nx, ny = ex / rho, ey / rho
-    tx, ty = -ny, nx
-    drho = nx * u + ny * v  # = delta'
-    et = tx * u + ty * v
-    Rb = Rj + c
-    if delta.real > 0.0:
-        vi = v_imp if v_imp.real > p[P_VMIN] else p[P_VMIN]  # (the floor: grazing contacts)
-        fn = normal_force(delta, drho, vi, K, p[P_CHI])
-        vt = et + w_j * Rj - w_b * Rb  # sliding velocity, bearing relative to journal
-        ft = fn * friction(vt, p, fo)
-        fx = -fn * nx + ft * tx
-        fy = -fn * ny + ft * ty
-        tb = -Rb * ft
-        tj = Rj * ft
-        fnn = fn
-        ftt = ft
-        lost = (fn - K * delta * np.sqrt(delta)) * drho - ft * vt
-    if oil > 0.0:
-        # film forces on the journal, along its eccentricity -n and t_j = k x (-n) = -t
-        fr, fth = short_bearing_forces(rho / c, drho / c, et / rho, w_j + w_b, oil, p[P_LB],
-                                       Rj, c, p[P_EPSDRY])  # fmt: skip
-        bx = fr * nx + fth * tx  # on the bearing: minus the force on the journal
-        by = fr * ny + fth * ty
-        fx = fx + bx
-        fy = fy + by
-        fnn = fnn - fr
-        ftt = ftt + fth
-        lost = lost - (bx * u + by * v)
-    return fx, fy, tb, tj, fnn, ftt, lost
-
-
-@nb.njit(cache=True, inline="always")
-def _joints(t, y, p, cfg, friction, fo):
-    """Both joints' forces (tuples as `_pair`, with its friction law ``friction`` and its
-    slice ``fo``; a rigid joint's are 0) and (power from the crank, power lost in the joints,
-    theta2', x3', cos theta2, sin and cos theta1), the crank turning at the prescribed speed."""
-    w = p[P_OMEGA]
-    return _joints_at(p[P_TH10] + w * t, w, y, p, cfg, friction, fo)
-
-
-@nb.njit(cache=True, inline="always")
-def _joints_at(th1, w, y, p, cfg, friction, fo):
-    """`_joints` at the crank angle ``th1`` and speed ``w`` (a free crank's states)."""
-    _, c2, th2d, v3, s1, c1 = _kinematics_at(th1, w, p, y[0], y[1], y[4], y[5], y[2], y[3],
-                                             y[6], y[7])  # fmt: skip
-    z = 0.0 * y[0]
-    p_crank = z
-    f1 = (z, z, z, z, z, z, z)
-    f2 = (z, z, z, z, z, z, z)
-    if cfg != 1:  # crank pin: journal on the crank (w), bearing on the rod
-        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
-                   p[P_OIL], p, friction, fo)  # fmt: skip
-        vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
-        p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
-    if cfg != 0:  # crosshead pin: journal on the crosshead (not turning), bearing on the rod
-        f2 = _pair(y[2], y[3], y[6], y[7], 0.0, th2d, p[P_C2], p[P_K2], p[P_RJ2], _abs(y[9]),
-                   p[P_OIL2], p, friction, fo)  # fmt: skip
-    return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
-
-
 #: The first gas state and the first mass counter of a load with states (the dynamic valves),
 #: after the joints' twelve.
 G_GAS = len(STATE_NAMES)
@@ -216,7 +144,7 @@ def _ideal_crank_power(t, y, p, yd, f2):
     return r * w * (-fax * s1 + fay * c1)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _accelerate(t, y, p, out, cfg, j, fg):
     """The mechanism's derivatives ``out[:12]`` (real or complex ``y``, ``out``; no arrays
     allocated) from the joints' forces ``j`` (`_joints`) and the gas force ``fg`` (the load
@@ -246,7 +174,7 @@ def _accelerate(t, y, p, out, cfg, j, fg):
     return v3, c2
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _accelerate_free(y, p, out, cfg, j, fg, m, tm, co):
     """`_accelerate` with the crank angle free (a motor drive): the derivatives of the
     joints' twelve states and of the crank's ``y[m:m + 3]`` (angle, speed, the motor's work)
@@ -263,54 +191,28 @@ def _accelerate_free(y, p, out, cfg, j, fg, m, tm, co):
     if cfg == 0:
         a = crank_free_accelerations(0.0, (y[m], y[0], y[1], w1, y[4], y[5]), p, u)
         out[4], out[5], out[6], out[7] = a[1], a[2], 0.0, 0.0
+        a0 = a[0]
     elif cfg == 1:
         a = crosshead_free_accelerations(0.0, (y[m], y[2], y[3], w1, y[6], y[7]), p, u)
         out[4], out[5], out[6], out[7] = 0.0, 0.0, a[1], a[2]
+        a0 = a[0]
     else:
-        a = both_free_accelerations(0.0, (y[m], y[0], y[1], y[2], y[3], w1, y[4], y[5], y[6],
-                                          y[7]), p, u)  # fmt: skip
-        out[4], out[5], out[6], out[7] = a[1], a[2], a[3], a[4]
+        a5 = both_free_accelerations(0.0, (y[m], y[0], y[1], y[2], y[3], w1, y[4], y[5], y[6],
+                                           y[7]), p, u)  # fmt: skip
+        out[4], out[5], out[6], out[7] = a5[1], a5[2], a5[3], a5[4]
+        a0 = a5[0]
     out[8] = 0.0
     out[9] = 0.0
     out[I_WIN] = fg * v3 + tm * w1
     out[I_WLOSS] = p_loss
     out[m] = w1
-    out[m + 1] = a[0]
+    out[m + 1] = a0
     out[m + 2] = tm * w1
     return v3, c2
 
 
 # ---- the guide's clearance (`recipdyn.model.components.guide`): the crosshead pin's lateral
 # position ``y[gy]``, the tilt ``y[gy + 1]``, their rates, the corners' phases ``y[gy + 4:]``
-
-
-@nb.njit(cache=True, inline="always")
-def _joints_guide(t, y, p, cfg, gy, friction, fo):
-    """`_joints` with the guide's clearance (``cfg`` 3: both pins ideal): the rod's small end
-    follows the crosshead pin's lateral position, and the crosshead pin's journal turns with
-    the crosshead's tilt."""
-    w = p[P_OMEGA]
-    return _joints_guide_at(p[P_TH10] + w * t, w, y, p, cfg, gy, friction, fo)
-
-
-@nb.njit(cache=True, inline="always")
-def _joints_guide_at(th1, w, y, p, cfg, gy, friction, fo):
-    """`_joints_guide` at the crank angle ``th1`` and speed ``w`` (a free crank's states)."""
-    _, c2, th2d, v3, s1, c1 = _kinematics_at(th1, w, p, y[0], y[1], y[4], y[5], y[2],
-                                             y[3] + y[gy], y[6], y[7] + y[gy + 2])  # fmt: skip
-    z = 0.0 * y[0]
-    p_crank = z
-    f1 = (z, z, z, z, z, z, z)
-    f2 = (z, z, z, z, z, z, z)
-    if cfg == 0 or cfg == 2:  # crank pin: journal on the crank (w), bearing on the rod
-        f1 = _pair(y[0], y[1], y[4], y[5], w, th2d, p[P_C1], p[P_K1], p[P_RJ1], _abs(y[8]),
-                   p[P_OIL], p, friction, fo)  # fmt: skip
-        vjx, vjy = -p[P_R] * w * s1, p[P_R] * w * c1
-        p_crank = f1[0] * vjx + f1[1] * vjy - f1[3] * w
-    if cfg == 1 or cfg == 2:  # crosshead pin: journal on the crosshead (turning with its tilt)
-        f2 = _pair(y[2], y[3], y[6], y[7], y[gy + 3], th2d, p[P_C2], p[P_K2], p[P_RJ2],
-                   _abs(y[9]), p[P_OIL2], p, friction, fo)  # fmt: skip
-    return f1, f2, p_crank, f1[6] + f2[6], th2d, v3, c2, s1, c1
 
 
 @nb.njit(cache=True)
@@ -342,7 +244,7 @@ def _guide_crank_power(t, y, p, yd, f2, cfg, gy, fgx, fgy):
     return r * w * (-fax * s1 + fay * c1)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _accelerate_guide(t, y, p, out, cfg, gy, j3, j, fg, gf):
     """`_accelerate` with the guide's clearance: the derivatives of the joints' twelve states
     and of the guide's eight (``y[gy:gy + 8]``) from the joints' forces ``j``
@@ -385,7 +287,7 @@ def _accelerate_guide(t, y, p, out, cfg, gy, j3, j, fg, gf):
     return v3, c2
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _accelerate_guide_free(y, p, out, cfg, gy, j3, j, fg, gf, m, tm, co):
     """`_accelerate_guide` with the crank angle free (a motor drive, as `_accelerate_free`):
     the derivatives of the joints' twelve states, the guide's eight (``y[gy:gy + 8]``) and
@@ -542,36 +444,6 @@ CFG = {"crank": 0, "crosshead": 1, "both": 2, "ideal": 3}
 #: The roles of a contact law from a user's file (`law_part`): required, then optional.
 LAW_ROLES = ("normal", "elastic")
 LAW_OPTIONAL = ("friction", "potential")
-
-
-def law_source(law, offset: int) -> str:
-    """The joints' force functions (`_pair`, `_joints`, `_joints_guide`) with the contact law
-    ``law`` of a user's file, its slice at ``offset``: the source of the built-in functions
-    with the law's calls in place of the built-in normal force and its elastic part (in the
-    power lost); the rest (kinematics, the oil film, the torques) is the same text, so the
-    physics stays written once. Its friction, like a built-in law's, is the function the glue
-    passes to `_joints` (`friction_part`). For the generated glue
-    (`recipdyn.model.components.contact`)."""
-    import inspect
-
-    pair = inspect.getsource(_pair.py_func)
-    swaps = {"normal_force(delta, drho, vi, K, p[P_CHI])":
-             f"law_normal(delta, drho, vi, K, p, {offset})",
-             "K * delta * np.sqrt(delta)": f"law_elastic(delta, K, p, {offset})"}  # fmt: skip
-    for old, new in swaps.items():
-        if pair.count(old) != 1:  # pragma: no cover - guards an edit of _pair
-            raise RuntimeError(f"_pair no longer holds {old!r} once; update law_source")
-        pair = pair.replace(old, new)
-    names = sorted(k for k in globals() if k.startswith("P_"))
-    head = [f"from {law.module} import {law.kernel(r)} as law_{r}" for r in LAW_ROLES]
-    head.append(
-        "from recipdyn.model.joints.pins import (_abs, _kinematics, _kinematics_at, "
-        f"short_bearing_forces, {', '.join(names)})"
-    )
-    body = [pair] + [inspect.getsource(f.py_func) for f in (_joints_at, _joints,
-                                                             _joints_guide_at,
-                                                             _joints_guide)]  # fmt: skip
-    return "\n".join(head) + "\n\n\n" + "\n\n".join(body)
 
 
 #: The guide's slice, with its clearance: after the joints' part, before the load's.

@@ -1,4 +1,10 @@
-r"""The compressor with clearance in the crosshead guide ("crosshead knock").
+r"""The compressor with clearance in the crosshead guide ("crosshead knock"): the reference.
+
+An implementation of its own, kept as the independent check of the guide that the contact
+joints' kernels carry (``--model compressor-guide``, ``--set guide=clearance``, which run on
+them since the assembler; `tests/test_guide_component.py` compares the two): registered as
+``compressor-guide-reference``, with ideal pins, the paper's load, a table or the cycle, and a
+prescribed crank.
 
 The paper's mechanism (crank ``r`` driven at ``omega``, rod ``l`` with centroid at ``ls``, the
 gas load on the crosshead) with ideal pins, and a crosshead that is a body of its own between
@@ -35,10 +41,10 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..errors import ParameterError
-from .base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
-from .components.guide import GUIDE_PARAMS, tilt_inertia
-from .components.load import (
+from ...errors import ParameterError
+from ..base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, Event, ODESystem, Signal, compiled
+from ..components.guide import GUIDE_PARAMS, tilt_inertia
+from ..components.load import (
     cycle_force,
     cycle_outputs,
     cycle_summary,
@@ -46,15 +52,15 @@ from .components.load import (
     load_component,
     table_force,
 )
-from .joints._guide import guide_energy, guide_system
-from .joints.contact import (
+from ..joints._guide import guide_energy, guide_system
+from ..joints.contact import (
     FRICTION_ROLES,
     ambrosio_friction,
     delivered_restitution,
     hysteresis_factor,
     tanh_friction,
 )
-from .joints.guide import (
+from ..joints.guide import (
     N_HEAD,
     P_A,
     P_B,
@@ -70,11 +76,11 @@ from .joints.guide import (
     smallest_factor,
     solve_prescribed,
 )
-from .kinematics import ideal_mechanism
-from .load import CYCLE_PARAMS, mu_sincos
-from .parameters import SCHEMA as LINK_SCHEMA
-from .parameters import check_reach
-from .protocol import Model, Param, Schema
+from ..kinematics import ideal_mechanism
+from ..load import CYCLE_PARAMS, mu_sincos
+from ..parameters import SCHEMA as LINK_SCHEMA
+from ..parameters import check_reach
+from ..protocol import Model, Param, Schema
 
 __all__ = ["CompressorGuide", "COMPRESSOR_GUIDE", "ideal_crosshead"]
 
@@ -306,8 +312,9 @@ def ideal_crosshead(values: Mapping[str, Any], theta1: np.ndarray) -> dict[str, 
 class CompressorGuide(Model):
     """The compressor with clearance in the crosshead guide (crosshead knock)."""
 
-    name = "compressor-guide"
-    description = ("compressor with clearance in the crosshead guide: the crosshead moves "
+    name = "compressor-guide-reference"
+    description = ("compressor with clearance in the crosshead guide, its own kernel (the "
+                   "reference for compressor-guide): the crosshead moves "
                    "sideways and tilts between the shoes and knocks on them (Flores, Leine & "
                    "Glocker 2010 joint, compliant contact)")  # fmt: skip
     state_names = STATE_NAMES
@@ -321,14 +328,15 @@ class CompressorGuide(Model):
     #: With 0.2 mm of play and a tenth of the paper's load the crosshead knocks at every
     #: side-force reversal.
     event_example = {"guide_clearance": 2e-4, "load_amplitude": 2e4}
-    lyapunov_refusal = ("Benettin's method is not offered for compressor-guide: its tangent "
+    lyapunov_refusal = ("Benettin's method is not offered for compressor-guide-reference: its "
+                        "tangent "
                         "integration across the shoe impacts (the saltation matrices of the four "
                         "corners' event) has not been checked against differences of the flow, "
                         "as compressor-contact's has; use compressor-contact for exponents of a "
                         "worn machine")  # fmt: skip
 
     def check(self, values: Mapping[str, Any]) -> None:
-        from ..errors import ParameterError
+        from ...errors import ParameterError
 
         check_reach(values["l"], values["r"], 1e-3, "1 mm")
         dmax = values["l"] - values["r"] - 1e-3

@@ -1,0 +1,83 @@
+"""Benchmark (issue 43): the cost per revolution of N identical throws on one crankshaft
+against N times one throw, measured side by side in one run.
+
+Each case integrates the machine of N identical throws of the paper's compressor (the
+paper's load; in phase, or with ``--phases spread`` evenly spread over a turn), with a
+prescribed crank and with the induction motor, for ``--revolutions`` revolutions at the
+default tolerances, in alternating rounds in one process (CPU time, the best of the rounds).
+In phase, the throws take the steps one throw takes, and the ratio measures the cost of one
+right-hand side of N throws against N of one throw; spread, each throw's fast motion comes at
+its own time and the runs take more steps (printed). Target: at most 1.1.
+
+    python benchmarks/bench_throws.py [--throws 1 2 4] [--rounds 5] [--revolutions 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+
+def _machine(n: int, drive: str, spread: bool):
+    from recipdyn.model.assembler.model import MachineModel
+    from recipdyn.model.machine import Machine, Shaft, Throw
+
+    throws = tuple(Throw(f"throw{k + 1}",
+                         params=(("phase", 2 * math.pi * k / n if spread else 0.0),))
+                   for k in range(n))  # fmt: skip
+    return MachineModel(Machine(f"bench-{n}", shaft=Shaft(drive), throws=throws))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--throws", type=int, nargs="*", default=[1, 2, 4])
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--revolutions", type=float, default=1.0)
+    ap.add_argument(
+        "--phases",
+        choices=("same", "spread"),
+        default="same",
+        help="the throws in phase (the same steps as one throw) or spread evenly "
+        "over a turn (each throw's fast motion at its own time: more steps)",
+    )
+    args = ap.parse_args()
+
+    from recipdyn.integrate import integrate
+
+    for drive in ("prescribed", "motor"):
+        cases = {}
+        for n in args.throws:
+            m = _machine(n, drive, args.phases == "spread") if n > 1 else None
+            if m is None:  # one throw: the compressor itself (the same kernels as a file's)
+                from recipdyn.model.registry import get_model
+
+                m = get_model("compressor")
+                v = m.parameters({"drive": drive})
+            else:
+                v = m.parameters()
+            s = m.system(v)
+            y0 = m.initial_state(v)
+            period = m.period(v)
+            integrate(s, y0, (0.0, 0.01 * period))  # compiled before the timing
+            cases[n] = (s, y0, period)
+        best = dict.fromkeys(cases, math.inf)
+        steps = {}
+        for r in range(args.rounds):
+            order = list(cases) if r % 2 == 0 else list(cases)[::-1]
+            for n in order:
+                s, y0, period = cases[n]
+                t0 = time.process_time()
+                run = integrate(s, y0, (0.0, args.revolutions * period))
+                best[n] = min(best[n], (time.process_time() - t0) / args.revolutions)
+                steps[n] = run.nsteps / args.revolutions
+        one = best[min(cases)] / min(cases)
+        print(f"{drive}: CPU s per revolution (steps per revolution), ratio to N x one throw")
+        for n in cases:
+            print(f"  {n} throw(s): {best[n]:.4f} s ({steps[n]:.0f} steps)  ratio per step "
+                  f"{best[n] / steps[n] / (n * one / steps[min(cases)]):.2f}  ratio "
+                  f"{best[n] / (n * one):.2f}")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,727 @@
+r"""A machine as a [`Model`][recipdyn.model.protocol.Model]: what every layer above uses.
+
+`MachineModel` is a machine read from a file or built in Python (`recipdyn.model.machine`):
+its schema holds each part's parameters under the part's name (``throw2.rc``,
+``shaft.J_drive``, ``stage1.suction_pressure``), each with its unit, range and default (the
+file's value, else the compressor's); `system` assembles it (`.assemble`) and its records
+hold every throw's signals under the throw's name (``throw2.a``) and the crank's (``theta1``,
+``omega1``, ``energy``).
+
+`OneThrow` is the compressor of one throw with the massless link or an ideal crank pin, as
+``--model compressor`` (and ``compressor-valves``) take it: the compressor's names
+(``rc``, ``omega``) and selectors (``load``, ``drive``, ``motor``, ``equations``) choose the
+one throw's parts, so every record, config and sweep store made before the assembler still
+runs, with the same values. Both go through the same assembler and templates: one path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import fields as dataclass_fields
+from dataclasses import replace
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ...errors import ParameterError
+from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
+from ..mechanism.link import (
+    PHASE,
+    SIGN_CONVENTION,
+    equilibrium_theta_c,
+    mechanism_energy,
+    mechanism_outputs,
+)
+from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
+from ..protocol import Model, Param, Schema
+from ..registry import absolute_spec, is_spec
+from .assemble import Configuration, assemble, load_of, throw_values
+
+if TYPE_CHECKING:
+    from ..base import Event, Signal
+    from .system import AssembledSystem
+
+__all__ = [
+    "MachineModel",
+    "OneThrow",
+    "LINK",
+    "LINK_VALVES",  # noqa: F822 (built on first use, __getattr__)
+    "VALVES_SCHEMA",  # noqa: F822
+    "machine_schema",
+    "compressor_model",
+]
+
+_FIELDS = frozenset(f.name for f in dataclass_fields(CompressorParams))
+
+#: The compressor with dynamic valves: the massless link's parameters without the paper's
+#: load and equations, with the valves'.
+_DROP = {"load", "load_amplitude", "load_sign", "equations", "gas"}
+
+
+@lru_cache(maxsize=1)
+def _valves_schema() -> Schema:
+    """`VALVES_SCHEMA` (the valves' parameters live beside their compiled code: built when
+    first asked for, so a machine without valves is validated before numba loads)."""
+    from .. import valves as va
+
+    return Schema((*(p for p in SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
+                  aliases=dict(SCHEMA.aliases))  # fmt: skip
+
+
+#: The structure's keys, which a machine file gives as parts, not parameters.
+_SELECTORS = ("load", "drive", "motor", "equations")
+#: The cycle's parameters, which a throw with the paper's load does not have.
+_CYCLE_GROUP = "cycle"
+
+
+def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
+    """A throw's parameters under their local names: its configuration's (the compressor's
+    schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
+    adds its own) without the shaft's, the stages' and the selectors, with its ``phase``."""
+    if throw.load == "valves":
+        base = list(_valves_schema())
+    else:
+        base = [p for p in SCHEMA if not (throw.load != "cycle" and p.group == _CYCLE_GROUP)]
+        if throw.load != "paper":
+            base = [p for p in base if p.name not in ("load_amplitude", "load_sign")]
+        if is_spec(throw.load):
+            from ..components.contract import resolve_component
+            from ..components.load import LOADS
+
+            base += list(resolve_component("load", throw.load, LOADS).params)
+    skip = {*SHAFT_NAMES, *STAGE_NAMES, *_SELECTORS}
+    out = [p for p in base if p.name not in skip and p.group != "drive"]
+    if throw.crank_joint == "ideal":
+        out = [p for p in out if p.name != "rc"]
+    return (*out, PHASE)
+
+
+def _shaft_params(shaft: Shaft) -> tuple[Param, ...]:
+    from ..components.contract import resolve_component
+    from ..components.drive import MOTOR, MOTORS
+
+    out = [SCHEMA["omega"], SCHEMA["theta1_0"]]
+    if shaft.drive == "motor":
+        out += list(MOTOR.params) + list(resolve_component("motor", shaft.motor, MOTORS).params)
+    return tuple(out)
+
+
+def _with_default(p: Param, name: str, raw: Any) -> Param:
+    """``p`` under ``name`` with the default ``raw`` (a machine file's value, with units); a
+    derivation rule reads the names of its own namespace (`protocol.derive_value`), and a
+    value the file gives replaces it."""
+    from ...quantity import to_unit
+
+    q = replace(p, name=name)
+    if raw is None:
+        return q
+    value = str(raw) if p.choices is not None else to_unit(name, raw, p.unit)
+    return replace(q, default=q.check(value), derive="")  # (the file's value, not the rule's)
+
+
+def machine_schema(machine: Machine) -> Schema:
+    """The schema of a machine: each throw's parameters under its name, the shaft's under
+    ``shaft.``, each stage's under its name (one throw: the compressor's names); each default
+    the file's value, else the compressor's."""
+    params: list[Param] = []
+    extras: list[str] = []
+    for p in _shaft_params(machine.shaft):
+        params.append(_with_default(p, machine.prefix("shaft") + p.name,
+                                    machine.shaft.values.get(p.name)))  # fmt: skip
+    for st in machine.stages:
+        throws = [t for t in machine.throws if t.stage == st.name]
+        if any(t.load in ("cycle", "valves") for t in throws):
+            for name in STAGE_NAMES:
+                params.append(_with_default(SCHEMA[name], machine.prefix(st.name) + name,
+                                            st.values.get(name)))  # fmt: skip
+    for t in machine.throws:
+        given = t.values
+        own = _throw_params(t, machine.shaft)
+        known = {p.name for p in own} | {"load_table"}
+        for k in given:
+            if k not in known:
+                raise ParameterError(f"machine {machine.name!r}: {t.name}.{k} is not a parameter "
+                                     f"of a throw with load = {t.load!r}")  # fmt: skip
+        pre = machine.prefix(t.name)
+        params += [_with_default(p, pre + p.name, given.get(p.name)) for p in own]
+        if t.load == "table":
+            extras.append(pre + "load_table")
+    return Schema(tuple(params), extras=tuple(extras))
+
+
+def _prefixed_message(prefix: str, exc: ParameterError) -> ParameterError:
+    """A throw's refusal with its namespace: ``rc = ...`` becomes ``throw2.rc = ...``."""
+    return ParameterError(f"{prefix}{exc}" if prefix else str(exc))
+
+
+@lru_cache(maxsize=32)
+def _configuration(model_key, machine: Machine, items: tuple) -> Configuration:
+    return assemble(machine, dict(items))
+
+
+class MachineModel(Model):
+    """A machine of any number of throws (module docstring)."""
+
+    validity_bounds_instead = "the contact-impact joint (--model compressor-contact)"
+
+    def __init__(self, machine: Machine, schema: Schema | None = None) -> None:
+        self.machine = machine
+        self.name = machine.name
+        n = len(machine.throws)
+        self.description = machine.description or (
+            f"{n} throws on one crankshaft ({machine.shaft.drive} drive), massless links"
+        )
+        if machine.source:
+            self.spec = machine.source
+        self.schema = schema if schema is not None else machine_schema(machine)
+        pre = [machine.prefix(t.name) for t in machine.throws]
+        self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
+            ("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
+            ("a", "m/s**2")))  # fmt: skip
+        accel = next((s.signal for s in machine.sensors if s.kind == "accelerometer"), None)
+        self.vibration_signal = (accel or f"{pre[0]}a", "m/s**2")
+        self.section_pair = (f"{pre[0]}v", f"{pre[0]}a")
+        self.validity_bounds = tuple((
+            f"{q}contact_force", "N", 0.0,
+            "the massless link can only push: a negative joint contact force means the pin "
+            "would leave the bearing wall, where the permanent-contact model no longer holds",
+            self.validity_bounds_instead) for q in pre)  # fmt: skip
+        if any(t.load == "valves" for t in machine.throws):
+            self.lyapunov_refusal = (
+                "valve plates come to rest on their stops in resets with a singular saltation "
+                "matrix (Benettin's QR is undefined there); use the signal estimators or "
+                "load=cycle (ideal valves)"
+            )
+            self.event_example = {}
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The states at the defaults (assembled when first asked for: building the model
+        loads no compiled code, so a bad value is refused before numba loads)."""
+        return tuple(n for n, _ in self._default_states())
+
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        return tuple(u for _, u in self._default_states())
+
+    def _default_states(self) -> tuple[tuple[str, str], ...]:
+        if "_states0" not in self.__dict__:
+            self.__dict__["_states0"] = self.states(self.parameters())
+        return self.__dict__["_states0"]
+
+    # -- what the values choose --------------------------------------------------------
+    def structure(self, values: Mapping[str, Any]) -> Machine:
+        """The machine at ``values`` (fixed for a machine file)."""
+        return self.machine
+
+    def throws(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
+        """Each throw's values under the compressor's names (`.assemble.throw_values`)."""
+        m = self.structure(values)
+        return [throw_values(m, values, k) for k in range(len(m.throws))]
+
+    @staticmethod
+    def throw_params(local: Mapping[str, Any]) -> CompressorParams:
+        """A throw's [`CompressorParams`][recipdyn.model.parameters.CompressorParams] (its
+        geometry, masses, load and the shaft's speed; checks across its parameters)."""
+        kw = {k: v for k, v in local.items() if k in _FIELDS}
+        if local.get("load") == "valves":
+            kw = {k: v for k, v in kw.items() if k not in ("gas", "load")}
+            kw["load"] = "cycle"
+        elif is_spec(local.get("load")) or local.get("load") == "table":
+            kw.pop("load", None)
+        return CompressorParams(**kw)
+
+    def plugged(self, local: Mapping[str, Any]) -> dict[str, Any]:
+        """A throw's values of components from a user's file (their own fragments)."""
+        if not any(is_spec(local.get(f)) for f in PLUGGABLE):
+            return {}
+        return {k: v for k, v in local.items() if k not in _FIELDS and k != "phase"}
+
+    def configuration(self, values: Mapping[str, Any]) -> Configuration:
+        """The machine assembled at validated ``values`` (remembered per values: a streamed
+        run asks per block)."""
+        machine = self.structure(values)
+        items = tuple(sorted(values.items()))
+        try:
+            hash(items)
+        except TypeError:  # an unhashable value (a table as lists): assembled each time
+            return assemble(machine, dict(values))
+        return _configuration(id(type(self)), machine, items)
+
+    # -- parameters ----------------------------------------------------------------------
+    def _file_extras(self) -> dict[str, Any]:
+        """The values a machine file gives beside the schema: a throw's ``load_table`` (rows,
+        or a CSV file relative to the machine file), as ``throwK.load_table``."""
+        from pathlib import Path
+
+        out = {}
+        for t in self.machine.throws:
+            table = t.values.get("load_table")
+            if isinstance(table, str):
+                from ..load import read_load_table
+
+                path = Path(table)
+                if not path.is_absolute() and self.machine.source:
+                    path = Path(self.machine.source).parent / path
+                table = read_load_table(path)
+            if table is not None:
+                out[self.machine.prefix(t.name) + "load_table"] = tuple(
+                    tuple(map(float, r)) for r in table)  # fmt: skip
+        return out
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        """Validated values: the machine file's (its tables too), updated with ``values``."""
+        if values is not None and not isinstance(values, Mapping):
+            return super().parameters(values, **kw)
+        return super().parameters({**self._file_extras(), **(values or {}), **kw})
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        """Each throw's checks across its parameters (rs <= r, rc < r, |d| < l - r - rc, the
+        motor's slip), refused with the throw's namespace."""
+        machine = self.structure(values)
+        for t, local in zip(machine.throws, self.throws(values), strict=True):
+            try:
+                self.throw_params(local)
+                if is_spec(local.get("load")):  # a user's component's own checks
+                    load = load_of(local)
+                    if load.check is not None:
+                        load.check(local)
+            except ParameterError as exc:
+                raise _prefixed_message(machine.prefix(t.name), exc) from None
+
+    def period(self, values: Mapping[str, Any]) -> float:
+        """The crank period at ``omega``: the forcing period with a prescribed crank, the
+        nominal one with a motor (runs and sweeps count revolutions in it; the system itself
+        is autonomous then, its ``period`` None)."""
+        return 2.0 * math.pi / float(self._shaft(values, "omega"))
+
+    def _shaft(self, values: Mapping[str, Any], name: str) -> Any:
+        return values[f"{self.structure(values).prefix('shaft')}{name}"]
+
+    def section_angle(self, values: Mapping[str, Any]) -> str | None:
+        """``theta1`` with a motor (a state: the section once per turn of the crank)."""
+        return "theta1" if self.structure(values).shaft.drive == "motor" else None
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        return self.structure(values).shaft.drive == "motor" or any(
+            float(v["rc"]) > 0.0 for v in self.throws(values)
+        )
+
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        """The link's bound (it can only push) needs a link: rc > 0 at some throw."""
+        return any(float(v["rc"]) > 0.0 for v in self.throws(values))
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        return not any(t.load == "valves" for t in self.structure(values).throws)
+
+    # -- the system ----------------------------------------------------------------------
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        return self.configuration(values).layout.state.named()
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        from ..base import Event
+
+        c = self.configuration(values)
+        if not c.has_states:
+            return ()
+        return (Event("impact", c.kernels.event, direction=-1, action="reset",
+                      reset=c.kernels.reset, description="a valve plate reaches its seat or "
+                      "guard: rebound with the restitution, or rest"),)  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> AssembledSystem:
+        from .system import AssembledSystem, Frozen
+
+        c = self.configuration(values)
+        machine = c.machine
+        motor = c.motor is not None
+        exact = machine.throws[0].equations == "exact"
+        names, units = zip(*c.layout.state.named(), strict=True)
+        return AssembledSystem(
+            rhs=c.kernels.rhs,
+            jac=c.kernels.jac,
+            rhs_jac=c.kernels.rhs_jac if not (motor or c.has_states) and exact else None,
+            params=c.params,
+            state_names=names,
+            state_units=units,
+            period=None if motor else self.period(values),
+            name=self.system_name(values),
+            attrs=self.system_attrs(values),
+            events=self.events(values),
+            aux_states=c.aux_states,
+            passive=c.passive(self.throws(values)),
+            model=self,
+            values=Frozen(values),
+        )
+
+    def system_name(self, values: Mapping[str, Any]) -> str:
+        return self.name
+
+    def system_attrs(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return dict(values)
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Per throw: the link aligned with its rod load at its crank angle (static
+        equilibrium) plus ``theta_c_offset``, or ``theta_c0``, at rest; the crank at
+        ``theta1_0`` turning at ``omega`` (a motor), works 0; a load's states at the throw's
+        crank angle (the dynamic valves: the ideal cycle's pressures, plates closed), its
+        counters 0."""
+        from .. import valves as va
+
+        c = self.configuration(values)
+        st = c.layout.state
+        y = np.zeros(st.size)
+        for t, local in zip(c.machine.throws, self.throws(values), strict=True):
+            p = self.throw_params(local)
+            phase = float(local["phase"])
+            s = st.start(f"{t.name}.mechanism")
+            if p.theta_c0 is not None:
+                thc = p.theta_c0
+            else:
+                thc = equilibrium_theta_c(p, extra=self.plugged(local), phase=phase)
+            y[s], y[s + 1] = thc + p.theta_c_offset, p.thetadot_c0
+            load = c.loads[0]
+            if load.states:
+                g = st.start(f"{t.name}.load")
+                if load.name == "valves":
+                    cyc = c.params[c.layout.params[f"{t.name}.load"]][: _n_cycle()]
+                    y[g : g + len(load.states)] = va.gas_initial(local, cyc, p.theta1_0 + phase)
+                else:
+                    init = np.asarray(load.initial(local), dtype=float)
+                    y[g : g + len(load.states)] = init[: len(load.states)]
+                    a = st.start(f"{t.name}.load_aux")
+                    y[a : a + len(load.aux_states)] = init[len(load.states) :]
+        if c.motor is not None:
+            y[st["theta1"]] = float(self._shaft(values, "theta1_0"))
+            y[st["omega1"]] = float(self._shaft(values, "omega"))
+        return y
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """``max(1, |y0|)``; a load's states at their own size (the valves':
+        [`gas_scale`][recipdyn.model.valves.gas_scale])."""
+        from .. import valves as va
+
+        c = self.configuration(values)
+        y0 = self.initial_state(values)
+        out = np.maximum(1.0, np.abs(y0))
+        if c.loads[0].name == "valves":
+            for t, local in zip(c.machine.throws, self.throws(values), strict=True):
+                out = va.gas_scale(local, y0, c.layout.state.start(f"{t.name}.load"),
+                                   c.layout.state.start(f"{t.name}.load_aux"), out)  # fmt: skip
+        return out
+
+    # -- outputs -------------------------------------------------------------------------
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """Per throw: its crosshead's motion, rod angle, clearance state, gas force, joint and
+        guide forces, and its cylinder's signals (the cycle's pressures and volumes; the
+        valves' pressures, volumes, temperatures and mass flows), under its name; with a motor
+        the crank's speed and acceleration, the motor's torque and work, each throw's gas work
+        and the machine's energy. The crank angle, speed and gas forces come from the
+        compiled observer: the functions that were integrated."""
+        from .. import valves as va
+        from ..base import Signal, rhs_series
+        from ..components.load import cycle_outputs
+        from ..kinematics import kinematics
+
+        c = self.configuration(values)
+        st, ov = c.layout.state, c.layout.outputs
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        dy = rhs_series(c.kernels.rhs, c.params, t, y)
+        obs = c.kernels.observe(t, y, c.params)
+        w1 = obs[:, ov["omega1"]]
+        motor = c.motor is not None
+        a1 = dy[:, st["omega1"]] if motor else None
+        out: dict[str, Signal] = {}
+        energy = np.zeros(t.shape[0])
+        for k, (th, local) in enumerate(zip(c.machine.throws, self.throws(values), strict=True)):
+            pre = c.machine.prefix(th.name)
+            p = self.throw_params(local)
+            s = st.start(f"{th.name}.mechanism")
+            thc, thcd, thcdd = y[:, s], y[:, s + 1], dy[:, s + 1]
+            th1 = obs[:, ov[f"{th.name}.theta1"]]
+            fg = obs[:, ov[f"{th.name}.gas_force"]]
+            kin = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=w1, alpha1=a1)
+            own = mechanism_outputs(p, kin, thc, thcd, thcdd, fg)
+            own["crank_torque"] = Signal(
+                obs[:, ov[f"{th.name}.crank_torque"]],
+                "N*m",
+                "torque the shaft applies to this throw's crank",
+            )
+            if c.loads[0].name == "valves":
+                g, a = st.start(f"{th.name}.load"), st.start(f"{th.name}.load_aux")
+                cyc = c.params[c.layout.params[f"{th.name}.load"]][: _n_cycle()]
+                own.update(va.gas_outputs(local, kin.x3, y, dy, g, a, cyc))
+            else:
+                own.update(cycle_outputs(local, th1))
+            if motor:
+                wk = st.start(f"{th.name}.work")
+                own["W_gas"] = Signal(
+                    y[:, wk], "J", "work done by the gas on the crosshead since t = 0"
+                )
+                own_energy = mechanism_energy(p, th1, thc, w1, thcd)
+                if not c.machine.flat:
+                    own["energy"] = Signal(own_energy, "J", "kinetic + potential energy of this "
+                                           "throw's crank, rod and crosshead")  # fmt: skip
+                    energy += own_energy + 0.5 * p.J_drive * w1 * w1 if k == 0 else own_energy
+                else:  # (the drive's inertia in the same expression, as before the assembler)
+                    energy += mechanism_energy(p, th1, thc, w1, thcd, p.J_drive)
+            if not c.machine.flat:
+                own["theta1"] = Signal(th1, "rad", "crank angle of this throw (phase included)")
+            out.update({pre + name: sig for name, sig in own.items()})
+        if motor:
+            out.update({
+                "omega1": Signal(w1, "rad/s", "crank speed"),
+                "alpha1": Signal(a1, "rad/s**2", "crank angular acceleration"),
+                "motor_torque": Signal(dy[:, st["W_motor"]] / w1, "N*m",
+                                       "motor torque at the crank"),
+                "W_motor": Signal(y[:, st["W_motor"]], "J", "work done by the motor since t = 0"),
+                "energy": Signal(energy, "J", "kinetic + potential energy of the mechanism and "
+                                 "the drive"),
+            })  # fmt: skip
+        if not c.machine.flat:
+            out["theta1"] = Signal(obs[:, ov["theta1"]], "rad", "crank angle of the shaft")
+        return out
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """Per throw, its cylinder's figures (`_throw_summary`) under its name."""
+        machine = self.structure(values)
+        if machine.flat:
+            return self._throw_summary(self.throws(values)[0], ds)
+        out: dict[str, Any] = {}
+        for t, local in zip(machine.throws, self.throws(values), strict=True):
+            pre = f"{t.name}."
+            view = ds[[k for k in ds.data_vars if str(k).startswith(pre)]]
+            view = view.rename({k: str(k)[len(pre) :] for k in view.data_vars})
+            view = view.assign_attrs(ds.attrs)
+            for k, v in self._throw_summary(local, view).items():
+                out[pre + k] = v
+        return out
+
+    @staticmethod
+    def _throw_summary(local: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """A throw's figures: with the cycle, the API 618 pin-load reversal and the indicated
+        power and volumetric efficiencies; with the dynamic valves, theirs too."""
+        from .. import valves as va
+        from ..components.load import cycle_summary
+
+        if local.get("load") == "valves":
+            return va.valve_summary(local, ds)
+        return cycle_summary(local, ds)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        out = super().record_attrs(values, y0)
+        out.update({"sign_convention": SIGN_CONVENTION,
+                    "throws": len(self.structure(values).throws)})  # fmt: skip
+        return out
+
+
+def _n_cycle() -> int:
+    from ..cycle import N_CYCLE
+
+    return N_CYCLE
+
+
+# -- the compressor of one throw: the compressor's names and selectors ----------------------
+
+
+_PLUGGED: dict[tuple[int, tuple], Schema] = {}
+
+
+def _plugged_schema(base: Schema, chosen: tuple[tuple[str, str], ...]) -> Schema:
+    """``base`` with the components ``(family, spec)`` from users' files: each spec one more
+    choice of its family's parameter, each fragment appended (a name may belong to one
+    component only). Remembered per base schema and choice."""
+    key = (id(base), chosen)
+    if key not in _PLUGGED:
+        _PLUGGED[key] = _plug(base, chosen)
+    return _PLUGGED[key]
+
+
+def _plug(base: Schema, chosen: tuple[tuple[str, str], ...]) -> Schema:
+    from ..components.contract import check_fragments, resolve_component
+    from ..components.drive import MOTORS
+    from ..components.load import LOADS
+
+    builtin = {"load": LOADS, "motor": MOTORS}
+    comps = [resolve_component(f, spec, builtin[f]) for f, spec in chosen]
+    check_fragments(comps, base=base.params)
+    specs = dict(chosen)
+    params = tuple(replace(p, choices=(*p.choices, specs[p.name])) if p.name in specs else p
+                   for p in base)  # fmt: skip
+    return Schema(params + tuple(q for c in comps for q in c.params), aliases=base.aliases,
+                  extras=base.extras)  # fmt: skip
+
+
+class OneThrow(MachineModel):
+    """The compressor of one throw with the massless link (or an ideal pin, rc = 0): the
+    machine its selectors choose (module docstring)."""
+
+    def __init__(self, name: str, description: str, schema: Schema, valves: bool = False,
+                 instead: str = "the contact-impact joint (--model compressor-contact)"
+                 ) -> None:  # fmt: skip
+        self.valves = valves
+        self.validity_bounds_instead = instead
+        super().__init__(Machine(name=name, description=description), schema=schema)
+        self.section_signals = (("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"),
+                                ("v", "m/s"), ("a", "m/s**2"))  # fmt: skip
+        self.vibration_signal = ("a", "m/s**2")
+        self.section_pair = ("v", "a")
+        if valves:
+            self.lyapunov_refusal = (
+                "valve plates come to rest on their stops in resets with a singular saltation "
+                "matrix (Benettin's QR is undefined there); use the signal estimators or "
+                "--model compressor with load=cycle (ideal valves)"
+            )
+        else:
+            self.summary_verdicts = ("api618_pin_reversal",)
+
+    def structure(self, values: Mapping[str, Any]) -> Machine:
+        load = "valves" if self.valves else values.get("load", "paper")
+        throw = Throw(load=load, equations=values.get("equations", "exact"))
+        shaft = Shaft(drive=values.get("drive", "prescribed"),
+                      motor=values.get("motor", "induction"))  # fmt: skip
+        return _one_throw(self.machine.name, self.machine.description, throw, shaft)
+
+    def system_name(self, values: Mapping[str, Any]) -> str:
+        if self.valves:
+            return self.name
+        return f"compressor-{values.get('equations', 'exact')}"
+
+    def system_attrs(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return self.params(values).to_attrs()
+
+    @classmethod
+    def params(cls, values: Mapping[str, Any]) -> CompressorParams:
+        """The [`CompressorParams`][recipdyn.model.parameters.CompressorParams] view of
+        ``values`` (the values of components from a user's file left out)."""
+        if values.get("load") is None and "valve_lift" in values:
+            return cls.throw_params({**values, "load": "valves"})
+        return CompressorParams(**{k: v for k, v in values.items() if k in _FIELDS})
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        return not self.valves
+
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        """The compressor's schema, or with a load or a torque law from a user's module or
+        file (``load = "file.py:OBJ"``) that component's fragment added."""
+        chosen = tuple((f, absolute_spec(values[f])) for f in PLUGGABLE if is_spec(values.get(f)))
+        return _plugged_schema(self.schema, chosen) if chosen else self.schema
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        """Validated values; a component spec (``file.py:OBJ``) is made absolute, so records
+        and worker processes find its file from any folder."""
+        if values is not None and not isinstance(values, Mapping):
+            values = super().parameters(values)  # a CompressorParams, valid as a whole
+        raw = {**(values or {}), **kw}
+        for f in PLUGGABLE:
+            if is_spec(raw.get(f)):
+                raw[f] = absolute_spec(raw[f])
+        return super().parameters(raw)
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        from ..components.contract import resolve_component
+
+        self.params(values) if not self.valves else self.throw_params(
+            {**values, "load": "valves"}
+        )  # the ranges that depend on other parameters
+        for f in PLUGGABLE:  # a user's component's own checks
+            if is_spec(values.get(f)):
+                c = resolve_component(f, values[f], {})
+                if c.states or c.aux_states:  # (no initial states are declared for them)
+                    raise ParameterError(f"{f} = {values[f]!r} has states: a {f} of your own "
+                                         "with states runs at a contact or lubricated pin or in "
+                                         "the worn guide; allowed on the massless link and ideal "
+                                         f"pins: a {f} of your own without states, or load = "
+                                         "'valves'")  # fmt: skip
+                if c.check is not None:
+                    c.check(values)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        """Every model's record attributes, the axes and signs, the paper, the crank
+        frequency, the initial clearance angle and how it was chosen, and what the parameter
+        view adds (the load's description, its table, the list of assumptions)."""
+        p = self.params(values)
+        out = Model.record_attrs(self, values, y0)
+        out.update({
+            "sign_convention": SIGN_CONVENTION,
+            "reference": "Xiao et al. (2017), J. Vibroengineering 19(7), "
+                         "doi:10.21595/jve.2017.18771",
+            "crank_frequency_hz": p.crank_frequency,
+        })  # fmt: skip
+        if y0 is not None:
+            out["theta_c_initial"] = float(y0[0])
+            out["thetadot_c_initial"] = float(y0[1])
+            out["theta_c_initial_rule"] = (
+                "user-set theta_c0" if p.theta_c0 is not None else
+                "link aligned with the rod load at t=0 (static equilibrium) + theta_c_offset"
+            )  # fmt: skip
+        for k, v in p.to_attrs().items():
+            out.setdefault(f"param_{k}", v)
+        return out
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        """The values a record holds, its load table included."""
+        chosen = {f: attrs[f"param_{f}"] for f in PLUGGABLE if f"param_{f}" in attrs}
+        values = self.schema_for(chosen).from_attrs(attrs)
+        flat = attrs.get("param_load_table_deg_N")
+        if flat is not None and "load_table" in self.schema.extras:
+            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
+            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
+        self.check(values)
+        return values
+
+
+@lru_cache(maxsize=64)
+def _one_throw(name: str, description: str, throw: Throw, shaft: Shaft) -> Machine:
+    return Machine(name=name, description=description, shaft=shaft, throws=(throw,))
+
+
+#: ``--model compressor``'s massless link and ideal pin (`recipdyn.model.family`, route
+#: ``link``): the paper's load, a table, the ideal cycle or a load of a user's file.
+LINK = OneThrow(
+    "compressor",
+    "single-cylinder reciprocating compressor, massless-link clearance at the crank pin and "
+    "crosshead subsidence (Xiao et al. 2017)",
+    SCHEMA,
+)
+
+
+def _link_valves() -> OneThrow:
+    """The same mechanism with the cylinder gas and dynamic plate valves as states (route
+    ``link-valves``, the preset ``compressor-valves``), built when first asked for."""
+    return OneThrow(
+        "compressor-valves",
+        "the compressor (massless-link clearance) driven by the compression cycle with dynamic "
+        "plate valves: cylinder pressures and valves as states",
+        _valves_schema(),
+        valves=True,
+        instead="the contact-impact joint with dynamic valves (--model compressor-contact-valves)",
+    )
+
+
+def __getattr__(name: str):
+    if name == "VALVES_SCHEMA":
+        return _valves_schema()
+    if name == "LINK_VALVES":
+        globals()[name] = _link_valves()
+        return globals()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def compressor_model(p: CompressorParams | None = None,
+                     extra: Mapping[str, Any] | None = None) -> AssembledSystem:  # fmt: skip
+    """The one-throw compressor's system for ``p`` (default: the paper's base case),
+    assembled (`.assemble`); ``extra``: the parameter values of components from a user's
+    file."""
+    p = CompressorParams() if p is None else p
+    if not isinstance(p, CompressorParams):
+        raise ParameterError(f"expected CompressorParams, got {type(p).__name__}")
+    values = {f.name: getattr(p, f.name) for f in dataclass_fields(CompressorParams)}
+    return LINK.system(LINK.parameters({**values, **(extra or {})}))

@@ -1,0 +1,184 @@
+"""Template of a machine's kernels with the crank free, driven by a motor.
+
+Written per configuration like `prescribed` (the module docstring there): this file verbatim,
+the block between the ``<bindings>`` markers replaced by the configuration's names and
+constants. As it stands the block binds the reference configuration: one throw of the paper's
+compressor on the induction motor.
+
+The crank angle and speed are states (``y[CRANK]``, ``y[CRANK + 1]``), the motor's work
+``y[CRANK + 2]``, and each throw's gas work ``y[THROW_WORK[k]]``. The throws share the crank:
+each one's equations ``M (theta1'', theta_c'') = b`` give its clearance angle's
+acceleration affine in the crank's, ``theta_c'' = c - k theta1''``, and with it the throw's
+share ``(I, Q)`` of the crank's equation (``free_contribution``), so the crank's acceleration
+is ``theta1'' = (T_m + sum Q) / (J_drive + sum I)`` without a derivation of the whole machine.
+
+Roles: ``torque(omega1, p, o)`` (the motor's torque law), ``free_contribution(th1, thc, w,
+thcd, F, p, m) -> (I, Q, k, c)``, ``crosshead``, ``crank_torque``, and the loads' roles as in
+`prescribed`.
+Constants: ``CRANK``, ``SHAFT`` (the offset of ``J_drive``), ``MOTOR`` (the torque law's
+slice), ``THROW_WORK``, ``STEP_KIND`` (per state: how the Jacobian's central differences
+step it: ``0`` an angle, absolute 1e-4; ``1`` a rate, 1e-4 max(1, |y|); ``2`` a load's
+state, 1e-7 max(|y|, 1e-3); ``3`` a column left 0, a work integral or a counter nothing
+depends on), and the throws' and loads' as in `prescribed`.
+"""
+
+import numba as nb
+import numpy as np
+
+from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, compiled
+
+# isort: split
+# <bindings>
+from recipdyn.model.assembler.generate import absent as load_event
+from recipdyn.model.assembler.generate import absent as load_reset
+from recipdyn.model.assembler.generate import absent as load_rhs
+from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.components.drive_kernels import induction_torque as torque
+from recipdyn.model.components.load import paper_force as load_force
+from recipdyn.model.mechanism.link_kernels import crank_torque, crosshead, free_contribution
+
+LOAD_STATES = False
+N_THROWS = np.int64(1)
+CRANK = np.int64(2)
+SHAFT = np.int64(0)
+MOTOR = np.int64(1)
+THROW_STATE = np.array([0], dtype=np.int64)
+THROW_WORK = np.array([5], dtype=np.int64)
+THROW_MECH = np.array([4], dtype=np.int64)
+THROW_PHASE = np.array([16], dtype=np.int64)
+THROW_LOAD = np.array([17], dtype=np.int64)
+LOAD_STATE = np.array([6], dtype=np.int64)
+LOAD_AUX = np.array([6], dtype=np.int64)
+STEP_KIND = np.array([0, 1, 0, 1, 3, 3], dtype=np.int64)
+N_OBS = np.int64(5)
+OBS_THROW = np.array([2], dtype=np.int64)
+# </bindings>
+
+
+@nb.njit(cache=True)
+def _force(th1, y, p, k):
+    """Throw ``k``'s gas force on its crosshead along +x."""
+    if LOAD_STATES:
+        return load_state_force(y, LOAD_STATE[k], p, THROW_LOAD[k])
+    return load_force(th1, p, THROW_LOAD[k])
+
+
+@nb.njit(cache=True)
+def _rhs(t, y, p, out):
+    th1 = y[CRANK]
+    w1 = y[CRANK + 1]
+    Tm = torque(w1, p, MOTOR)
+    inertia = p[SHAFT]
+    load = Tm
+    for k in range(N_THROWS):  # each throw's share of the crank's equation
+        s, m = THROW_STATE[k], THROW_MECH[k]
+        thk = th1 + p[THROW_PHASE[k]]
+        F = _force(thk, y, p, k)
+        inertia_k, load_k, out[s], out[s + 1] = free_contribution(thk, y[s], w1, y[s + 1], F,
+                                                                  p, m)  # fmt: skip
+        inertia += inertia_k
+        load += load_k
+        out[THROW_WORK[k]] = F  # (held here until the crosshead's speed is known)
+    a1 = load / inertia
+    out[CRANK] = w1
+    out[CRANK + 1] = a1
+    out[CRANK + 2] = Tm * w1
+    for k in range(N_THROWS):  # each throw's own accelerations, its gas work, its load
+        s, m = THROW_STATE[k], THROW_MECH[k]
+        thk = th1 + p[THROW_PHASE[k]]
+        out[s + 1] = out[s + 1] - out[s] * a1
+        out[s] = y[s + 1]
+        x, v = crosshead(thk, y[s], w1, y[s + 1], p, m)
+        out[THROW_WORK[k]] = out[THROW_WORK[k]] * v
+        if LOAD_STATES:
+            load_rhs(x, v, y, LOAD_STATE[k], LOAD_AUX[k], p, THROW_LOAD[k], out)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac(t, y, p, J):
+    """Central differences with one Richardson step, (4 D(h/2) - D(h)) / 3: truncation
+    O(h**4), rounding ~eps |f| / h, with each state's step by its kind (``STEP_KIND``): with
+    |f| ~ 1e6 (theta_c'') rounding ~2e-6 and truncation ~1e-10 for the angles and rates; a
+    load's states step by 1e-7 of their size (its stops and regularised nozzles are not
+    smooth everywhere). The work integrals' and counters' columns are 0 (nothing depends on
+    them)."""
+    n = y.shape[0]
+    fp = np.empty(n)
+    fm = np.empty(n)
+    d1 = np.empty(n)
+    yy = y.copy()
+    for k in range(n):
+        kind = STEP_KIND[k]
+        if kind == 3:
+            for i in range(n):
+                J[i, k] = 0.0
+            continue
+        if kind == 0:
+            h = 1e-4
+        elif kind == 1:
+            h = 1e-4 * max(1.0, abs(y[k]))
+        else:
+            h = 1e-7 * max(abs(y[k]), 1e-3)
+        for level in range(2):
+            hk = h if level == 0 else 0.5 * h
+            yy[k] = y[k] + hk
+            _rhs(t, yy, p, fp)
+            yy[k] = y[k] - hk
+            _rhs(t, yy, p, fm)
+            yy[k] = y[k]
+            for i in range(n):
+                dk = (fp[i] - fm[i]) / (2.0 * hk)
+                if level == 0:
+                    d1[i] = dk
+                else:
+                    J[i, k] = (4.0 * dk - d1[i]) / 3.0
+
+
+@compiled(EVENT_SIGNATURE)
+def event(t, y, p):
+    """The smallest of the throws' load event factors (each positive between its events)."""
+    low = np.inf
+    for k in range(N_THROWS):
+        low = min(low, load_event(y, LOAD_STATE[k], p, THROW_LOAD[k]))
+    return low
+
+
+@compiled(RHS_SIGNATURE)
+def reset(t, y, p, out):
+    """The reset of the throw whose load's event factor is the smallest (at the event)."""
+    best, low = 0, np.inf
+    for k in range(N_THROWS):
+        e = load_event(y, LOAD_STATE[k], p, THROW_LOAD[k])
+        if e < low:
+            best, low = k, e
+    load_reset(y, LOAD_STATE[best], p, THROW_LOAD[best], out)
+
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    """The crank's angle and speed (columns 0, 1), then per throw its crank angle, its gas
+    force and the torque the shaft applies to its crank (columns ``OBS_THROW[k]`` to ``+
+    2``), by the functions that were integrated."""
+    out = np.empty((t.shape[0], N_OBS))
+    f = np.empty(y.shape[1])
+    for i in range(t.shape[0]):
+        yi = y[i]
+        _rhs(t[i], yi, p, f)
+        th1 = yi[CRANK]
+        w1 = yi[CRANK + 1]
+        out[i, 0] = th1
+        out[i, 1] = w1
+        for k in range(N_THROWS):
+            s, m, c = THROW_STATE[k], THROW_MECH[k], OBS_THROW[k]
+            thk = th1 + p[THROW_PHASE[k]]
+            F = _force(thk, yi, p, k)
+            out[i, c] = thk
+            out[i, c + 1] = F
+            out[i, c + 2] = crank_torque(thk, yi[s], w1, yi[s + 1], f[s + 1], f[CRANK + 1], F,
+                                         p, m)  # fmt: skip
+    return out

@@ -1,0 +1,213 @@
+"""Template of a machine's kernels with the crank turning at a prescribed speed.
+
+The assembler (`recipdyn.model.assembler.generate`) writes one module per configuration: this
+file verbatim, with the block between the ``<bindings>`` markers replaced by the
+configuration's own block of the same form — which component function plays each role
+(imports) and the constants of its layout (offsets, counts). As it stands, the block binds the
+reference configuration (one throw of the paper's compressor: the paper's load, the exact
+equation), so this file is itself a valid module, linted and importable like any other.
+
+Roles (each a compiled function of a component, called, not inlined):
+
+* ``crank(t, y, p, o) -> (theta1, omega1)``: the shaft's crank angle and speed;
+* ``throw_acc(th1, thc, thcd, F, w, p, m)``, ``throw_acc_jac(...)``: a throw's clearance
+  angle acceleration (and its partial derivatives) at its crank angle ``th1``;
+* ``crosshead(th1, thc, w, thcd, p, m) -> (x3, x3')``;
+* ``crank_torque(th1, thc, w, thcd, thcdd, a1, F, p, m)``: the torque the shaft applies to a
+  throw's crank (recorded per throw);
+* ``load_force(th1, p, o)`` (a load without states), or ``load_state_force(y, g, p, o)``,
+  ``load_rhs(x3, x3', y, g, a, p, o, out)``, ``load_event(y, g, p, o)``,
+  ``load_reset(y, g, p, o, out)`` (a load with states; ``LOAD_STATES``). The roles a
+  configuration lacks are bound to `recipdyn.model.assembler.generate.absent`, in branches
+  numba removes before typing (``LOAD_STATES`` is a constant).
+
+Constants: ``N_THROWS``; per throw ``k`` the index of its first state ``THROW_STATE[k]`` and
+the offsets of its mechanism, phase and load slices (``THROW_MECH``, ``THROW_PHASE``,
+``THROW_LOAD``); its load's first state and first auxiliary state (``LOAD_STATE``,
+``LOAD_AUX``), their counts (``LOAD_N``, ``LOAD_NAUX``) and the offset of its load's
+difference steps (``LOAD_STEPS``: per state a relative and an absolute part); ``SHAFT``, the
+offset of the drive's slice; ``N_OBS`` and ``OBS_THROW[k]``, the observer's columns.
+"""
+
+import numba as nb
+import numpy as np
+
+from recipdyn.model.base import (
+    EVENT_SIGNATURE,
+    JAC_SIGNATURE,
+    RHS_JAC_SIGNATURE,
+    RHS_SIGNATURE,
+    compiled,
+)
+
+# isort: split
+# <bindings>
+from recipdyn.model.assembler.generate import absent as load_event
+from recipdyn.model.assembler.generate import absent as load_reset
+from recipdyn.model.assembler.generate import absent as load_rhs
+from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.components.drive_kernels import prescribed_crank as crank
+from recipdyn.model.components.load import paper_force as load_force
+from recipdyn.model.mechanism.link_kernels import acceleration as throw_acc
+from recipdyn.model.mechanism.link_kernels import acceleration_jac as throw_acc_jac
+from recipdyn.model.mechanism.link_kernels import crank_torque, crosshead
+
+LOAD_STATES = False
+N_THROWS = np.int64(1)
+SHAFT = np.int64(0)
+THROW_STATE = np.array([0], dtype=np.int64)
+THROW_MECH = np.array([2], dtype=np.int64)
+THROW_PHASE = np.array([14], dtype=np.int64)
+THROW_LOAD = np.array([15], dtype=np.int64)
+LOAD_STATE = np.array([2], dtype=np.int64)
+LOAD_AUX = np.array([2], dtype=np.int64)
+LOAD_N = np.array([0], dtype=np.int64)
+LOAD_NAUX = np.array([0], dtype=np.int64)
+LOAD_STEPS = np.array([15], dtype=np.int64)
+N_OBS = np.int64(5)
+OBS_THROW = np.array([2], dtype=np.int64)
+# </bindings>
+
+
+@nb.njit(cache=True)
+def _force(th1, y, p, k):
+    """Throw ``k``'s gas force on its crosshead along +x."""
+    if LOAD_STATES:
+        return load_state_force(y, LOAD_STATE[k], p, THROW_LOAD[k])
+    return load_force(th1, p, THROW_LOAD[k])
+
+
+@nb.njit(cache=True)
+def _throw(th1, w, y, p, k, out):
+    """Throw ``k``'s derivatives: its clearance angle's, then its load's states'."""
+    s, m = THROW_STATE[k], THROW_MECH[k]
+    thk = th1 + p[THROW_PHASE[k]]
+    out[s] = y[s + 1]
+    if LOAD_STATES:
+        x, v = crosshead(thk, y[s], w, y[s + 1], p, m)
+        load_rhs(x, v, y, LOAD_STATE[k], LOAD_AUX[k], p, THROW_LOAD[k], out)
+    out[s + 1] = throw_acc(thk, y[s], y[s + 1], _force(thk, y, p, k), w, p, m)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    th1, w = crank(t, y, p, SHAFT)
+    for k in range(N_THROWS):
+        _throw(th1, w, y, p, k, out)
+
+
+@nb.njit(cache=True)
+def _throw_jac(th1, w, y, p, k, out, J):
+    """Throw ``k``'s derivatives and the exact partial derivatives of its clearance angle's
+    (a load without states: the throws are independent, the rest of ``J`` is 0)."""
+    s, m = THROW_STATE[k], THROW_MECH[k]
+    thk = th1 + p[THROW_PHASE[k]]
+    out[s] = y[s + 1]
+    J[s, s] = 0.0
+    J[s, s + 1] = 1.0
+    F = _force(thk, y, p, k)
+    out[s + 1], J[s + 1, s], J[s + 1, s + 1] = throw_acc_jac(thk, y[s], y[s + 1], F, w, p, m)
+
+
+@compiled(RHS_JAC_SIGNATURE)
+def rhs_jac(t, y, p, out, J):
+    """The right-hand side and the Jacobian in one call, for a configuration whose loads
+    have no states (the assembler hands it out only then)."""
+    th1, w = crank(t, y, p, SHAFT)
+    for k in range(N_THROWS):
+        _throw_jac(th1, w, y, p, k, out, J)
+
+
+@nb.njit(cache=True)
+def _load_columns(th1, w, y, p, k, J):
+    """Throw ``k`` with a load with states: the clearance angle's dependence on the load's
+    states (through the gas force, in which the equation is linear) and the load's rows, by
+    central differences of the load's laws (its stops and regularised nozzles are not smooth
+    everywhere), with each state's step ``1e-7 (|y| (1 + rel) + abs)`` from its slice."""
+    s, m, lo = THROW_STATE[k], THROW_MECH[k], THROW_LOAD[k]
+    g, a, ng, na = LOAD_STATE[k], LOAD_AUX[k], LOAD_N[k], LOAD_NAUX[k]
+    thk = th1 + p[THROW_PHASE[k]]
+    F = load_state_force(y, g, p, lo)
+    acc = throw_acc(thk, y[s], y[s + 1], F, w, p, m)
+    dF = 1.0 + abs(F)
+    dadF = (throw_acc(thk, y[s], y[s + 1], F + dF, w, p, m) - acc) / dF
+    n = y.shape[0]
+    yy = y.copy()
+    f1 = np.zeros(n)
+    f2 = np.zeros(n)
+    for c in range(ng + 2):
+        j = s + c if c < 2 else g + c - 2
+        st = LOAD_STEPS[k] + 2 * (c - 2)
+        h = 1e-7 * (abs(y[j]) + 1.0) if c < 2 else 1e-7 * (abs(y[j]) * (1.0 + p[st]) + p[st + 1])
+        yy[j] = y[j] + h
+        x, v = crosshead(thk, yy[s], w, yy[s + 1], p, m)
+        load_rhs(x, v, yy, g, a, p, lo, f1)
+        Fp = load_state_force(yy, g, p, lo)
+        yy[j] = y[j] - h
+        x, v = crosshead(thk, yy[s], w, yy[s + 1], p, m)
+        load_rhs(x, v, yy, g, a, p, lo, f2)
+        Fm = load_state_force(yy, g, p, lo)
+        yy[j] = y[j]
+        if c >= 2:
+            J[s + 1, j] = dadF * (Fp - Fm) / (2.0 * h)
+        for i in range(ng):
+            J[g + i, j] = (f1[g + i] - f2[g + i]) / (2.0 * h)
+        for i in range(na):
+            J[a + i, j] = (f1[a + i] - f2[a + i]) / (2.0 * h)
+
+
+@compiled(JAC_SIGNATURE, allocates=True)
+def jac(t, y, p, J):
+    n = y.shape[0]
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+    f = np.empty(n)
+    th1, w = crank(t, y, p, SHAFT)
+    for k in range(N_THROWS):
+        _throw_jac(th1, w, y, p, k, f, J)
+        if LOAD_STATES:
+            _load_columns(th1, w, y, p, k, J)
+
+
+@compiled(EVENT_SIGNATURE)
+def event(t, y, p):
+    """The smallest of the throws' load event factors (each positive between its events)."""
+    low = np.inf
+    for k in range(N_THROWS):
+        low = min(low, load_event(y, LOAD_STATE[k], p, THROW_LOAD[k]))
+    return low
+
+
+@compiled(RHS_SIGNATURE)
+def reset(t, y, p, out):
+    """The reset of the throw whose load's event factor is the smallest (at the event)."""
+    best, low = 0, np.inf
+    for k in range(N_THROWS):
+        e = load_event(y, LOAD_STATE[k], p, THROW_LOAD[k])
+        if e < low:
+            best, low = k, e
+    load_reset(y, LOAD_STATE[best], p, THROW_LOAD[best], out)
+
+
+@nb.njit(cache=True)
+def observe(t, y, p):
+    """The outputs compiled code computes from the integrated states, by the functions that
+    were integrated: the crank's angle and speed (columns 0, 1), then per throw its crank
+    angle, its gas force and the torque the shaft applies to its crank (columns
+    ``OBS_THROW[k]`` to ``+ 2``)."""
+    out = np.empty((t.shape[0], N_OBS))
+    for i in range(t.shape[0]):
+        yi = y[i]
+        th1, w = crank(t[i], yi, p, SHAFT)
+        out[i, 0] = th1
+        out[i, 1] = w
+        for k in range(N_THROWS):
+            s, m, c = THROW_STATE[k], THROW_MECH[k], OBS_THROW[k]
+            thk = th1 + p[THROW_PHASE[k]]
+            F = _force(thk, yi, p, k)
+            acc = throw_acc(thk, yi[s], yi[s + 1], F, w, p, m)
+            out[i, c] = thk
+            out[i, c + 1] = F
+            out[i, c + 2] = crank_torque(thk, yi[s], w, yi[s + 1], acc, 0.0, F, p, m)
+    return out

@@ -1,0 +1,319 @@
+"""The declarative machine: frozen Python objects and the TOML file that holds them.
+
+A machine file::
+
+    name = "two-throw"
+    description = "two throws at 180 deg on one crankshaft"
+
+    [shaft]                  # the crankshaft and what turns it
+    drive = "motor"          # prescribed | motor
+    motor = "induction"      # the motor's torque law: induction | constant | file.py:OBJ
+    omega = "20 rad/s"       # the shaft's parameters: omega, theta1_0, J_drive, motor_*
+    J_drive = "3000 kg*m**2"
+
+    [[stage]]                # a compression stage: its line pressures and temperature
+    name = "stage1"
+    suction_pressure = "1 bar"
+    discharge_pressure = "3 bar"
+
+    [[throw]]                # one crank of the shaft, at its phase angle
+    stage = "stage1"
+    load = "cycle"           # paper | table | cycle | valves | file.py:OBJ
+    crank_joint = "link"     # link (the massless link of length rc) | ideal
+    phase = "0 deg"
+    rc = "1 mm"              # any parameter of the throw: its mechanism, its cylinder
+
+    [[throw]]
+    stage = "stage1"
+    load = "cycle"
+    phase = "180 deg"
+
+    [[sensor]]               # what a monitoring system records: the model's vibration
+    name = "accel_throw2"    # signal is the first accelerometer's
+    kind = "accelerometer"
+    signal = "throw2.a"
+
+The keys that choose a part (a throw's ``load``, ``crank_joint``, ``equations``, ``stage``,
+``name``; the shaft's ``drive`` and ``motor``; a stage's and a sensor's keys) are the
+machine's structure; every other key is a parameter value, with its unit (a number in SI or a
+quantity such as ``"1 mm"``), checked against its range when the machine becomes a model. A
+machine of several throws names its parameters by part: ``throw2.rc``, ``shaft.J_drive``,
+``stage1.suction_pressure``; a machine of one throw keeps the compressor's names (``rc``,
+``omega``), so a one-throw machine and ``--model compressor`` take the same values.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from ...errors import ParameterError
+
+__all__ = [
+    "Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine", "SHAFT_NAMES",
+    "STAGE_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS",
+]  # fmt: skip
+
+#: The parameters of the shaft (its speed, angle and drive) and of a stage (its line
+#: pressures and suction temperature): every other parameter of a throw's configuration is
+#: the throw's own.
+SHAFT_NAMES = ("omega", "theta1_0", "J_drive", "motor_torque", "motor_sync_speed",
+               "motor_breakdown_torque", "motor_breakdown_slip")  # fmt: skip
+STAGE_NAMES = ("suction_pressure", "discharge_pressure", "suction_temperature")
+#: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
+#: crosshead guide's clearance run on one throw through ``--model compressor``).
+LOADS = ("paper", "table", "cycle", "valves")
+JOINTS = ("link", "ideal")
+DRIVES = ("prescribed", "motor")
+SENSOR_KINDS = ("accelerometer", "pressure", "tacho")
+
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def _pairs(values: Mapping[str, Any]) -> tuple[tuple[str, Any], ...]:
+    return tuple((k, tuple(map(tuple, v)) if isinstance(v, list) else v)
+                 for k, v in values.items())  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Throw:
+    """One crank of the shaft with its rod, crosshead and cylinder.
+
+    Attributes
+    ----------
+    name : str
+        Its namespace (``throw2``): its parameters are ``throw2.rc`` and its signals
+        ``throw2.a`` in a machine of several throws.
+    stage : str
+        The stage it compresses for (its cylinder's line pressures are the stage's).
+    crank_joint : {"link", "ideal"}
+        The crank pin: the paper's massless link of length ``rc``, or ideal (rc = 0).
+    load : str
+        The gas force on its crosshead: ``paper``, ``table``, ``cycle``, ``valves`` or a load
+        component of a user's file (``file.py:OBJ``).
+    equations : {"exact", "paper-printed"}
+        The massless link's equation (the paper's printed one with a prescribed crank only).
+    params : tuple of (name, value)
+        Its parameter values by local name (``rc``, ``phase``: the angle its crank leads the
+        shaft's by), raw (numbers in SI or quantities); the rest take their defaults.
+    """
+
+    name: str = "throw1"
+    stage: str = "stage1"
+    crank_joint: str = "link"
+    load: str = "paper"
+    equations: str = "exact"
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """The crankshaft and its drive: ``prescribed`` (it turns at ``omega``) or ``motor`` (its
+    angle and speed are states, driven by the torque law ``motor`` on ``J_drive``)."""
+
+    drive: str = "prescribed"
+    motor: str = "induction"
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A compression stage: the line pressures and suction temperature its throws' cylinders
+    work between."""
+
+    name: str = "stage1"
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """A sensor of the machine: ``kind`` (accelerometer, pressure, tacho) reading the
+    recorded ``signal`` (``throw2.a``). The model's vibration signal (peak, RMS and
+    spectrum in sweeps and features) is its first accelerometer's."""
+
+    name: str
+    kind: str
+    signal: str
+
+
+@dataclass(frozen=True)
+class Machine:
+    """A machine: its shaft, its throws (in the order of their namespaces), stages and
+    sensors."""
+
+    name: str = "machine"
+    description: str = ""
+    shaft: Shaft = field(default_factory=Shaft)
+    throws: tuple[Throw, ...] = (Throw(),)
+    stages: tuple[Stage, ...] = (Stage(),)
+    sensors: tuple[Sensor, ...] = ()
+    #: Where it was read from (an absolute path: a record and a sweep's workers find it again).
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.throws:
+            raise ParameterError(f"machine {self.name!r}: needs at least one [[throw]]")
+        names = [t.name for t in self.throws]
+        for t in self.throws:
+            where = f"machine {self.name!r}: {t.name}"
+            if not _NAME.match(t.name) or t.name in ("shaft", *[s.name for s in self.stages]):
+                raise ParameterError(f"{where}: a throw's name is a letter then letters, digits "
+                                     "or _, unlike the shaft's and the stages'")  # fmt: skip
+            if t.crank_joint not in JOINTS:
+                raise ParameterError(f"{where}.crank_joint = {t.crank_joint!r}; allowed: "
+                                     f"{', '.join(map(repr, JOINTS))} (the contact and "
+                                     "lubricated pins run on one throw: --model compressor "
+                                     "--set crank_joint=contact)")  # fmt: skip
+            if t.load not in LOADS and ":" not in t.load:
+                raise ParameterError(f"{where}.load = {t.load!r}; allowed: "
+                                     f"{', '.join(map(repr, LOADS))} or file.py:OBJ")  # fmt: skip
+            if t.equations not in ("exact", "paper-printed"):
+                raise ParameterError(f"{where}.equations = {t.equations!r}; allowed: 'exact', "
+                                     "'paper-printed'")  # fmt: skip
+            if t.equations != "exact" and self.shaft.drive != "prescribed":
+                raise ParameterError(f"{where}.equations = 'paper-printed' exists for a "
+                                     "prescribed crank only; allowed with drive = 'motor': "
+                                     "'exact'")  # fmt: skip
+            if t.stage not in [s.name for s in self.stages]:
+                raise ParameterError(f"{where}.stage = {t.stage!r}; the machine's stages: "
+                                     f"{', '.join(s.name for s in self.stages)}")  # fmt: skip
+        first = self.throws[0]
+        for t in self.throws[1:]:
+            if (t.load, t.equations) != (first.load, first.equations):
+                raise ParameterError(
+                    f"machine {self.name!r}: {t.name}.load = {t.load!r} ({t.equations}) beside "
+                    f"{first.name}.load = {first.load!r} ({first.equations}): the throws of a "
+                    "machine carry one kind of load and one set of equations today (their "
+                    "parameters differ freely)"
+                )
+        if len(set(names)) != len(names):
+            raise ParameterError(f"machine {self.name!r}: two throws named alike: {names}")
+        if len({s.name for s in self.stages}) != len(self.stages):
+            raise ParameterError(f"machine {self.name!r}: two stages named alike")
+        if self.shaft.drive not in DRIVES:
+            raise ParameterError(f"machine {self.name!r}: shaft.drive = {self.shaft.drive!r}; "
+                                 f"allowed: {', '.join(map(repr, DRIVES))}")  # fmt: skip
+        for s in self.sensors:
+            if s.kind not in SENSOR_KINDS:
+                raise ParameterError(f"machine {self.name!r}: sensor {s.name!r}: kind = "
+                                     f"{s.kind!r}; allowed: {', '.join(SENSOR_KINDS)}")  # fmt: skip
+
+    @property
+    def flat(self) -> bool:
+        """One throw: the compressor's names, without namespaces."""
+        return len(self.throws) == 1
+
+    def prefix(self, part: str) -> str:
+        """The namespace of part ``part`` (a throw's or a stage's name, or ``shaft``) in the
+        machine's names: ``"throw2."``, or ``""`` in a machine of one throw."""
+        return "" if self.flat else f"{part}."
+
+    def stage_of(self, throw: Throw) -> Stage:
+        return next(s for s in self.stages if s.name == throw.stage)
+
+    def with_throws(self, throws) -> Machine:
+        return replace(self, throws=tuple(throws))
+
+
+_TOP = ("name", "description", "shaft", "throw", "stage", "sensor")
+_THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
+
+
+def _table(raw: Any, where: str) -> dict[str, Any]:
+    if not isinstance(raw, dict):
+        raise ParameterError(f"{where}: expected a table, got {type(raw).__name__}")
+    return raw
+
+
+def _split(raw: dict, keys: tuple[str, ...]) -> tuple[dict, dict]:
+    return ({k: v for k, v in raw.items() if k in keys},
+            {k: v for k, v in raw.items() if k not in keys})  # fmt: skip
+
+
+def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
+                      source: str = "") -> Machine:  # fmt: skip
+    """The `Machine` of a parsed machine file (module docstring); one-line
+    [`ParameterError`][recipdyn.errors.ParameterError] naming the key."""
+    for k in raw:
+        if k not in _TOP:
+            raise ParameterError(f"{where}: unknown key {k!r}; allowed: {', '.join(_TOP)}")
+    shaft_raw = _table(raw.get("shaft", {}), f"{where}: [shaft]")
+    shaft_keys, shaft_params = _split(shaft_raw, ("drive", "motor"))
+    for k in shaft_params:
+        if k not in SHAFT_NAMES:
+            raise ParameterError(f"{where}: [shaft] {k!r} is not a parameter of the shaft; "
+                                 f"allowed: drive, motor, {', '.join(SHAFT_NAMES)}")  # fmt: skip
+    shaft = Shaft(**{k: str(v) for k, v in shaft_keys.items()}, params=_pairs(shaft_params))
+    stages = []
+    for i, st in enumerate(raw.get("stage", []), 1):
+        st = _table(st, f"{where}: stage {i}")
+        keys, params = _split(st, ("name",))
+        for k in params:
+            if k not in STAGE_NAMES:
+                raise ParameterError(f"{where}: stage {i}: {k!r} is not a parameter of a stage; "
+                                     f"allowed: name, {', '.join(STAGE_NAMES)}")  # fmt: skip
+        stages.append(Stage(name=str(keys.get("name", f"stage{i}")), params=_pairs(params)))
+    stages = stages or [Stage()]
+    throws = []
+    for i, th in enumerate(raw.get("throw", []), 1):
+        th = _table(th, f"{where}: throw {i}")
+        keys, params = _split(th, _THROW_KEYS)
+        keys = {k: str(v) for k, v in keys.items()}
+        keys.setdefault("name", f"throw{i}")
+        keys.setdefault("stage", stages[0].name)
+        for k in params:
+            if k in SHAFT_NAMES or k in STAGE_NAMES:
+                part = "[shaft]" if k in SHAFT_NAMES else f"its [[stage]] ({keys['stage']})"
+                raise ParameterError(f"{where}: {keys['name']}.{k}: a parameter of {part}, not "
+                                     "of a throw")  # fmt: skip
+        throws.append(Throw(**keys, params=_pairs(params)))
+    sensors = []
+    for i, se in enumerate(raw.get("sensor", []), 1):
+        se = _table(se, f"{where}: sensor {i}")
+        missing = {"kind", "signal"} - set(se)
+        extra = set(se) - {"name", "kind", "signal"}
+        if missing or extra:
+            raise ParameterError(
+                f"{where}: sensor {i}: needs kind and signal (and a name); "
+                f"{'missing ' + ', '.join(sorted(missing)) if missing else ''}"
+                f"{'unknown ' + ', '.join(sorted(extra)) if extra else ''}"
+            )
+        sensors.append(Sensor(str(se.get("name", f"sensor{i}")), str(se["kind"]),
+                              str(se["signal"])))  # fmt: skip
+    return Machine(name=str(raw.get("name", Path(source).stem if source else "machine")),
+                   description=str(raw.get("description", "")), shaft=shaft,
+                   throws=tuple(throws), stages=tuple(stages), sensors=tuple(sensors),
+                   source=source)  # fmt: skip
+
+
+def read_machine(path: str | Path) -> Machine:
+    """The `Machine` of a TOML machine file (module docstring)."""
+    import tomllib
+
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ParameterError(f"machine: file not found: {path}") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"machine {path}: cannot read it ({type(exc).__name__})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"machine {path}: malformed TOML ({exc})") from None
+    if not raw.get("throw"):
+        raise ParameterError(f"machine {path}: needs at least one [[throw]]")
+    return machine_from_dict(raw, f"machine {path.name}", str(path.resolve()))
