@@ -2,7 +2,8 @@
 
 Design: ``n_conditions`` operating conditions (speed, suction and discharge pressure, rod and
 crosshead masses, the accelerometer's mounting resonance and the sampling rate), drawn
-uniformly from `CONDITIONS` with a seeded generator; at each condition
+uniformly from the machine's ranges (`recipdyn.diagnosis.machine.condition_ranges`; the
+default machine's are `CONDITIONS`) with a seeded generator; at each condition
 every fault class at every severity level (the healthy machine as often as each fault, so the
 classes are balanced), or, with ``severity_range``, at severities drawn uniformly (seeded) in
 that range; each record sensed at the data set's SNR (`recipdyn.sensors`) with its own noise
@@ -46,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .classes import BASELINE, CONDITIONS, MODEL, class_names, get_class
+from .classes import MODEL, class_names, get_class
 
 __all__ = [
     "DatasetSpec",
@@ -96,6 +97,11 @@ class DatasetSpec:
         Each record's accelerometer SNR drawn uniformly in ``[lo, hi]`` dB (seeded per
         condition, class and record) instead of ``snr_db`` for all, so that a diagnoser learns
         the machine apart from the sensor's noise floor (docs/diagnosis.md, robustness).
+    machine : tuple of (str, value)
+        The machine simulated, as its changes from the diagnosis model's defaults
+        (`recipdyn.diagnosis.machine.Machine.changes`; a dict is accepted): its operating
+        ranges, fault ranges and healthy pins are re-derived from it
+        (`recipdyn.diagnosis.machine`). Empty: the default machine.
 
     Notes
     -----
@@ -115,6 +121,7 @@ class DatasetSpec:
     severity_range: tuple[float, float] | None = None
     severity_draws: int | None = None
     snr_range: tuple[float, float] | None = None
+    machine: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self):
         if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
@@ -146,6 +153,7 @@ class DatasetSpec:
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
+        object.__setattr__(self, "machine", _machine_pairs(self.machine))
 
     @property
     def continuous(self) -> bool:
@@ -166,12 +174,38 @@ class DatasetSpec:
         for k in ("severity_range", "severity_draws", "snr_range"):
             if d[k] is None:
                 del d[k]
+        if not d["machine"]:  # the default machine: the store keeps its identity
+            del d["machine"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
         """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+
+
+def _machine_pairs(m: Any) -> tuple[tuple[str, Any], ...]:
+    """A spec's machine as sorted ``(name, value)`` pairs (a dict, pairs or a JSON list of
+    pairs), each name a machine parameter."""
+    from .machine import MACHINE_PARAMETERS, NOMINAL, _not_machine
+
+    try:
+        pairs = dict(m.items() if hasattr(m, "items") else ((k, v) for k, v in m))
+    except (TypeError, ValueError):
+        raise ParameterError(f"machine = {m!r}; allowed: pairs (name, value)") from None
+    for k in pairs:
+        if k not in (*MACHINE_PARAMETERS, *NOMINAL):
+            raise ParameterError(_not_machine(k))
+    return tuple(sorted(pairs.items()))
+
+
+def spec_machine(spec: DatasetSpec):
+    """The `recipdyn.diagnosis.machine.Machine` of ``spec`` (None: the default machine)."""
+    if not spec.machine:
+        return None
+    from .machine import Machine
+
+    return Machine.of(spec.machine, source="the data set's machine")
 
 
 def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, float]:
@@ -187,10 +221,13 @@ def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, 
 
 
 def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
+    from .machine import condition_ranges
+
+    ranges = condition_ranges(spec_machine(spec))
     rng = np.random.default_rng([spec.seed, 0])
     out = []
     for _ in range(spec.n_conditions):
-        c = {k: r.draw(rng) for k, r in CONDITIONS.items()}
+        c = {k: r.draw(rng) for k, r in ranges.items()}
         c["fs"] = round(c["fs"] / 100.0) * 100.0
         out.append(c)
     return out
@@ -230,15 +267,20 @@ def snrs(spec: DatasetSpec, condition: int, name: str, n: int) -> list[float]:
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     """The records of ``spec``: one task per (condition, class, severity), in a fixed order
     (``level`` numbers a class's records at a condition)."""
+    from .machine import fault_classes, healthy_parameters
+
     tasks = []
     splits = split_of(spec)
+    machine = spec_machine(spec)
+    classes = fault_classes(machine)
     for ci, cond in enumerate(_conditions(spec)):
         for name in spec.classes:
-            fc = get_class(name)
+            fc = get_class(name, classes)
             sev = severities(spec, ci, name)
             for li, (s, snr) in enumerate(zip(sev, snrs(spec, ci, name, len(sev)), strict=True)):
                 idx = len(tasks)
-                params = dict(BASELINE)
+                params = {} if machine is None else dict(machine.changes())
+                params.update(healthy_parameters(machine))
                 params.update(
                     {
                         k: cond[k]
@@ -264,6 +306,8 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                         "noise_seed": int(spec.seed * 1_000_003 + idx),
                     }
                 )
+                if machine is not None:  # the features read the machine's geometry
+                    tasks[-1]["machine"] = dict(machine.changes())
     return tasks
 
 
@@ -307,10 +351,13 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
     )
 
 
-def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
+def features_of(
+    channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None
+) -> dict[str, float]:
     """A record's features from its sensed channels: the crank angle from the tacho's first
     edge and the record's constant crank speed (a short record has too few pulses for
-    the speed to be read from them)."""
+    the speed to be read from them). ``machine``: the changes of the machine the record's
+    cycle features are read against (None: the default machine)."""
     from ..analysis.vibration import tacho_times
     from .evidence import record_features
 
@@ -320,7 +367,12 @@ def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> 
         raise ValueError("no tacho edge in the record")
     revs = (np.arange(x.size) / fs - edges[0]) * speed_hz
     return record_features(
-        x, fs, revs, p_head=channels.get("p_head_sensor"), p_crank=channels.get("p_crank_sensor")
+        x,
+        fs,
+        revs,
+        p_head=channels.get("p_head_sensor"),
+        p_crank=channels.get("p_crank_sensor"),
+        machine=machine,
     )
 
 
@@ -337,7 +389,7 @@ def make_record(task: dict[str, Any]) -> dict[str, Any]:
         out["channels"] = ch
         speed = task["params"]["omega"] / (2 * math.pi)
         out["features"] = features_of(
-            {k: v.astype(float) for k, v in ch.items()}, task["fs"], speed
+            {k: v.astype(float) for k, v in ch.items()}, task["fs"], speed, task.get("machine")
         )
     except Exception as exc:  # noqa: BLE001 - recorded; the data set goes on
         out["error"] = f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)}"
@@ -534,7 +586,7 @@ def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
             continue
         n = int(g["n_samples"][i])
         ch = {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
-        f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
+        f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi), t.get("machine"))
         g["features"][i, :] = np.array([f[k] for k in names], float)
     g.attrs["feature_names"] = names
     card = json.loads((folder / "datacard.json").read_text(encoding="utf-8"))
@@ -631,9 +683,13 @@ def _finish(out: Path, g, spec: DatasetSpec, tasks, names, throughput) -> None:
 
 def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str, Any]:
     """The data card: what the data set holds and how it was made."""
+    from .machine import condition_ranges, fault_classes, healthy_parameters
+
+    machine = spec_machine(spec)
+    known = fault_classes(machine)
     classes = []
     for name in spec.classes:
-        fc = get_class(name)
+        fc = get_class(name, known)
         classes.append(
             {
                 "name": fc.name,
@@ -641,6 +697,8 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
                 "meaning": fc.meaning,
                 "unit": fc.unit,
                 "scale": fc.scale,
+                "mild": fc.mild,
+                "severe": fc.severe,
                 "values": [fc.value(s) for s in spec.levels]
                 if fc.parameter and not spec.continuous
                 else [],
@@ -657,12 +715,13 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
     return {
         "recipdyn_version": version,
         "model": MODEL,
-        "baseline": BASELINE,
+        "baseline": healthy_parameters(machine),
+        "machine": machine.as_dict if machine is not None else {},
         "spec": asdict(spec),
         "classes": classes,
         "conditions": {
             k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
-            for k, r in CONDITIONS.items()
+            for k, r in condition_ranges(machine).items()
         },
         "sensors": {
             "accelerometer": "recipdyn.sensors.Accelerometer(snr_db="
@@ -717,6 +776,18 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"revolutions after {s['transient']}; accelerometer SNR "
         f"{_snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
+        "",
+        "Machine: "
+        + (
+            ", ".join(
+                f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                for k, v in s.get("machine") or ()
+            )
+            + " (changed from the diagnosis model's defaults; ranges and fault values "
+            "re-derived for it: recipdyn.diagnosis.machine)"
+            if s.get("machine")
+            else "the diagnosis model's defaults"
+        ),
         "",
         f"| class | parameter | {head} | meaning |",
         "|---|---|---|---|",
@@ -780,4 +851,7 @@ def records_done(folder: str | Path) -> np.ndarray:
 
 
 def classes_of(card) -> list:
-    return [get_class(n) for n in card["spec"]["classes"]]
+    from .machine import fault_classes
+
+    known = fault_classes(spec_machine(DatasetSpec.from_dict(card["spec"])))
+    return [get_class(n, known) for n in card["spec"]["classes"]]

@@ -8,7 +8,10 @@ diagnoser's training domain: its crank speed and sampling rate inside the traini
 the frequency at which its impacts ring inside the training sensor band, its
 features no farther from the training records than the held-out conditions were
 (`recipdyn.diagnosis.train.Diagnoser.ood`). Otherwise the diagnosis is withheld, with the
-reason.
+reason. First of all, the record's machine (the user's machine file, or the parameters a
+simulated record carries) must be the diagnoser's within the tolerances of
+`recipdyn.diagnosis.machine`: a record of another machine is refused with the commands that
+build a diagnoser for it.
 """
 
 from __future__ import annotations
@@ -134,6 +137,8 @@ def diagnose(
     p_crank: str | None = None,
     model=None,
     out: str | Path | None = None,
+    machine=None,
+    baseline=None,
 ) -> Diagnosis:
     """Diagnose the record in the file ``record``.
 
@@ -155,6 +160,15 @@ def diagnose(
         Default: the diagnoser shipped with recipdyn.
     out : path, optional
         Folder for the overlay figure (none without it).
+    machine : path or Machine, optional
+        The machine the record was taken on (a machine file: `recipdyn.diagnosis.machine.
+        read_machine`). Without it, a simulated record's own parameters are read, if it has
+        them. A machine other than the diagnoser's (`recipdyn.diagnosis.machine.refusal`)
+        is refused.
+    baseline : path or Baseline, optional
+        The machine's own healthy baseline for this diagnoser (``recipdyn baseline``:
+        `recipdyn.diagnosis.baseline`): the record's chain is corrected with it and its
+        features referred to the machine's own healthy state.
 
     Returns
     -------
@@ -162,16 +176,30 @@ def diagnose(
         ``refused=True`` with ``reason`` for a record outside the training domain.
     """
     from ..io_signal import speed_hz
+    from .machine import machine_from_file, record_machine
 
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
+    if machine is None:
+        machine = record_machine(record)
+    elif isinstance(machine, (str, Path)):
+        machine = machine_from_file(machine)
     sig = _read(record, channel, fs)
     x, rate = np.asarray(sig.x, float), float(sig.fs)
     tach = _read(record, tacho, rate).x if tacho is not None else None
     ph = _read(record, p_head, rate).x if p_head is not None else None
     pc = _read(record, p_crank, rate).x if p_crank is not None else None
     return diagnose_arrays(
-        x, rate, tacho=tach, speed_hz=speed_hz(speed), p_head=ph, p_crank=pc, model=model, out=out
+        x,
+        rate,
+        tacho=tach,
+        speed_hz=speed_hz(speed),
+        p_head=ph,
+        p_crank=pc,
+        model=model,
+        out=out,
+        machine=machine,
+        baseline=baseline,
     )
 
 
@@ -193,21 +221,44 @@ def diagnose_arrays(
     p_crank=None,
     model=None,
     out=None,
+    machine=None,
+    baseline=None,
 ) -> Diagnosis:
-    """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed)."""
+    """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed);
+    ``machine``: the `recipdyn.diagnosis.machine.Machine` (or a machine file) the record was
+    taken on, if known; ``baseline``: the machine's own healthy baseline (a file or a
+    `recipdyn.diagnosis.baseline.Baseline`)."""
     from .train import one_thread
 
     with one_thread():
         return _diagnose_arrays(x, fs, tacho=tacho, speed_hz=speed_hz, p_head=p_head,
-                                p_crank=p_crank, model=model, out=out)  # fmt: skip
+                                p_crank=p_crank, model=model, out=out,
+                                machine=machine, baseline=baseline)  # fmt: skip
 
 
-def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> Diagnosis:
+def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, machine,
+                     baseline) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
     from .evidence import impacts, record_features
+    from .machine import machine_from_file, refusal
 
     t0 = time.perf_counter()
     diag = _load(model)
+    if isinstance(machine, (str, Path)):
+        machine = machine_from_file(machine)
+    why = refusal(diag, machine)
+    if why is not None:
+        return _refuse(Diagnosis(refused=True), why, t0)
+    chain = {}
+    if baseline is not None:
+        from .baseline import baseline_for
+
+        baseline = baseline_for(diag, baseline)
+        chain = baseline.chain
+        if p_head is not None:
+            p_head = np.asarray(p_head, float) - chain["p_head_offset"]
+        if p_crank is not None:
+            p_crank = np.asarray(p_crank, float) - chain["p_crank_offset"]
     x = np.asarray(x, float)
     if tacho is not None:
         edges = tacho_times(np.asarray(tacho, float), fs)
@@ -215,7 +266,8 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
             )
-        revs = crank_angle(x.size, fs, pulses=edges)
+        # the tacho mark's angle after outer dead centre (a baseline's chain): re-phased
+        revs = crank_angle(x.size, fs, pulses=edges) + chain.get("phase_deg", 0.0) / 360.0
         keep = np.isfinite(revs)
     else:
         if speed_hz is None:
@@ -227,9 +279,19 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     x, revs = x[sl], revs[sl]
     ph = None if p_head is None else np.asarray(p_head, float)[sl]
     pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
-    row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
+    row = record_features(
+        x,
+        fs,
+        revs,
+        angle=tacho is not None,
+        p_head=ph,
+        p_crank=pc,
+        machine=diag.card["spec"].get("machine") or None,
+    )
     names = diag.names
     X = np.array([[row[n] for n in names]], float)
+    if baseline is not None:  # the machine's own healthy state (speed and ringing kept)
+        X = baseline.refer(X, names)
     st = diag.state
     f_rev = row["speed_hz"]
     res = Diagnosis(refused=False)
@@ -296,7 +358,7 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     res.label = classes[k]
     if res.label != "healthy":
         s, slo, shi = diag.severity(X, res.label)
-        fc = get_class(res.label)
+        fc = diag.fault_class(res.label)
         res.severity, res.severity_interval = float(s[0]), (float(slo[0]), float(shi[0]))
         res.value = fc.value(res.severity)
         res.value_interval = (
@@ -312,6 +374,12 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out) -> 
     }
     if floor is not None:
         res.evidence["noise_floor"] = floor_ev
+    if baseline is not None:
+        res.evidence["baseline"] = {
+            "records": list(baseline.records),
+            "chain": dict(chain),
+            "machine": dict(baseline.fit.machine),
+        }
     j = _closest(diag, X[0], res.label)
     if ph is not None and tacho is not None:
         from .train import curve
