@@ -21,10 +21,14 @@ with the simulator:
    pressures cannot tell a parameter (the masses, which the pressures barely see).
 3. **The referral** (`build_baseline`, `Baseline.refer`): the healthy machine with the fitted
    parameters and the diagnoser's nominal one are simulated and sensed at each record's
-   operating point with the same noise; the difference of their features is the machine's own
-   healthy offset from the diagnoser's machine, taken off every later record's features
-   after its chain is corrected (offsets removed, crank angle re-phased): the diagnoser then
-   reads deviations from the machine's own healthy state.
+   operating point with the same noise; the difference of their pressure and cycle features
+   (the features the fitted parameters act on, and those the diagnoser's own healthy
+   baseline, `recipdyn.diagnosis.train.fit_baseline`, refers to the operating point) is the
+   machine's own healthy offset from the diagnoser's machine, taken off every later record's
+   features after its chain is corrected (offsets removed, crank angle re-phased): the
+   diagnoser then reads deviations from the machine's own healthy state. The acceleration's
+   features are not referred: the masses that act on them are not fitted, and two simulated
+   records' impacts differ by more than the fitted parameters move them.
 
 The baseline is a small JSON file tied to one diagnoser (its data set's spec).
 """
@@ -59,6 +63,7 @@ __all__ = [
     "Baseline",
     "build_baseline",
     "load_baseline",
+    "simulated_record",
 ]
 
 #: Layout version of a baseline file.
@@ -71,8 +76,6 @@ COVERAGE = 0.9
 #: so a simulated curve is a mean over revolutions as the record's is.
 FIT_REVOLUTIONS = 2.0
 FIT_TRANSIENT = 1.0
-#: Sampling rate of the fit's simulations, Hz (about 9 samples per one-degree bin at 20 rad/s).
-FIT_FS = 10_000.0
 #: Finite-difference step of the fit's Jacobian on an uncertain factor (`fit_machine`).
 FD_FACTOR = 0.05
 #: Prior standard deviations of the chain: the transducers' offsets (Pa) and the tacho mark's
@@ -245,20 +248,26 @@ def correct(record: Record, chain: Mapping[str, float]) -> tuple[Record, float]:
 
 def _sim_curves(job):
     """(key, (2, 360) chamber-pressure curves by crank angle: the mean over the simulation's
-    `FIT_REVOLUTIONS` revolutions) of one healthy simulation (picklable unit of work)."""
+    `FIT_REVOLUTIONS` revolutions) of one healthy simulation (picklable unit of work), sampled
+    at the record's rate and through the data set's pressure transducers without their noise
+    (`recipdyn.sensors.PressureTransducer`: their causal anti-alias filter delays the
+    pressures by ~0.1 degree, which the mark angle would otherwise take up)."""
+    from .. import sensors
     from ..simulate import simulate
 
-    key, params = job
+    key, params, fs = job
     with warnings.catch_warnings():  # the healthy pins stretch Hertz's law (docs/diagnosis.md)
         warnings.simplefilter("ignore")
         ds = simulate(model=MODEL, revolutions=FIT_REVOLUTIONS, transient=FIT_TRANSIENT,
-                      fs=FIT_FS, summary=False, **params)  # fmt: skip
+                      fs=fs, summary=False, **params)  # fmt: skip
+        clean = sensors.PressureTransducer(snr_db=None, bits=None)
+        ds = sensors.record(ds, accelerometer=None, pressure=clean)
     th = np.mod(np.asarray(ds["theta1"].values, float), 2 * np.pi)
     b = np.minimum((th / (2 * np.pi) * 360).astype(int), 359)
     n = np.bincount(b, minlength=360)
     out = np.array(
         [np.bincount(b, weights=np.asarray(ds[v].values, float), minlength=360) / n
-         for v in ("p_head", "p_crank")]
+         for v in ("p_head_sensor", "p_crank_sensor")]
     )  # fmt: skip
     return key, out
 
@@ -426,14 +435,17 @@ def fit_machine(
     cache: dict[tuple, np.ndarray] = {}
 
     def simulate_all(jobs):
-        todo = list({k: (k, p) for k, p in jobs if k not in cache}.values())
+        todo = list({j[0]: j for j in jobs if j[0] not in cache}.values())
         if todo:
             run = pool.map if workers > 1 and len(todo) > 1 else map
             for k, c in run(_sim_curves, todo):
                 cache[k] = c
             count["sims"] += len(todo)
             pending.check()
-        return [cache[k] for k, _ in jobs]
+        return [cache[j[0]] for j in jobs]
+
+    def job(x, i):
+        return sim_key(x, i), params_of(x, i), float(records[i].fs)
 
     def sim_key(x, i):
         sub = [x[idx[n]] for n in uncertain] + [x[idx[f"suction_pressure_{i}"]],
@@ -450,20 +462,20 @@ def fit_machine(
         return out
 
     def residuals(x, scale):
-        sims = simulate_all([(sim_key(x, i), params_of(x, i)) for i in range(len(meas))])
+        sims = simulate_all([job(x, i) for i in range(len(meas))])
         data = np.concatenate([((y - m) / sc).ravel() for y, m, sc in
                                zip(model_curves(x, sims), meas, scale, strict=True)])  # fmt: skip
         return np.concatenate([data, (x - mu) / sd])
 
     def jacobian(x, scale):
         h = steps * np.where(x + steps < hi, 1, -1)
-        jobs = [(sim_key(x, i), params_of(x, i)) for i in range(len(meas))]
+        jobs = [job(x, i) for i in range(len(meas))]
         for j, n in enumerate(names):
             if j < n_unc or n.startswith(("suction_pressure_", "discharge_pressure_")):
                 xj = x.copy()
                 xj[j] += h[j]
                 rows = range(len(meas)) if j < n_unc else [int(n.rsplit("_", 1)[1])]
-                jobs += [(sim_key(xj, i), params_of(xj, i)) for i in rows]
+                jobs += [job(xj, i) for i in rows]
         simulate_all(jobs)  # one batch: every simulation the columns need
         r0 = residuals(x, scale)
         J = np.empty((r0.size, x.size))
@@ -636,9 +648,10 @@ def _features_job(task):
 class Baseline:
     """A machine's own healthy baseline for one diagnoser (module docstring).
 
-    ``fit``: the fitted parameters and chain (`MachineFit`); ``delta``: each feature's
-    healthy offset of this machine from the diagnoser's (fitted minus nominal, averaged over
-    the records' operating points) and ``delta_spread`` its spread over them; ``check``: the
+    ``fit``: the fitted parameters and chain (`MachineFit`); ``delta``: each pressure and
+    cycle feature's healthy offset of this machine from the diagnoser's (fitted minus nominal,
+    averaged over the records' operating points) and ``delta_spread`` its spread over them;
+    ``check``: the
     largest departure of the (chain-corrected) healthy records' features from the fitted
     machine's, in the healthy machine's own spreads (`recipdyn.diagnosis.machine.
     healthy_spreads`), and the feature; ``diagnoser``: `diagnoser_id`."""
@@ -767,9 +780,11 @@ def build_baseline(
     finally:
         if pool is not None:
             stop_pool(pool)
-    names = diag.names
+    from .evidence import feature_groups
+
+    groups = feature_groups(diag.names)
     delta, spread = {}, {}
-    for n in names:
+    for n in groups["pressure"] + groups["cycle"]:
         d = [feats[2 * i][n] - feats[2 * i + 1][n] for i in range(len(records))]
         d = [v for v in d if math.isfinite(v)]
         if d:
@@ -801,3 +816,44 @@ def record_features_of(rec: Record, chain: Mapping[str, float], machine=None) ->
     sl = slice(ok[0], ok[-1] + 1)
     return record_features(fixed.accel[sl], fixed.fs, r[sl], p_head=fixed.p_head[sl],
                            p_crank=fixed.p_crank[sl], machine=machine)  # fmt: skip
+
+
+def simulated_record(
+    params: Mapping[str, Any],
+    *,
+    fs: float = 10_000.0,
+    revolutions: float = 6.0,
+    transient: float = 1.0,
+    resonance_hz: float = 4000.0,
+    snr_db: float = 30.0,
+    chain: Mapping[str, float] | None = None,
+    seed: int = 0,
+    name: str = "",
+) -> Record:
+    """A sensed `Record` of the diagnosis model at ``params`` (the data set's sensors,
+    `recipdyn.sensors`), through a chain with the errors ``chain`` (``p_head_offset``,
+    ``p_crank_offset``, Pa, added to the transducers' output; ``phase_deg``, the tacho mark's
+    angle after outer dead centre): a record to try a baseline on, whose truth is known."""
+    from .. import sensors
+    from ..simulate import simulate
+
+    chain = dict(chain or {})
+    with warnings.catch_warnings():  # the healthy pins stretch Hertz's law (docs/diagnosis.md)
+        warnings.simplefilter("ignore")
+        ds = simulate(model=MODEL, revolutions=revolutions, transient=transient, fs=fs,
+                      summary=False, **params)  # fmt: skip
+    rec = sensors.record(
+        ds,
+        accelerometer=sensors.Accelerometer(snr_db=snr_db, resonance_hz=resonance_hz),
+        pressure=sensors.PressureTransducer(),
+        tacho=sensors.Tacho(angle=math.radians(chain.get("phase_deg", 0.0))),
+        seed=seed,
+    )
+    return Record(
+        np.asarray(rec["accel_guide"].values, float),
+        float(fs),
+        np.asarray(rec["tacho"].values, float),
+        np.asarray(rec["p_head_sensor"].values, float) + chain.get("p_head_offset", 0.0),
+        np.asarray(rec["p_crank_sensor"].values, float) + chain.get("p_crank_offset", 0.0),
+        name,
+    )
