@@ -136,6 +136,10 @@ def test_differences_follow_the_tolerances_and_the_drawn_ranges():
     assert differences(d, Machine.of({"gas": "Nitrogen"}), drawn) == [
         "gas = Nitrogen (the diagnoser's: ideal)"
     ]
+    # the nominal operating point: inside the drawn ranges (2.7-3.3 bar, 16-24 rad/s) or not
+    assert differences(d, Machine.of({"discharge_pressure": 3.3e5, "omega": 16.0}), drawn) == []
+    six = differences(d, Machine.of({"discharge_pressure": 6e5}), drawn)
+    assert six == ["discharge_pressure = 6e+05 (nominal; the diagnoser's range: 2.7e+05..3.3e+05)"]
     assert set(TOLERANCES) | {"acting", "gas"} == set(
         __import__("recipdyn.diagnosis.machine", fromlist=["x"]).MACHINE_PARAMETERS
     )

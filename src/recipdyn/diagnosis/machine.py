@@ -465,9 +465,20 @@ def differences(trained: Machine, other: Machine, drawn: Mapping[str, tuple[floa
 
     ``drawn``: the ranges the diagnoser's data set drew for a machine parameter (the masses,
     `condition_ranges`); such a parameter may lie anywhere in its range widened by its
-    tolerance. A categorical parameter (`CATEGORICAL`) must be equal."""
+    tolerance. A categorical parameter (`CATEGORICAL`) must be equal. The machine's nominal
+    operating point (`NOMINAL`) must lie in the ranges the data set drew for it, with the
+    slack `recipdyn.diagnosis.diagnose.RANGE_SLACK` of the crank speed's refusal."""
+    from .diagnose import RANGE_SLACK
+
     a, b = trained.as_dict, other.as_dict
     out = []
+    for k in NOMINAL:
+        if k in drawn and k in b:
+            lo, hi = drawn[k]
+            if not lo * (1 - RANGE_SLACK) <= b[k] <= hi * (1 + RANGE_SLACK):
+                out.append(
+                    f"{k} = {_fmt(b[k])} (nominal; the diagnoser's range: {_fmt(lo)}..{_fmt(hi)})"
+                )
     for k in MACHINE_PARAMETERS:
         va, vb = a.get(k), b.get(k)
         if k in CATEGORICAL or not isinstance(va, (int, float)):
@@ -486,9 +497,10 @@ def differences(trained: Machine, other: Machine, drawn: Mapping[str, tuple[floa
 
 
 def drawn_ranges(machine: Machine) -> dict[str, tuple[float, float]]:
-    """The machine parameters a data set of ``machine`` draws, and their ranges."""
+    """The machine parameters and the operating point a data set of ``machine`` draws, and
+    their ranges."""
     r = condition_ranges(machine)
-    return {k: (r[k].lo, r[k].hi) for k in r if k in MACHINE_PARAMETERS}
+    return {k: (r[k].lo, r[k].hi) for k in r if k in (*MACHINE_PARAMETERS, *NOMINAL)}
 
 
 #: The options of ``recipdyn dataset`` that a data set's spec holds, as a data card writes
