@@ -10,6 +10,7 @@ OUT ?= out
 $(STAMP): pyproject.toml requirements/constraints.txt
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) on PATH (set PYTHON=...)"; exit 2; }
 	$(PYTHON) -m venv $(VENV)
+	@echo "installing recipdyn and its dependencies into $(VENV) with pip (quiet; a few minutes on a fresh machine)..."
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c requirements/constraints.txt -e ".[dev]"
 	@touch $(STAMP)
@@ -61,7 +62,8 @@ clean:
 
 # the diagnoser shipped with recipdyn (docs/diagnosis.md): the default data set (40 operating
 # conditions x 9 classes x 4 records, severities drawn in [0.25, 1], accelerometer SNRs drawn
-# in [10, 40] dB: 1440 records, ~30 min on 2 loaded cores), trained, evaluated
+# in [10, 40] dB, each record's measurement chain drawn from recipdyn.chain's ranges: 1440
+# records, ~30 min on 2 loaded cores), trained, evaluated
 diagnoser: warmup
 	$(VENV)/bin/recipdyn dataset -o $(OUT)/diagnoser-data --conditions 40 --severity-range 0.25,1 --draws 4 --snr-range 10,40 --resume
 	$(VENV)/bin/recipdyn train $(OUT)/diagnoser-data -o src/recipdyn/diagnosis/data/default.skops --report $(OUT)/diagnoser-report

@@ -145,7 +145,7 @@ def main() -> None:
     ap.add_argument("--compare", action="store_true", help="before/after, alternating")
     ap.add_argument("--rounds", type=int, default=4, help="rounds of --compare")
     a = ap.parse_args()
-    spec = DatasetSpec(n_conditions=2, classes=("healthy",) + CLASSES[1:])
+    spec = DatasetSpec(n_conditions=3, classes=("healthy",) + CLASSES[1:])
     tasks = [t for t in design(spec) if t["condition"] == 0 and t["level"] == 3]
     with tempfile.TemporaryDirectory() as tmp:
         g, names = _open_store(Path(tmp) / "s.zarr", spec, design(spec), False, True)

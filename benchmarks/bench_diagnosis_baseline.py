@@ -107,7 +107,7 @@ def main() -> None:
                 p["omega"] *= rng.uniform(0.97, 1.03)
                 p["suction_pressure"] *= rng.uniform(0.98, 1.02)
                 p["discharge_pressure"] *= rng.uniform(0.97, 1.03)
-                jobs.append((("healthy", i), p, {**base_kw, "seed": 1000 * c + i,
+                jobs.append((("baseline", i), p, {**base_kw, "seed": 1000 * c + i,
                                                  "name": f"h{i}"}))  # fmt: skip
             test = []
             for fc in CLASSES:
@@ -120,7 +120,7 @@ def main() -> None:
                     jobs.append(((fc.name, k), p, kw))
             recs = dict(pool.map(record_job, jobs))
             t_sim = time.perf_counter() - t0
-            healthy = [recs[("healthy", i)] for i in range(args.records)]
+            healthy = [recs[("baseline", i)] for i in range(args.records)]
             t0 = time.perf_counter()
             b = build_baseline(healthy, diag, workers=args.workers)
             t_fit = time.perf_counter() - t0

@@ -99,8 +99,7 @@ def main() -> None:
     else:
         diag = load(args.model or default_model_path())
         spec_dict = diag.card["spec"]
-    base = {k: tuple(v) if isinstance(v, list) else v for k, v in spec_dict.items()}
-    spec = DatasetSpec(**base)
+    spec = DatasetSpec.from_dict(spec_dict)  # a card without a chain: the fixed one
     test = [t for t in design(spec) if t["split"] == "test"]
     conds = sorted({t["condition"] for t in test})[: args.conditions]
     tasks = [

@@ -46,7 +46,7 @@ def test_every_class_is_one_entry_with_a_meaning_and_a_valid_range():
 
 
 def test_design_is_seeded_balanced_and_split_by_condition():
-    spec = DatasetSpec(n_conditions=20, seed=7)
+    spec = DatasetSpec(n_conditions=20, seed=7, chain="fixed")  # the condition's resonance
     tasks = design(spec)
     assert tasks == design(spec)  # deterministic
     other = design(DatasetSpec(n_conditions=20, seed=8))
@@ -144,7 +144,7 @@ def test_process_pool_gives_the_serial_records_to_the_bit(small, tmp_path):
     features as the serial (interrupted and resumed) build."""
     out, *_ = small
     spec = DatasetSpec(
-        n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.5, seed=3
+        n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"), test_fraction=0.25, seed=3
     )
     a = build_dataset(tmp_path / "p", spec, backend="processes", workers=2, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
@@ -199,7 +199,7 @@ def test_a_fixed_level_store_keeps_its_identity():
     """A store is identified by its spec's JSON: the fixed-level spec of the shipped data set
     must give the string stored in its folder, or `--resume` refuses it as another spec.
     (The literal is the spec's JSON before the continuous-severity settings existed.)"""
-    spec = DatasetSpec(n_conditions=40, classes=SHIPPED_CLASSES)
+    spec = DatasetSpec(n_conditions=40, classes=SHIPPED_CLASSES, chain="fixed")
     assert spec.to_json() == (
         '{"classes": ["healthy", "crank_pin_clearance", "crosshead_pin_clearance", '
         '"suction_valve_leak", "discharge_valve_leak", "weak_valve_spring", "sticking_valve", '
@@ -457,9 +457,7 @@ def _record(tmp_path, name, **change):
     from recipdyn.diagnosis.train import load
 
     card = load(default_model_path()).card
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(card["spec"])  # its chain: fixed, as it was built
     task = next(
         t
         for t in design(spec)
@@ -553,9 +551,7 @@ def test_without_a_tacho_the_noise_floor_is_still_read(tmp_path, snr_db, answere
     i = diag.names.index("acc_quiet_share")
     assert all(i not in _cols(diag.names, k) for k in AVAILABILITY)
     path = _record(tmp_path, f"snr{snr_db:g}", snr_db=snr_db)
-    spec = DatasetSpec(
-        **{k: tuple(v) if isinstance(v, list) else v for k, v in diag.card["spec"].items()}
-    )
+    spec = DatasetSpec.from_dict(diag.card["spec"])
     omega = next(t for t in design(spec) if t["split"] == "test")["params"]["omega"]
     res = diagnose(path, speed=f"{omega} rad/s", model=diag)  # _record's condition
     if answered:
@@ -600,19 +596,60 @@ def test_shipped_diagnoser_matches_todays_physics():
         assert diag.predict_proba(x)[0] == pytest.approx(pin["proba"], abs=0.05)
 
 
-def test_cli_refuses_bad_settings_in_one_line(capsys):
+def test_cli_refuses_bad_settings_in_one_line(capsys, tmp_path):
     from recipdyn.cli import main
 
+    rec = tmp_path / "r.csv"
+    rec.write_text("time,accel_guide\n0,1\n0.001,2\n")
     assert main(["dataset", "--conditions", "1", "-o", "unused-folder"]) == 2
-    assert main(["diagnose", "missing.csv"]) == 2  # neither --speed nor --tacho
+    assert main(["diagnose", str(rec)]) == 2  # neither --speed nor --tacho
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "n_conditions" in err[0] and "speed and tacho" in err[1]
 
 
+def _simulated_record(path, sensed: bool = False):
+    """A file laid out as ``recipdyn simulate`` writes one: 108 outputs over time and the
+    record's title (with ``sensed``, as ``recipdyn sense`` leaves it)."""
+    import xarray as xr
+
+    t = np.arange(200) / 2000.0
+    attrs = {"title": "recipdyn simulation: compressor", "model": "compressor"}
+    ds = xr.Dataset({f"out{i}": ("time", np.sin((i + 1) * t)) for i in range(108)},
+                    coords={"time": t}, attrs=attrs)  # fmt: skip
+    if sensed:
+        ds.attrs["sensor_channels"] = "out0"
+    ds.to_netcdf(path)
+    return path
+
+
+def test_diagnose_points_at_the_cause_of_a_bad_input(tmp_path, capsys):
+    """Issue 44, item 4: a file that is not there is said first (it was "speed and tacho:
+    give exactly one"); a simulated record without sensor channels says to run `recipdyn
+    sense` (it listed 108 column names); a record already sensed lists what it has, shortly."""
+    from recipdyn.cli import main
+
+    assert main(["diagnose", str(tmp_path / "nonexist.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "file not found" in err and "speed" not in err, err
+    sim = _simulated_record(tmp_path / "sim.nc")
+    an = str(tmp_path / "an")
+    for argv in (["diagnose", str(sim), "--speed", "20 rad/s"],
+                 ["analyze", str(sim), "-c", "accel_guide", "-o", an]):  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"recipdyn sense {sim}" in err, err
+        assert "out57" not in err and len(err) < 400, err
+    sensed = _simulated_record(tmp_path / "sensed.nc", sensed=True)
+    assert main(["diagnose", str(sensed), "--speed", "20 rad/s"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "recipdyn sense" not in err and "(108 variables in all)" in err and len(err) < 400
+    assert not (tmp_path / "an").exists()
+
+
 def test_dask_backend_gives_the_serial_records_to_the_bit(tmp_path):
     pytest.importorskip("dask.distributed")
-    spec = DatasetSpec(n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"),
-                       test_fraction=0.5, seed=3)  # fmt: skip
+    spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"),
+                       test_fraction=0.25, seed=3)  # fmt: skip
     a = build_dataset(tmp_path / "d", spec, backend="dask", dask_local=1, progress=False)
     b = build_dataset(tmp_path / "s", spec, backend="serial", progress=False)
     assert read_features(a)[0].equals(read_features(b)[0])
@@ -740,9 +777,10 @@ def test_drawn_snrs_are_seeded_in_range_and_leave_the_rest_of_the_design():
     in one line naming the setting."""
     from recipdyn.cli import main
 
-    fixed = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3)
+    fixed = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3,
+                        chain="fixed")  # fmt: skip
     drawn = DatasetSpec(n_conditions=4, severity_range=(0.25, 1.0), severity_draws=2, seed=3,
-                        snr_range=(10.0, 40.0))  # fmt: skip
+                        snr_range=(10.0, 40.0), chain="fixed")  # fmt: skip
     a, b = design(fixed), design(drawn)
     snr = np.array([t["snr_db"] for t in b])
     assert {t["snr_db"] for t in a} == {20.0}
@@ -837,3 +875,178 @@ def test_a_diagnoser_with_a_baseline_reads_the_deviations_and_saves_them(
     assert np.array_equal(back.predict_proba(X), diag.predict_proba(X))
     c = diag.classes[1]
     assert np.array_equal(back.severity(X, c)[0], diag.severity(X, c)[0])
+
+
+# ---- the measurement chain drawn per record (issue 42, item 1) ------------------------------
+
+
+def test_drawn_chains_are_seeded_per_record_inside_the_ranges():
+    """The default data set draws each record's chain: seeded by (seed, condition, class,
+    record), so the same spec gives the same chains and a data set with fewer classes the
+    same chains for the classes it keeps; every chain inside the data set's ranges (with its
+    ``snr_range`` replacing the SNR's); the task's resonance and SNR are its chain's. The
+    fixed chain's tasks carry none (their records are those of earlier versions)."""
+    from recipdyn.chain import Chain
+
+    spec = DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11)
+    tasks = design(spec)
+    assert spec.chain == "drawn" and all("chain" in t for t in tasks)
+    chains = [Chain.from_dict(t["chain"]) for t in tasks]
+    for t, c in zip(tasks, chains, strict=True):
+        assert spec.chain_ranges.contains(c, t["fs"]) == []
+        assert t["resonance_hz"] == c.accelerometer.resonance_hz
+        assert t["snr_db"] == c.accelerometer.snr_db
+    assert len({c.accelerometer.gain for c in chains}) == len(chains)  # one draw a record
+    assert [t["chain"] for t in design(spec)] == [t["chain"] for t in tasks]
+    few = design(DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11,
+                             classes=("healthy", "ring_leak")))  # fmt: skip
+    keep = [t["chain"] for t in tasks if t["label"] in ("healthy", "ring_leak")]
+    assert [t["chain"] for t in few] == keep
+    narrow = design(DatasetSpec(n_conditions=3, levels=(1.0,), snr_range=(30.0, 31.0)))
+    assert all(30.0 <= t["snr_db"] <= 31.0 for t in narrow)
+    fixed = design(DatasetSpec(n_conditions=3, levels=(0.5, 1.0), seed=11, chain="fixed"))
+    assert not any("chain" in t for t in fixed)
+    assert {t["snr_db"] for t in fixed} == {20.0}
+    assert DatasetSpec.from_dict({"n_conditions": 3}).chain == "fixed"  # a spec from before
+
+
+def test_a_drawn_data_set_stores_every_records_chain_and_its_card_lists_the_ranges(small):
+    """The small data set (drawn chains, built, interrupted and resumed): the feature table
+    holds each record's chain (``chain.*`` columns equal to the design's), the store its JSON,
+    every record's features are finite (the tacho read whatever its polarity, width, noise
+    and filter), and the data card lists every range with its source."""
+    import json
+
+    import zarr
+
+    from recipdyn.chain import Chain, ChainRanges
+
+    out, *_ = small
+    df, card = read_features(out)
+    tasks = {t["index"]: t for t in design(SMALL)}
+    for _, row in df.iterrows():
+        want = Chain.from_dict(tasks[row.record]["chain"]).columns()
+        for k, v in want.items():
+            got = row[f"chain.{k}"]
+            assert (v is None and (got is None or got != got)) or got == v, k
+    g = zarr.open_group(str(out / "signals.zarr"), mode="r")
+    stored = json.loads(str(g["chain"][3]))
+    assert stored == tasks[3]["chain"]
+    assert np.isfinite(df.filter(like="f_").to_numpy()).all()
+    assert card["chain"]["kind"] == "drawn"
+    assert card["chain"]["ranges"] == ChainRanges().describe()
+    md = (out / "datacard.md").read_text()
+    assert "| tacho.angle_deg | -2 .. 2 deg |" in md and "`issue42`" in md
+
+
+def test_cli_dataset_refuses_a_fixed_snr_with_the_drawn_chain(capsys):
+    from recipdyn.cli import main
+
+    assert main(["dataset", "--snr", "30", "-o", "unused-folder"]) == 2
+    assert main(["dataset", "--chain", "fixd", "-o", "unused-folder"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "--snr-range" in err[0] and "chain = 'fixd'" in err[1]
+
+
+def test_a_default_sensed_record_is_not_another_snr_for_a_default_data_sets_diagnoser(trained):
+    """Issue 44: `recipdyn dataset` drew at 20 dB while `recipdyn sense` recorded at 40 dB, so a
+    diagnoser of a default data set refused every default-sensed record as another SNR (the same
+    small data set with the fixed 20 dB chain refuses this record so, measured). Now the data
+    set draws its chains (SNR 10-40 dB) and sense records at 30 dB: the small data set's
+    diagnoser reads a new record (6 revolutions, other noise) of one of its training
+    conditions -- inside its speed range, which three conditions span narrowly -- sensed
+    through `SENSE_DEFAULT`, past the speed, sampling-rate and noise-floor gates, with its
+    noise floor inside the training range (FLOOR_SLACK 1.5)."""
+    from recipdyn import sensors
+    from recipdyn.chain import SENSE_DEFAULT
+    from recipdyn.diagnosis.dataset import simulate_record
+    from recipdyn.diagnosis.diagnose import diagnose_arrays
+
+    diag, _ = trained
+    task = next(t for t in design(SMALL) if t["split"] == "train" and t["label"] == "healthy")
+    task = {k: v for k, v in task.items() if k != "chain"}  # the exact outputs only
+    task["revolutions"] = 6.0
+    ds = simulate_record(task)
+    rec = sensors.record(ds, chain=SENSE_DEFAULT, seed=1)
+    res = diagnose_arrays(rec["accel_guide"].values, task["fs"], tacho=rec["tacho"].values,
+                          p_head=rec["p_head_sensor"].values,
+                          p_crank=rec["p_crank_sensor"].values, model=diag)  # fmt: skip
+    gates = ("crank speed", "sampling rate", "noise floor")
+    assert not (res.refused and any(g in res.reason for g in gates)), res.reason
+    if not res.refused:
+        q, (lo, hi) = res.evidence["noise_floor"]["share"], res.evidence["noise_floor"][
+            "training_range"]  # fmt: skip
+        assert lo / 1.5 <= q <= hi * 1.5
+
+
+# ---- data sets too small or unfinished (issue 44, item 3) -----------------------------------
+
+
+def test_a_data_set_too_small_to_train_on_is_refused_when_asked_for(tmp_path, capsys):
+    """``dataset --conditions 2``: one training condition, which `train` cannot both fit and
+    calibrate on (its split-conformal intervals and out-of-distribution threshold come from
+    conditions the fit has not seen; it crashed with a TypeError). Refused at once, with the
+    minimum for the test fraction; the minimum itself is accepted."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.dataset import min_conditions
+
+    with pytest.raises(ParameterError, match=r"n_conditions = 2 .*leaves 1 training condition"
+                                             r".*allowed: n_conditions >= 3"):  # fmt: skip
+        DatasetSpec(n_conditions=2, classes=("healthy", "crank_pin_clearance"))
+    out = tmp_path / "ds2"
+    assert main(["dataset", "-o", str(out), "--conditions", "2", "--classes",
+                 "healthy,crank_pin_clearance", "--backend", "serial"]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "n_conditions >= 3" in err[0] and not out.exists()
+    assert DatasetSpec(n_conditions=3).n_conditions == 3
+    assert (min_conditions(0.25), min_conditions(0.5), min_conditions(0.75)) == (3, 4, 6)
+
+
+def _table_only_data_set(folder, conditions, splits):
+    """A data set folder holding only a feature table and a data card (what `train` reads
+    before it fits anything)."""
+    import json
+
+    import pandas as pd
+
+    folder.mkdir()
+    cells = [(c, s, lab) for c, s in zip(conditions, splits, strict=True)
+             for lab in ("healthy", "ring_leak")]  # fmt: skip
+    rows = [
+        dict(record=i, condition=c, split=s, label=lab, level=0, severity=0.5, f_x=1.0)
+        for i, (c, s, lab) in enumerate(cells)
+    ]
+    pd.DataFrame(rows).to_parquet(folder / "features.parquet")
+    spec = {"classes": ["healthy", "ring_leak"]}
+    (folder / "datacard.json").write_text(json.dumps({"spec": spec}))
+    return folder
+
+
+def test_train_refuses_a_data_set_with_one_training_condition(tmp_path, capsys):
+    """A data set of two conditions made before the refusal (one train, one test)."""
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.train import train
+
+    folder = _table_only_data_set(tmp_path / "old", (0, 1), ("train", "test"))
+    with pytest.raises(ParameterError, match=r"1 training condition\(s\); a diagnoser trains "
+                                             r"on 2 at least .* 3 conditions or more"):  # fmt: skip
+        train(folder)
+    assert main(["train", str(folder), "-o", str(tmp_path / "x.skops")]) == 2
+    assert "internal error" not in capsys.readouterr().err
+    assert not (tmp_path / "x.skops").exists()
+
+
+def test_train_on_a_missing_or_unfinished_data_set_says_so(tmp_path):
+    import zarr
+
+    from recipdyn.diagnosis.train import train
+
+    with pytest.raises(ParameterError, match="no such folder"):
+        train(tmp_path / "nowhere")
+    folder = tmp_path / "interrupted"
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="w")
+    g.create_array("done", shape=(6,), chunks=(1,), dtype=bool, fill_value=False)
+    g["done"][:2] = True
+    with pytest.raises(ParameterError, match=r"unfinished data set \(2 of 6 records\): "
+                                             r"finish it with .*--resume"):  # fmt: skip
+        train(folder)

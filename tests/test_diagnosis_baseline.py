@@ -156,7 +156,7 @@ def test_the_commands_refuse_bad_input_in_one_line(tmp_path, monkeypatch, capsys
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "m.csv").write_text("x\n")
-    (tmp_path / "r.nc").write_text("")
+    (tmp_path / "r.nc").write_text("not read: the machine file is refused first")
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err

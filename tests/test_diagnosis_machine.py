@@ -67,7 +67,7 @@ def test_the_default_machine_leaves_the_data_set_as_it_was():
     d = Machine.default()
     assert condition_ranges(d) is CONDITIONS and condition_ranges(None) is CONDITIONS
     assert fault_classes(d) == tuple(CLASSES) and healthy_parameters(d) == BASELINE
-    assert all("machine" not in t for t in design(DatasetSpec(n_conditions=2)))
+    assert all("machine" not in t for t in design(DatasetSpec(n_conditions=3)))
 
 
 def test_another_machine_re_derives_its_ranges_fault_values_and_healthy_pins():
@@ -96,7 +96,7 @@ def test_another_machine_re_derives_its_ranges_fault_values_and_healthy_pins():
             assert (c.mild, c.severe) == pytest.approx(
                 (base[c.name].mild * f, base[c.name].severe * f)
             )
-    spec = DatasetSpec(n_conditions=2, levels=(1.0,), classes=("healthy", "ring_leak"),
+    spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"),
                        machine=m.changes())  # fmt: skip
     tasks = design(spec)
     assert all(t["machine"] == dict(m.changes()) for t in tasks)

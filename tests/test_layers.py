@@ -19,7 +19,7 @@ LAYERS = [
     {"units", "config"},  # read the model's parameter schema
     {"integrate"},
     {"analysis"},
-    {"simulate", "io_signal", "sensors"},  # sensors read records
+    {"simulate", "io_signal", "sensors", "chain"},  # sensors read records; chain describes them
     {"plotting", "analyze", "compare", "animate"},
     {"sweep", "features"},  # features reads sweep stores
     {"diagnosis"},  # data sets, diagnosers: simulate + sensors + features, sweep's backends

@@ -290,7 +290,8 @@ def test_analyze_reads_a_sensed_record_and_takes_its_orders_from_the_tacho(sense
 
 @pytest.mark.parametrize("args, name", [
     (["--snr", "loud"], "snr"), (["--damping", "0"], "damping"), (["--bits", "1"], "bits"),
-    (["--resonance", "3kHz"], "resonance"), (["--source", "theta1"], "accelerometer source"),
+    (["--resonance", "3kHz", "--response", "bilinear"], "resonance"),
+    (["--response", "zoh"], "response"), (["--source", "theta1"], "accelerometer source"),
     (["--no-accel", "--no-pressure", "--no-tacho"], "sensors"),
 ])  # fmt: skip
 def test_sense_refuses_bad_values_in_one_line_and_writes_nothing(sensed, tmp_path, capsys,
@@ -338,7 +339,228 @@ def test_a_sensed_record_writes_as_mat_with_every_setting(sensed, tmp_path):
 
     run, _ = sensed
     out = tmp_path / "s.mat"
-    assert main(["sense", str(run), "-o", str(out), "--resonance", "1.5kHz"]) == 0
+    assert main(["sense", str(run), "-o", str(out), "--resonance", "1.5kHz", "--response",
+                 "bilinear"]) == 0  # the bilinear chain states its flank error  # fmt: skip
     mat = loadmat(out, squeeze_me=True)
     assert mat["attrs"]["sensor_accel_guide_resonance_flank_error"].item() > 0
     assert mat["units"]["accel_guide"].item() == "m/s**2" and mat["tacho"].size > 0
+
+
+# ---- the chain's further blocks (recipdyn.chain draws them) ----------------------------------
+
+
+def _old_chain(x, fs, *, resonance, highpass, hp_order, lowpass, lp_order, snr, lo, hi, bits,
+               rng):  # fmt: skip
+    """The conditioning chain as recipdyn recorded it before the chain's further blocks
+    (commit e2fe659, recipdyn/sensors.py: resonance_filter, band_filters, adc, _condition),
+    copied here so that the test compares against the old code, not against itself."""
+    from scipy.signal import bilinear, butter, lfilter, lfilter_zi, sosfilt, sosfilt_zi
+
+    y = np.asarray(x, dtype=float)
+    if resonance is not None:
+        c, wn = 2 * fs, 2 * np.pi * resonance[0]
+        wp = c * math.tan(wn / c)
+        b, a = bilinear([wp**2], [1.0, 2 * resonance[1] * wp, wp**2], fs=fs)
+        y, _ = lfilter(b, a, y, zi=lfilter_zi(b, a) * y[0])
+    sos = []
+    if highpass is not None:
+        sos.append(butter(hp_order, highpass, "highpass", fs=fs, output="sos"))
+    sos.append(butter(lp_order, lowpass, "lowpass", fs=fs, output="sos"))
+    sos = np.concatenate(sos)
+    y, _ = sosfilt(sos, y, zi=sosfilt_zi(sos) * y[0])
+    if snr is not None:
+        sigma = float(np.sqrt(np.mean(y**2))) * 10.0 ** (-snr / 20.0)
+        y = y + sigma * rng.standard_normal(y.size)
+    lsb = (hi - lo) / 2.0**bits
+    code = np.clip(np.round((y - lo) / lsb), 0, 2.0**bits - 1)
+    return code * lsb + lo
+
+
+@pytest.mark.parametrize("resonance_hz, snr", [(4000.0, 40.0), (3100.0, 20.0), (4450.0, 10.0)])
+def test_the_chain_of_earlier_versions_records_to_the_bit(resonance_hz, snr):
+    """Keep the old chain as one point of the new: the sensors' defaults (the data set's fixed
+    chain: a condition's resonance at its SNR, the pressure transducers, the tacho) give the
+    channels of the code before the chain's further blocks, equal to the bit (same
+    operations in the same order; the noise from the same streams)."""
+    import zlib
+
+    fs, n = 11_000.0, 12_000
+    ds = _record(fs, n, a=lambda t: 300 * np.sin(2 * np.pi * 37 * t) + 2e3 * (np.sin(
+        2 * np.pi * 3.1 * t) > 0.995), theta1=lambda t: 0.3 + 20.0 * t,
+        p_head=lambda t: 2e5 + 1e5 * np.sin(20 * t), p_crank=lambda t: 2e5 - 1e5 * np.cos(20 * t),
+    )  # fmt: skip
+    seed = 123
+    out = record(ds, accelerometer=Accelerometer(snr_db=snr, resonance_hz=resonance_hz),
+                 pressure=PressureTransducer(), tacho=Tacho(), seed=seed)  # fmt: skip
+
+    def rng(name):
+        return np.random.default_rng([seed, zlib.crc32(name.encode())])
+
+    want = _old_chain(ds.a.values, fs, resonance=(resonance_hz, 0.05), highpass=1.0, hp_order=2,
+                      lowpass=0.4 * fs, lp_order=4, snr=snr, lo=-500 * 9.80665,
+                      hi=500 * 9.80665, bits=16, rng=rng("accel_guide"))  # fmt: skip
+    np.testing.assert_array_equal(out["accel_guide"].values, want)
+    for src in ("p_head", "p_crank"):
+        x = ds[src].values
+        top = 1.25 * float(np.max(x))
+        e = 10.0 ** math.floor(math.log10(top))
+        top = next(m * e for m in (1, 2, 5, 10) if m * e >= top)
+        want = _old_chain(x, fs, resonance=None, highpass=None, hp_order=2, lowpass=0.4 * fs,
+                          lp_order=4, snr=60.0, lo=0.0, hi=top, bits=16,
+                          rng=rng(f"{src}_sensor"))  # fmt: skip
+        np.testing.assert_array_equal(out[f"{src}_sensor"].values, want)
+    tach = np.where(np.mod(ds.theta1.values, 2 * np.pi) < np.deg2rad(10.0), 5.0, 0.0)
+    np.testing.assert_array_equal(out["tacho"].values, tach)
+
+
+def _fit(y, fs, f, sl, *, mean=False):
+    """Amplitude and phase (rad) of the sine at ``f`` in ``y[sl]`` (least squares; with
+    ``mean``, also the constant)."""
+    t = np.arange(y.size)[sl] / fs
+    m = np.c_[np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t), np.ones_like(t)]
+    c = np.linalg.lstsq(m, y[sl], rcond=None)[0]
+    out = math.hypot(c[0], c[1]), math.atan2(-c[1], c[0])
+    return (*out, c[2]) if mean else out
+
+
+@pytest.mark.parametrize("fn, f", [(4000.0, 1234.5), (4000.0, 3987.0), (25_000.0, 3000.0)])
+def test_the_exact_response_is_the_closed_form_at_any_frequency(fn, f):
+    """``response="exact"``: a sine's steady amplitude and phase equal the continuous-time
+    closed form, resonance times the analog Butterworth low-pass, at any frequency -- near
+    the resonance at 0.4 fs, where the bilinear flank is 20 % off, and for a stud mount's
+    resonance at 25 kHz, above the record's Nyquist frequency (its flank only). The record
+    is read as band-limited and padded with twelve decay times (residual e^-12); the sine
+    does not fit the record's length, so the bound is the fit over a window of whole
+    periods in the record's middle: 1e-6."""
+    from scipy.signal import butter, freqs
+
+    fs, n, zeta, fc = 10e3, 20_000, 0.05, 4500.0
+    ds = _record(fs, n, a=lambda t: np.cos(2 * np.pi * f * t))
+    s = Accelerometer(**(CLEAN | dict(resonance_hz=fn, damping=zeta, lowpass_hz=fc,
+                                      response="exact")))  # fmt: skip
+    y = record(ds, accelerometer=s)["accel_guide"].values
+    w, wn = 2 * np.pi * f, 2 * np.pi * fn
+    h = wn**2 / (wn**2 - w**2 + 2j * zeta * wn * w)
+    b, a = butter(4, 2 * np.pi * fc, analog=True)
+    h *= freqs(b, a, worN=[w])[1][0]
+    periods = int(8000 * f / fs)
+    sl = slice(6000, 6000 + int(round(periods * fs / f)))
+    amp, ph = _fit(y, fs, f, sl)
+    assert amp == pytest.approx(abs(h), rel=1e-6)
+    assert math.remainder(ph - np.angle(h), 2 * np.pi) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_delay_gain_offset_and_zero_phase_are_their_closed_forms():
+    """A band-limited fractional delay of 2.37 samples gives cos(w (t - d)) (1e-6 in the
+    middle); gain and offset give g x + o; a zero-phase low-pass keeps the phase (0 to 1e-6)
+    and applies the Butterworth magnitude 1/sqrt(1 + (f/fc)^8)."""
+    fs, n, f = 10e3, 20_000, 777.0
+    ds = _record(fs, n, a=lambda t: np.cos(2 * np.pi * f * t))
+    sl = slice(6000, 6000 + int(round(int(8000 * f / fs) * fs / f)))
+    d = 2.37 / fs
+    s = Accelerometer(**(CLEAN | dict(lowpass_hz=None, response="exact", delay_s=d)))
+    y = record(ds, accelerometer=s)["accel_guide"].values
+    lp = 1 / math.sqrt(1 + (f / (0.4 * fs)) ** 8)  # the default 4th-order low-pass at 0.4 fs
+    amp, ph = _fit(y, fs, f, sl)
+    from scipy.signal import butter, freqs
+
+    b, a = butter(4, 2 * np.pi * 0.4 * fs, analog=True)
+    h = freqs(b, a, worN=[2 * np.pi * f])[1][0]
+    assert amp == pytest.approx(lp, rel=1e-6)
+    assert math.remainder(ph - (np.angle(h) - 2 * np.pi * f * d), 2 * np.pi) == pytest.approx(
+        0.0, abs=1e-6)  # fmt: skip
+    z = Accelerometer(**(CLEAN | dict(response="exact", lowpass_phase="zero", gain=1.03,
+                                      offset=0.25)))  # fmt: skip
+    y = record(ds, accelerometer=z)["accel_guide"].values
+    amp, ph, c = _fit(y, fs, f, sl, mean=True)
+    assert amp == pytest.approx(1.03 * lp, rel=1e-6) and ph == pytest.approx(0.0, abs=1e-6)
+    assert c == pytest.approx(0.25, abs=1e-6)
+
+
+def test_hum_and_drift_add_their_lines():
+    """Hum at -30 dB with harmonics (1, 0.2, 0.5) of 60 Hz: least-squares lines at 60, 120,
+    180 Hz of 10^(-30/20) (1, 0.2, 0.5) times the band-limited signal's RMS (the pure 37 Hz
+    sine's 1/sqrt 2), to 1e-9; a drift of 0.4 at 0.1 Hz (no high-pass) is the record minus
+    the same record without it, a sine of that amplitude and frequency (1e-9)."""
+    fs, n = 6000.0, 60_000
+    ds = _record(fs, n, a=lambda t: np.sin(2 * np.pi * 37 * t))
+    base = dict(CLEAN, response="exact", lowpass_hz=2500.0)
+    hum = Accelerometer(**(base | dict(hum_db=-30.0, hum_harmonics=(1.0, 0.2, 0.5),
+                                       mains_hz=60.0)))  # fmt: skip
+    y = record(ds, accelerometer=hum, seed=4)["accel_guide"].values
+    clean = record(ds, accelerometer=Accelerometer(**base))["accel_guide"].values
+    rms = float(np.sqrt(np.mean(clean**2)))
+    for k, rel in ((1, 1.0), (2, 0.2), (3, 0.5)):
+        amp, _ = _fit(y - clean, fs, 60.0 * k, slice(0, n))
+        assert amp == pytest.approx(rms * 10 ** (-1.5) * rel, rel=1e-9)
+    drift = Accelerometer(**(base | dict(drift=0.4, drift_hz=0.1)))
+    y = record(ds, accelerometer=drift, seed=4)["accel_guide"].values
+    amp, _ = _fit(y - clean, fs, 0.1, slice(0, n))
+    assert amp == pytest.approx(0.4, rel=1e-6)
+    assert np.max(np.abs(y - clean)) <= 0.4 * (1 + 1e-6)
+
+
+def test_pressure_offsets_gains_and_passage_resonance_per_chamber():
+    """Per-chamber gain and offset: each channel is g_i p_i + o_i (clean chain, exact, no
+    low-pass effect at 3 Hz: 1e-9 relative); a passage resonance at 1.5 kHz (damping 0.1)
+    multiplies a 1.5 kHz pressure ripple by 1/(2 zeta) = 5 at -90 degrees (closed form of the
+    exact response, times the low-pass's gain)."""
+    fs, n = 10e3, 20_000
+    ds = _record(fs, n, p_head=lambda t: 2e5 + 1e5 * np.sin(20 * t),
+                 p_crank=lambda t: 2e5 - 1e5 * np.sin(20 * t))  # fmt: skip
+    s = PressureTransducer(snr_db=None, bits=None, response="exact", gain=(1.01, 0.99),
+                           offset=(5e3, -3e3), lowpass_hz=4000.0, lowpass_phase="zero")  # fmt: skip
+    out = record(ds, accelerometer=None, pressure=s)
+    for src, g, o in (("p_head", 1.01, 5e3), ("p_crank", 0.99, -3e3)):
+        np.testing.assert_allclose(out[f"{src}_sensor"].values[2000:-2000],
+                                   g * ds[src].values[2000:-2000] + o, rtol=1e-7)  # fmt: skip
+        assert out[f"{src}_sensor"].attrs["sensor_offset"] == o
+    ripple = _record(fs, n, p_head=lambda t: 2e5 + 1e3 * np.cos(2 * np.pi * 1500 * t))
+    r = PressureTransducer(snr_db=None, bits=None, response="exact", resonance_hz=1500.0,
+                           damping=0.1, lowpass_hz=None)  # fmt: skip
+    y = record(ripple, accelerometer=None, pressure=r)["p_head_sensor"].values
+    lp = 1 / math.sqrt(1 + (1500 / 4000) ** 8)
+    sl = slice(6000, 6000 + 8 * 500 * 2)
+    amp, ph = _fit(y, fs, 1500.0, sl)
+    assert amp == pytest.approx(1e3 * 5 * lp, rel=1e-4)
+
+
+@pytest.mark.parametrize("polarity", ["positive", "negative"])
+def test_tacho_polarity_baseline_jitter_and_noise(polarity):
+    """The tacho's further settings: the pulse lies ``high`` from the baseline on its side;
+    each mark moves by its revolution's jitter (the edges read by tacho_times within one
+    sample of the crossings of 2 pi k + delta_k, whose scatter has the jitter's standard
+    deviation within its sampling error); white noise of the given deviation (its robust
+    estimate within 5 %)."""
+    fs, n, w = 10e3, 100_000, 2 * np.pi * 5.0
+    ds = _record(fs, n, theta1=lambda t: 0.3 + w * t, a=lambda t: 0 * t)
+    s = Tacho(baseline=-8.0, high=4.0, polarity=polarity, jitter_deg=2.0, width_deg=20.0)
+    out = record(ds, accelerometer=None, tacho=s, seed=9)
+    y = out["tacho"].values
+    level = -4.0 if polarity == "positive" else -12.0
+    assert set(np.unique(y)) == {-8.0, level}
+    e = tacho_times(y, fs)
+    ideal = (2 * np.pi * np.arange(1, e.size + 1) - 0.3) / w
+    dev = (e - ideal) * w  # the jitter, rad (each within a sample)
+    assert np.std(np.rad2deg(dev)) == pytest.approx(2.0, rel=3 / math.sqrt(2 * e.size))
+    noisy = record(ds, accelerometer=None, tacho=Tacho(noise_std=0.05), seed=9)["tacho"].values
+    quiet = noisy[np.mod(ds.theta1.values, 2 * np.pi) > 0.5]
+    assert 1.4826 * np.median(np.abs(quiet - np.median(quiet))) == pytest.approx(0.05, rel=0.05)
+
+
+def test_sense_refuses_what_is_not_a_simulated_run(tmp_path, capsys):
+    """Issue 44, item 4 (its class of defect in `sense`): a NetCDF file that no simulation
+    wrote was refused naming the accelerometer's source, a CSV file as unreadable NetCDF;
+    both now say what sense reads and what to do with a measured signal."""
+    from recipdyn.cli import main
+
+    foreign, csv = tmp_path / "measured.nc", tmp_path / "measured.csv"
+    xr.Dataset({"a": ("time", np.zeros(8))}, coords={"time": np.arange(8) / 1e3}).to_netcdf(foreign)
+    csv.write_text("time,a\n0,1\n0.001,2\n")
+    for path, words in ((foreign, "not a run of 'recipdyn simulate'"),
+                        (csv, "sense reads a run of 'recipdyn simulate' (.nc)")):  # fmt: skip
+        out = tmp_path / "o" / "x.nc"
+        assert main(["sense", str(path), "-o", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert words in err and f"recipdyn analyze {path}" in err and "\n" not in err, err
+        assert not out.parent.exists()

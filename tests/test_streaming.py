@@ -217,3 +217,22 @@ def test_features_of_a_whole_file_longer_than_memory_is_refused_with_the_remedy(
     code = main(["features", str(p), "--fs", "5kHz", "--max-memory-samples", "20000",
                  "--window", "2 s", "-o", str(out), "--no-progress"])  # fmt: skip
     assert code == 0 and len(out.read_text().strip().splitlines()) == 1 + n // 10_000
+
+
+def test_a_tacho_column_that_is_no_pulse_train_is_refused_naming_it(tmp_path):
+    """features --window with --tacho: a pulse missing from the tacho column is refused with
+    the column's name and the reason (read block by block, checked as tacho_times checks)."""
+    import pandas as pd
+
+    from recipdyn.errors import ParameterError
+    from recipdyn.features import file_features
+
+    fs, n = 2000.0, 8000
+    revs = 11.3 * np.arange(n) / fs + 0.37
+    key = 5.0 * ((revs % 1.0) < 0.1)
+    key[(revs > 20.5) & (revs < 21.5)] = 0.0
+    p = tmp_path / "m.csv"
+    acc = np.sin(2 * np.pi * revs)
+    pd.DataFrame({"time": np.arange(n) / fs, "acc": acc, "key": key}).to_csv(p, index=False)
+    with pytest.raises(ParameterError, match=r"tacho 'key': .*pulse missed"):
+        file_features(p, column="acc", window="0.365 s", tacho="key")

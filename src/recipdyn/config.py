@@ -25,7 +25,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from .defaults import SIMULATION
-from .model.parameters import SCHEMA, CompressorParams, ParameterError, resolve_name
+from .model.parameters import (
+    PIN_SPELLINGS,
+    SCHEMA,
+    CompressorParams,
+    ParameterError,
+    resolve_name,
+)
+from .model.protocol import Derived
 from .units import to_si
 
 if TYPE_CHECKING:
@@ -121,6 +128,8 @@ def build_params(values: dict[str, Any], base: CompressorParams | None = None) -
                 kw[name] = read_load_table(v)
         elif _optional(name) and (v is None or str(v).lower() in ("default", "none")):
             kw[name] = None  # derived by the model (theta_c0, motor_torque)
+        elif isinstance(v, Derived):
+            kw[name] = v  # (a record's derived value, in SI: derived again)
         else:
             kw[name] = to_si(name, v)
     params = dataclasses.replace(base or CompressorParams(), **kw)
@@ -173,6 +182,9 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
     schema = model.schema_for(values)
     out: dict[str, Any] = {}
     for k, v in values.items():
+        if k in PIN_SPELLINGS and k not in schema.names:  # (the compressor's pins, spelt
+            out[k] = str(v)  # the older way: the model reads them into its selectors)
+            continue
         if k in ("load_table", "pressure_table") and k not in schema.names:
             # a table (rows) or its file beside the schema: the model's parameters() reads it
             # or refuses it
@@ -180,7 +192,8 @@ def model_values(model, values: dict[str, Any]) -> dict[str, Any]:
             continue
         name = schema.resolve(k)
         p = schema[name]
-        out[p.name] = str(v) if p.choices is not None else to_si(p.name, v, unit=p.unit)
+        out[p.name] = (str(v) if p.choices is not None else v if isinstance(v, Derived)
+                       else to_si(p.name, v, unit=p.unit))  # fmt: skip
     return model.parameters(out)
 
 
@@ -215,6 +228,8 @@ def dump_config(model, values: dict[str, Any], settings: dict[str, Any], *,
         comment = f"  # {p.unit or '-'}; {p.description}; allowed {rng}{note}"
         if v is None:
             lines.append(f"# {p.name} = (derived by the model){comment}")
+        elif isinstance(v, Derived):  # (commented: it follows what it derives from)
+            lines.append(f"# {p.name} = {_toml_value(v)} (derived: {p.derive}){comment}")
         else:
             lines.append(f"{p.name} = {_toml_value(v)}{comment}")
     for name in model.schema.extras:  # values without a schema row: a table as rows

@@ -351,9 +351,12 @@ def _tacho_pulses(path, tacho, fs, progress) -> np.ndarray:
     for block in blocks:
         try:
             edges.feed(block)
-        except ValueError as exc:  # a flat first block
+        except ValueError as exc:  # a flat first block, or no pulses standing out of it
             raise ParameterError(f"tacho {tacho!r}: {exc}") from None
-    pulses = edges.times()
+    try:
+        pulses = edges.times()
+    except ValueError as exc:  # not a once-per-revolution train
+        raise ParameterError(f"tacho {tacho!r}: {exc}") from None
     if pulses.size < 3:
         raise ParameterError(f"tacho {tacho!r}: {pulses.size} pulses; at least 3 needed")
     return pulses

@@ -102,6 +102,10 @@ def _fs_from_time(t, path, name) -> float:
     return 1.0 / float(np.median(dt))
 
 
+#: The most names a refusal lists (then: the closest ones, the first ones and the count).
+_LISTED = 12
+
+
 def _pick(names, column, path, kind="column"):
     """The chosen column name among ``names`` (by name or index)."""
     names = list(names)
@@ -119,6 +123,13 @@ def _pick(names, column, path, kind="column"):
     if i is not None and 0 <= i < len(names):
         return names[i]
     allowed = ", ".join(map(str, names))
+    if len(names) > _LISTED:  # (a record's hundred outputs: the closest and the first ones)
+        from .model.protocol import close_matches
+
+        close = close_matches(str(column), map(str, names))
+        first = [str(n) for n in names if str(n) not in close][: _LISTED - len(close)]
+        allowed = (f"{', '.join(close)} (the closest), " if close else "") + \
+            f"{', '.join(first)}, ... ({len(names)} {kind}s in all)"  # fmt: skip
     raise ParameterError(f"column: {column!r} not in {path}; allowed: {allowed} or an index "
                          f"0..{len(names) - 1}")  # fmt: skip
 
@@ -142,17 +153,10 @@ def _table(frame, path, column, fs):
     return frame[name].to_numpy(dtype=float), fs, str(name), notes
 
 
-def read_signal(
-    path: str | Path, *, column=None, fs=None, rows: int | None = None
-) -> MeasuredSignal:
-    """Read one channel of ``path`` (its first ``rows`` samples only, if given: CSV/TSV/TXT
-    parse only those lines, Parquet its first batch, WAV and NPY are memory-mapped, NetCDF
-    sliced lazily; MAT files are read whole and cut).
-
-    ``column``: column name or index (CSV, Parquet), variable name (MAT, NetCDF), channel
-    index (WAV). ``fs``: sampling rate (number in Hz or text with units); needed unless the
-    file gives it (a time column, the WAV header, an ``fs`` variable in a MAT file, the time
-    coordinate of a NetCDF variable); a given ``fs`` overrides the file's."""
+def check_signal_file(path: str | Path) -> Path:
+    """``path`` if it can be a signal file (it exists, is a file, is not empty, has a known
+    extension); else [`ParameterError`][recipdyn.errors.ParameterError] in one line. Cheap:
+    commands check their input file with it before anything else about it."""
     path = Path(path)
     if not path.exists():
         raise ParameterError(f"input {path}: file not found")
@@ -165,6 +169,42 @@ def read_signal(
     if suffix not in SIGNAL_SUFFIXES:
         raise ParameterError(f"input {path}: unknown format {suffix!r}; allowed: "
                              f"{', '.join(SIGNAL_SUFFIXES)}")  # fmt: skip
+    return path
+
+
+def _unsensed(ds, path: Path, column) -> None:
+    """Refuse a column a simulated record (the model's outputs, ``recipdyn simulate``) does
+    not hold, pointing at what makes the sensors' channels from it (``recipdyn sense``)."""
+    simulated = str(ds.attrs.get("title", "")).startswith("recipdyn simulation")
+    if column is None or not simulated or "sensor_channels" in ds.attrs:
+        return
+    names = [str(k) for k, v in ds.data_vars.items() if v.ndim == 1]
+    if str(column) in names:
+        return
+    from .model.protocol import close_matches
+
+    close = close_matches(str(column), names)
+    hint = f" (or one of its outputs: {', '.join(close)} ...)" if close else ""
+    raise ParameterError(
+        f"{path}: a simulated record (model {ds.attrs.get('model', '?')!r}) holds the "
+        f"model's {len(names)} outputs, not the sensor channel {column!r}: run 'recipdyn "
+        f"sense {path} -o SENSED.nc' first and read SENSED.nc{hint}"
+    )
+
+
+def read_signal(
+    path: str | Path, *, column=None, fs=None, rows: int | None = None
+) -> MeasuredSignal:
+    """Read one channel of ``path`` (its first ``rows`` samples only, if given: CSV/TSV/TXT
+    parse only those lines, Parquet its first batch, WAV and NPY are memory-mapped, NetCDF
+    sliced lazily; MAT files are read whole and cut).
+
+    ``column``: column name or index (CSV, Parquet), variable name (MAT, NetCDF), channel
+    index (WAV). ``fs``: sampling rate (number in Hz or text with units); needed unless the
+    file gives it (a time column, the WAV header, an ``fs`` variable in a MAT file, the time
+    coordinate of a NetCDF variable); a given ``fs`` overrides the file's."""
+    path = check_signal_file(path)
+    suffix = path.suffix.lower()
     fs = _fs_option(fs)
     notes: list[str] = []
     units = ""
@@ -232,6 +272,7 @@ def read_signal(
                     ds = read_dataset(path, expected="a NetCDF file with a 1-D signal")
                 else:  # lazily: only the first rows are read from disk
                     ds = stack.enter_context(xr.open_dataset(path))
+                _unsensed(ds, path, column)
                 names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
                 name = _pick(names, column, path, "variable")
                 da = ds[name]
@@ -396,6 +437,7 @@ def record_length(path: str | Path, *, column=None) -> int | None:
             import xarray as xr
 
             with xr.open_dataset(path) as ds:
+                _unsensed(ds, path, column)
                 names = [k for k, v in ds.data_vars.items() if v.ndim == 1]
                 return int(ds[_pick(names, column, path, "variable")].shape[0])
     except ParameterError:

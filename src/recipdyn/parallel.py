@@ -79,6 +79,26 @@ def stop_pool(pool: ProcessPoolExecutor, timeout: float = 5.0) -> None:
 POLL = 0.2
 
 
+def _with_warnings(fn: Callable[[Any], Any], task: Any) -> tuple[Any, list]:
+    """``fn(task)`` in a worker, and the warnings it raised (category and text): they are
+    raised again in the coordinating process, which says them (the workers' own standard
+    error would print them with their source lines in the middle of its progress bars)."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:  # (the worker's filters apply)
+        result = fn(task)
+    return result, [(w.category, str(w.message), w.filename, w.lineno) for w in caught]
+
+
+def _raise_again(caught: list, registry: dict) -> None:
+    """Raise a worker's warnings here, where they were raised there (file and line: this
+    process's filters see the same origin); ``registry``: one run's, so each is said once."""
+    import warnings
+
+    for category, text, filename, lineno in caught:
+        warnings.warn_explicit(text, category, filename, lineno, registry=registry)
+
+
 def run_unordered(fn: Callable[[Any], Any], tasks: Iterable, workers: int,
                   on_result: Callable[[Any], None], pending) -> None:  # fmt: skip
     """``fn(task)`` for every task on a pool of ``workers`` processes.
@@ -87,9 +107,11 @@ def run_unordered(fn: Callable[[Any], Any], tasks: Iterable, workers: int,
     per worker are queued (bounded memory for huge task lists); ``pending.check()`` (from
     [`recipdyn.errors.deferred_signals`][recipdyn.errors.deferred_signals]) runs between results, so
     a signal stops the work promptly. On any exception or interruption the pool is stopped
-    ([`stop_pool`][recipdyn.parallel.stop_pool]).
+    ([`stop_pool`][recipdyn.parallel.stop_pool]). The warnings a task raises in its worker are
+    raised again here, before its result is handed on (`_with_warnings`).
     """
     pool = process_pool(workers)
+    registry: dict = {}
     try:
         it = iter(tasks)
         in_flight: set = set()
@@ -97,14 +119,16 @@ def run_unordered(fn: Callable[[Any], Any], tasks: Iterable, workers: int,
         while True:
             while not exhausted and len(in_flight) < 2 * workers:
                 try:
-                    in_flight.add(pool.submit(fn, next(it)))
+                    in_flight.add(pool.submit(_with_warnings, fn, next(it)))
                 except StopIteration:
                     exhausted = True
             if not in_flight:
                 break
             finished, in_flight = wait(in_flight, timeout=POLL, return_when=FIRST_COMPLETED)
             for fut in finished:
-                on_result(fut.result())
+                result, caught = fut.result()
+                _raise_again(caught, registry)
+                on_result(result)
             pending.check()
     except BaseException:
         stop_pool(pool)

@@ -136,48 +136,50 @@ class StreamingWelch:
 
 
 class TachoEdges:
-    """Rising edges of a once-per-revolution pulse channel fed block by block: the rule of
-    [`recipdyn.analysis.vibration.tacho_times`][recipdyn.analysis.vibration.tacho_times] (threshold
-    halfway between the 5th and 95th percentiles, or the minimum and maximum for narrow pulses; an
-    edge re-arms after a fall ``hysteresis`` of the span below the threshold), with the levels taken
-    from the first block (which must hold a few revolutions) and the re-arm state carried across
-    blocks, so an edge on a block boundary counts once."""
+    """Leading edges of a once-per-revolution pulse channel fed block by block: the rule of
+    [`recipdyn.analysis.vibration.tacho_times`][recipdyn.analysis.vibration.tacho_times] (the
+    levels, polarity and noise of
+    [`tacho_levels`][recipdyn.analysis.vibration.tacho_levels], a half-way trigger, an edge
+    re-armed once the signal has passed back through the re-arm level), with the levels taken
+    from the first block (which must hold a few revolutions) and the re-arm state carried
+    across blocks, so an edge on a block boundary counts once; `times` checks the train as
+    ``tacho_times`` does."""
 
-    def __init__(self, fs: float, *, hysteresis: float = 0.1) -> None:
-        self.fs, self.hysteresis = float(fs), float(hysteresis)
+    def __init__(self, fs: float, *, hysteresis: float = 0.1, polarity: str = "auto",
+                 max_speed_hz: float = 100.0) -> None:  # fmt: skip
+        self.fs, self.hysteresis, self.polarity = float(fs), float(hysteresis), polarity
+        self.max_speed_hz = float(max_speed_hz)
+        self.levels = None
         self.threshold: float | None = None
-        self._rearm = 0.0
         self._armed = True
         self._last = math.nan
         self._offset = 0  # index of the block's first sample in the record
         self._edges: list[float] = []
 
     def feed(self, block) -> None:
+        from .vibration import _leading_edges, tacho_levels
+
         v = np.asarray(block, dtype=float).ravel()
         if v.size == 0:
             return
-        if self.threshold is None:
-            lo, hi = np.percentile(v, [5, 95])
-            if hi <= lo:
-                lo, hi = float(np.min(v)), float(np.max(v))
-            if hi <= lo:
+        if self.levels is None:
+            if not np.ptp(v) > 0:
                 raise ValueError("tacho channel is flat in its first block: no pulses")
-            self.threshold = 0.5 * (lo + hi)
-            self._rearm = self.threshold - self.hysteresis * (hi - lo)
+            self.levels = tacho_levels(v, polarity=self.polarity, hysteresis=self.hysteresis)
+            self.threshold = self.levels.threshold
         w = np.r_[self._last, v]  # the previous block's last sample: edges across the seam
-        thr, rearm = self.threshold, self._rearm
-        ups = np.flatnonzero((w[1:] >= thr) & (w[:-1] < thr)) + 1
-        downs = np.flatnonzero((w[1:] < rearm) & (w[:-1] >= rearm)) + 1
-        for i, is_up in sorted([(int(u), True) for u in ups] + [(int(d), False) for d in downs]):
-            if not is_up:
-                self._armed = True
-            elif self._armed:
-                frac = (thr - w[i - 1]) / (w[i] - w[i - 1])
-                self._edges.append((self._offset + i - 2 + frac) / self.fs)
-                self._armed = False
+        if self._offset == 0:
+            w = w[1:]
+        edges, self._armed = _leading_edges(w, self.levels, self.fs,
+                                            offset=self._offset - (self._offset > 0),
+                                            armed=self._armed)  # fmt: skip
+        self._edges.extend(edges)
         self._last = float(v[-1])
         self._offset += v.size
 
     def times(self) -> np.ndarray:
         """Edge times (s from the record's first sample)."""
+        from .vibration import check_pulse_train
+
+        check_pulse_train(self._edges, max_speed_hz=self.max_speed_hz)
         return np.array(self._edges)

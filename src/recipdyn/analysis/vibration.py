@@ -20,6 +20,7 @@ with ``zones=`` from your copy of the standard).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,8 +30,9 @@ from scipy.stats import kurtosis, skew
 from .checks import as_signal
 from .spectrum import Spectrum, amplitude_spectrum, find_spectral_peaks
 
-__all__ = ["tacho_times", "crank_angle", "angle_resample", "order_spectrum_angle",
-           "spectrogram", "campbell", "envelope_spectrum", "cepstrum", "band_rms",
+__all__ = ["tacho_times", "tacho_levels", "TachoLevels", "check_pulse_train", "crank_angle",
+           "angle_resample", "order_spectrum_angle", "spectrogram", "campbell",
+           "envelope_spectrum", "cepstrum", "band_rms",
            "velocity_rms", "zone", "indicators", "Impact", "detect_impacts",
            "ISO20816_8_BAND_HZ", "vibration_report", "resonance_band",
            "impact_pattern"]  # fmt: skip
@@ -39,33 +41,179 @@ __all__ = ["tacho_times", "crank_angle", "angle_resample", "order_spectrum_angle
 ISO20816_8_BAND_HZ = (2.0, 1000.0)
 
 
-def tacho_times(tacho, fs: float, *, threshold: float | None = None,
-                hysteresis: float = 0.1) -> np.ndarray:  # fmt: skip
-    """Times (s) of the rising edges of a pulse channel, interpolated between samples.
+#: Smallest pulse height, in standard deviations of the levels' noise, at which a pulse train
+#: is read: the trigger sits half a height, six or more standard deviations, from either
+#: level, so white Gaussian noise crosses it falsely with probability 1e-9 per sample or
+#: less (1e-4 over a record of 1e5 samples); below it the channel is refused.
+TACHO_MIN_HEIGHT_SIGMAS = 12.0
 
-    ``threshold`` defaults to halfway between the 5th and 95th percentiles (robust to spikes),
-    or between the minimum and the maximum when the pulses are narrower than 5 % of the
-    revolution (a keyphasor notch: the percentiles then both lie on the baseline); an edge
-    re-arms only after the signal falls ``hysteresis`` (a fraction of that span) below it, so
-    noise on a slow edge does not count twice."""
+
+@dataclass(frozen=True)
+class TachoLevels:
+    """A pulse channel's two levels and the thresholds read from them (`tacho_levels`):
+    ``baseline`` and ``pulse`` levels, the ``noise``'s standard deviation, ``polarity`` +1
+    (the pulse above the baseline) or -1, the trigger ``threshold`` (half-way) and the
+    ``rearm`` level the signal must pass back through before the next edge counts."""
+
+    baseline: float
+    pulse: float
+    noise: float
+    polarity: int
+    threshold: float
+    rearm: float
+
+    @property
+    def height(self) -> float:
+        return abs(self.pulse - self.baseline)
+
+
+def _otsu_split(v: np.ndarray, bins: int = 4096) -> float:
+    """The value that splits ``v`` into two classes of largest between-class variance (Otsu
+    1979), over a histogram of ``bins`` equal bins spanning the samples: the split lands in
+    the gap between two levels whenever that gap is wider than a bin, 1/4096 of the span."""
+    counts, edges = np.histogram(v, bins=bins)
+    mids = 0.5 * (edges[1:] + edges[:-1])
+    w = np.cumsum(counts)[:-1].astype(float)  # samples at or below each candidate split
+    s = np.cumsum(counts * mids)[:-1]
+    n, total = float(v.size), float(np.sum(counts * mids))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        between = (total * w / n - s) ** 2 / (w * (n - w))
+    between[(w == 0) | (w == n)] = -1.0
+    return float(edges[int(np.argmax(between)) + 1])
+
+
+def tacho_levels(tacho, *, polarity: str = "auto", hysteresis: float = 0.1) -> TachoLevels:
+    """The two levels of a once-per-revolution pulse channel, robustly.
+
+    The noise's standard deviation comes from the sample-to-sample differences
+    (``1.4826 median|diff| / sqrt 2``: a pulse's plateaus do not change from sample to
+    sample and its two edges per revolution are a few samples among thousands, so the
+    estimate holds for any width); the baseline is the level most samples hold (their
+    median), the pulse the median of the samples more than eight noise deviations from it.
+    So a pulse 1 degree wide (0.3 % of the samples) is found as well as one 179 degrees wide,
+    and the polarity (``"auto"``) is the side the minority level lies on; with ``"positive"``
+    or ``"negative"`` the pulse is taken on that side. A channel whose median falls between
+    its levels (a pulse of exactly half a revolution) is split by Otsu's criterion instead.
+    The trigger is half-way between the levels; an edge re-arms once the signal has passed
+    back through ``rearm``, ``max(hysteresis * height, 3 noise)`` short of the trigger.
+
+    Raises ``ValueError`` naming the tacho when the channel is flat or its pulses stand less
+    than `TACHO_MIN_HEIGHT_SIGMAS` noise deviations from the baseline.
+    """
     v = as_signal(tacho, name="tacho", min_samples=3, allow_constant=True)
-    lo, hi = np.percentile(v, [5, 95])
-    if hi <= lo:
-        lo, hi = float(np.min(v)), float(np.max(v))
-    if hi <= lo:
+    span = float(np.ptp(v))
+    if not span > 0:
         raise ValueError("tacho channel is flat: no pulses")
-    thr = 0.5 * (lo + hi) if threshold is None else float(threshold)
-    rearm = thr - hysteresis * (hi - lo)
-    ups = np.flatnonzero((v[1:] >= thr) & (v[:-1] < thr)) + 1
-    downs = np.flatnonzero((v[1:] < rearm) & (v[:-1] >= rearm)) + 1
+    noise = 1.4826 * float(np.median(np.abs(np.diff(v)))) / math.sqrt(2.0)
+    if polarity not in ("auto", "positive", "negative"):
+        raise ValueError(f"tacho polarity = {polarity!r}; allowed: auto, positive, negative")
+    med = float(np.median(v))
+    d = v - med
+    far = np.abs(d) > max(8.0 * noise, 1e-9 * span)
+    up, down = far & (d > 0), far & (d < 0)
+    if polarity == "auto":
+        sign = 1 if np.count_nonzero(up) >= np.count_nonzero(down) else -1
+    else:
+        sign = 1 if polarity == "positive" else -1
+    side = up if sign > 0 else down
+    other = down if sign > 0 else up
+    if np.count_nonzero(other) > 0.1 * max(1, np.count_nonzero(side)) or not side.any():
+        split = _otsu_split(v)  # the median lies between the levels: half duty
+        hi_side = v >= split
+        side = hi_side if sign > 0 else ~hi_side
+        base = float(np.median(v[~side]))
+    else:
+        base = float(np.median(v[~far]))
+    pulse = float(np.median(v[side])) if side.any() else base
+    height = sign * (pulse - base)
+    if not height > 0 or height < TACHO_MIN_HEIGHT_SIGMAS * noise:
+        raise ValueError(
+            f"tacho: no pulse train stands out of the noise (baseline {base:.4g}, pulses at "
+            f"{pulse:.4g}, noise {noise:.3g} standard deviation; the pulses must stand "
+            f"{TACHO_MIN_HEIGHT_SIGMAS:g} deviations from the baseline, on the "
+            f"{'positive' if sign > 0 else 'negative'} side)"
+        )
+    thr = 0.5 * (base + pulse)
+    back = max(hysteresis * height, 3.0 * noise)
+    return TachoLevels(base, pulse, noise, sign, thr, thr - sign * back)
+
+
+def _leading_edges(v: np.ndarray, lv: TachoLevels, fs: float, offset: int = 0,
+                   armed: bool = True) -> tuple[list[float], bool]:  # fmt: skip
+    """Leading-edge times (s) of the pulses in ``v`` (its first sample at index ``offset``)
+    and whether the detector is armed after its last sample. An edge is the crossing of the
+    threshold away from the baseline, interpolated linearly between the two samples; it
+    counts only once the signal has passed back through ``rearm`` since the last one."""
+    w = lv.polarity * (v - lv.threshold)  # > 0 inside a pulse, whatever its polarity
+    r = lv.polarity * (v - lv.rearm)
+    ups = np.flatnonzero((w[1:] >= 0) & (w[:-1] < 0)) + 1
+    downs = np.flatnonzero((r[1:] < 0) & (r[:-1] >= 0)) + 1
+    events = sorted([(int(u), 1) for u in ups] + [(int(d), 0) for d in downs])
     edges = []
-    last = None
-    for u in ups:
-        if last is not None and np.searchsorted(downs, u) == np.searchsorted(downs, last, "right"):
-            continue  # no fall below the re-arm level since the last edge: the same pulse
-        frac = (thr - v[u - 1]) / (v[u] - v[u - 1])
-        edges.append((u - 1 + frac) / fs)
-        last = u
+    for i, is_up in events:
+        if not is_up:
+            armed = True
+        elif armed:
+            frac = -w[i - 1] / (w[i] - w[i - 1])
+            edges.append((offset + i - 1 + frac) / fs)
+            armed = False
+    return edges, armed
+
+
+def check_pulse_train(edges, *, max_speed_hz: float = 100.0, max_step: float = 1.5) -> None:
+    """Refuse (``ValueError``, naming the tacho) edge times that are not a once-per-revolution
+    pulse train: two edges closer than ``1 / max_speed_hz`` (a crank faster than that), or a
+    revolution's period more than ``max_step`` times its neighbour's or less than its
+    inverse (a pulse missed or one too many; a crank does not change its speed by half in a
+    revolution)."""
+    e = np.asarray(edges, dtype=float)
+    if e.size < 2:
+        return
+    d = np.diff(e)
+    if np.min(d) < 1.0 / max_speed_hz:
+        i = int(np.argmin(d))
+        raise ValueError(
+            f"tacho: pulses {d[i] * 1e3:.3g} ms apart at t = {e[i]:.4g} s, a crank speed of "
+            f"{1 / d[i]:.4g} Hz, above the {max_speed_hz:g} Hz a reciprocating machine "
+            "turns at: not a once-per-revolution pulse train (noise or a multi-tooth wheel?)"
+        )
+    if d.size >= 2:
+        ratio = d[1:] / d[:-1]
+        bad = np.flatnonzero((ratio > max_step) | (ratio < 1 / max_step))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"tacho: the revolution after t = {e[i + 1]:.4g} s lasts {d[i + 1] * 1e3:.4g} ms "
+                f"against {d[i] * 1e3:.4g} ms before it: a pulse missed or one too many"
+            )
+
+
+def tacho_times(tacho, fs: float, *, threshold: float | None = None,
+                hysteresis: float = 0.1, polarity: str = "auto",
+                max_speed_hz: float = 100.0) -> np.ndarray:  # fmt: skip
+    """Times (s) of the leading edges of a once-per-revolution pulse channel, interpolated
+    between samples.
+
+    The levels come from `tacho_levels` (Otsu's split of the samples, each level its side's
+    median, the noise their robust spread), so a pulse from about 1 degree wide (as long as
+    it spans a sample or two) to 180 degrees, of either polarity (``polarity="auto"``: the
+    pulse is the level held by fewer samples), is found with noise up to 1/12 of its height
+    (`TACHO_MIN_HEIGHT_SIGMAS`). ``threshold`` replaces the half-way trigger. An edge
+    re-arms only after the signal passes back through the re-arm level (hysteresis: a
+    fraction ``hysteresis`` of the height, or three noise standard deviations if more), so
+    noise on a slow edge does not count twice. The edges must form a pulse train
+    (`check_pulse_train`: no two closer than ``1 / max_speed_hz``, no period 1.5 times its
+    neighbour's or less than its inverse). Raises ``ValueError`` naming the tacho and the
+    reason otherwise.
+    """
+    lv = tacho_levels(tacho, polarity=polarity, hysteresis=hysteresis)
+    if threshold is not None:
+        back = lv.threshold - lv.rearm
+        lv = TachoLevels(lv.baseline, lv.pulse, lv.noise, lv.polarity, float(threshold),
+                         float(threshold) - back)  # fmt: skip
+    v = np.asarray(tacho, dtype=float).ravel()
+    edges, _ = _leading_edges(v, lv, fs)
+    check_pulse_train(edges, max_speed_hz=max_speed_hz)
     return np.array(edges)
 
 

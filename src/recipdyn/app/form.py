@@ -261,6 +261,13 @@ def _owner(message: str, keys: list[str]) -> str | None:
     return None
 
 
+def _derived(f: Field, text: Any) -> bool:
+    """Whether field ``f`` is left to its rule (a default that follows other parameters,
+    ``ls = l / 2``): its text is missing or still its default's."""
+    return bool(f.param is not None and f.param.derive
+                and (text is None or str(text).strip() == f.default_text))  # fmt: skip
+
+
 def read_form(model: Any, texts: dict[str, Any]) -> Form:
     """Read the field ``texts`` (key -> text; missing keys take the default) of ``model``.
 
@@ -281,7 +288,8 @@ def read_form(model: Any, texts: dict[str, Any]) -> Form:
     form.settings = {f.name: raw[f.key] for f in flds if f.key.startswith(RUN) and f.key in raw}
     if form.errors:
         return form
-    values = {f.name: raw[f.key] for f in flds if not f.key.startswith(RUN)}
+    values = {f.name: raw[f.key] for f in flds if not f.key.startswith(RUN)
+              and not _derived(f, texts.get(f.key))}  # fmt: skip
     try:
         # the schema's ranges, then the model's checks across parameters; an empty optional
         # field (None) is derived by the model

@@ -21,6 +21,7 @@ import inspect
 import json
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import typer
@@ -164,14 +165,55 @@ def _err(msg: str) -> None:
     typer.echo(msg, err=True)
 
 
+def say_line(text: str) -> None:
+    """One line on standard error that leaves a running progress bar whole (tqdm's write
+    clears the bar, prints the line and draws the bar again below it)."""
+    if "tqdm" in sys.modules:  # (a bar can only be running once tqdm is loaded)
+        from tqdm import tqdm
+
+        tqdm.write(text, file=sys.stderr)
+    else:
+        typer.echo(text, err=True)
+
+
+@contextlib.contextmanager
+def warnings_said_once() -> Iterator[None]:
+    """Every warning that reaches the user while a command runs is one line, ``warning:
+    TEXT`` (its text on one line; no category, file or source line), through `say_line`, and
+    each text is said once per command: a warning a worker process raised comes back to this
+    process with the worker's result (`recipdyn.parallel.run_unordered`), so a hundred
+    records that warn alike say it once. ``--debug`` shows warnings as Python does."""
+    import warnings
+
+    seen: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        if not category.__module__.startswith("recipdyn"):  # (a library's: where it arose)
+            where = "/".join(Path(str(filename)).parts[-2:])
+            text = f"{text} ({category.__name__} in {where}:{lineno})"
+        if text not in seen:
+            seen.add(text)
+            say_line(f"warning: {text}")
+
+    old = warnings.showwarning
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = old
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the exit status (see the module docstring)."""
     _register()
     raise_on_signals()
 
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    said = contextlib.nullcontext() if debug else warnings_said_once()
     try:
-        rv = app(args=argv, standalone_mode=False)
+        with said:
+            rv = app(args=argv, standalone_mode=False)
     except ParameterError as exc:
         _err(f"error: {exc}")
         return 2

@@ -66,7 +66,15 @@ def dataset(
         help="With --severity-range: records of each class per condition (default: "
         "as many as --levels).",
     ),
-    snr: float = typer.Option(20.0, "--snr", help="Accelerometer SNR, dB."),
+    chain: str = typer.Option(
+        "drawn",
+        "--chain",
+        help="drawn (default): every record's measurement chain drawn from the stated ranges "
+        "(docs/sensors.md); fixed: the one chain of earlier versions (for comparisons).",
+    ),
+    snr: float = typer.Option(
+        None, "--snr", help="Accelerometer SNR, dB, with --chain fixed (default 20)."
+    ),
     snr_range: str = typer.Option(
         None,
         "--snr-range",
@@ -114,10 +122,18 @@ def dataset(
         kw["severity_draws"] = draws
     if snr_range is not None:
         kw["snr_range"] = _snrs(snr_range)
+    if snr is not None and chain != "fixed":
+        from ..errors import ParameterError
+
+        raise ParameterError(
+            "snr: sets the fixed chain's accelerometer SNR; allowed with --chain fixed, or "
+            "give the drawn chain's range with --snr-range LO,HI"
+        )
     spec = DatasetSpec(
         n_conditions=conditions,
         levels=_levels(levels),
-        snr_db=snr,
+        snr_db=20.0 if snr is None else snr,
+        chain=chain,
         revolutions=revolutions,
         transient=transient,
         test_fraction=test_fraction,
@@ -224,7 +240,9 @@ def diagnose(
     closest simulated record overlaid; a record outside the training domain is refused."""
     from ..diagnosis.diagnose import diagnose as diagnose_fn
     from ..errors import ParameterError
+    from ..io_signal import check_signal_file
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     res = diagnose_fn(

@@ -77,12 +77,18 @@ def sense(
     ),  # fmt: skip
     lowpass: str = typer.Option(None, "--lowpass", help="Low-pass corner (default 0.4 fs)."),
     snr: str = typer.Option(
-        None, "--snr", help="Signal-to-noise ratio, e.g. 40dB (default), or none."
+        None, "--snr", help="Signal-to-noise ratio, e.g. 30dB (default), or none."
     ),  # fmt: skip
     full_scale: str = typer.Option(
         None, "--full-scale", help="ADC range +-, e.g. '490 m/s^2' (default 500 g)."
     ),  # fmt: skip
     bits: str = typer.Option(None, "--bits", help="ADC bits (default 16) or none."),
+    response: str = typer.Option(
+        "exact",
+        "--response",
+        help="exact (default: the continuous-time response at every frequency) or bilinear "
+        "(the resonance and filters discretised, as before 0.x; warped near fs/2).",
+    ),  # fmt: skip
     accel: bool = typer.Option(True, "--accel/--no-accel", help="Record the accelerometer."),
     pressure: bool = typer.Option(
         True,
@@ -105,6 +111,7 @@ def sense(
 
     The channels carry their units and every sensor setting (attributes sensor_*); analyze
     them like a measured record: recipdyn analyze OUT.nc -c accel_guide --tacho tacho"""
+    from ..chain import SENSE_DEFAULT
     from ..errors import ParameterError
     from ..io import check_output
     from ..sensors import Accelerometer, PressureTransducer, Tacho
@@ -112,12 +119,16 @@ def sense(
     # every option is checked before the record is read or anything is written
     if not run.exists():
         raise ParameterError(f"run file not found: {run}")
+    if run.suffix.lower() != ".nc":
+        raise ParameterError(f"input {run}: sense reads a run of 'recipdyn simulate' (.nc); "
+                             "a measured signal is analysed as it is: recipdyn analyze "
+                             f"{run}")  # fmt: skip
     if not (accel or pressure or tacho):
         raise ParameterError("sensors: --no-accel, --no-pressure and --no-tacho leave nothing "
                              "to record; allowed: at least one sensor")  # fmt: skip
-    a0, p0 = Accelerometer(), PressureTransducer()
+    a0, p0 = SENSE_DEFAULT.accelerometer, SENSE_DEFAULT.pressure  # inside the data set's ranges
     acc = Accelerometer(
-        source=source, location=location,
+        source=source, location=location, response=response,
         resonance_hz=_quantity("resonance", resonance, "Hz", a0.resonance_hz),
         damping=damping, highpass_hz=_quantity("highpass", highpass, "Hz", a0.highpass_hz),
         lowpass_hz=_quantity("lowpass", lowpass, "Hz", a0.lowpass_hz),
@@ -126,6 +137,7 @@ def sense(
         bits=_bits("bits", bits, a0.bits),
     ) if accel else None  # fmt: skip
     pres = PressureTransducer(
+        response=response,
         lowpass_hz=_quantity("pressure_lowpass", pressure_lowpass, "Hz", p0.lowpass_hz),
         snr_db=_db("pressure_snr", pressure_snr, p0.snr_db),
         full_scale=_quantity("pressure_full_scale", pressure_full_scale, "Pa", p0.full_scale),
@@ -136,7 +148,12 @@ def sense(
         from ..io import read_dataset, write_dataset
         from ..sensors import record
 
-        ds = read_dataset(run)
+        ds = read_dataset(run, expected="a recipdyn run (NetCDF from 'recipdyn simulate')")
+        if not str(ds.attrs.get("title", "")).startswith("recipdyn simulation"):
+            raise ParameterError(f"input {run}: not a run of 'recipdyn simulate' (no model "
+                                 "recorded); sense makes sensor channels from a simulated "
+                                 f"record; a measured signal is analysed as it is: recipdyn "
+                                 f"analyze {run}")  # fmt: skip
         has_p = any(n in ds.data_vars for n in pres.sources)
         res = record(ds, accelerometer=acc, pressure=pres if pressure and has_p else None,
                      tacho=Tacho() if tacho and "theta1" in ds.data_vars else None,

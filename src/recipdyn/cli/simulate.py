@@ -151,52 +151,82 @@ STREAM_AUTO = 1e6
 FIGURE_SAMPLES = 500_000
 
 
-#: First-run compile time per model, said before compiling: the CPU time of `recipdyn warmup
-#: MODEL` with an empty numba cache (the integrator loop, shared by every model, included) on a
-#: 2-core machine, which is its duration when the machine is idle: 21, 41, 64 and 69 s. Other
-#: models: "a few seconds to a minute".
-COMPILE_SECONDS = {"compressor": 20, "compressor-valves": 40, "compressor-contact": 65,
-                   "compressor-contact-valves": 70}  # fmt: skip
+#: CPU seconds the first run of a configuration spends compiling (its kernels before the run,
+#: its outputs' when it records them), by what compiles: the integrator loop (once for every
+#: model), and the model's right-hand side by its module, whose name (a generated glue's: its
+#: configuration) holds the parts that add up. Measured with numba 0.68 on a 2-core machine,
+#: one configuration after another into one empty cache: `time.process_time` of
+#: `recipdyn.integrate.prepare` plus that of a first 0.05-revolution `recipdyn.simulate` less
+#: a second one's (2026-12, this branch): loop 8.6; massless link 2.7 (with a motor 3.2);
+#: its dynamic valves 54.7; contact pins 12.9 (both pins 16.1, a motor 11.2, the worn guide
+#: 48.2, the dynamic valves 127.1); compressor-guide's own kernel 21.5. The wall time is this
+#: on an idle machine; beside six other busy processes it was 3 to 9 times longer (the
+#: contact pins with valves: 457 s).
+COMPILE_CPU = {"recipdyn.integrate.kernels": 9.0, "recipdyn.model.compressor_valves": 55.0,
+               "recipdyn.model.compressor_guide": 22.0, "recipdyn_assembled_compressor_": 3.0,
+               "recipdyn_assembled_contact_": 13.0}  # fmt: skip
+#: What a part of a contact glue's configuration adds (its name holds them).
+COMPILE_CPU_PARTS = {"_valves_": 115.0, "_guide_": 35.0, "contact_both_": 3.0,
+                     "contact_crosshead_": 3.0}  # fmt: skip
 
 
-def _cache_cold(dispatchers) -> bool:
-    """Whether one of these numba dispatchers has no machine code in the on-disk cache yet
-    (its index file is missing), i.e. whether preparing them will compile. numba's cache
-    layout is not public API: if it changes this answers False (nothing said in advance)."""
-    import os
-
-    for fn in dispatchers:
-        cache = getattr(fn, "_cache", None)
-        try:
-            index = cache._cache_file._index_path
-        except AttributeError:  # not a cached dispatcher (NUMBA_DISABLE_JIT, a plain function)
+def compile_seconds(kernels: list[str]) -> float | None:
+    """The CPU seconds a first run spends compiling ``kernels`` (``module.function`` names
+    as `recipdyn.integrate.compiles` gives them; a module's compile counted once), from
+    `COMPILE_CPU`; None if one is not among the measured ones (another model's)."""
+    total = 0.0
+    for module in {k.rpartition(".")[0] for k in kernels}:
+        if module.startswith("recipdyn.model.joints."):  # (a pin's event: with its glue)
             continue
-        if not os.path.exists(index):
-            return True
-    return False
+        base = next((v for k, v in COMPILE_CPU.items() if module.startswith(k)), None)
+        if base is None:
+            return None
+        total += base
+        if module.startswith("recipdyn_assembled_contact_"):
+            total += sum(v for k, v in COMPILE_CPU_PARTS.items() if k in module)
+    return total
 
 
-def compile_note(name: str) -> str:
-    """The line said before a model's kernels are compiled."""
-    secs = COMPILE_SECONDS.get(name)
-    took = f"~{secs} s" if secs else "a few seconds to a minute"
-    return f"compiling the {name} model's kernels (first run only, {took}; 'recipdyn warmup' " \
-        "does it ahead)..."  # fmt: skip
+def _about(seconds: float) -> str:
+    return f"~{seconds:.0f} s" if seconds < 90 else f"~{seconds / 60:.0f} min"
+
+
+def compile_note(name: str, configuration: str, kernels: list[str]) -> str:
+    """The line said before a configuration's kernels are compiled: what, how long (CPU
+    time, `COMPILE_CPU`), that it happens once."""
+    secs = compile_seconds(kernels)
+    took = (f"{_about(secs)} of CPU on a 2-core machine, longer while other programs share "
+            "its cores" if secs else "a few seconds to a few minutes")  # fmt: skip
+    what = f"{name} ({configuration})" if configuration else name
+    return f"compiling the kernels of {what}: {took}; once per configuration, later runs " \
+        "load them ('recipdyn warmup' compiles ahead)..."  # fmt: skip
+
+
+def configuration(m, params) -> str:
+    """The choices of ``params`` away from the model's defaults (``crosshead_joint =
+    contact``): what a configuration's compiled kernels depend on, as text."""
+    schema = m.configured(params).schema
+    chosen = [p for p in schema
+              if p.choices is not None and params.get(p.name, p.default) != p.default]  # fmt: skip
+    return ", ".join(f"{p.name} = {params[p.name]}" for p in chosen)
 
 
 def _prepare(m, params, method: str) -> None:
-    """Load the compiled code a run needs (compile it on the first run), saying so."""
-    from ..integrate import kernels, prepare
+    """Load the compiled code a run needs, or compile it (said before, with its estimate)."""
+    from ..integrate import compiles, prepare
 
     if m.kind == "map":  # iterated, not integrated: nothing to prepare
         return
     system = m.system(params)
-    own = system.acting_event
-    loop = kernels.dop853_kernel if method == "dop853" else kernels.fixed_step_kernel
-    if _cache_cold((loop, system.rhs, getattr(own, "function", None),
-                    getattr(own, "reset", None))):  # fmt: skip
-        typer.echo(compile_note(m.name), err=True)
-    with phase("loading compiled kernels"):
+    todo = compiles(system, method)
+    if todo is None:  # (numba's cache cannot be read: either may happen)
+        label = "preparing compiled kernels (compiling them on a first run)"
+    elif todo:
+        typer.echo(compile_note(m.name, configuration(m, params), todo), err=True)
+        label = "compiling kernels"
+    else:
+        label = "loading compiled kernels"
+    with phase(label):
         prepare(system, method)
 
 

@@ -54,6 +54,8 @@ def sweep(
 ) -> None:
     """Sweep one or two parameters; write OUT/sweep.zarr and the figures."""
     from ..errors import ParameterError
+    from ..io import check_output
+    from ..sweep.spec import split_axis
     from ..units import to_si
     from .simulate import _collect_model, max_memory_bytes
 
@@ -72,22 +74,26 @@ def sweep(
     bad = [x for x in measures if x not in _MEASURES]
     if bad or not measures:
         raise ParameterError(f"--measure {bad or '(none)'}; allowed: {', '.join(_MEASURES)}")
+    for p in params:  # (the axes' syntax and counts; their names need the model)
+        split_axis(p)
     settings = dict(revolutions=revolutions, transient=transient, points=points,
                     lyap_revolutions=lyap_revolutions, fs=to_si("fs", fs), rtol=rtol,
                     atol=atol)  # fmt: skip
     limit = max_memory_bytes(max_memory)
-    m, base, _ = _collect_model(model, None, None, None, sets, config)
+    m, base, _ = _collect_model(model, None, None, None, sets, config, load=False)
     if dask_local is not None or scheduler is not None:
         backend = "dask"
-    from ..model.registry import model_spec
-    from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
-
-    spec = SweepSpec(axes=tuple(parse_axis(p, m, base) for p in params), measures=measures,
-                     base=base, settings=settings, continuation=continuation,
-                     model=model_spec(m))  # fmt: skip
-    run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler, resume=resume,
-                  max_memory=limit)  # fmt: skip
     with refused_leaves_nothing(out):
+        check_output(out, formats=None, what="sweep folder")  # (before the machinery loads)
+        from ..model.registry import get_model, model_spec
+        from ..sweep import SweepSpec, open_sweep, parse_axis, run_sweep, sweep_figures
+
+        m = m or get_model()
+        spec = SweepSpec(axes=tuple(parse_axis(p, m, base) for p in params),
+                         measures=measures, base=base, settings=settings,
+                         continuation=continuation, model=model_spec(m))  # fmt: skip
+        run_kw = dict(workers=workers, dask_local=dask_local, scheduler=scheduler,
+                      resume=resume, max_memory=limit)  # fmt: skip
         store = run_sweep(spec, out, backend=backend, force=force, progress=progress, **run_kw)
     for p in sweep_figures(open_sweep(store).load(), out):
         typer.echo(f"wrote {p}")

@@ -23,27 +23,28 @@ def warmup(
     import warnings
 
     from ..errors import ParameterError
+    from ..integrate import compiles
     from ..model.registry import get_model, model_names
     from ..simulate import simulate
-    from .simulate import METHOD_NAMES, _cache_cold, compile_note
+    from .simulate import METHOD_NAMES, compile_note, configuration
 
     methods = METHOD_NAMES if method == "all" else (method,)
     if method != "all" and method not in METHOD_NAMES:
         raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHOD_NAMES)}, all")
     names = list(models or model_names())
     loaded = [get_model(n) for n in names]  # every name checked before any compiling
-    from ..integrate import kernels
-
     for m in loaded:
-        system = m.system(m.parameters({}))
+        values = m.parameters({})
+        system = m.system(values)
         for meth in methods[:1] if m.kind == "map" else methods:  # a map is iterated
-            loop = kernels.dop853_kernel if meth == "dop853" else kernels.fixed_step_kernel
-            cold = _cache_cold((loop, getattr(system, "rhs", None)))
-            if cold:
-                typer.echo(compile_note(m.name), err=True)
+            todo = [] if m.kind == "map" else compiles(system, meth)
+            cold = todo is None or bool(todo)
+            if todo:
+                typer.echo(compile_note(m.name, configuration(m, values), todo), err=True)
             t0 = time.perf_counter()
             with warnings.catch_warnings():  # a fraction of a revolution: no verdicts drawn
                 warnings.simplefilter("ignore")
                 simulate(model=m, revolutions=0.05, transient=0.0, method=meth)
-            how = "compiled" if cold else "loaded from the cache"
+            how = ("compiled or loaded" if todo is None else "compiled" if cold
+                   else "loaded from the cache")  # fmt: skip
             typer.echo(f"{m.name} ({meth}): {time.perf_counter() - t0:.1f} s ({how})")

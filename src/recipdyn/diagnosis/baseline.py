@@ -214,12 +214,18 @@ class ChainEstimator(Protocol):
     def __call__(self, record: Record) -> ChainEstimate: ...
 
 
+#: The impacts' ringing lies within this fraction of the mounting resonance on 95 % of the
+#: data set's records (`recipdyn.diagnosis.evidence.ringing_hz`): the resonance estimate's
+#: 95 % half-width.
+RINGING_ACCURACY = 0.07
+
+
 def estimate_chain(record: Record) -> ChainEstimate:
     """The chain as one record shows it without a model: the mounting resonance from the
-    impacts' ringing (`recipdyn.diagnosis.evidence.ringing_hz`, its uncertainty the spread
-    between the record's two halves and the spectrum's resolution); the offsets and the mark
-    angle unknown (0, with the priors `OFFSET_PRIOR_PA`, `PHASE_PRIOR_DEG`): the fit finds
-    them."""
+    impacts' ringing (`recipdyn.diagnosis.evidence.ringing_hz`; its standard uncertainty the
+    larger of the ringing's measured accuracy, `RINGING_ACCURACY` over 1.96, and the spread
+    between the record's two halves); the offsets and the mark angle unknown (0, with the
+    priors `OFFSET_PRIOR_PA`, `PHASE_PRIOR_DEG`): the fit finds them."""
     from .evidence import ringing_hz
 
     x, fs = record.accel, record.fs
@@ -229,7 +235,8 @@ def estimate_chain(record: Record) -> ChainEstimate:
     return ChainEstimate(
         {"p_head_offset": 0.0, "p_crank_offset": 0.0, "phase_deg": 0.0, "resonance_hz": whole},
         {"p_head_offset": OFFSET_PRIOR_PA, "p_crank_offset": OFFSET_PRIOR_PA,
-         "phase_deg": PHASE_PRIOR_DEG, "resonance_hz": max(spread, fs / 1024)},
+         "phase_deg": PHASE_PRIOR_DEG,
+         "resonance_hz": max(spread, RINGING_ACCURACY / 1.96 * whole)},
         "resonance from the ringing; offsets and mark angle from the fit",
     )  # fmt: skip
 

@@ -64,6 +64,8 @@ __all__ = [
 #: The sensed channels stored per record.
 CHANNELS = ("accel_guide", "p_head_sensor", "p_crank_sensor", "tacho")
 BACKENDS = ("serial", "processes", "dask")
+#: How a data set's records are sensed (`DatasetSpec.chain`).
+CHAIN_KINDS = ("drawn", "fixed")
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,14 @@ class DatasetSpec:
         Each record's accelerometer SNR drawn uniformly in ``[lo, hi]`` dB (seeded per
         condition, class and record) instead of ``snr_db`` for all, so that a diagnoser learns
         the machine apart from the sensor's noise floor (docs/diagnosis.md, robustness).
+        With the drawn chain it replaces the ranges' accelerometer SNR.
+    chain : {"drawn", "fixed"}
+        ``drawn`` (default): every record's measurement chain drawn from
+        `recipdyn.chain.DEFAULT_RANGES` (seeded per condition, class and record; domain
+        randomisation), its resonance and SNR in place of the condition's resonance and
+        ``snr_db``. ``fixed``: the one chain every data set used before
+        (`recipdyn.chain.legacy_chain`: the condition's resonance, ``snr_db`` or
+        ``snr_range``), its records those of earlier versions to the bit.
     machine : tuple of (str, value)
         The machine simulated, as its changes from the diagnosis model's defaults
         (`recipdyn.diagnosis.machine.Machine.changes`; a dict is accepted): its operating
@@ -105,9 +115,10 @@ class DatasetSpec:
 
     Notes
     -----
-    A data set's store is identified by `to_json`, which leaves out the two continuous-
-    severity settings while they are None, so a store built with fixed levels keeps its
-    identity (and resumes) whatever settings are added here later.
+    A data set's store is identified by `to_json`, which leaves out the continuous-severity
+    and SNR-range settings while they are None and the chain while it is ``fixed``, so a
+    store built before keeps its identity (and resumes) whatever settings are added here
+    later; `from_dict` reads a spec without ``chain`` as the fixed chain it was built with.
     """
 
     n_conditions: int = 16
@@ -121,13 +132,22 @@ class DatasetSpec:
     severity_range: tuple[float, float] | None = None
     severity_draws: int | None = None
     snr_range: tuple[float, float] | None = None
+    chain: str = "drawn"
     machine: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self):
-        if not (isinstance(self.n_conditions, int) and self.n_conditions >= 2):
+        if not 0 < self.test_fraction < 1:
+            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
+        n, need = self.n_conditions, min_conditions(self.test_fraction)
+        if not (isinstance(n, int) and n >= 1):
+            raise ParameterError(f"n_conditions = {n!r}; allowed: an integer >= {need}")
+        if n - n_test_conditions(n, self.test_fraction) < MIN_TRAIN_CONDITIONS:
             raise ParameterError(
-                f"n_conditions = {self.n_conditions!r}; allowed: an integer "
-                ">= 2 (one for training, one for testing)"
+                f"n_conditions = {n} (test_fraction = {self.test_fraction:g}) leaves "
+                f"{max(0, n - n_test_conditions(n, self.test_fraction))} training "
+                f"condition(s); allowed: n_conditions >= {need} (a diagnoser trains on "
+                f"{MIN_TRAIN_CONDITIONS} conditions at least, one to fit and one to calibrate "
+                "its severity intervals and out-of-distribution threshold, and tests on 1)"
             )
         if not self.levels or not all(0 < s <= 1 for s in self.levels):
             raise ParameterError(f"levels = {self.levels!r}; allowed: severities in (0, 1]")
@@ -137,8 +157,6 @@ class DatasetSpec:
             raise ParameterError(f"revolutions = {self.revolutions!r}; allowed: [1, 100]")
         if not 0 <= self.transient <= 100:
             raise ParameterError(f"transient = {self.transient!r}; allowed: [0, 100]")
-        if not 0 < self.test_fraction < 1:
-            raise ParameterError(f"test_fraction = {self.test_fraction!r}; allowed: (0, 1)")
         if not (isinstance(self.seed, int) and 0 <= self.seed < 2**63):
             raise ParameterError(f"seed = {self.seed!r}; allowed: an integer >= 0")
         for c in self.classes:
@@ -153,7 +171,26 @@ class DatasetSpec:
         d = self.severity_draws
         if d is not None and not (isinstance(d, int) and 1 <= d <= 1000):
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
+        if self.chain not in CHAIN_KINDS:
+            raise ParameterError(f"chain = {self.chain!r}; allowed: {', '.join(CHAIN_KINDS)}")
         object.__setattr__(self, "machine", _machine_pairs(self.machine))
+
+    @property
+    def chain_ranges(self):
+        """The ranges a drawn chain comes from (`recipdyn.chain.ChainRanges`; ``snr_range``
+        replaces the accelerometer's SNR range)."""
+        from ..chain import DEFAULT_RANGES, ChainRanges, Span
+
+        ranges = ChainRanges()
+        if self.snr_range is not None:
+            old = DEFAULT_RANGES["accelerometer.snr_db"]
+            lo, hi = self.snr_range
+            ranges = ranges.with_spans(
+                accelerometer__snr_db=Span(
+                    lo, hi, old.unit, old.meaning, "the data set's snr_range"
+                )  # fmt: skip
+            )
+        return ranges
 
     @property
     def continuous(self) -> bool:
@@ -174,14 +211,18 @@ class DatasetSpec:
         for k in ("severity_range", "severity_draws", "snr_range"):
             if d[k] is None:
                 del d[k]
+        if d["chain"] == "fixed":
+            del d["chain"]
         if not d["machine"]:  # the default machine: the store keeps its identity
             del d["machine"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> DatasetSpec:
-        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples)."""
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+        """The spec of a store's ``spec_json`` or a data card's ``spec`` (lists as tuples);
+        one without ``chain`` was built with the fixed chain."""
+        kw = {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+        return cls(**{"chain": "fixed", **kw})
 
 
 def _machine_pairs(m: Any) -> tuple[tuple[str, Any], ...]:
@@ -233,9 +274,30 @@ def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
     return out
 
 
+#: Training conditions a diagnoser needs: one to fit on and one to calibrate on (its
+#: severity intervals' conformal quantiles and its out-of-distribution threshold come from
+#: whole conditions the fit has not seen: `recipdyn.diagnosis.train`).
+MIN_TRAIN_CONDITIONS = 2
+
+
+def n_test_conditions(n: int, test_fraction: float) -> int:
+    """Conditions held out for testing: ``test_fraction`` of ``n``, at least 1 (and at most
+    ``n - 1``)."""
+    return max(1, min(round(test_fraction * n), n - 1))
+
+
+def min_conditions(test_fraction: float) -> int:
+    """The fewest conditions that leave `MIN_TRAIN_CONDITIONS` for training and one for
+    testing at ``test_fraction``."""
+    n = MIN_TRAIN_CONDITIONS + 1
+    while n - n_test_conditions(n, test_fraction) < MIN_TRAIN_CONDITIONS:
+        n += 1
+    return n
+
+
 def split_of(spec: DatasetSpec) -> list[str]:
     """``"train"`` or ``"test"`` per condition (seeded; at least one of each)."""
-    n_test = min(max(1, round(spec.test_fraction * spec.n_conditions)), spec.n_conditions - 1)
+    n_test = n_test_conditions(spec.n_conditions, spec.test_fraction)
     perm = np.random.default_rng([spec.seed, 1]).permutation(spec.n_conditions)
     test = set(perm[:n_test].tolist())
     return ["test" if i in test else "train" for i in range(spec.n_conditions)]
@@ -264,9 +326,20 @@ def snrs(spec: DatasetSpec, condition: int, name: str, n: int) -> list[float]:
     return rng.uniform(lo, hi, n).tolist()
 
 
+def chain_draw(spec: DatasetSpec, condition: int, name: str, level: int, fs: float):
+    """The drawn measurement chain (`recipdyn.chain.Chain`) of record ``level`` of class
+    ``name`` at ``condition``: from a generator seeded by the data set's seed, the condition,
+    the class name and the record (as `severities`: adding a class, a condition or a record
+    leaves the other chains as they were)."""
+    rng = np.random.default_rng([spec.seed, 5, condition, zlib.crc32(name.encode()), level])
+    return spec.chain_ranges.draw(rng, fs)
+
+
 def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     """The records of ``spec``: one task per (condition, class, severity), in a fixed order
-    (``level`` numbers a class's records at a condition)."""
+    (``level`` numbers a class's records at a condition). With the drawn chain each task
+    holds its chain (``chain``, `recipdyn.chain.Chain.to_dict`), whose resonance and SNR are
+    the task's ``resonance_hz`` and ``snr_db``."""
     from .machine import fault_classes, healthy_parameters
 
     tasks = []
@@ -308,12 +381,26 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                 )
                 if machine is not None:  # the features read the machine's geometry
                     tasks[-1]["machine"] = dict(machine.changes())
+                if spec.chain == "drawn":
+                    ch = chain_draw(spec, ci, name, li, cond["fs"])
+                    tasks[-1]["chain"] = ch.to_dict()
+                    tasks[-1]["resonance_hz"] = ch.accelerometer.resonance_hz
+                    tasks[-1]["snr_db"] = ch.accelerometer.snr_db
     return tasks
 
 
-def _snr_text(spec: dict[str, Any]) -> str:
+def snr_text(spec: dict[str, Any]) -> str:
+    """The accelerometer SNR (dB) a data set's spec (``asdict``) records at: one value, or
+    the range drawn in."""
     r = spec.get("snr_range")
-    return f"{spec['snr_db']}" if r is None else f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if r is not None:
+        return f"{r[0]:g}..{r[1]:g} (drawn a record)"
+    if spec.get("chain", "fixed") == "drawn":
+        from ..chain import DEFAULT_RANGES
+
+        a = DEFAULT_RANGES["accelerometer.snr_db"]
+        return f"{a.lo:g}..{a.hi:g} (drawn a record)"
+    return f"{spec['snr_db']:g}"
 
 
 def n_samples_max(tasks) -> int:
@@ -340,6 +427,10 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
             summary=summary,
             **task["params"],
         )
+    if "chain" in task:  # a drawn chain; a task without one has the fixed chain
+        from ..chain import Chain
+
+        return sensors.record(ds, chain=Chain.from_dict(task["chain"]), seed=task["noise_seed"])
     return sensors.record(
         ds,
         accelerometer=sensors.Accelerometer(
@@ -440,6 +531,9 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     g.create_array("done", shape=(n,), chunks=(1,), dtype=bool, fill_value=False)
     g.create_array("error", shape=(n,), chunks=(1,), dtype=str)
     g.create_array("seconds", shape=(n,), chunks=(1,), dtype="f8", fill_value=np.nan)
+    if spec.chain == "drawn":  # each record's drawn chain, as JSON
+        g.create_array("chain", shape=(n,), chunks=(n,), dtype=str)
+        g["chain"][:] = np.array([json.dumps(t["chain"]) for t in tasks])
     from .. import __version__
 
     g.attrs.update(
@@ -650,6 +744,10 @@ def _table(g, tasks, names: list[str]):
             "snr_db": t["snr_db"],
             "noise_seed": t["noise_seed"],
         }
+        if "chain" in t:
+            from ..chain import Chain
+
+            row.update({f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()})
         row.update({f"f_{k}": v for k, v in zip(names, feats[i], strict=True)})
         rows.append(row)
     return pd.DataFrame(rows)
@@ -722,18 +820,10 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "conditions": {
             k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
             for k, r in condition_ranges(machine).items()
+            if not (spec.chain == "drawn" and k == "resonance_hz")  # the chain's, below
         },
-        "sensors": {
-            "accelerometer": "recipdyn.sensors.Accelerometer(snr_db="
-            + (
-                f"{spec.snr_db}"
-                if spec.snr_range is None
-                else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
-            )
-            + ", resonance_hz=<condition>), other settings default",
-            "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
-            "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
-        },
+        "sensors": _sensors_card(spec),
+        "chain": _chain_card(spec),
         "seeds": {
             "conditions": [spec.seed, 0],
             "split": [spec.seed, 1],
@@ -751,6 +841,41 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
         "records": int(len(df)),
         "balance": balance,
         "throughput": throughput,
+    }
+
+
+def _sensors_card(spec: DatasetSpec) -> dict[str, str]:
+    if spec.chain == "drawn":
+        return {"all": "recipdyn.chain.ChainRanges().draw(rng, fs) per record (chain, below), "
+                "applied by recipdyn.sensors.record(..., chain=...)"}  # fmt: skip
+    snr = (
+        f"{spec.snr_db}"
+        if spec.snr_range is None
+        else f"<drawn uniformly in [{spec.snr_range[0]}, {spec.snr_range[1]}] a record>"
+    )
+    return {
+        "accelerometer": f"recipdyn.sensors.Accelerometer(snr_db={snr}, "
+        "resonance_hz=<condition>), other settings default",
+        "pressure": "recipdyn.sensors.PressureTransducer() (60 dB)",
+        "tacho": "recipdyn.sensors.Tacho() (mark at outer dead centre)",
+    }
+
+
+def _chain_card(spec: DatasetSpec) -> dict[str, Any]:
+    """The data card's measurement chain: fixed, or the ranges drawn from with their
+    sources."""
+    if spec.chain == "fixed":
+        return {"kind": "fixed", "chain": "recipdyn.chain.legacy_chain(<condition's "
+                "resonance>, <snr>): the one chain of every record"}  # fmt: skip
+    from ..chain import SOURCES
+
+    return {
+        "kind": "drawn",
+        "seed": f"[{spec.seed}, 5, condition, crc32(class name), record]",
+        "response": "exact (the continuous-time response at every frequency of the record)",
+        "ranges": spec.chain_ranges.describe(),
+        "sources": SOURCES,
+        "per_record": "features.parquet columns chain.*; signals.zarr array chain (JSON)",
     }
 
 
@@ -774,7 +899,7 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"{s['n_conditions']} operating conditions x {len(s['classes'])} classes x "
         f"{how}; {s['revolutions']} "
         f"revolutions after {s['transient']}; accelerometer SNR "
-        f"{_snr_text(s)} dB; "
+        f"{snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
         "",
         "Machine: "
@@ -800,6 +925,17 @@ def datacard_markdown(card: dict[str, Any]) -> str:
     lines += ["", "| condition | range | meaning |", "|---|---|---|"]
     for k, r in card["conditions"].items():
         lines.append(f"| {k} | {r['lo']:g} .. {r['hi']:g} {r['unit']} | {r['meaning']} |")
+    chain = card.get("chain", {"kind": "fixed"})
+    if chain["kind"] == "drawn":
+        lines += ["", f"Measurement chain: drawn per record (seed {chain['seed']}), applied "
+                  "with the exact response.", "", "| parameter | range | meaning | source |",
+                  "|---|---|---|---|"]  # fmt: skip
+        for r in chain["ranges"]:
+            lines.append(f"| {r['parameter']} | {r['range']} | {r['meaning']} | {r['source']} |")
+        lines += ["", "Sources:", ""]
+        lines += [f"- `{k}`: {v}" for k, v in chain["sources"].items()]
+    else:
+        lines += ["", "Measurement chain: fixed (recipdyn.chain.legacy_chain)."]
     lines += [
         "",
         "Class balance (records): " + json.dumps(card["balance"]),
@@ -816,6 +952,19 @@ def read_features(folder: str | Path):
 
     folder = Path(folder)
     table, card = folder / "features.parquet", folder / "datacard.json"
+    if not folder.is_dir():
+        raise ParameterError(f"{folder}: no such folder; build a data set there with "
+                             f"'recipdyn dataset -o {folder}'")  # fmt: skip
+    if (folder / "signals.zarr").is_dir() and not table.exists():
+        try:
+            done = records_done(folder)
+            count = f" ({int(done.sum())} of {done.size} records)"
+        except Exception:  # noqa: BLE001 - a store too damaged to count: said without
+            count = ""
+        raise ParameterError(
+            f"{folder}: an unfinished data set{count}: finish it with 'recipdyn dataset -o "
+            f"{folder} --resume' and the options that started it"
+        )
     if not table.exists() or not card.exists():
         raise ParameterError(
             f"{folder}: not a data set (no features.parquet/datacard.json); "

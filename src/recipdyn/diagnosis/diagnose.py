@@ -175,9 +175,10 @@ def diagnose(
     Diagnosis
         ``refused=True`` with ``reason`` for a record outside the training domain.
     """
-    from ..io_signal import speed_hz
+    from ..io_signal import check_signal_file, speed_hz
     from .machine import machine_from_file, record_machine
 
+    check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
     if machine is None:
@@ -261,7 +262,10 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
             p_crank = np.asarray(p_crank, float) - chain["p_crank_offset"]
     x = np.asarray(x, float)
     if tacho is not None:
-        edges = tacho_times(np.asarray(tacho, float), fs)
+        try:  # a channel that is no pulse train is refused with the tacho's reason
+            edges = tacho_times(np.asarray(tacho, float), fs)
+        except ValueError as exc:
+            raise ParameterError(str(exc)) from None
         if edges.size < 3:
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
@@ -408,8 +412,9 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
 
 
 def _trained_snr(spec: dict[str, Any]) -> str:
-    r = spec.get("snr_range")
-    return f"{spec['snr_db']:g}" if r is None else f"{r[0]:g}..{r[1]:g}"
+    from .dataset import snr_text
+
+    return snr_text(spec).split(" ")[0]
 
 
 def _db(share: float) -> float:

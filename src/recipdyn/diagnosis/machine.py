@@ -130,10 +130,15 @@ class Machine:
         `read_machine`).
     source : str
         Where the description came from (a file name, or the model's defaults).
+    nominal : bool
+        Whether its `NOMINAL` values are the machine's nominal operating point (a machine
+        file), not the operating point of one record (a record's own attributes: its speed
+        and pressures are then the record's, which `recipdyn diagnose` checks as such).
     """
 
     values: tuple[tuple[str, Any], ...]
     source: str = "the diagnosis model's defaults"
+    nominal: bool = True
 
     @classmethod
     def default(cls) -> Machine:
@@ -467,12 +472,13 @@ def differences(trained: Machine, other: Machine, drawn: Mapping[str, tuple[floa
     `condition_ranges`); such a parameter may lie anywhere in its range widened by its
     tolerance. A categorical parameter (`CATEGORICAL`) must be equal. The machine's nominal
     operating point (`NOMINAL`) must lie in the ranges the data set drew for it, with the
-    slack `recipdyn.diagnosis.diagnose.RANGE_SLACK` of the crank speed's refusal."""
+    slack `recipdyn.diagnosis.diagnose.RANGE_SLACK` of the crank speed's refusal (a machine
+    read from a record's attributes has no nominal operating point: `Machine.nominal`)."""
     from .diagnose import RANGE_SLACK
 
     a, b = trained.as_dict, other.as_dict
     out = []
-    for k in NOMINAL:
+    for k in NOMINAL if other.nominal else ():
         if k in drawn and k in b:
             lo, hi = drawn[k]
             if not lo * (1 - RANGE_SLACK) <= b[k] <= hi * (1 + RANGE_SLACK):
@@ -514,11 +520,14 @@ def _dataset_options(spec: Mapping[str, Any]) -> list[str]:
             opts += ["--draws", str(spec["severity_draws"])]
     else:
         opts += ["--levels", ",".join(f"{v:g}" for v in spec.get("levels", (0.25, 0.5, 0.75, 1)))]
+    fixed = spec.get("chain", "fixed") == "fixed"  # a spec without one: the fixed chain
     if spec.get("snr_range") is not None:
         lo, hi = spec["snr_range"]
         opts += ["--snr-range", f"{lo:g},{hi:g}"]
-    else:
+    elif fixed:
         opts += ["--snr", f"{spec.get('snr_db', 20.0):g}"]
+    if fixed:
+        opts += ["--chain", "fixed"]
     for k, flag in (("revolutions", "--revolutions"), ("transient", "--transient"),
                     ("test_fraction", "--test-fraction"), ("seed", "--seed")):  # fmt: skip
         if k in spec:
@@ -554,7 +563,7 @@ def record_machine(path: str | Path) -> Machine | None:
         return None
     if not (attrs.get("model_spec") or attrs.get("model_name")) or "param_r" not in attrs:
         return None
-    return machine_from_file(path)
+    return replace(machine_from_file(path), nominal=False)
 
 
 def refusal(diag, machine: Machine | None) -> str | None:

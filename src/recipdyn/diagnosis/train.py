@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .classes import get_class
-from .dataset import CONDITION_COLUMNS, read_features
+from .dataset import CONDITION_COLUMNS, MIN_TRAIN_CONDITIONS, min_conditions, read_features
 from .evidence import feature_groups
 
 __all__ = [
@@ -512,6 +512,14 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         df = df[df.label.isin(classes)].reset_index(drop=True)
     train_df = df[df.split == "train"].reset_index(drop=True)
     test_df = df[df.split == "test"].reset_index(drop=True)
+    n_train = train_df.condition.nunique()
+    if n_train < MIN_TRAIN_CONDITIONS:
+        raise ParameterError(
+            f"{folder}: {n_train} training condition(s); a diagnoser trains on "
+            f"{MIN_TRAIN_CONDITIONS} at least (one to fit, one to calibrate its severity "
+            "intervals and out-of-distribution threshold): build a data set of "
+            f"{min_conditions(0.25)} conditions or more ('recipdyn dataset --conditions')"
+        )
     if train_df.label.nunique() < len(classes) or test_df.empty:
         raise ParameterError(
             f"{folder}: the training conditions lack some classes or there "

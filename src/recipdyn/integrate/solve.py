@@ -21,12 +21,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from ..defaults import ATOL, ATOL_RANGE, RTOL, RTOL_RANGE
 from ..errors import IntegrationError, Interrupted, ParameterError, deferred_signals, is_number
-from ..model.base import ODESystem, typed
+from ..model.base import ODESystem, cache_holds, typed
 from . import kernels
 from .tableaus import RK4, Tableau, dop853
 
@@ -385,6 +386,35 @@ def _count_le(t_eval, t: float) -> int:
     return k
 
 
+def _to_prepare(system: ODESystem, method: str) -> list[tuple[Any, Any]]:
+    """The (dispatcher, signature) pairs `prepare` compiles or loads for ``system``."""
+    if method not in METHODS:
+        raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
+    loop = ((kernels.dop853_kernel, kernels.DOP853_SIG) if METHODS[method].adaptive
+            else (kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG))  # fmt: skip
+    out = [loop]
+    own = system.acting_event
+    for fn in (system.rhs, getattr(own, "function", None), getattr(own, "reset", None)):
+        sig_obj = getattr(fn, "recipdyn_signature", None)
+        if sig_obj is not None:
+            out.append((fn, sig_obj.args))
+    return out
+
+
+def compiles(system: ODESystem, method: str = "dop853") -> list[str] | None:
+    """What `prepare` will compile for ``system`` (the kernels' names; empty: it will load
+    everything from numba's disk cache), decided before it happens from the cache's index
+    (`recipdyn.model.base.cache_holds`); None if that cannot be told."""
+    names = []
+    for fn, sig in _to_prepare(system, method):
+        held = cache_holds(fn, sig)
+        if held is None:
+            return None
+        if not held:
+            names.append(f"{fn.py_func.__module__}.{fn.__name__}")
+    return names
+
+
 def prepare(system: ODESystem, method: str = "dop853") -> None:
     """Compile (first run on a machine) or load from the cache everything
     [`integrate`][recipdyn.integrate.solve.integrate] needs for ``system``: the integrator loop, the
@@ -392,18 +422,12 @@ def prepare(system: ODESystem, method: str = "dop853") -> None:
 
     Optional: [`integrate`][recipdyn.integrate.solve.integrate] does the same on its first call. The
     command line calls it first, to say "compiling" while it takes long."""
-    if method not in METHODS:
-        raise ParameterError(f"method = {method!r}; allowed: {', '.join(METHODS)}")
+    (loop, sig), *own = _to_prepare(system, method)
+    typed(loop, sig)
     if METHODS[method].adaptive:
-        typed(kernels.dop853_kernel, kernels.DOP853_SIG)
         METHODS[method].tableau()
-    else:
-        typed(kernels.fixed_step_kernel, kernels.FIXED_STEP_SIG)
-    own = system.acting_event
-    for fn in (system.rhs, getattr(own, "function", None), getattr(own, "reset", None)):
-        sig_obj = getattr(fn, "recipdyn_signature", None)
-        if sig_obj is not None:  # a compiled() kernel: compile exactly its signature
-            fn.compile(sig_obj.args)
+    for fn, args in own:  # a compiled() kernel: compile exactly its signature
+        fn.compile(args)
 
 
 def propagate(system: ODESystem, y0, t0: float, t1: float, **kwargs) -> np.ndarray:

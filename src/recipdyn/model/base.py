@@ -49,7 +49,7 @@ from ..errors import KernelAllocatesWarning
 __all__ = [
     "ODESystem", "DiscreteMap", "Signal", "Event", "RHS_SIGNATURE", "JAC_SIGNATURE",
     "EVENT_SIGNATURE", "RHS_TYPE", "JAC_TYPE", "EVENT_TYPE", "RHS_JAC_SIGNATURE", "compiled",
-    "typed", "rhs_series",
+    "typed", "rhs_series", "cache_holds",
 ]  # fmt: skip
 
 #: ``rhs(t, y, p, out) -> None`` (also a map's ``step``).
@@ -170,6 +170,27 @@ def _fall_back_to_counting(dispatcher) -> None:
             return result
 
     dispatcher.compile = compile_or_fall_back
+
+
+def cache_holds(dispatcher, signature) -> bool | None:
+    """Whether compiling ``dispatcher`` for ``signature`` (what is passed to its ``compile``)
+    will load machine code rather than make it: True if this process has it already or
+    numba's disk cache holds it for this source, signature and CPU; False if it will be
+    compiled; None if that cannot be told (not a numba dispatcher, no disk cache, or numba's
+    cache layout changed: it is not public API; numba 0.59-0.68 checked). Reads the cache's
+    index file only (milliseconds): commands say "compiling" or "loading" before it happens.
+    """
+    try:
+        args, _ = _nb.core.sigutils.normalize_signature(signature)
+        if dispatcher.overloads.get(tuple(args)) is not None:
+            return True
+        cache = dispatcher._cache
+        if not getattr(cache, "_enabled", False):  # (NullCache: cache=False)
+            return None
+        key = cache._index_key(signature, dispatcher.targetctx.codegen())
+        return key in cache._cache_file._load_index()
+    except Exception:  # noqa: BLE001 - numba's private layout: unknown, not an error
+        return None
 
 
 _TYPED: dict[int, Any] = {}

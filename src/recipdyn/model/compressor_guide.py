@@ -73,6 +73,7 @@ from .joints.guide import (
 from .kinematics import ideal_mechanism
 from .load import CYCLE_PARAMS, mu_sincos
 from .parameters import SCHEMA as LINK_SCHEMA
+from .parameters import check_reach
 from .protocol import Model, Param, Schema
 
 __all__ = ["CompressorGuide", "COMPRESSOR_GUIDE", "ideal_crosshead"]
@@ -329,6 +330,7 @@ class CompressorGuide(Model):
     def check(self, values: Mapping[str, Any]) -> None:
         from ..errors import ParameterError
 
+        check_reach(values["l"], values["r"], 1e-3, "1 mm")
         dmax = values["l"] - values["r"] - 1e-3
         if not abs(values["d"]) < dmax:
             raise ParameterError(f"d = {values['d']!r} m is out of range; allowed: "

@@ -43,12 +43,13 @@ import copy
 import importlib
 from collections.abc import Mapping
 from dataclasses import fields, is_dataclass, replace
+from os import PathLike
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
-from .parameters import PIN_SPELLINGS, SELECTORS
+from .parameters import PIN_SPELLINGS, SELECTORS, pin_joints
 from .protocol import Model, Param, Schema, UnknownParameterError
 from .registry import is_spec
 
@@ -118,20 +119,21 @@ def route(s: Mapping[str, Any], table: bool = False, guide_kernel: bool = False)
 def _chosen(raw: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, Any]:
     """The selector values in ``raw`` (names, raw or validated; a record's ``None``, unset)
     over ``defaults``, checked against their choices. The contact joints' older spelling
-    (``clearance_joints`` where, ``joint`` dry or lubricated) gives the two pins when neither
-    is named."""
+    (``clearance_joints`` where, ``joint`` dry or lubricated) gives the pins it names where
+    the selectors do not (`pin_joints`: a contradiction of the two is refused); a load table
+    given makes the load ``table``."""
     s = dict(defaults)
     for k in SELECTORS.names:
         v = raw.get(k)
         if v is not None:
             s[k] = v
-    if any(raw.get(k) is not None for k in ("clearance_joints", "joint")):
-        where = raw.get("clearance_joints") or "crank"
-        kind = "lubricated" if raw.get("joint") == "lubricated" else "contact"
-        if raw.get("crank_joint") is None:
-            s["crank_joint"] = "ideal" if where == "crosshead" else kind
-        if raw.get("crosshead_joint") is None:
-            s["crosshead_joint"] = "ideal" if where == "crank" else kind
+    crank, cross = pin_joints(raw)  # (the older spelling; its contradictions refused)
+    if crank is not None:
+        s["crank_joint"] = crank
+    if cross is not None:
+        s["crosshead_joint"] = cross
+    if s["load"] == "paper" and any(raw.get(k) is not None for k in _TABLES):
+        s["load"] = "table"  # (a table given is the table load: records say so)
     for k, v in s.items():
         if not (k == "load" and is_spec(v)):
             SELECTORS[k].check(v)
@@ -173,6 +175,13 @@ def _not_own(impl: Model) -> frozenset[str]:
     if key not in _NOT_OWN:
         _NOT_OWN[key] = frozenset(SELECTORS.names) - set(impl.schema.names)
     return _NOT_OWN[key]
+
+
+def _holds_valves(attrs: Mapping[str, Any]) -> bool:
+    """Whether record attributes hold the dynamic valves' parameters."""
+    link = implementation("link").schema.names
+    return any(f"param_{k}" in attrs for k in implementation("link-valves").schema.names
+               if k not in link)  # fmt: skip
 
 
 def owner(name: str, s: Mapping[str, Any]) -> str:
@@ -315,18 +324,18 @@ class Compressor(Model):
     # -- parameters ---------------------------------------------------------------------
     def schema_for(self, values: Mapping[str, Any]) -> Schema:
         """The implementation's schema at ``values``, with the selectors that it does not
-        have and ``values`` holds (set away from this preset's defaults)."""
-        _, impl, s = self.route(values)
+        have and ``values`` holds."""
+        name, impl, s = self.route(values)
         mine = _known(impl.schema)
         schema = impl.schema_for({k: v for k, v in values.items() if k in mine})
-        if schema is impl.schema and self._route0() == self._route0(s):
+        if schema is impl.schema and name == self._route0():
             schema = self._schema0  # (a preset's defaults)
         known = _known(schema) | _ALWAYS
         for k in values:
             if k not in known and (where := owner(k, s)):
                 raise ParameterError(self._elsewhere(k, where))
         extra = [p for p in SELECTORS if p.name not in schema.names and p.name in values
-                 and values[p.name] != self._selectors[p.name]]  # fmt: skip
+                 and values[p.name] is not None]  # fmt: skip
         if not extra:
             return schema
         extra = [replace(p, choices=(*p.choices, values[p.name])) if is_spec(values[p.name])
@@ -349,7 +358,8 @@ class Compressor(Model):
         raw.update(kw)
         name, impl, s = self.route(raw)
         own = _known(impl.schema)
-        mine = {k: v for k, v in raw.items() if k not in SELECTORS.names or k in own}
+        mine = {k: v for k, v in raw.items()
+                if k not in (*SELECTORS.names, *PIN_SPELLINGS) or k in own}  # fmt: skip
         for k in SELECTORS.names:  # a selector the implementation has (the pins, the guide)
             if k in own:
                 mine[k] = s[k]
@@ -361,10 +371,10 @@ class Compressor(Model):
                 "load = 'table' needs load_table (rows of crank angle in deg "
                 "and force in N, or their CSV file) or pressure_table"
             )
-        if s["load"] == "valves":
+        if s["load"] in ("cycle", "valves"):
             for k in _TABLES:
                 if raw.get(k) is not None:
-                    raise ParameterError(f"{k}: not with load = 'valves', whose gas force "
+                    raise ParameterError(f"{k}: not with load = {s['load']!r}, whose gas force "
                                          "follows the chamber pressures; allowed: load = "
                                          "'table'")  # fmt: skip
         if s["crank_joint"] == "ideal" and "rc" in own and name.startswith("link"):
@@ -383,6 +393,10 @@ class Compressor(Model):
                 "or the guide's clearance: motor = 'constant' or 'induction'"
             )
         ptab = mine.pop("pressure_table", None) if "pressure_table" not in impl.schema else None
+        if isinstance(mine.get("load_table"), (str, PathLike)):  # (a CSV file of the rows)
+            from .load import read_load_table
+
+            mine["load_table"] = read_load_table(mine["load_table"])
         try:
             out = impl.parameters(mine)
             if ptab is not None:
@@ -475,12 +489,16 @@ class Compressor(Model):
                      ) -> dict[str, Any]:  # fmt: skip
         """The implementation's record attributes under this model's name, with the
         selectors ``values`` holds beside the implementation's parameters."""
-        impl, own = self._split(values)
+        _, impl, s = self.route(values)
+        own = {k: v for k, v in values.items() if k not in _not_own(impl)}
         out = impl.record_attrs(own, y0)
         out.update({"title": f"recipdyn simulation: {self.name}", "model": self.name,
                     "model_description": self.description})  # fmt: skip
         extra = [p for p in self.schema_for(values) if p.name not in own]
         out.update(Schema(tuple(extra)).to_attrs(values))
+        # every selector at the value that ran (an implementation's own ``load`` is its
+        # mechanism's: 'paper' under a table, 'cycle' under the valves)
+        out.update({f"param_{k}": v for k, v in s.items() if not is_spec(v)})
         return out
 
     def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
@@ -492,7 +510,12 @@ class Compressor(Model):
         given = {k: (None if isinstance(v, str) and v == "default" else
                      v.item() if isinstance(v, np.generic) else v)
                  for k, v in given.items()}  # fmt: skip
+        if given.get("load") == "cycle" and _holds_valves(attrs):
+            given["load"] = "valves"  # (a record of the massless link with dynamic valves
+            # made before the selectors were recorded: its mechanism's own load, 'cycle')
         _, impl, s = self.route(given)
+        if "load" in impl.schema.names and s["load"] in ("table", "valves"):
+            attrs = {**attrs, "param_load": "paper"}  # (the implementation's own load)
         out = impl.values_from_record(attrs)
         for k in SELECTORS.names:
             if k not in out and s[k] != self._selectors[k]:

@@ -30,7 +30,7 @@ from ..errors import ParameterError
 from .components.contract import resolve_component
 from .components.drive import CONSTANT_TORQUE, DRIVES, INDUCTION, MOTOR, MOTORS
 from .gases import GASES
-from .protocol import Param, Schema
+from .protocol import Derived, Param, Schema, derive_value
 from .registry import is_spec
 
 __all__ = [
@@ -46,6 +46,7 @@ __all__ = [
     "SCHEMA",
     "SELECTORS",
     "configures",
+    "pin_joints",
 ]
 
 
@@ -85,12 +86,12 @@ _INF = math.inf
 #: `CompressorParams.__post_init__`.
 SCHEMA = Schema((
     Param("r", "m", 0.12, "crank radius A-B (paper)", 0.0, _INF, True, True, group="mechanism"),
-    Param("rs", "m", 0.06, "main bearing to crank centroid (mid-length)", 0.0, _INF,
-          high_ref="r", group="mechanism"),
+    Param("rs", "m", 0.06, "main bearing to crank centroid (default: mid-length, r / 2)",
+          0.0, _INF, high_ref="r", group="mechanism", derive="r / 2"),
     Param("l", "m", 0.6, "connecting-rod length (paper)", 0.0, _INF, True, True,
           group="mechanism"),
-    Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (mid-length)", 0.0, _INF,
-          high_ref="l", group="mechanism"),
+    Param("ls", "m", 0.3, "crank-pin end of the rod to its centroid (default: mid-length, "
+          "l / 2)", 0.0, _INF, high_ref="l", group="mechanism", derive="l / 2"),
     Param("m1", "kg", 15.0, "crank mass", 0.0, _INF, high_open=True, assumed=ASSUMED["m1"],
           group="mechanism"),
     Param("m2", "kg", 20.0, "connecting-rod mass", 0.0, _INF, high_open=True,
@@ -99,8 +100,9 @@ SCHEMA = Schema((
           assumed=ASSUMED["m3"], group="mechanism"),
     Param("J1", "kg*m**2", 0.0012, "crank moment of inertia about its centroid", 0.0, _INF,
           high_open=True, assumed=ASSUMED["J1"], group="mechanism"),
-    Param("J2", "kg*m**2", 0.6, "rod moment of inertia about its centroid", 0.0, _INF,
-          high_open=True, assumed=ASSUMED["J2"], group="mechanism"),
+    Param("J2", "kg*m**2", 0.6, "rod moment of inertia about its centroid (default: a "
+          "slender uniform rod, m2 l^2 / 12)", 0.0, _INF, high_open=True, assumed=ASSUMED["J2"],
+          group="mechanism", derive="m2 * l**2 / 12"),
     Param("g", "m/s**2", 9.81, "gravitational acceleration (along -y)", 0.0, 100.0,
           group="mechanism"),
     Param("rc", "m", 1.0e-3, "radial clearance of the crank-pin joint (massless link length); "
@@ -188,6 +190,52 @@ SELECTORS = Schema((
 #: The contact joints' older way to name the pins (``clearance_joints``: where, ``joint``: dry
 #: or lubricated), which the selectors read too.
 PIN_SPELLINGS = ("clearance_joints", "joint")
+#: The older spelling's ``clearance_joints``: which pins (crank, crosshead) have clearance.
+_WHERE = {"crank": (True, False), "crosshead": (False, True), "both": (True, True),
+          "ideal": (False, False)}  # fmt: skip
+
+
+def pin_joints(values: Mapping[str, Any]) -> tuple[str | None, str | None]:
+    """The joints at the crank pin and at the crosshead pin that ``values`` (names, raw or
+    validated) ask for, None for a pin they say nothing of: ``crank_joint`` and
+    ``crosshead_joint`` where given, else the older spelling's where it is given
+    (``clearance_joints``: where the clearance is, default the crank pin; ``joint``: 'dry'
+    contact or 'lubricated' at those pins; the other pins ideal).
+
+    Where the two spellings contradict each other (``clearance_joints = 'crosshead'`` with
+    ``crank_joint = 'contact'``, or ``joint = 'lubricated'`` where no pin is lubricated), one
+    of the user's values would not be run as asked: [`ParameterError`][recipdyn.errors.
+    ParameterError] names both."""
+    crank, cross = values.get("crank_joint"), values.get("crosshead_joint")
+    where, joint = values.get("clearance_joints"), values.get("joint")
+    if where is None and joint is None:
+        return crank, cross
+    if where is not None and where not in _WHERE:
+        raise ParameterError(f"clearance_joints = {where!r}; allowed: {', '.join(_WHERE)}")
+    if joint is not None and joint not in ("dry", "lubricated"):
+        raise ParameterError(f"joint = {joint!r}; allowed: dry, lubricated")
+    kind = "lubricated" if joint == "lubricated" else "contact"
+    has = _WHERE[where or "crank"]
+    spelled = tuple(kind if h else "ideal" for h in has)
+    pins = []
+    for name, given, old, h in zip(("crank_joint", "crosshead_joint"), (crank, cross),
+                                   spelled, has, strict=True):  # fmt: skip
+        if given is not None and where is not None and (given != "ideal") != h:
+            pin = name.split("_")[0]
+            raise ParameterError(
+                f"{name} = {given!r} and clearance_joints = {where!r} contradict each other: "
+                f"clearance_joints = {where!r} makes the {pin} pin "
+                f"{'a clearance joint' if h else 'ideal'}; give one of them (crank_joint and "
+                "crosshead_joint name each pin)"
+            )
+        pins.append(old if given is None else given)
+    if joint == "lubricated" and "lubricated" not in pins:
+        raise ParameterError(
+            f"joint = 'lubricated' acts on no pin here (crank_joint = {pins[0]!r}, "
+            f"crosshead_joint = {pins[1]!r}): set crank_joint or crosshead_joint = "
+            "'lubricated' instead"
+        )
+    return pins[0], pins[1]
 
 
 def configures(values: Mapping[str, Any]) -> bool:
@@ -295,14 +343,14 @@ class CompressorParams:
     """
 
     r: float = 0.12
-    rs: float = 0.06
+    rs: float = Derived(0.06)  # (r / 2 unless set: `SCHEMA`'s rules, derived again on replace)
     l: float = 0.6
-    ls: float = 0.3
+    ls: float = Derived(0.3)  # (l / 2)
     m1: float = 15.0
     m2: float = 20.0
     m3: float = 30.0
     J1: float = 0.0012
-    J2: float = 0.6
+    J2: float = Derived(0.6)  # (m2 l^2 / 12)
     g: float = 9.81
     rc: float = 1.0e-3
     d: float = 1.0e-3
@@ -336,10 +384,16 @@ class CompressorParams:
     load_table: tuple[tuple[float, float], ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        rules = [p for p in SCHEMA if p.derive]
         for p in SCHEMA:  # the static ranges, declared once in the schema
             if p.name in PLUGGABLE and is_spec(getattr(self, p.name)):
                 continue  # a component from a user's file (checked when it is loaded)
-            p.check(getattr(self, p.name))
+            if p not in rules or not isinstance(getattr(self, p.name), Derived):
+                p.check(getattr(self, p.name))
+        given = {k: getattr(self, k) for k in SCHEMA.names if k not in PLUGGABLE}
+        for p in rules:  # a default derived from the values it follows (unless set)
+            if isinstance(given[p.name], Derived) or given[p.name] is None:
+                object.__setattr__(self, p.name, derive_value(p, given))
         _check("rs", self.rs, 0.0, self.r)
         _check("ls", self.ls, 0.0, self.l)
         _check("rc", self.rc, 0.0, self.r, hi_open=True)
@@ -350,6 +404,7 @@ class CompressorParams:
                 "needs millions of steps per revolution)"
             )
         # |d + r sin(theta1) + rc sin(theta_c)| < l must hold for every crank and link angle.
+        check_reach(self.l, self.r, self.rc, "rc")
         dmax = self.l - self.r - self.rc
         _check("d", self.d, -dmax, dmax, lo_open=True, hi_open=True)
         if self.m2 + self.m3 + self.J2 <= 0 and self.rc > 0:
@@ -412,6 +467,17 @@ class CompressorParams:
         for k, why in ASSUMED.items():
             out[f"{k}_note"] = why
         return out
+
+
+def check_reach(l: float, r: float, rc: float, rc_text: str) -> None:
+    """Refuse a connecting rod that cannot reach past the crank: the slider-crank exists for
+    ``l > r + rc`` (``rc_text``: what the clearance term is, e.g. ``"1.5 (rc + rc_crosshead)"``),
+    named by the lengths the user gives, not by a parameter whose range they make empty."""
+    if not l > r + rc:
+        raise ParameterError(
+            f"l = {l:g} m and r = {r:g} m: the connecting rod must be longer than the crank "
+            f"radius plus the clearance, l > r + {rc_text} = {r + rc:g} m"
+        )
 
 
 def _validate_table(table) -> None:

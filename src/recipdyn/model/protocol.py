@@ -42,7 +42,12 @@ if TYPE_CHECKING:
 
 from ..errors import ParameterError, is_number
 
-__all__ = ["Param", "Schema", "Model", "Event", "UnknownParameterError", "close_matches"]
+__all__ = ["Param", "Schema", "Model", "Event", "UnknownParameterError", "close_matches",
+           "Derived", "DERIVED_ATTR", "derive_value", "derived_names", "rule_inputs"]  # fmt: skip
+
+#: The record attribute that lists the values derived from others (`Derived`), each with its
+#: rule: ``"rs = r / 2, ls = l / 2"``.
+DERIVED_ATTR = "derived_parameters"
 
 
 def __getattr__(name: str):
@@ -70,6 +75,39 @@ def close_matches(word: str, candidates) -> list[str]:
         return []
     best = max(r for r, _ in scored)
     return [c for r, c in sorted(scored, key=lambda rc: (-rc[0], rc[1])) if r >= best - 0.1][:3]
+
+
+class Derived(float):
+    """A parameter value derived from other parameters by its `Param.derive` rule, not set by
+    the user. It is a number like any other; validation derives it again from the values it
+    follows (so ``{**values, "l": 0.45}`` moves a derived ``ls`` with ``l``), records name it
+    (`DERIVED_ATTR`), and reading a record back keeps it derived."""
+
+    __slots__ = ()
+
+    def __reduce__(self):
+        return Derived, (float(self),)
+
+
+def rule_inputs(rule: str) -> tuple[str, ...]:
+    """The parameter names a derivation rule (``"m2 * l**2 / 12"``) reads."""
+    return compile(rule, "<rule>", "eval").co_names
+
+
+def derive_value(p: Param, values: Mapping[str, Any]) -> Derived:
+    """``p``'s value derived by its rule from ``values`` (validated numbers); a value out of
+    ``p``'s range is refused naming the rule and the values it was derived from."""
+    names = rule_inputs(p.derive)
+    v = float(eval(p.derive, {"__builtins__": {}}, {k: float(values[k]) for k in names}))  # noqa: S307 - a rule declared in recipdyn's code
+    try:
+        p.check(v)
+    except ParameterError:
+        given = ", ".join(f"{k} = {float(values[k]):g}" for k in names)
+        raise ParameterError(
+            f"{p.name} = {p.derive} = {v:g} {p.unit} (derived from {given}) is out of range; "
+            f"allowed: {p.range_text()}: set {p.name} or change {', '.join(names)}"
+        ) from None
+    return Derived(v)
 
 
 class UnknownParameterError(ParameterError):
@@ -114,6 +152,11 @@ class Param:
         A bound that depends on other parameters, as text (``"r"``, ``"l - r - rc"``): shown
         in place of ``low``/``high`` by `range_text`; the model's cross-field check
         (`Model.check`) enforces it.
+    derive : str
+        A default that follows other parameters: an arithmetic rule over their names
+        (``"l / 2"``, ``"m2 * l**2 / 12"``). Unless the value is set, validation derives it
+        (a `Derived` number) from the validated values; ``default`` is its value at the
+        defaults of the others.
     """
 
     name: str
@@ -130,6 +173,7 @@ class Param:
     optional: bool = False
     low_ref: str = ""
     high_ref: str = ""
+    derive: str = ""
 
     @property
     def kind(self) -> str:
@@ -217,9 +261,17 @@ class Schema:
     def validate(self, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """Defaults updated with ``values`` (names or aliases), each checked against its range."""
         out = {**self.defaults(), **dict.fromkeys(self.extras)}
+        given = set()
         for k, v in (values or {}).items():
-            out[self.resolve(k)] = v
-        checked = {p.name: p.check(out[p.name]) for p in self.params}
+            name = self.resolve(k)
+            out[name] = v
+            if not (v is None or isinstance(v, Derived)):
+                given.add(name)
+        rules = [p for p in self.params if p.derive and p.name not in given]
+        checked = {p.name: p.check(out[p.name]) for p in self.params if p not in rules}
+        for p in rules:  # a default that follows the values it derives from
+            checked[p.name] = derive_value(p, checked)
+        checked = {p.name: checked[p.name] for p in self.params}  # (the schema's order)
         return {**checked, **{e: out[e] for e in self.extras}}
 
     def units(self) -> dict[str, str]:
@@ -228,6 +280,7 @@ class Schema:
     def to_attrs(self, values: Mapping[str, Any]) -> dict[str, Any]:
         """Flat attributes for result files: ``param_NAME``, its units, and assumption notes."""
         out: dict[str, Any] = {}
+        derived = []
         for p in self.params:
             v = values[p.name]
             out[f"param_{p.name}"] = "default" if v is None else v
@@ -235,26 +288,38 @@ class Schema:
                 out[f"param_{p.name}_units"] = p.unit
             if p.assumed:
                 out[f"param_{p.name}_note"] = p.assumed
+            if p.derive and isinstance(v, Derived):
+                derived.append(f"{p.name} = {p.derive}")
+        if derived:
+            out[DERIVED_ATTR] = ", ".join(derived)
         return out
 
     def from_attrs(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
         """Values recorded by `to_attrs` (unknown keys ignored)."""
         out: dict[str, Any] = {}
+        derived = derived_names(attrs)
         for p in self.params:
             key = f"param_{p.name}"
             if key in attrs:
                 v = attrs[key]
                 if isinstance(v, np.generic):
                     v = v.item()
-                out[p.name] = None if v == "default" else v
+                out[p.name] = None if v == "default" else Derived(v) if p.name in derived else v
         return self.validate(out)
 
     def table(self) -> list[dict[str, str]]:
         """Rows for display: name, default, unit, range, group, assumed, description."""
-        return [dict(name=p.name, default="derived" if p.default is None else f"{p.default:g}"
+        return [dict(name=p.name, default="derived" if p.default is None else p.derive
+                     if p.derive else f"{p.default:g}"
                      if is_number(p.default) else str(p.default), unit=p.unit or "-",
                      range=p.range_text(), group=p.group, assumed="yes" if p.assumed else "",
                      description=p.description) for p in self.params]  # fmt: skip
+
+
+def derived_names(attrs: Mapping[str, Any]) -> set[str]:
+    """The names a record lists as derived from others (`DERIVED_ATTR`)."""
+    text = attrs.get(DERIVED_ATTR, "")
+    return {part.split("=")[0].strip() for part in str(text).split(",") if "=" in part}
 
 
 class Model(ABC):

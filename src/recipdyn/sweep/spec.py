@@ -22,11 +22,11 @@ import numpy as np
 
 from ..defaults import SWEEP
 from ..errors import ParameterError, is_number
-from ..model.protocol import Model
+from ..model.protocol import Derived, Model, rule_inputs
 from ..model.registry import DEFAULT_MODEL, get_model
 from ..units import to_si
 
-__all__ = ["Axis", "SweepSpec", "parse_axis", "MEASURES"]
+__all__ = ["Axis", "SweepSpec", "parse_axis", "split_axis", "MEASURES"]
 
 #: Per-point work that can be requested.
 MEASURES = ("poincare", "peak", "spectrum", "lyapunov", "verdict", "features")
@@ -49,35 +49,45 @@ class Axis:
     scale: str = "linear"
 
 
+def split_axis(text: str) -> tuple[str, str, list[str] | None, int | None]:
+    """The syntax of an axis, ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...``, checked
+    without the model (the command line refuses a malformed one before anything loads):
+    ``(name as written, right-hand side, range parts or None, count or None)``."""
+    if "=" not in text:
+        raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
+    raw_name, rhs = (s.strip() for s in text.split("=", 1))
+    if ":" not in rhs:
+        if not [s for s in rhs.split(",") if s.strip()]:
+            raise ParameterError(f"--param {raw_name}: no values given")
+        return raw_name, rhs, None, None
+    parts = rhs.split(":")
+    if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+        raise ParameterError(
+            f"--param {raw_name}: range must be start:stop:count or start:stop:count:log"
+        )
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise ParameterError(f"--param {raw_name}: count {parts[2]!r} is not an integer") from None
+    if not 1 <= count <= MAX_POINTS:
+        raise ParameterError(f"--param {raw_name}: count = {count}; allowed: 1..{MAX_POINTS}")
+    return raw_name, rhs, parts, count
+
+
 def parse_axis(text: str, model: str | Model | None = None,
                base: Mapping[str, Any] | None = None) -> Axis:  # fmt: skip
     """Parse ``NAME=start:stop:count[:log]`` or ``NAME=v1,v2,...`` (values may have units,
     converted to the unit of the parameter in ``model``'s schema at the ``base`` values --
     a component from a user's file brings its parameters; default the compressor)."""
-    if "=" not in text:
-        raise ParameterError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2")
-    raw_name, rhs = (s.strip() for s in text.split("=", 1))
+    raw_name, rhs, parts, count = split_axis(text)
     m = get_model(model)
     schema = m.schema_for(base or {})
     name = schema.resolve(raw_name)
     if name not in schema or schema[name].choices is not None:
         raise ParameterError(f"--param {raw_name}: only numeric parameters can be swept")
     unit = schema[name].unit
-    if ":" in rhs:
-        parts = rhs.split(":")
-        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
-            raise ParameterError(
-                f"--param {raw_name}: range must be start:stop:count or start:stop:count:log"
-            )
+    if parts is not None:
         lo, hi = to_si(name, parts[0], unit=unit), to_si(name, parts[1], unit=unit)
-        try:
-            count = int(parts[2])
-        except ValueError:
-            raise ParameterError(
-                f"--param {raw_name}: count {parts[2]!r} is not an integer"
-            ) from None
-        if not 1 <= count <= MAX_POINTS:
-            raise ParameterError(f"--param {raw_name}: count = {count}; allowed: 1..{MAX_POINTS}")
         scale = "log" if len(parts) == 4 and parts[3] == "log" else "linear"
         if scale == "log":
             if lo <= 0 or hi <= 0:
@@ -200,9 +210,20 @@ class SweepSpec:
                  continuation=self.continuation,
                  # (the default model is not named: the digests of stores made before
                  # sweeps took other models stay the same)
-                 **({} if self.model == DEFAULT_MODEL else {"model": self.model})),
+                 **({} if self.model == DEFAULT_MODEL else {"model": self.model}),
+                 **self._followers()),
             sort_keys=True, default=str,
         )  # fmt: skip
+
+    def _followers(self) -> dict[str, list[str]]:
+        """The base's derived values that follow a swept parameter (``ls = l / 2`` in a
+        sweep of ``l``), by their rules: part of the spec (a store made when they did not
+        follow differs; other specs keep their digests)."""
+        swept = {a.name for a in self.axes}
+        rules = sorted(f"{p.name} = {p.derive}" for p in self.get_model().schema_for(self.base)
+                       if p.derive and isinstance(self.base.get(p.name), Derived)
+                       and swept & set(rule_inputs(p.derive)))  # fmt: skip
+        return {"derived": rules} if rules else {}
 
     @property
     def digest(self) -> str:

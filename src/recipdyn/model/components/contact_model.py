@@ -42,6 +42,7 @@ from ..joints.pins import (
 )
 from ..load import CYCLE_PARAMS
 from ..parameters import SCHEMA as LINK_SCHEMA
+from ..parameters import check_reach
 from ..protocol import Model, Param, Schema
 from .guide import GUIDE_PARAMS, GUIDES
 from .load import cycle_outputs, cycle_summary
@@ -666,7 +667,9 @@ class CompressorContact(Model):
         if values["rc"] >= values["r"]:
             raise ParameterError(f"rc = {values['rc']!r} m is out of range; allowed: "
                                  f"(0, r = {values['r']!r}) m")  # fmt: skip
-        dmax = values["l"] - values["r"] - 1.5 * (values["rc"] + values["rc_crosshead"])
+        margin = 1.5 * (values["rc"] + values["rc_crosshead"])
+        check_reach(values["l"], values["r"], margin, "1.5 (rc + rc_crosshead)")
+        dmax = values["l"] - values["r"] - margin
         if not abs(values["d"]) < dmax:
             raise ParameterError(
                 f"d = {values['d']!r} m is out of range; allowed: "
@@ -1094,17 +1097,14 @@ class CompressorContact(Model):
             c = float(values[rc])
             arc = overlap_half_angle(float(values[rj]), c, pen)
             if arc > HERTZ_ARC_LIMIT_DEG:
-                out.append(f"{where}: penetration {pen * 1e6:.4g} um = {100 * pen / c:.3g} % of "
-                           f"the clearance, contact arc +-{arc:.3g} deg")  # fmt: skip
+                out.append(f"the {where} (+-{arc:.3g} deg)")
         if not out:
             return ""
-        return (f"the point-contact law {values['contact_law']!r} is stretched beyond its range "
-                f"({'; '.join(out)} > {HERTZ_ARC_LIMIT_DEG:.3g} deg, an arc as long as the "
-                "radius): Hertz's theory assumes a contact small against the radii (Johnson "
-                "1985, Contact Mechanics, sec. 4.1) and does not hold when the arc is of the "
-                "order of the radius (Mostofi & Gohar, as summarised in Lubricants 10 "
-                "(2022) 233); the forces and accelerations are the model's, not a real "
-                "bearing's: set a stiffer K or a larger clearance")  # fmt: skip
+        # (one short line: the why, with its sources, is docs/contact.md's "contact arc")
+        return (f"the point-contact law {values['contact_law']!r} is out of its range (contact "
+                f"arc > +-{HERTZ_ARC_LIMIT_DEG:.3g} deg, Johnson 1985 sec. 4.1) at "
+                f"{' and '.join(out)}: forces are the model's, not a real bearing's "
+                "(docs/contact.md)")  # fmt: skip
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, float]:
         """Per clearance joint (suffix ``_crosshead`` for the crosshead pin): impacts (count,
