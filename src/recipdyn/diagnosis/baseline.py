@@ -76,8 +76,11 @@ COVERAGE = 0.9
 #: so a simulated curve is a mean over revolutions as the record's is.
 FIT_REVOLUTIONS = 2.0
 FIT_TRANSIENT = 1.0
-#: Finite-difference step of the fit's Jacobian on an uncertain factor (`fit_machine`).
-FD_FACTOR = 0.05
+#: Central-difference step of the fit's Jacobian on an uncertain factor (`fit_machine`): a
+#: 2 % step of the crosshead mass, which the pressures do not feel, changed the simulated
+#: curves by ~100 Pa (over the 720 bins) of numerical noise, while 5 % of the valve lift
+#: changes them by ~1 kPa; 10 % on either side keeps that noise a few per cent of the effect.
+FD_FACTOR = 0.1
 #: Prior standard deviations of the chain: the transducers' offsets (Pa) and the tacho mark's
 #: angle (degrees) when the chain estimator gives none (the issue's examples: offsets of
 #: +5 / -3 kPa, marks set to a degree or worse).
@@ -113,14 +116,15 @@ UNCERTAIN: dict[str, Uncertain] = {
         1.2,
         ("clearance_fraction",),
         "clearance volume (pockets, gaskets, the piston's end clearance as set at the overhaul)",
-    ),  # fmt: skip
+    ),
     "valve_spring": Uncertain(
         0.8,
         1.2,
         ("valve_stiffness", "valve_preload"),
         "every valve's springs (stiffness and preload together)",
-    ),  # fmt: skip
-    "valve_lift": Uncertain(0.9, 1.1, ("valve_lift",), "every valve plate's lift"),
+        fitted=False,
+    ),
+    "valve_lift": Uncertain(0.9, 1.1, ("valve_lift",), "every valve plate's lift", fitted=False),
 }
 
 
@@ -330,7 +334,7 @@ def fit_machine(
     uncertain: Mapping[str, Uncertain] | None = None,
     estimator: ChainEstimator | Callable[[Record], ChainEstimate] = estimate_chain,
     workers: int = 2,
-    max_nfev: int = 12,
+    max_nfev: int = 25,
     progress: Callable[[str], None] | None = None,
 ) -> MachineFit:
     """Fit the healthy machine and the chain to ``records`` (module docstring, step 2).
@@ -349,7 +353,7 @@ def fit_machine(
     workers : int
         Processes that run the simulations.
     max_nfev : int
-        Largest number of residual evaluations of the least-squares solver.
+        Largest number of residual evaluations of each of the two least-squares stages.
 
     Notes
     -----
@@ -360,13 +364,15 @@ def fit_machine(
     own plateaus +-10 %. The residuals: the simulated chamber pressures read at the crank
     angle plus the mark angle, plus the offsets, minus the records' one-degree means, each
     bin over its own error's standard deviation (`_bin_sigma`: the cycle-to-cycle variation
-    the records themselves show); the Jacobian is a forward difference (steps: `FD_FACTOR` of
-    a factor, 0.2 kPa, 0.05 degree, 0.5 % of a line pressure) whose simulations run in one
-    batch. The uncertainty is the sandwich covariance of `_covariance` and the intervals are
+    the records themselves show); the Jacobian is a central difference for the factors
+    (`FD_FACTOR`) and a forward one elsewhere (0.2 kPa, 0.05 degree, 0.5 % of a line
+    pressure), its simulations run in one batch. The uncertainty is the sandwich covariance
+    of `_covariance` and the intervals are
     Student's t at the degrees of freedom of the variation's estimate (the revolutions less
     one per record). Uncertain parameters that the pressures do not tell (``fitted=False``:
     the masses) keep their nominal values with their whole range as the interval.
     """
+    from scipy.ndimage import maximum_filter1d
     from scipy.optimize import least_squares
 
     from ..errors import deferred_signals
@@ -413,16 +419,15 @@ def fit_machine(
         add(n, chain0[n] / 1e3, chain0[n] / 1e3, chain_sd[n] / 1e3, -500.0, 500.0)  # kPa
     add("phase_deg", chain0["phase_deg"], chain0["phase_deg"], chain_sd["phase_deg"], -30, 30)
     for i, c in enumerate(meas):
-        ps0 = float(np.min(c)) / 1e5  # the suction level (bar) the record shows (a guess)
-        pd0 = float(np.max(c)) / 1e5
+        ps0, pd0 = (v / 1e5 for v in _levels(c, machine))  # the record's plateaus, bar
         add(f"suction_pressure_{i}", ps0, ps0, 0.1 * ps0, 0.2 * ps0, 5 * ps0)
         add(f"discharge_pressure_{i}", pd0, pd0, 0.1 * pd0, 0.2 * pd0, 5 * pd0)
     x0, mu, sd = np.array(x0), np.array(mu), np.array(sd)
     lo, hi = np.array(lo), np.array(hi)
     x0 = np.clip(x0, lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo))
     n_unc = len(uncertain)
-    # forward-difference steps: 5 % of a factor (the valves' effects are then ~5 times the
-    # numerical noise of a simulated curve), 0.2 kPa, 0.05 degree, 0.5 % of a line pressure
+    # difference steps: `FD_FACTOR` of a factor (central), 0.2 kPa, 0.05 degree, 0.5 % of a
+    # line pressure (forward)
     steps = np.array([FD_FACTOR if i < n_unc else 0.2 if n.endswith("_offset") else
                       0.05 if n == "phase_deg" else 0.005 * x0[i]
                       for i, n in enumerate(names)])  # fmt: skip
@@ -454,6 +459,23 @@ def fit_machine(
     def job(x, i):
         return sim_key(x, i), params_of(x, i), float(records[i].fs)
 
+    def nuisance(x):
+        """Each draw's curves (of every record) less the draws' mean: (draws, records, 2,
+        360), the unfitted factors drawn over their ranges (a seeded Latin hypercube)."""
+        from scipy.stats import qmc
+
+        u = qmc.LatinHypercube(d=len(unseen), seed=NUISANCE_SEED).random(NUISANCE_DRAWS)
+        jobs = []
+        for k, row in enumerate(u):
+            for i in range(len(meas)):
+                p = params_of(x, i)
+                for un, q in zip(unseen.values(), row, strict=True):
+                    for name in un.sets:
+                        p[name] = base[name] * (un.lo + (un.hi - un.lo) * q)
+                jobs.append((("nuisance", k, i), p, float(records[i].fs)))
+        c = np.array(simulate_all(jobs)).reshape(NUISANCE_DRAWS, len(meas), 2, 360)
+        return c - c.mean(axis=0)
+
     def sim_key(x, i):
         sub = [x[idx[n]] for n in uncertain] + [x[idx[f"suction_pressure_{i}"]],
                                                 x[idx[f"discharge_pressure_{i}"]]]  # fmt: skip
@@ -474,29 +496,66 @@ def fit_machine(
                                zip(model_curves(x, sims), meas, scale, strict=True)])  # fmt: skip
         return np.concatenate([data, (x - mu) / sd])
 
-    def jacobian(x, scale):
+    def jacobian(x, scale, cols=None):
+        # central differences for the uncertain factors (a valve's bounces differ from one
+        # simulation to the next by an amount that does not shrink with the step: a wide,
+        # two-sided step keeps it small against the effect), forward ones elsewhere
+        cols = range(x.size) if cols is None else cols
         h = steps * np.where(x + steps < hi, 1, -1)
+        h[:n_unc] = steps[:n_unc]
         jobs = [job(x, i) for i in range(len(meas))]
         for j, n in enumerate(names):
+            if j not in cols:
+                continue
             if j < n_unc or n.startswith(("suction_pressure_", "discharge_pressure_")):
-                xj = x.copy()
-                xj[j] += h[j]
                 rows = range(len(meas)) if j < n_unc else [int(n.rsplit("_", 1)[1])]
-                jobs += [job(xj, i) for i in rows]
+                for sign in (1, -1) if j < n_unc else (1,):
+                    xj = x.copy()
+                    xj[j] += sign * h[j]
+                    jobs += [job(xj, i) for i in rows]
         simulate_all(jobs)  # one batch: every simulation the columns need
         r0 = residuals(x, scale)
-        J = np.empty((r0.size, x.size))
-        for j in range(x.size):
+        J = np.zeros((r0.size, x.size))
+        for j in cols:
             xj = x.copy()
             xj[j] += h[j]
-            J[:, j] = (residuals(xj, scale) - r0) / h[j]
+            if j < n_unc:
+                xm = x.copy()
+                xm[j] -= h[j]
+                J[:, j] = (residuals(xj, scale) - residuals(xm, scale)) / (2 * h[j])
+            else:
+                J[:, j] = (residuals(xj, scale) - r0) / h[j]
         return J
 
     with deferred_signals() as pending:
         pool = process_pool(workers) if workers > 1 else None
         try:
-            sol = least_squares(residuals, x0, jac=jacobian, bounds=(lo, hi), args=(scale,),
-                                method="trf", x_scale=sd, max_nfev=max_nfev)  # fmt: skip
+            # the unfitted parameters drawn over their ranges: how much the curves depend on
+            # them, bin by bin, is error the fit cannot take off (their marginal, in the
+            # weights and the covariance)
+            nuis = None
+            if unseen:
+                nuis = nuisance(x0)
+                var = maximum_filter1d(np.sum(nuis**2, axis=0) / (len(nuis) - 1), SPREAD_BINS,
+                                       axis=-1, mode="wrap")  # fmt: skip
+                scale = np.sqrt(scale**2 + var)
+            # first the chain and the line pressures with the machine as described (a
+            # simulation per record and column), then everything from there
+            rest = np.arange(n_unc, x0.size)
+
+            def sub(z):
+                x = x0.copy()
+                x[rest] = z
+                return x
+
+            first = least_squares(
+                lambda z: residuals(sub(z), scale), x0[rest],
+                jac=lambda z: jacobian(sub(z), scale, rest)[:, rest], bounds=(lo[rest], hi[rest]),
+                method="trf", x_scale=sd[rest], max_nfev=max_nfev,
+            )  # fmt: skip
+            sol = least_squares(residuals, sub(first.x), jac=jacobian, bounds=(lo, hi),
+                                args=(scale,), method="trf", x_scale=sd,
+                                max_nfev=max_nfev)  # fmt: skip
             J = jacobian(sol.x, scale)
         finally:
             if pool is not None:
@@ -508,9 +567,11 @@ def fit_machine(
     if progress is not None:
         progress(f"baseline fit: residual RMS {rms:.0f} Pa, {count['sims']} simulations, "
                  f"{sol.nfev} evaluations ({sol.message})")  # fmt: skip
-    cov = _covariance(J[:n_data], J[n_data:], per_rev, scale)
+    cov = _covariance(J[:n_data], J[n_data:], per_rev, scale, nuis)
     sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
     x = sol.x
+    if nuis is not None:  # the unfitted parameters' spread: estimated from its draws
+        dof = min(dof, NUISANCE_DRAWS - 1)
     z = _quantile(COVERAGE, dof)
     fitted, intervals = {}, {}
     for u in unseen.values():  # not told by the pressures: the nominal value, the whole range
@@ -541,6 +602,10 @@ def fit_machine(
                       dof, z, sorted(unseen))  # fmt: skip
 
 
+#: Draws of the unfitted parameters (`Uncertain.fitted` False) over their ranges whose
+#: curves' spread enters the fit's weights and covariance (`fit_machine`), and their seed.
+NUISANCE_DRAWS = 6
+NUISANCE_SEED = 42
 #: Crank-angle bins (degrees) over which a bin's cycle-to-cycle variance is spread
 #: (`_bin_sigma`: a valve event's angle moves from one revolution to the next).
 SPREAD_BINS = 7
@@ -575,7 +640,7 @@ def _bin_sigma(per_rev) -> tuple[np.ndarray, int]:
                      for pr in per_rev]), dof  # fmt: skip
 
 
-def _covariance(Jd, Jp, per_rev, scale):
+def _covariance(Jd, Jp, per_rev, scale, nuisance=None):
     """The fitted parameters' covariance (scaled units).
 
     The estimate is the regularised, weighted least-squares solution, ``x - x_true ~ H^-1
@@ -584,7 +649,10 @@ def _covariance(Jd, Jp, per_rev, scale):
     a weighted curve error ``e`` of covariance ``S``: ``cov = H^-1 (Jd^T S Jd + Jp^T Jp)
     H^-1`` (the sandwich; ``H^-1`` when the bins' errors are independent). ``S`` is the
     records' own revolutions' deviations (whatever their correlation along the crank angle),
-    pooled, times ``1/R + 1/K`` as in `_bin_sigma`."""
+    pooled, times ``1/R + 1/K`` as in `_bin_sigma`; and, with ``nuisance`` (each draw of the
+    unfitted parameters' curves less their mean, shape (draws, records, 2, 360)), the error
+    their unknown values leave, the same in every record (one machine): each draw's
+    deviations over all records projected together."""
     H = Jd.T @ Jd + Jp.T @ Jp
     Hi = np.linalg.pinv(H)
     n = Jd.shape[0] // len(per_rev)
@@ -599,6 +667,10 @@ def _covariance(Jd, Jp, per_rev, scale):
             D = (pr - pr.mean(axis=0)) / scale[i] * math.sqrt(f)
             P = D.reshape(pr.shape[0], -1) @ Ji
             G += P.T @ P / dof
+    if nuisance is not None and len(nuisance) > 1:
+        P = np.array([sum((d[i] / scale[i]).ravel() @ Jd[i * n : (i + 1) * n]
+                          for i in range(len(per_rev))) for d in nuisance])  # fmt: skip
+        G += P.T @ P / (len(nuisance) - 1)
     return Hi @ (G + Jp.T @ Jp) @ Hi
 
 
@@ -609,6 +681,25 @@ def _quantile(coverage: float, dof: int) -> float:
 
     q = 0.5 + coverage / 2
     return float(t.ppf(q, dof)) if dof >= 1 else float(norm.ppf(q))
+
+
+def _levels(curves: np.ndarray, machine) -> tuple[float, float]:
+    """The suction and discharge levels (Pa) a record's two chamber curves show (each
+    chamber's plateaus over its own strokes, `recipdyn.diagnosis.evidence`, averaged): where a
+    fit starts the line pressures."""
+    from .evidence import _chamber_cycle, geometry
+
+    g = geometry(None if machine.is_default else machine.changes())
+    lo, hi = [], []
+    for c, v, vs in ((curves[0], g["V_head"], g["Vs_head"]), (curves[1], g["V_crank"],
+                                                                g["Vs_crank"])):  # fmt: skip
+        out = _chamber_cycle(c, v, vs, g["clearance"])
+        lo.append(out["p_lo"])
+        hi.append(out["p_hi"])
+    ps, pd = float(np.nanmean(lo)), float(np.nanmean(hi))
+    if not (ps > 0 and pd > ps):
+        ps, pd = float(np.min(curves)), float(np.max(curves))
+    return ps, pd
 
 
 def _lag1(r: np.ndarray, sizes: Sequence[int]) -> float:
@@ -754,7 +845,7 @@ def build_baseline(
     uncertain: Mapping[str, Uncertain] | None = None,
     estimator: ChainEstimator | Callable[[Record], ChainEstimate] = estimate_chain,
     workers: int = 2,
-    max_nfev: int = 12,
+    max_nfev: int = 25,
     progress: Callable[[str], None] | None = None,
 ) -> Baseline:
     """The machine's own healthy baseline for diagnoser ``diag`` from healthy ``records``
