@@ -46,6 +46,12 @@ def test_a_machine_file_reads_into_its_model_and_values(tmp_path):
     )
     assert m.source == str(path)
     assert Machine.default().is_default and not m.is_default
+    # what the file says is the machine, a value the model would otherwise derive included
+    # (the rod's centroid, half its length when not given): the data set simulates it
+    rod = machine_from_file(_dump(tmp_path, "rod.toml", "l=450 mm", "ls=300 mm"))
+    assert rod["ls"] == pytest.approx(0.3) and Machine.of({"l": 0.45})["ls"] == pytest.approx(0.225)
+    spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy",), machine=rod.pairs())
+    assert all(t["params"]["ls"] == pytest.approx(0.3) for t in design(spec))
     with pytest.raises(ParameterError, match="machine .*unknown format"):
         read_machine(tmp_path / "m.csv")
     with pytest.raises(ParameterError, match="file not found"):
@@ -97,9 +103,9 @@ def test_another_machine_re_derives_its_ranges_fault_values_and_healthy_pins():
                 (base[c.name].mild * f, base[c.name].severe * f)
             )
     spec = DatasetSpec(n_conditions=3, levels=(1.0,), classes=("healthy", "ring_leak"),
-                       machine=m.changes())  # fmt: skip
+                       machine=m.pairs())  # fmt: skip
     tasks = design(spec)
-    assert all(t["machine"] == dict(m.changes()) for t in tasks)
+    assert all(t["machine"] == dict(m.pairs()) for t in tasks)
     assert all(t["params"]["bore"] == 0.25 and t["params"]["rc"] == pytest.approx(2e-4)
                for t in tasks)  # fmt: skip
     assert all(32.0 <= t["params"]["omega"] <= 48.0 for t in tasks)

@@ -43,11 +43,7 @@ def _machine_changes(machine: Path | None, sets: list[str] | None):
     changes = dict(parse_assignment(item) for item in sets or [])
     _machine_pairs(changes)  # only machine parameters
     m = machine_from_file(machine, changes) if machine is not None else Machine.of(changes)
-    return m.changes()
-
-
-def _changes_text(pairs) -> str:
-    return ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in pairs)
+    return m.pairs()
 
 
 @app.command()
@@ -112,7 +108,7 @@ def dataset(
     Fault classes x severities x operating conditions x sensor settings; signals in Zarr,
     features and labels in Parquet, a data card (docs/diagnosis.md)."""
     from ..diagnosis.classes import class_names
-    from ..diagnosis.dataset import DatasetSpec, build_dataset
+    from ..diagnosis.dataset import DatasetSpec, build_dataset, spec_machine
 
     kw = {} if classes is None else {"classes": tuple(c.strip() for c in classes.split(","))}
     if machine is not None or sets:
@@ -157,7 +153,7 @@ def dataset(
     typer.echo(
         f"wrote {out}/features.parquet, {out}/signals.zarr, {out}/datacard.md "
         f"({len(spec.classes)} of {len(class_names())} classes"
-        + (f"; machine: {_changes_text(spec.machine)}" if spec.machine else "")
+        + (f"; machine: {spec_machine(spec).text()}" if spec.machine else "")
         + f"); train a diagnoser on it: recipdyn train {out} -o {out}.skops"
     )
 

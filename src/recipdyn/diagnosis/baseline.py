@@ -689,7 +689,7 @@ def _levels(curves: np.ndarray, machine) -> tuple[float, float]:
     fit starts the line pressures."""
     from .evidence import _chamber_cycle, geometry
 
-    g = geometry(None if machine.is_default else machine.changes())
+    g = geometry(machine.pairs() or None)
     lo, hi = [], []
     for c, v, vs in ((curves[0], g["V_head"], g["Vs_head"]), (curves[1], g["V_crank"],
                                                                 g["Vs_crank"])):  # fmt: skip

@@ -352,7 +352,7 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
             sev = severities(spec, ci, name)
             for li, (s, snr) in enumerate(zip(sev, snrs(spec, ci, name, len(sev)), strict=True)):
                 idx = len(tasks)
-                params = {} if machine is None else dict(machine.changes())
+                params = {} if machine is None else dict(machine.pairs())
                 params.update(healthy_parameters(machine))
                 params.update(
                     {
@@ -380,7 +380,7 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                     }
                 )
                 if machine is not None:  # the features read the machine's geometry
-                    tasks[-1]["machine"] = dict(machine.changes())
+                    tasks[-1]["machine"] = dict(machine.pairs())
                 if spec.chain == "drawn":
                     ch = chain_draw(spec, ci, name, li, cond["fs"])
                     tasks[-1]["chain"] = ch.to_dict()

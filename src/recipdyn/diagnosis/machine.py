@@ -171,10 +171,16 @@ class Machine:
         return self.as_dict[name]
 
     def changes(self) -> tuple[tuple[str, Any], ...]:
-        """The parameters that differ from the default machine (sorted pairs): what a data
-        set's spec stores (`recipdyn.diagnosis.dataset.DatasetSpec.machine`)."""
+        """The parameters that differ from the default machine (sorted pairs)."""
         base = dict(_default_values())
         return tuple((k, v) for k, v in self.values if base.get(k) != v)
+
+    def pairs(self) -> tuple[tuple[str, Any], ...]:
+        """What a data set's spec stores (`recipdyn.diagnosis.dataset.DatasetSpec.machine`):
+        every parameter of a machine other than the default one (a parameter the model
+        derives from others, the rod's centroid and inertia from its length, keeps the
+        machine's own value), nothing for the default machine."""
+        return () if self.is_default else self.values
 
     @property
     def is_default(self) -> bool:
