@@ -25,6 +25,7 @@ the faults' recall (their own class) and detection (not called healthy, not refu
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
 from pathlib import Path
@@ -153,7 +154,9 @@ def main() -> None:
                 r = recs[(name, k)]
                 kw = {"tacho": r.tacho, "p_head": r.p_head, "p_crank": r.p_crank, "model": diag}
                 row = {"truth": name, "severity": s}
-                for tag, extra in (("without", {}), ("with", {"baseline": b})):
+                model_b = dataclasses.replace(b, delta=b.delta_model, referral="model")
+                for tag, extra in (("without", {}), ("with", {"baseline": b}),
+                                   ("with model referral", {"baseline": model_b})):  # fmt: skip
                     a = diagnose_arrays(r.accel, r.fs, **kw, **extra)
                     row[tag] = "refused" if a.refused else a.label
                 answers.append(row)
@@ -191,8 +194,8 @@ def report(done: dict) -> None:
             ratio = [abs(r["value"] - r["truth"]) / max((r["hi"] - r["lo"]) / 2, 1e-300)
                      for r in rows]  # fmt: skip
             print(f"| {n} | {ins}/{len(rows)} | {np.median(ratio):.2f} |")
-        for tag in ("without", "with"):
-            ans = [a for c in cases for a in c["answers"]]
+        for tag in ("without", "with", "with model referral"):
+            ans = [a for c in cases for a in c["answers"] if tag in a]
             h = [a for a in ans if a["truth"] == "healthy"]
             f = [a for a in ans if a["truth"] != "healthy"]
             hr = sum(a[tag] == "healthy" for a in h) / len(h)

@@ -100,6 +100,7 @@ def test_recipdyn_sense_at_its_defaults_prints_no_note_and_records_the_default_c
     ds = xr.Dataset(
         {"a": ("time", a, {"units": "m/s**2"}), "theta1": ("time", 20.0 * t, {"units": "rad"})},
         coords={"time": t},
+        attrs={"title": "recipdyn simulation: test record"},  # sense reads simulated runs only
     )
     run, out = tmp_path / "run.nc", tmp_path / "sensed.nc"
     ds.to_netcdf(run)

@@ -227,13 +227,23 @@ def diagnose(
         None,
         "--baseline",
         help="The machine's own healthy baseline ('recipdyn baseline'): the chain is corrected "
-        "and the features referred to the machine's healthy state.",
+        "with it and the features referred to the machine's healthy state.",
+    ),
+    no_correction: bool = typer.Option(
+        False,
+        "--no-correction",
+        help="Trust the tacho's mark, the pressures' zero and alignment (no chain correction).",
     ),
 ) -> None:
     """Diagnose a record: fault class, severity and evidence, or a refusal with its reason.
 
-    Class probabilities, the severity with its interval, impacts and deciding features, the
-    closest simulated record overlaid; a record outside the training domain is refused."""
+    The measurement chain's errors read from the record (the tacho mark's crank angle and
+    the pressures' offsets from the polytropes, their relative gain, the tacho's jitter, the
+    mount's resonance) and corrected; class probabilities, the severity with its interval,
+    the channels used and how often their answer was right on held-out conditions, impacts
+    and deciding features, the closest simulated record overlaid. A record outside the
+    training domain, whose chain cannot be made consistent, or whose channels cannot tell
+    its class apart is refused."""
     from ..diagnosis.diagnose import diagnose as diagnose_fn
     from ..errors import ParameterError
     from ..io_signal import check_signal_file
@@ -251,6 +261,7 @@ def diagnose(
         p_crank=p_crank,
         model=model,
         out=out,
+        correct=not no_correction,
         machine=machine,
         baseline=baseline,
     )

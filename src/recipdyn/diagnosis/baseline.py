@@ -7,10 +7,11 @@ angle from outer dead centre, the accelerometer's mounting resonance). Condition
 refers a machine's readings to its own healthy state after an overhaul; this module does it
 with the simulator:
 
-1. **The chain, first estimate** (`ChainEstimator`, default `estimate_chain`): what the records
-   themselves give: the mounting resonance from the impacts' ringing; the offsets and the
-   mark angle as prior guesses with their uncertainty. A chain-correction module that reads
-   them from the pressure trace itself plugs in here (any callable ``record -> ChainEstimate``).
+1. **The chain, first estimate** (`ChainEstimator`): any callable ``record -> ChainEstimate``
+   gives the fit its starting values and priors for the offsets and the mark angle, and the
+   mounting resonance. The default, `estimate_chain`, is the record-level estimators of
+   `recipdyn.diagnosis.correction` (the polytropes' phase and offsets, the mount's
+   spectrum); another estimator plugs in by the ``estimator`` argument.
 2. **The fit** (`fit_machine`): the simulator's healthy machine, its `UNCERTAIN` parameters
    free within their ranges, each record's line pressures free, and the chain's offsets and
    mark angle, fitted to the records' chamber pressures over the revolution (one-degree bins)
@@ -213,36 +214,71 @@ class ChainEstimate:
 
 class ChainEstimator(Protocol):
     """Anything that estimates a record's chain: ``estimator(record) -> ChainEstimate``
-    (`estimate_chain`, or a chain-correction module's estimator from the pressure trace)."""
+    (`estimate_chain`, which also takes the machine's changes as ``machine=``, or any other
+    estimator of the same signature)."""
 
     def __call__(self, record: Record) -> ChainEstimate: ...
 
 
 #: The impacts' ringing lies within this fraction of the mounting resonance on 95 % of the
-#: data set's records (`recipdyn.diagnosis.evidence.ringing_hz`): the resonance estimate's
-#: 95 % half-width.
+#: data set's records (`recipdyn.diagnosis.evidence.ringing_hz`): the resonance's 95 %
+#: half-width when the mount's response cannot be fitted.
 RINGING_ACCURACY = 0.07
+#: What the polytropes' phase and offset (`recipdyn.diagnosis.correction.pressure_phase`)
+#: may be off by beyond their own statistics when read without the diagnoser's chain
+#: reference (a healthy chamber's are within ~0.3 degree and a few kPa of the truth:
+#: `recipdyn.diagnosis.correction.ChainReference`): added to their uncertainty as priors.
+PHASE_PRIOR_FLOOR_DEG = 0.5
+OFFSET_PRIOR_FLOOR_PA = 2e3
 
 
-def estimate_chain(record: Record) -> ChainEstimate:
-    """The chain as one record shows it without a model: the mounting resonance from the
-    impacts' ringing (`recipdyn.diagnosis.evidence.ringing_hz`; its standard uncertainty the
-    larger of the ringing's measured accuracy, `RINGING_ACCURACY` over 1.96, and the spread
-    between the record's two halves); the offsets and the mark angle unknown (0, with the
-    priors `OFFSET_PRIOR_PA`, `PHASE_PRIOR_DEG`): the fit finds them."""
+def estimate_chain(record: Record, machine=None) -> ChainEstimate:
+    """The chain as one record shows it, by the record-level estimators of
+    `recipdyn.diagnosis.correction` (the first estimate and the prior of the baseline's fit):
+    the tacho mark's angle and each transducer's offset from the chambers' polytropes
+    (`pressure_phase`, the two chambers' phases combined by their weights; uncertainties
+    widened by `PHASE_PRIOR_FLOOR_DEG`, `OFFSET_PRIOR_FLOOR_PA`, or the priors
+    `PHASE_PRIOR_DEG`, `OFFSET_PRIOR_PA` where a chamber gives none), and the mounting
+    resonance from the acceleration's spectrum (`resonance`; the impacts' ringing,
+    `RINGING_ACCURACY`, where the mount's response cannot be fitted). ``machine``: its
+    changes (`recipdyn.diagnosis.machine.Machine.pairs`), whose chambers' volumes the
+    polytropes are read against."""
+    from .correction import K95, pressure_phase, resonance
     from .evidence import ringing_hz
 
-    x, fs = record.accel, record.fs
-    whole = ringing_hz(x, fs)
-    half = [ringing_hz(x[: x.size // 2], fs), ringing_hz(x[x.size // 2 :], fs)]
-    spread = float(np.nanstd(half)) if np.isfinite(half).all() else whole
-    return ChainEstimate(
-        {"p_head_offset": 0.0, "p_crank_offset": 0.0, "phase_deg": 0.0, "resonance_hz": whole},
-        {"p_head_offset": OFFSET_PRIOR_PA, "p_crank_offset": OFFSET_PRIOR_PA,
-         "phase_deg": PHASE_PRIOR_DEG,
-         "resonance_hz": max(spread, RINGING_ACCURACY / 1.96 * whole)},
-        "resonance from the ringing; offsets and mark angle from the fit",
-    )  # fmt: skip
+    revs = crank_revs(record)
+    values = {"p_head_offset": 0.0, "p_crank_offset": 0.0, "phase_deg": 0.0}
+    sigma = {"p_head_offset": OFFSET_PRIOR_PA, "p_crank_offset": OFFSET_PRIOR_PA,
+             "phase_deg": PHASE_PRIOR_DEG}  # fmt: skip
+    phases = []
+    for ch, p in (("head", record.p_head), ("crank", record.p_crank)):
+        r = pressure_phase(p, revs, ch, machine)
+        if not r.get("ok"):
+            continue
+        values[f"p_{ch}_offset"] = float(r["offset_pa"])
+        sigma[f"p_{ch}_offset"] = math.hypot(float(r["offset_sd"]), OFFSET_PRIOR_FLOOR_PA)
+        phases.append((float(r["phase_deg"]), math.hypot(float(r["phase_sd"]),
+                                                         PHASE_PRIOR_FLOOR_DEG)))  # fmt: skip
+    if phases:
+        w = [1.0 / sd**2 for _, sd in phases]
+        values["phase_deg"] = sum(v * wi for (v, _), wi in zip(phases, w, strict=True)) / sum(w)
+        sigma["phase_deg"] = max(1.0 / math.sqrt(sum(w)), PHASE_PRIOR_FLOOR_DEG)
+    est = resonance(record.accel, record.fs, revs).get("resonance_hz")
+    if est is not None and math.isfinite(est.value) and math.isfinite(est.uncertainty):
+        values["resonance_hz"], sigma["resonance_hz"] = est.value, est.uncertainty / K95
+    else:
+        hz = ringing_hz(record.accel, record.fs)
+        values["resonance_hz"], sigma["resonance_hz"] = hz, RINGING_ACCURACY / 1.96 * hz
+    return ChainEstimate(values, sigma, "recipdyn.diagnosis.correction (polytropes, spectrum)")
+
+
+def _estimate(estimator, rec: Record, machine) -> ChainEstimate:
+    """``estimator(rec)``, given the machine's changes when it takes them (`estimate_chain`)."""
+    import inspect
+
+    if "machine" in inspect.signature(estimator).parameters:
+        return estimator(rec, machine=machine.pairs() or None)
+    return estimator(rec)
 
 
 def correct(record: Record, chain: Mapping[str, float]) -> tuple[Record, float]:
@@ -397,7 +433,7 @@ def fit_machine(
         meas.append(c)
         speeds.append(sp)
         per_rev.append(pr[np.isfinite(pr).all(axis=(1, 2))])
-        chains.append(estimator(rec))
+        chains.append(_estimate(estimator, rec, machine))
     chain0 = {k: float(np.mean([c.values[k] for c in chains])) for k in chains[0].values}
     chain_sd = {k: float(np.mean([c.sigma[k] for c in chains])) for k in chains[0].sigma}
     res_hz = (chain0["resonance_hz"], chain_sd["resonance_hz"])
@@ -747,12 +783,15 @@ class Baseline:
     """A machine's own healthy baseline for one diagnoser (module docstring).
 
     ``fit``: the fitted parameters and chain (`MachineFit`); ``delta``: each pressure and
-    cycle feature's healthy offset of this machine from the diagnoser's (fitted minus nominal,
-    averaged over the records' operating points) and ``delta_spread`` its spread over them;
-    ``check``: the
-    largest departure of the (chain-corrected) healthy records' features from the fitted
-    machine's, in the healthy machine's own spreads (`recipdyn.diagnosis.machine.
-    healthy_spreads`), and the feature; ``diagnoser``: `diagnoser_id`."""
+    cycle feature's healthy offset of this machine from the diagnoser's, the one `refer`
+    takes off, by ``referral``: ``"records"`` (``delta_records``: the healthy records' own
+    features, chain corrected, less what the diagnoser's healthy machine shows at their
+    operating points, averaged) or ``"model"`` (``delta_model``: the fitted machine's
+    simulated features less the nominal one's, averaged over the records' operating points;
+    ``delta_spread`` its spread over them); ``check``: the largest departure of the
+    (chain-corrected) healthy records' features from the fitted machine's, in the healthy
+    machine's own spreads (`recipdyn.diagnosis.machine.healthy_spreads`), and the feature;
+    ``diagnoser``: `diagnoser_id`."""
 
     fit: MachineFit
     delta: dict[str, float]
@@ -761,6 +800,9 @@ class Baseline:
     diagnoser: str
     records: list[str] = field(default_factory=list)
     recipdyn_version: str = ""
+    referral: str = "records"
+    delta_model: dict[str, float] = field(default_factory=dict)
+    delta_records: dict[str, float] = field(default_factory=dict)
 
     @property
     def chain(self) -> dict[str, float]:
@@ -847,15 +889,21 @@ def build_baseline(
     workers: int = 2,
     max_nfev: int = 25,
     progress: Callable[[str], None] | None = None,
+    referral: str = "records",
 ) -> Baseline:
     """The machine's own healthy baseline for diagnoser ``diag`` from healthy ``records``
     (module docstring): the fit (`fit_machine`), then the healthy machine with the fitted
     parameters and the diagnoser's nominal one simulated and sensed at each record's
-    operating point, with the same noise, and their features' difference (`Baseline.delta`)."""
+    operating point, with the same noise, and their features' difference
+    (`Baseline.delta_model`); the healthy records' own departure from the diagnoser's healthy
+    machine (`Baseline.delta_records`); ``referral`` chooses which `Baseline.refer` takes
+    off."""
     from .. import __version__
     from ..parallel import process_pool, stop_pool
     from .machine import feature_shift, healthy_parameters, healthy_spreads
 
+    if referral not in ("records", "model"):
+        raise ParameterError(f"referral = {referral!r}; allowed: records, model")
     machine = machine or diag.machine
     fit = fit_machine(records, machine, uncertain=uncertain, estimator=estimator,
                       workers=workers, max_nfev=max_nfev, progress=progress)  # fmt: skip
@@ -881,25 +929,46 @@ def build_baseline(
     from .evidence import feature_groups
 
     groups = feature_groups(diag.names)
-    delta, spread = {}, {}
+    measured = [record_features_of(rec, fit.chain, changes) for rec in records]
+    expected = [_expected(diag, m, feats[2 * i + 1]) for i, m in enumerate(measured)]
+    delta_model, delta_records, spread = {}, {}, {}
     for n in groups["pressure"] + groups["cycle"]:
         d = [feats[2 * i][n] - feats[2 * i + 1][n] for i in range(len(records))]
         d = [v for v in d if math.isfinite(v)]
         if d:
-            delta[n] = float(np.mean(d))
+            delta_model[n] = float(np.mean(d))
             spread[n] = float(np.std(d))
+        e = [m[n] - x[n] for m, x in zip(measured, expected, strict=True)]
+        e = [v for v in e if math.isfinite(v)]
+        if e:
+            delta_records[n] = float(np.mean(e))
     spreads = healthy_spreads(diag)
     worst, which = 0.0, ""
-    for i, rec in enumerate(records):
-        got = record_features_of(rec, fit.chain, changes)
+    for i, got in enumerate(measured):
         s, n = feature_shift(got, feats[2 * i], spreads)
         if s > worst:
             worst, which = s, n
     check = {"shift": worst, "feature": which}
     if progress is not None:
         progress(f"baseline: referral simulated ({len(tasks)} records)")
+    delta = delta_records if referral == "records" else delta_model
     return Baseline(fit, delta, spread, check, diagnoser_id(diag),
-                    [r.name for r in records], __version__)  # fmt: skip
+                    [r.name for r in records], __version__, referral, delta_model,
+                    delta_records)  # fmt: skip
+
+
+def _expected(diag, row: Mapping[str, float], nominal: Mapping[str, float]) -> dict:
+    """What the diagnoser's healthy machine shows at the operating point of feature ``row``:
+    its healthy baseline's prediction (`recipdyn.diagnosis.train.fit_baseline`) for the
+    features it models, the nominal machine's simulated record (``nominal``) for the rest."""
+    out = dict(nominal)
+    b = diag.baseline
+    if b:
+        ops = np.array([row[o] for o in b["operating"]], float)
+        a = np.concatenate([[1.0], (ops - np.asarray(b["mean"])) / np.asarray(b["scale"])])
+        pred = np.asarray(b["coef"]) @ a
+        out.update(zip(b["targets"], pred.tolist(), strict=True))
+    return out
 
 
 def record_features_of(rec: Record, chain: Mapping[str, float], machine=None) -> dict[str, float]:

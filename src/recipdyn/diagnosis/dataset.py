@@ -442,29 +442,78 @@ def simulate_record(task: dict[str, Any], *, summary: bool = False):
     )
 
 
-def features_of(
-    channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None
-) -> dict[str, float]:
-    """A record's features from its sensed channels: the crank angle from the tacho's first
-    edge and the record's constant crank speed (a short record has too few pulses for
-    the speed to be read from them). ``machine``: the changes of the machine the record's
-    cycle features are read against (None: the default machine)."""
+def _revs(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> np.ndarray:
+    """The crank angle a data set's features read: from the tacho's first edge at the
+    record's constant crank speed (a short record has too few pulses for the speed to be
+    read from them)."""
     from ..analysis.vibration import tacho_times
-    from .evidence import record_features
 
-    x = channels["accel_guide"]
     edges = tacho_times(channels["tacho"], fs)
     if edges.size == 0:
         raise ValueError("no tacho edge in the record")
-    revs = (np.arange(x.size) / fs - edges[0]) * speed_hz
+    return (np.arange(channels["accel_guide"].size) / fs - edges[0]) * speed_hz
+
+
+def features_of(
+    channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None
+) -> dict[str, float]:
+    """A record's features from its sensed channels (the crank angle: `_revs`);
+    ``machine``: the changes of the machine the record's cycle features are read against
+    (None: the default machine)."""
+    from .evidence import record_features
+
+    revs = _revs(channels, fs, speed_hz)
     return record_features(
-        x,
-        fs,
+        channels["accel_guide"], fs, revs, p_head=channels.get("p_head_sensor"),
+        p_crank=channels.get("p_crank_sensor"), machine=machine,
+    )  # fmt: skip
+
+
+def chamber_fits(channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None) -> dict:
+    """Each chamber's `recipdyn.diagnosis.correction.pressure_phase` on the record's crank
+    angle (`_revs`), JSON-able: what the chain correction of a drawn-chain data set reads
+    (``machine``: the changes of the machine whose chambers they are; None: the default)."""
+    from .correction import pressure_phase
+
+    revs = _revs(channels, fs, speed_hz)
+    revs = np.where(revs >= 0, revs, np.nan)
+    out = {}
+    for ch in ("head", "crank"):
+        p = channels.get(f"p_{ch}_sensor")
+        if p is not None:
+            out[ch] = {k: (float(v) if isinstance(v, (float, np.floating)) else v)
+                       for k, v in pressure_phase(p, revs, ch, machine).items()}  # fmt: skip
+    return out
+
+
+def corrected_features(
+    channels, fs: float, speed_hz: float, reference, fits, condition=None, machine=None
+):
+    """``(features or None, correction)``: the record's chain estimated and corrected as
+    `recipdyn diagnose` does (`recipdyn.diagnosis.correction.correct_chain`, against
+    ``reference``, from its stored ``fits``, its own ``condition`` left out of the
+    reference), then its features (``machine``: the changes of the data set's machine);
+    None where the correction refuses the record."""
+    from .correction import correct_chain
+    from .evidence import record_features
+
+    revs = _revs(channels, fs, speed_hz)
+    fix = correct_chain(
         revs,
         p_head=channels.get("p_head_sensor"),
         p_crank=channels.get("p_crank_sensor"),
+        reference=reference,
+        fits=fits,
+        exclude_condition=condition,
         machine=machine,
     )
+    if fix.refused:
+        return None, fix
+    feats = record_features(
+        channels["accel_guide"], fs, fix.revs, p_head=fix.p_head, p_crank=fix.p_crank,
+        machine=machine,
+    )  # fmt: skip
+    return feats, fix
 
 
 def make_record(task: dict[str, Any]) -> dict[str, Any]:
@@ -479,9 +528,10 @@ def make_record(task: dict[str, Any]) -> dict[str, Any]:
         ch = {c: np.asarray(rec[c].values, dtype=np.float32) for c in CHANNELS}
         out["channels"] = ch
         speed = task["params"]["omega"] / (2 * math.pi)
-        out["features"] = features_of(
-            {k: v.astype(float) for k, v in ch.items()}, task["fs"], speed, task.get("machine")
-        )
+        chd = {k: v.astype(float) for k, v in ch.items()}
+        out["features"] = features_of(chd, task["fs"], speed, task.get("machine"))
+        if "chain" in task:  # a drawn chain: what its correction reads (_correct_records)
+            out["fits"] = chamber_fits(chd, task["fs"], speed, task.get("machine"))
     except Exception as exc:  # noqa: BLE001 - recorded; the data set goes on
         out["error"] = f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)}"
     out["seconds"] = time.perf_counter() - t0
@@ -519,6 +569,8 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
             raise ParameterError(
                 f"{path.parent}: a data set exists; --resume to continue it, --force to start over"
             )
+        if spec.chain == "drawn":
+            _chain_arrays(g, len(tasks))
         return g, names
     g = zarr.open_group(str(path), mode="w")
     chunk = (1, m)
@@ -534,6 +586,7 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     if spec.chain == "drawn":  # each record's drawn chain, as JSON
         g.create_array("chain", shape=(n,), chunks=(n,), dtype=str)
         g["chain"][:] = np.array([json.dumps(t["chain"]) for t in tasks])
+        _chain_arrays(g, n)
     from .. import __version__
 
     g.attrs.update(
@@ -547,8 +600,18 @@ def _open_store(path: Path, spec: DatasetSpec, tasks, resume: bool, force: bool)
     return g, names
 
 
+def _chain_arrays(g, n: int) -> None:
+    """A drawn-chain store's per-record chain correction (JSON strings): the chambers' fits
+    (`chamber_fits`), the estimates and the refusal (`_correct_records`)."""
+    for name in ("chain_fits", "chain_estimates", "chain_refused"):
+        if name not in g:
+            g.create_array(name, shape=(n,), chunks=(n,), dtype=str)
+
+
 def _write(g, res: dict[str, Any], names: list[str]) -> None:
     i = res["index"]
+    if "fits" in res:
+        g["chain_fits"][i] = json.dumps(res["fits"])
     if not res["error"]:
         for c, y in res["channels"].items():
             row = np.full(g[c].shape[1], np.nan, np.float32)
@@ -682,6 +745,10 @@ def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
         ch = {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
         f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi), t.get("machine"))
         g["features"][i, :] = np.array([f[k] for k in names], float)
+        if spec.chain == "drawn":  # the fits the correction reads (_finish corrects)
+            _chain_arrays(g, len(tasks))
+            fit = chamber_fits(ch, t["fs"], t["params"]["omega"] / (2 * math.pi), t.get("machine"))
+            g["chain_fits"][i] = json.dumps(fit)
     g.attrs["feature_names"] = names
     card = json.loads((folder / "datacard.json").read_text(encoding="utf-8"))
     _finish(folder, g, spec, tasks, names, card["throughput"])
@@ -748,6 +815,11 @@ def _table(g, tasks, names: list[str]):
             from ..chain import Chain
 
             row.update({f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()})
+            if "chain_refused" in g:  # the correction's estimates and refusal (_correct_records)
+                row["chain_refused"] = str(g["chain_refused"][i])
+                raw = str(g["chain_estimates"][i])
+                for k, (v, u, _) in (json.loads(raw) if raw else {}).items():
+                    row[f"est.{k}"], row[f"est.{k}.u95"] = v, u
         row.update({f"f_{k}": v for k, v in zip(names, feats[i], strict=True)})
         rows.append(row)
     return pd.DataFrame(rows)
@@ -765,14 +837,98 @@ CONDITION_COLUMNS = (
 )
 
 
+def _correct_records(g, tasks, names) -> dict[str, Any]:
+    """A drawn-chain data set's records, put through the chain correction `recipdyn
+    diagnose` runs (issue 42): the reference is built from the training records' fits with
+    each one's drawn chain taken off (`recipdyn.diagnosis.correction.known_chain`); every
+    record is then corrected against it (its own condition left out, as a new record's
+    would be) and its features recomputed from the corrected channels, so the training
+    features carry the estimator's real errors; a record the correction refuses keeps its
+    reason (``chain_refused``) and is left out of training. Each record's estimates are
+    stored beside its drawn chain, and their coverage is measured here."""
+    from ..chain import Chain
+    from .correction import known_chain, reference_from
+
+    done, err = np.asarray(g["done"][:]), np.asarray(g["error"][:])
+    ok = [t for t in tasks if done[t["index"]] and not err[t["index"]]]
+    t0 = time.perf_counter()
+
+    def channels(i):
+        n = int(g["n_samples"][i])
+        return {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
+
+    fits, truth = {}, {}
+    for t in ok:
+        i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
+        raw = str(g["chain_fits"][i])
+        fits[i] = (
+            json.loads(raw) if raw else chamber_fits(channels(i), t["fs"], speed, t.get("machine"))
+        )
+        row = {f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()}
+        truth[i] = [known_chain(row, k, speed) for k in (0, 1)]
+    ref_fits = []
+    for t in ok:
+        if t["split"] != "train":
+            continue
+        i = t["index"]
+        f = {"condition": t["condition"]}
+        for k, ch in enumerate(("head", "crank")):
+            r = dict(fits[i].get(ch, {"ok": False}))
+            if r.get("ok"):
+                phase, offset, gain = truth[i][k]
+                r["phase_deg"] -= phase
+                r["offset_pa"] -= offset
+                r["p_lo"] = (r["p_lo"] - offset) / gain
+                r["p_hi"] = (r["p_hi"] - offset) / gain
+            f[ch] = r
+        ref_fits.append(f)
+    ref = reference_from(ref_fits, source=f"{len(ref_fits)} training records, drawn chains")
+    if not ref.rows:
+        return {"reference": None, "refused": 0, "records": len(ok),
+                "note": "too few training records for a reference: not corrected"}  # fmt: skip
+    hits: dict[str, list[int]] = {}
+    refused = 0
+    for t in ok:
+        i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
+        feats, fix = corrected_features(
+            channels(i), t["fs"], speed, ref, fits[i], t["condition"], t.get("machine")
+        )
+        est = {k: [e.value, e.uncertainty, e.status] for k, e in fix.estimates.items()}
+        g["chain_estimates"][i] = json.dumps(est)
+        g["chain_refused"][i] = fix.refused[:500]
+        if feats is None:
+            refused += 1
+            continue
+        g["features"][i, :] = np.array([feats[k] for k in names], float)
+        (ph, oh, gh), (pc, oc, gc) = truth[i]
+        want = {"phase_head": ph, "phase_crank": pc, "offset_head": oh,
+                "offset_crank": oc, "gain_ratio": gh / gc - 1.0}  # fmt: skip
+        for k, w in want.items():
+            e = fix.estimates.get(k)
+            if e is not None and math.isfinite(e.value) and math.isfinite(e.uncertainty):
+                h = hits.setdefault(k, [0, 0])
+                h[0] += abs(e.value - w) <= e.uncertainty
+                h[1] += 1
+    return {
+        "reference": ref.to_dict(),
+        "records": len(ok),
+        "refused": refused,
+        "coverage": {k: {"within": h[0], "of": h[1]} for k, h in hits.items()},
+        "seconds": time.perf_counter() - t0,
+    }
+
+
 def _finish(out: Path, g, spec: DatasetSpec, tasks, names, throughput) -> None:
     from .. import __version__
     from ..io import atomic_path
 
+    correction = _correct_records(g, tasks, names) if spec.chain == "drawn" else None
     df = _table(g, tasks, names)
     with atomic_path(out / "features.parquet") as tmp:
         df.to_parquet(tmp, index=False)
     card = datacard(spec, df, throughput, __version__)
+    if correction is not None:
+        card["chain_correction"] = correction
     with atomic_path(out / "datacard.json") as tmp:
         Path(tmp).write_text(json.dumps(card, indent=1, default=float), encoding="utf-8")
     with atomic_path(out / "datacard.md") as tmp:
@@ -936,6 +1092,19 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         lines += [f"- `{k}`: {v}" for k, v in chain["sources"].items()]
     else:
         lines += ["", "Measurement chain: fixed (recipdyn.chain.legacy_chain)."]
+    cc = card.get("chain_correction")
+    if cc:
+        cov = ", ".join(
+            f"{k} {v['within']}/{v['of']}" for k, v in (cc.get("coverage") or {}).items()
+        )
+        lines += [
+            "",
+            f"Chain correction (as `recipdyn diagnose` runs it, before the features): "
+            f"{cc['refused']} of {cc['records']} records refused (left out of training); "
+            f"estimates within their 95 % intervals of the drawn chain: {cov or 'none'}"
+            + (f"; {cc['note']}" if cc.get("note") else "")
+            + ".",
+        ]
     lines += [
         "",
         "Class balance (records): " + json.dumps(card["balance"]),

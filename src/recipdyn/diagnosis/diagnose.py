@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .channels import gate
 from .classes import get_class
 
 __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
@@ -83,6 +84,18 @@ class Diagnosis:
                 f"{self.value:.3g} {self.unit} ({min(lo, hi):.3g}..{max(lo, hi):.3g})"
             )
         ev = self.evidence
+        ch = ev.get("channels", {})
+        if ch:
+            line = f"channels used: {ch['channels']}"
+            if ch.get("measured"):
+                line += (
+                    f"; on held-out conditions '{self.label}' from them was right for "
+                    f"{ch['precision']:.0%} of its {ch['answers']} answers (recall "
+                    f"{ch['recall']:.0%}; all classes {ch['accuracy']:.0%} of {ch['n']} records)"
+                )
+            lines.append(line)
+        for name, e in ev.get("chain", {}).items():
+            lines.append(f"chain: {name.replace('_', ' ')} {_estimate_text(e)}")
         lines.append(
             f"impacts: {ev['impacts_per_rev']:.1f} per revolution"
             + (
@@ -120,6 +133,15 @@ class Diagnosis:
         return "\n".join(lines)
 
 
+def _estimate_text(e: dict[str, Any]) -> str:
+    """One chain estimate (`recipdyn.diagnosis.correction.Estimate` as a dict) in words."""
+    v, u = e["value"], e["uncertainty"]
+    if not math.isfinite(v):
+        return e["status"] + (f" ({e['note']})" if e["note"] else "")
+    unc = f" +- {u:.2g}" if math.isfinite(u) else ""
+    return f"{v:+.3g}{unc} {e['unit']} ({e['status']})"
+
+
 def _read(path, column, fs):
     from ..io_signal import read_signal
 
@@ -137,6 +159,7 @@ def diagnose(
     p_crank: str | None = None,
     model=None,
     out: str | Path | None = None,
+    correct: bool = True,
     machine=None,
     baseline=None,
 ) -> Diagnosis:
@@ -160,6 +183,11 @@ def diagnose(
         Default: the diagnoser shipped with recipdyn.
     out : path, optional
         Folder for the overlay figure (none without it).
+    correct : bool
+        Estimate the measurement chain's errors from the record and correct them before the
+        features (`recipdyn.diagnosis.correction`); False: trust the tacho's mark, the
+        pressures' zero and the channels' alignment, and interpolate the crank angle
+        through every tacho pulse, as recipdyn did before (for comparison).
     machine : path or Machine, optional
         The machine the record was taken on (a machine file: `recipdyn.diagnosis.machine.
         read_machine`). Without it, a simulated record's own parameters are read, if it has
@@ -199,6 +227,7 @@ def diagnose(
         p_crank=pc,
         model=model,
         out=out,
+        correct=correct,
         machine=machine,
         baseline=baseline,
     )
@@ -222,6 +251,7 @@ def diagnose_arrays(
     p_crank=None,
     model=None,
     out=None,
+    correct: bool = True,
     machine=None,
     baseline=None,
 ) -> Diagnosis:
@@ -234,12 +264,16 @@ def diagnose_arrays(
     with one_thread():
         return _diagnose_arrays(x, fs, tacho=tacho, speed_hz=speed_hz, p_head=p_head,
                                 p_crank=p_crank, model=model, out=out,
-                                machine=machine, baseline=baseline)  # fmt: skip
+                                correct=correct, machine=machine,
+                                baseline=baseline)  # fmt: skip
 
 
-def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, machine,
-                     baseline) -> Diagnosis:  # fmt: skip
+def _diagnose_arrays(
+    x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, correct=True, machine=None,
+    baseline=None,
+) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
+    from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
     from .machine import machine_from_file, refusal
 
@@ -250,17 +284,18 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
     why = refusal(diag, machine)
     if why is not None:
         return _refuse(Diagnosis(refused=True), why, t0)
-    chain = {}
+    own_chain = {}  # the machine's own chain, from its baseline
     if baseline is not None:
         from .baseline import baseline_for
 
         baseline = baseline_for(diag, baseline)
-        chain = baseline.chain
+        own_chain = baseline.chain
         if p_head is not None:
-            p_head = np.asarray(p_head, float) - chain["p_head_offset"]
+            p_head = np.asarray(p_head, float) - own_chain["p_head_offset"]
         if p_crank is not None:
-            p_crank = np.asarray(p_crank, float) - chain["p_crank_offset"]
+            p_crank = np.asarray(p_crank, float) - own_chain["p_crank_offset"]
     x = np.asarray(x, float)
+    jitter = None
     if tacho is not None:
         try:  # a channel that is no pulse train is refused with the tacho's reason
             edges = tacho_times(np.asarray(tacho, float), fs)
@@ -270,8 +305,12 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
             raise ParameterError(
                 f"tacho: {edges.size} pulse(s); at least 3 needed (2 whole revolutions)"
             )
+        if correct:  # a fit through the pulses (their jitter averaged), not an interpolation
+            revs, jitter = tacho_revolutions(edges, x.size, fs)
+        else:
+            revs = crank_angle(x.size, fs, pulses=edges)
         # the tacho mark's angle after outer dead centre (a baseline's chain): re-phased
-        revs = crank_angle(x.size, fs, pulses=edges) + chain.get("phase_deg", 0.0) / 360.0
+        revs = revs + own_chain.get("phase_deg", 0.0) / 360.0
         keep = np.isfinite(revs)
     else:
         if speed_hz is None:
@@ -283,14 +322,36 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
     x, revs = x[sl], revs[sl]
     ph = None if p_head is None else np.asarray(p_head, float)[sl]
     pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
+    res = Diagnosis(refused=False)
+    # the measurement chain, estimated from the record and corrected before any feature
+    chain: dict[str, Any] = {}
+    if jitter is not None:
+        chain["tacho_jitter"] = jitter
+    machine_pairs = diag.card["spec"].get("machine") or None
+    if correct and baseline is None and tacho is not None and (ph is not None or pc is not None):
+        # (a baseline's chain, fitted on the machine's own healthy records, replaces it)
+        fix = correct_chain(
+            revs,
+            p_head=ph,
+            p_crank=pc,
+            reference=chain_reference(diag),
+            axis_sd_deg=axis_sd(jitter, edges.size) if jitter is not None else 0.0,
+            machine=machine_pairs,
+        )
+        chain.update(fix.estimates)
+        res.evidence["chain"] = _chain_summary(chain)
+        if fix.refused:
+            return _refuse(res, fix.refused, t0)
+        revs, ph, pc = fix.revs, fix.p_head, fix.p_crank
+    if correct:
+        # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
+        # chain's exact (analog) one
+        drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
+        form = "analog" if drawn else "bilinear"
+        chain.update(resonance(x, fs, revs if tacho is not None else None, form))
+        res.evidence["chain"] = _chain_summary(chain)
     row = record_features(
-        x,
-        fs,
-        revs,
-        angle=tacho is not None,
-        p_head=ph,
-        p_crank=pc,
-        machine=diag.card["spec"].get("machine") or None,
+        x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc, machine=machine_pairs
     )
     names = diag.names
     X = np.array([[row[n] for n in names]], float)
@@ -298,7 +359,6 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
         X = baseline.refer(X, names)
     st = diag.state
     f_rev = row["speed_hz"]
-    res = Diagnosis(refused=False)
     lo, hi = st["speed_range"]
     if not lo * (1 - RANGE_SLACK) <= f_rev <= hi * (1 + RANGE_SLACK):
         return _refuse(
@@ -322,6 +382,7 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
     if floor is not None:
         q, lo, hi = floor
         floor_ev = {"share": q, "training_range": [lo, hi]}
+        res.evidence["noise_floor"] = floor_ev
         if not lo / FLOOR_SLACK <= q <= hi * FLOOR_SLACK:
             return _refuse(
                 res,
@@ -359,6 +420,11 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
     classes = diag.classes
     k = int(np.argmax(proba))
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
+    # a class is named only with channels whose held-out answers of it were right
+    named, why, facts = gate(naming_of(diag), subset, classes[k])
+    res.evidence["channels"] = facts
+    if not named:
+        return _refuse(res, why, t0)
     res.label = classes[k]
     if res.label != "healthy":
         s, slo, shi = diag.severity(X, res.label)
@@ -371,17 +437,17 @@ def _diagnose_arrays(x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, mac
         )
         res.unit = fc.unit
     imp = impacts(x, fs, revs)
-    res.evidence = {
-        "impacts_per_rev": imp["per_rev"],
-        "impact_angles_deg": _top_angles(imp) if tacho is not None else [],
-        "deciding": _deciding(diag, X[0]),
-    }
-    if floor is not None:
-        res.evidence["noise_floor"] = floor_ev
+    res.evidence.update(
+        {
+            "impacts_per_rev": imp["per_rev"],
+            "impact_angles_deg": _top_angles(imp) if tacho is not None else [],
+            "deciding": _deciding(diag, X[0]),
+        }
+    )
     if baseline is not None:
         res.evidence["baseline"] = {
             "records": list(baseline.records),
-            "chain": dict(chain),
+            "chain": dict(own_chain),
             "machine": dict(baseline.fit.machine),
         }
     j = _closest(diag, X[0], res.label)
@@ -419,6 +485,51 @@ def _trained_snr(spec: dict[str, Any]) -> str:
 
 def _db(share: float) -> float:
     return -10.0 * math.log10(max(share, 1e-30))
+
+
+def _chain_summary(chain: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """The chain's estimates as plain dicts (value, uncertainty, unit, status, note)."""
+    from dataclasses import asdict
+
+    return {k: asdict(v) for k, v in chain.items()}
+
+
+def naming_of(diag) -> dict | None:
+    """What each channel set of ``diag`` can name (`recipdyn.diagnosis.channels`): stored in
+    the diagnoser when it was trained, or, for the shipped one trained before that, in the
+    file measured on its held-out conditions beside it (`held_out_file`), if it is this
+    diagnoser's."""
+    t = diag.state.get("naming")
+    return t if t else held_out(diag).get("naming")
+
+
+def chain_reference(diag):
+    """The `recipdyn.diagnosis.correction.ChainReference` of ``diag``'s own chain: stored
+    in it, or the shipped diagnoser's measured one (`held_out_file`), else the default."""
+    from .correction import ChainReference
+
+    d = diag.state.get("chain_reference") or held_out(diag).get("chain_reference")
+    return ChainReference.from_dict(d)
+
+
+def held_out_file() -> Path:
+    """Measurements of the shipped diagnoser made on its held-out conditions after it was
+    built (``benchmarks/bench_chain_correction.py --held-out``): what each channel set can
+    name and its chain's reference. Read only while they belong to the diagnoser loaded
+    (its pinned records' fingerprint)."""
+    return default_model_path().with_name("default.heldout.json")
+
+
+def held_out(diag) -> dict[str, Any]:
+    import hashlib
+    import json
+
+    path = held_out_file()
+    if not path.is_file():
+        return {}
+    d = json.loads(path.read_text(encoding="utf-8"))
+    mine = hashlib.sha256(str(diag.state.get("fingerprints_json", "")).encode()).hexdigest()
+    return d if d.get("fingerprint") == mine else {}
 
 
 def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:

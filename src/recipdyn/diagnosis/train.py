@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .channels import naming_table
 from .classes import get_class
 from .dataset import CONDITION_COLUMNS, MIN_TRAIN_CONDITIONS, min_conditions, read_features
 from .evidence import feature_groups
@@ -499,6 +500,8 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     from .. import __version__
 
     df, card = read_features(folder)
+    if "chain_refused" in df.columns:  # records the chain correction refused: left out
+        df = df[df.chain_refused.fillna("") == ""].reset_index(drop=True)
     names = [c[2:] for c in df.columns if c.startswith("f_")]
     classes = list(card["spec"]["classes"])
     if only is not None:
@@ -561,6 +564,10 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         thresholds[subset] = float(np.quantile(d, 0.99) * OOD_MARGIN)
     speed = train_df.f_speed_hz.to_numpy()
     acc_curves, p_curves = _library(folder, train_df)
+    # the reference the data set's features were corrected against, or one built here
+    chain_ref = (card.get("chain_correction") or {}).get("reference") or _chain_reference(
+        folder, train_df, seed
+    )
     state = {
         "format": FORMAT,
         "recipdyn_version": __version__,
@@ -587,6 +594,8 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
         "train_severity": train_df.severity.to_numpy(float),
         "train_records": train_df.record.to_numpy(int),
         "library_accel": acc_curves,
+        # what the chain estimators give on the diagnoser's own chain (correction.py)
+        "chain_reference": chain_ref,
         # the head-end pressure of the healthy records only: the evidence compares a record's
         # with its closest healthy one (zeros elsewhere, which compress away)
         "library_p_head": np.where(
@@ -599,7 +608,10 @@ def _train(folder: Path, seed: int, only=None) -> tuple[Diagnoser, dict]:
     state["fingerprints_json"] = json.dumps(
         _fingerprints(train_df, card, names, diag), default=float
     )
-    return diag, evaluate(diag, test_df, train_df, seed=seed)
+    ev = evaluate(diag, test_df, train_df, seed=seed)
+    # what each channel set can name, measured on the held-out conditions (channels.gate)
+    state["naming"] = {k: ev[k]["naming"] for k in AVAILABILITY}
+    return diag, ev
 
 
 def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
@@ -636,6 +648,55 @@ def _library(folder, train_df):
         acc[j] = curve(np.asarray(g["accel_guide"][i, :n], float), tach, fs, f_rev)
         ph[j] = curve(np.asarray(g["p_head_sensor"][i, :n], float), tach, fs, f_rev)
     return _half(acc), _half(ph / 1e5)  # the pressure in bar (float16 tops at 65 504)
+
+
+def _chain_reference(folder, train_df, seed: int) -> dict | None:
+    """The `recipdyn.diagnosis.correction.ChainReference` of the data set's own chain, from
+    up to `recipdyn.diagnosis.correction.REFERENCE_PER_CLASS` training records of each class
+    (seeded draw): the pressure channels' phase and offset estimates and the exponents
+    they go with. None without pressure channels."""
+    import zarr
+
+    from ..analysis.vibration import tacho_times
+    from .correction import REFERENCE_PER_CLASS, known_chain, pressure_phase, reference_from
+
+    g = zarr.open_group(str(folder / "signals.zarr"), mode="r")
+    if "p_head_sensor" not in g or "p_crank_sensor" not in g:
+        return None
+    machine = json.loads(g.attrs["spec_json"]).get("machine") or None  # its chambers
+    rng = np.random.default_rng([seed, 7])
+    pick = []
+    for _, sub in train_df.groupby("label"):
+        idx = sub.index.to_numpy()
+        pick += rng.permutation(idx)[:REFERENCE_PER_CLASS].tolist()
+    fits = []
+    for j in sorted(pick):
+        i = int(train_df.record.iloc[j])
+        n = int(g["n_samples"][i])
+        fs = float(train_df.fs.iloc[j])
+        edges = tacho_times(np.asarray(g["tacho"][i, :n], float), fs)
+        if not edges.size:
+            continue
+        # the crank angle as the data set's features read it (dataset.features_of)
+        revs = (np.arange(n) / fs - edges[0]) * float(train_df.f_speed_hz.iloc[j])
+        revs = np.where(revs >= 0, revs, np.nan)
+        fit = {"condition": int(train_df.condition.iloc[j])}
+        row = train_df.iloc[j]
+        for k, ch in enumerate(("head", "crank")):
+            p = np.asarray(g[f"p_{ch}_sensor"][i, :n], float)
+            f = pressure_phase(p, revs, ch, machine)
+            if f["ok"]:  # a drawn chain's own errors off: the reference is the physics'
+                phase, offset, gain = known_chain(row, k, float(row.f_speed_hz))
+                f["phase_deg"] -= phase
+                f["offset_pa"] -= offset
+                f["p_lo"] = (f["p_lo"] - offset) / gain
+                f["p_hi"] = (f["p_hi"] - offset) / gain
+            fit[ch] = f
+        fits.append(fit)
+    if not fits:
+        return None
+    ref = reference_from(fits, source=f"{len(fits)} training records of {folder.name}")
+    return ref.to_dict() if ref.rows else None
 
 
 def _half(a) -> np.ndarray:
@@ -711,6 +772,14 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
                 known=diag.fault_classes,
             ),
         }
+        # which classes this channel set can name (recipdyn.diagnosis.channels)
+        res[subset]["naming"] = naming_table(
+            test_df.label.to_numpy(),
+            np.array(classes)[pred],
+            test_df.severity.to_numpy(),
+            classes,
+            res[subset]["detection"],
+        )
         if subset == "full":
             res["predicted"] = np.array(classes)[pred].tolist()
             res["proba"] = proba.tolist()
