@@ -70,6 +70,7 @@ def main() -> None:
     from recipdyn.diagnosis.dataset import DatasetSpec, design
     from recipdyn.diagnosis.diagnose import diagnose_arrays
     from recipdyn.diagnosis.machine import Machine
+    from recipdyn.errors import ParameterError
     from recipdyn.parallel import process_pool, stop_pool
 
     ap = argparse.ArgumentParser()
@@ -117,7 +118,7 @@ def main() -> None:
                     s = float(rng.uniform(0.25, 1.0)) if fc.parameter else 0.0
                     p = {**case["params"], **fc.overrides(s)}
                     test.append((fc.name, s))
-                    kw = {**base_kw, "revolutions": 3.0, "seed": 1000 * c + 100 + len(test)}
+                    kw = {**base_kw, "revolutions": 4.0, "seed": 1000 * c + 100 + len(test)}
                     jobs.append(((fc.name, k), p, kw))
             recs = dict(pool.map(record_job, jobs))
             t_sim = time.perf_counter() - t0
@@ -157,8 +158,11 @@ def main() -> None:
                 model_b = dataclasses.replace(b, delta=b.delta_model, referral="model")
                 for tag, extra in (("without", {}), ("with", {"baseline": b}),
                                    ("with model referral", {"baseline": model_b})):  # fmt: skip
-                    a = diagnose_arrays(r.accel, r.fs, **kw, **extra)
-                    row[tag] = "refused" if a.refused else a.label
+                    try:
+                        a = diagnose_arrays(r.accel, r.fs, **kw, **extra)
+                        row[tag] = "refused" if a.refused else a.label
+                    except ParameterError:  # the command's one-line refusal (exit 2)
+                        row[tag] = "refused"
                 answers.append(row)
             done["cases"].append({
                 "kind": kind, "condition": cond["condition"], "truth": case["truth"],
