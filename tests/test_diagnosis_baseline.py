@@ -161,3 +161,34 @@ def test_the_commands_refuse_bad_input_in_one_line(tmp_path, monkeypatch, capsys
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.exhaustive  # a whole baseline, every uncertain parameter (1-3 min on 2 cores);
+# the fit itself runs in CI above (one parameter)
+def test_the_baseline_command_writes_a_baseline_that_diagnose_reads(case, tmp_path, capsys):
+    """``recipdyn baseline REC -o FILE`` (every uncertain parameter: the clearance volume
+    fitted, the springs, lifts and masses marginalised) writes a file whose summary names the
+    fitted values and whose chain ``recipdyn diagnose --baseline`` applies."""
+    import xarray as xr
+
+    from recipdyn.cli import main
+    from recipdyn.diagnosis.baseline import load_baseline, simulated_record
+
+    diag, _, params, kw, _ = case
+    rec = simulated_record(params, revolutions=4, seed=21, **kw)
+    t = np.arange(rec.accel.size) / rec.fs
+    path = tmp_path / "healthy.nc"
+    chans = {"accel_guide": rec.accel, "tacho": rec.tacho, "p_head_sensor": rec.p_head,
+             "p_crank_sensor": rec.p_crank}  # fmt: skip
+    xr.Dataset({k: ("time", v) for k, v in chans.items()}, coords={"time": t}).to_netcdf(path)
+    out = tmp_path / "b.json"
+    assert main(["baseline", str(path), "-o", str(out), "--workers", "1"]) == 0
+    text = capsys.readouterr().out
+    assert "clearance_fraction" in text and "valve_lift" in text and f"--baseline {out}" in text
+    b = load_baseline(out)
+    assert b.fit.unseen == ["m2", "m3", "valve_lift", "valve_spring"]
+    assert b.fit.machine_interval["valve_lift"] == pytest.approx([0.9 * 0.0025, 1.1 * 0.0025])
+    assert b.chain["p_head_offset"] == pytest.approx(CHAIN["p_head_offset"], abs=1000)
+    assert main(["diagnose", str(path), "--tacho", "tacho", "--p-head", "p_head_sensor",
+                 "--p-crank", "p_crank_sensor", "--baseline", str(out)]) == 0  # fmt: skip
+    assert "diagnosis: healthy" in capsys.readouterr().out
