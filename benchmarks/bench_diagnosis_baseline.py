@@ -155,9 +155,9 @@ def main() -> None:
                 r = recs[(name, k)]
                 kw = {"tacho": r.tacho, "p_head": r.p_head, "p_crank": r.p_crank, "model": diag}
                 row = {"truth": name, "severity": s}
-                model_b = dataclasses.replace(b, delta=b.delta_model, referral="model")
+                rec_b = dataclasses.replace(b, delta=b.delta_records, referral="records")
                 for tag, extra in (("without", {}), ("with", {"baseline": b}),
-                                   ("with model referral", {"baseline": model_b})):  # fmt: skip
+                                   ("with records referral", {"baseline": rec_b})):  # fmt: skip
                     try:
                         a = diagnose_arrays(r.accel, r.fs, **kw, **extra)
                         row[tag] = "refused" if a.refused else a.label
@@ -198,7 +198,7 @@ def report(done: dict) -> None:
             ratio = [abs(r["value"] - r["truth"]) / max((r["hi"] - r["lo"]) / 2, 1e-300)
                      for r in rows]  # fmt: skip
             print(f"| {n} | {ins}/{len(rows)} | {np.median(ratio):.2f} |")
-        for tag in ("without", "with", "with model referral"):
+        for tag in ("without", "with", "with records referral"):
             ans = [a for c in cases for a in c["answers"] if tag in a]
             h = [a for a in ans if a["truth"] == "healthy"]
             f = [a for a in ans if a["truth"] != "healthy"]
