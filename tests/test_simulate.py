@@ -290,3 +290,16 @@ def test_simulate_without_the_run_summary_records_the_same_signals():
     assert "impact_time" in a and a.sizes["impact_event"] > 0
     assert "summary_interval" in a.attrs and "summary_interval" not in b.attrs
     assert a.drop_attrs(deep=False).identical(b.drop_attrs(deep=False))
+
+
+def test_a_last_sample_a_rounding_error_past_the_end_is_recorded():
+    """Revolutions x period x rate a hair below a whole number of samples (within the 1e-9 of
+    a sample that counts it as whole): the last sample lies a rounding error past
+    ``revolutions x period``, and the run ends at it rather than refusing its own output
+    times as outside the span (met at a crank speed read from a tacho)."""
+    fs = 10_000.0
+    omega = 4 * math.pi * fs / (6100 - 1e-11)  # 2 revolutions: 6100 - 1e-11 sample intervals
+    ds = simulate(model="compressor", omega=omega, revolutions=2, transient=0, fs=fs,
+                  summary=False)  # fmt: skip
+    assert ds.time.size == 6101
+    assert float(ds.time[-1]) == pytest.approx(0.61, abs=1e-12)

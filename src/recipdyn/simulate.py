@@ -329,8 +329,10 @@ def simulate(
         e = events[0]
         ev_kw = dict(event=e.function, event_direction=e.direction, event_action=e.action,
                      reset=e.reset)  # fmt: skip
-    t_end = t_start + revolutions * T
     n = int(math.floor(n_float + 1e-9)) + 1
+    # the last sample may lie a rounding error past the run's end (n_float a hair below a
+    # whole number of samples): the run ends at it, not before
+    t_end = max(t_start + revolutions * T, t_start + (n - 1) / fs)
     # streamed: the output times are made block by block (never all 8 bytes x n at once)
     t_eval = UniformGrid(t_start, fs, n) if out is not None else t_start + np.arange(n) / fs
     t_last = t_start + (n - 1) / fs  # the last sample: events after it are not recorded

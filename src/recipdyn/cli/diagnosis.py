@@ -3,6 +3,7 @@ physics-generated records (docs/diagnosis.md)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import typer
@@ -30,6 +31,19 @@ def _snrs(text: str):
         raise ParameterError(
             f"snr_range = {text!r}; allowed: two SNRs in dB, LO,HI, e.g. 10,40"
         ) from None
+
+
+def _machine_changes(machine: Path | None, sets: list[str] | None):
+    """The machine of ``--machine`` and ``--set`` as its changes from the default machine; the
+    names are checked before the model loads."""
+    from ..diagnosis.dataset import _machine_pairs
+    from ..diagnosis.machine import Machine, machine_from_file
+    from ..units import parse_assignment
+
+    changes = dict(parse_assignment(item) for item in sets or [])
+    _machine_pairs(changes)  # only machine parameters
+    m = machine_from_file(machine, changes) if machine is not None else Machine.of(changes)
+    return m.pairs()
 
 
 @app.command()
@@ -75,15 +89,30 @@ def dataset(
     resume: bool = typer.Option(False, help="Continue an interrupted data set in OUT."),
     force: bool = typer.Option(False, help="Overwrite an existing data set in OUT."),
     progress: bool = typer.Option(True, "--progress/--no-progress"),
+    machine: Path = typer.Option(
+        None,
+        "--machine",
+        help="The machine to simulate: a config TOML ('recipdyn simulate --dump-config FILE') "
+        "or a recorded run (.nc); its geometry, masses, cylinder, valves, gas and nominal "
+        "operating point (default: the diagnosis model's machine).",
+    ),
+    sets: list[str] = typer.Option(
+        None,
+        "--set",
+        help="Set one machine parameter: NAME=VALUE with units, e.g. --set bore='300 mm' "
+        "(repeatable; after --machine).",
+    ),
 ) -> None:
     """Build a labelled data set of simulated, sensed records, split by operating condition.
 
     Fault classes x severities x operating conditions x sensor settings; signals in Zarr,
     features and labels in Parquet, a data card (docs/diagnosis.md)."""
     from ..diagnosis.classes import class_names
-    from ..diagnosis.dataset import DatasetSpec, build_dataset
+    from ..diagnosis.dataset import DatasetSpec, build_dataset, spec_machine
 
     kw = {} if classes is None else {"classes": tuple(c.strip() for c in classes.split(","))}
+    if machine is not None or sets:
+        kw["machine"] = _machine_changes(machine, sets)
     if severity_range is not None:
         kw["severity_range"] = _levels(severity_range, "severity_range", "0.1,1")
         kw["severity_draws"] = draws
@@ -123,7 +152,9 @@ def dataset(
         )
     typer.echo(
         f"wrote {out}/features.parquet, {out}/signals.zarr, {out}/datacard.md "
-        f"({len(spec.classes)} of {len(class_names())} classes)"
+        f"({len(spec.classes)} of {len(class_names())} classes"
+        + (f"; machine: {spec_machine(spec).text()}" if spec.machine else "")
+        + f"); train a diagnoser on it: recipdyn train {out} -o {out}.skops"
     )
 
 
@@ -218,6 +249,18 @@ def diagnose(
         None, "--model", "-m", help="Diagnoser file (default: the one shipped with recipdyn)."
     ),
     out: Path = typer.Option(None, "--out", "-o", help="Folder for the overlay figure."),
+    machine: Path = typer.Option(
+        None,
+        "--machine",
+        help="The record's machine: a config TOML ('recipdyn simulate --dump-config') or a "
+        "recorded run; a machine other than the diagnoser's is refused.",
+    ),
+    baseline: Path = typer.Option(
+        None,
+        "--baseline",
+        help="The machine's own healthy baseline ('recipdyn baseline'): the chain is corrected "
+        "with it and the features referred to the machine's healthy state.",
+    ),
     no_correction: bool = typer.Option(
         False,
         "--no-correction",
@@ -251,8 +294,70 @@ def diagnose(
         model=model,
         out=out,
         correct=not no_correction,
+        machine=machine,
+        baseline=baseline,
     )
     if res.refused:
         raise ParameterError(f"diagnose {record.name}: refused: {res.reason}")
     typer.echo(res.text())
     report(**res.summary())
+
+
+@app.command("baseline")
+@with_json
+def baseline_cmd(
+    records: list[Path] = typer.Argument(..., help="Records of the healthy machine."),
+    out: Path = typer.Option(Path("out/baseline.json"), "--out", "-o", help="Baseline file."),
+    model: Path = typer.Option(
+        None, "--model", "-m", help="Diagnoser file (default: the one shipped with recipdyn)."
+    ),
+    machine: Path = typer.Option(
+        None, "--machine", help="The machine's description (default: the diagnoser's)."
+    ),
+    channel: str = typer.Option(
+        "accel_guide", "--channel", "-c", help="Acceleration channel (m/s**2)."
+    ),
+    fs: str = typer.Option(None, "--fs", help="Sampling rate, if the files do not give it."),
+    tacho: str = typer.Option("tacho", "--tacho", help="Once-per-revolution pulse channel."),
+    p_head: str = typer.Option("p_head_sensor", "--p-head", help="Head-end pressure (Pa)."),
+    p_crank: str = typer.Option("p_crank_sensor", "--p-crank", help="Crank-end pressure (Pa)."),
+    workers: int = typer.Option(2, help="Processes that run the fit's simulations."),
+) -> None:
+    """The machine's own healthy baseline from records known to be healthy (after an overhaul).
+
+    Fits the simulator's healthy machine (masses, clearance volume, valve springs and lift,
+    within their ranges) and the measurement chain (pressure offsets, tacho mark angle,
+    mounting resonance) to the records; later 'recipdyn diagnose --baseline FILE' corrects the
+    chain and refers the features to the machine's own healthy state (docs/diagnosis.md)."""
+    import sys
+
+    from ..errors import ParameterError
+
+    if out.suffix != ".json":
+        raise ParameterError(f"--out {out}: use a .json file")
+    if workers < 1:
+        raise ParameterError(f"workers = {workers}; allowed: an integer >= 1")
+    for r in records:
+        if not r.is_file():
+            raise ParameterError(f"record {r}: file not found")
+    from ..diagnosis.baseline import build_baseline, read_record
+    from ..diagnosis.diagnose import _load
+    from ..diagnosis.machine import machine_from_file, refusal
+
+    diag = _load(model)
+    mach = None
+    if machine is not None:
+        mach = machine_from_file(machine)
+        why = refusal(diag, mach)
+        if why is not None:
+            raise ParameterError(f"baseline: {why}")
+    recs = [read_record(r, channel=channel, tacho=tacho, p_head=p_head, p_crank=p_crank, fs=fs)
+            for r in records]  # fmt: skip
+    with refused_leaves_nothing(out):
+        b = build_baseline(recs, diag, machine=mach, workers=workers,
+                           progress=lambda m: print(m, file=sys.stderr, flush=True))  # fmt: skip
+        b.save(out)
+    typer.echo(b.summary())
+    typer.echo(f"wrote {out}; diagnose with: recipdyn diagnose RECORD --baseline {out}"
+               + (f" -m {model}" if model else ""))  # fmt: skip
+    report(baseline=json.loads(b.to_json()))

@@ -365,21 +365,23 @@ class ChainCorrection:
 # -- kinematics ---------------------------------------------------------------------------------
 
 
-_GEOM: dict[str, float] | None = None
+#: `_machine` by machine (its changes as sorted pairs; () the default machine).
+_GEOM: dict[tuple, dict[str, float]] = {}
 
 
-def _machine() -> dict[str, float]:
-    """The diagnosis model's mechanism and cylinder (the one machine of the data set)."""
-    global _GEOM
-    if _GEOM is None:
+def _machine(machine=None) -> dict[str, float]:
+    """The diagnosis model's mechanism and cylinder: the default machine's, or those of
+    ``machine`` (a diagnoser's, `recipdyn.diagnosis.machine.Machine.pairs`)."""
+    key = tuple(sorted(dict(machine or {}).items()))
+    if key not in _GEOM:
         from ..model.cycle import cycle_geometry
         from ..model.registry import get_model
         from .classes import MODEL
 
-        v = get_model(MODEL).parameters({})
+        v = get_model(MODEL).parameters(dict(key))
         r, length, d = float(v["r"]), float(v["l"]), float(v["d"])
         g = cycle_geometry(r, length, d, float(v["bore"]), float(v["rod_diameter"]))
-        _GEOM = {
+        _GEOM[key] = {
             "r": r,
             "l": length,
             "d": d,
@@ -389,14 +391,14 @@ def _machine() -> dict[str, float]:
             "area_crank": g.area_crank,
             "clearance": float(v["clearance_fraction"]),
         }
-    return _GEOM
+    return _GEOM[key]
 
 
-def chamber_volume(theta, chamber: str) -> np.ndarray:
+def chamber_volume(theta, chamber: str, machine=None) -> np.ndarray:
     """A chamber's volume (m**3) at the crank angle ``theta`` (rad; 0 where the crank points
     along the cylinder axis toward the crosshead), from the slider-crank's kinematics and
-    the nominal clearance volume."""
-    g = _machine()
+    the nominal clearance volume (``machine``: another machine's, `_machine`)."""
+    g = _machine(machine)
     th = np.asarray(theta, float)
     x = g["r"] * np.cos(th) + np.sqrt(g["l"] ** 2 - (g["d"] + g["r"] * np.sin(th)) ** 2)
     stroke = g["x_max"] - g["x_min"]
@@ -513,7 +515,7 @@ def _segments(p, phi, bins: int = 360):
     return {k: np.isin(b, r[1:-1]) for k, r in out.items()}, (lo, hi)
 
 
-def _coarse_phase(parts, chamber) -> float:
+def _coarse_phase(parts, chamber, machine=None) -> float:
     """The basin of the phase: every 2 degrees around the circle, the one that straightens
     the segments best, read on their 1-degree means (a mark may sit anywhere)."""
     binned = []
@@ -526,14 +528,14 @@ def _coarse_phase(parts, chamber) -> float:
     for i, a in enumerate(grid):
         for q, f in binned:
             y = np.log(q)
-            lv = np.log(chamber_volume(f + a, chamber))
+            lv = np.log(chamber_volume(f + a, chamber, machine))
             A = np.column_stack([np.ones_like(lv), lv])
             coef, *_ = np.linalg.lstsq(A, y, rcond=None)
             cost[i] += float(np.sum(((y - A @ coef) * q) ** 2))
     return float(grid[np.argmin(cost)])
 
 
-def _fit_phase(p, phi, segs, chamber, a0=None):
+def _fit_phase(p, phi, segs, chamber, a0=None, machine=None):
     """Variable-projection least squares of ``(A, o)``; returns the solution, its
     covariance from the Jacobian and the residuals' RMS (Pa)."""
     from scipy.optimize import least_squares
@@ -546,14 +548,14 @@ def _fit_phase(p, phi, segs, chamber, a0=None):
         out = []
         for q, f in parts:
             y = np.log(np.maximum(q - o, 1e-3 * floor))
-            lv = np.log(chamber_volume(f + a, chamber))
+            lv = np.log(chamber_volume(f + a, chamber, machine))
             A = np.column_stack([np.ones_like(lv), lv])
             coef, *_ = np.linalg.lstsq(A, y, rcond=None)
             out.append((y - A @ coef) * (q - o))  # ~ the residual in Pa
         return np.concatenate(out)
 
     if a0 is None:
-        a0 = _coarse_phase(parts, chamber)
+        a0 = _coarse_phase(parts, chamber, machine)
     sol = least_squares(resid, [a0, 0.0], x_scale=[1e-2, 1e3], diff_step=[1e-6, 1e-6])
     n = sol.fun.size
     dof = max(n - 2 - 2 * len(parts), 1)
@@ -564,7 +566,7 @@ def _fit_phase(p, phi, segs, chamber, a0=None):
     a, o = sol.x
     exps, noise = {}, []
     for kind, (q, f) in zip(segs, parts, strict=True):
-        lv = np.log(chamber_volume(f + a, chamber))
+        lv = np.log(chamber_volume(f + a, chamber, machine))
         if np.all(q - o > 0):
             exps[kind] = -float(np.polyfit(lv, np.log(q - o), 1)[0])
         else:  # the segment dips below the fitted offset: no polytrope (not a chamber's)
@@ -574,7 +576,7 @@ def _fit_phase(p, phi, segs, chamber, a0=None):
     return sol.x, cov, math.sqrt(s2), exps, noise
 
 
-def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
+def pressure_phase(p, revs, chamber: str, machine=None) -> dict[str, Any]:
     """The crank-angle phase and the offset of one chamber's pressure (module docstring).
 
     Parameters
@@ -584,6 +586,9 @@ def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
     revs : array
         The crank angle in revolutions after the tacho's mark at each sample (NaN: none).
     chamber : {"head", "crank"}
+    machine : mapping, optional
+        The machine whose chamber it is (`recipdyn.diagnosis.machine.Machine.pairs`; None:
+        the default machine).
 
     Returns
     -------
@@ -612,7 +617,7 @@ def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
     if set(segs) != {"compression", "expansion"} or not hi > lo > 0:
         out.update(p_lo=lo, p_hi=hi)
         return out
-    x, cov, rms, exps, noise = _fit_phase(pp, phi, segs, chamber)
+    x, cov, rms, exps, noise = _fit_phase(pp, phi, segs, chamber, machine=machine)
     if not all(math.isfinite(v) for v in exps.values()):
         # no exponent could be fitted (a flat or noisy channel): no polytropic segments
         out.update(p_lo=float(lo), p_hi=float(hi))
@@ -625,7 +630,7 @@ def pressure_phase(p, revs, chamber: str) -> dict[str, Any]:
         seg_k = {s: v & m for s, v in segs.items()}
         if min(int(v.sum()) for v in seg_k.values()) < 10:
             continue
-        xk, *_ = _fit_phase(pp, phi, seg_k, chamber, a0=float(x[0]))
+        xk, *_ = _fit_phase(pp, phi, seg_k, chamber, a0=float(x[0]), machine=machine)
         per_rev.append(math.degrees(xk[0]))
         per_off.append(float(xk[1]))
     n = len(per_rev)
@@ -788,10 +793,13 @@ def correct_chain(
     axis_sd_deg: float = 0.0,
     fits: dict[str, dict[str, Any]] | None = None,
     exclude_condition=None,
+    machine=None,
 ) -> ChainCorrection:
     """Estimate the pressure channels' crank-angle phase, offsets and relative gain against
     the diagnoser's own chain (``reference``), check the two chambers against each other
-    and return the corrected crank angle and pressures. ``axis_sd_deg``: the standard error
+    and return the corrected crank angle and pressures (``machine``: the diagnoser's machine,
+    `recipdyn.diagnosis.machine.Machine.pairs`, whose chambers' volumes the polytropes are
+    read against; None: the default machine). ``axis_sd_deg``: the standard error
     of the crank angle's zero from the tacho's jitter (`axis_sd`); ``fits``: the chambers'
     `pressure_phase` already computed on these ``revs`` (a data set stores them);
     ``exclude_condition``: the record's operating condition, left out of the reference
@@ -825,7 +833,7 @@ def correct_chain(
     for chamber, p in (("head", p_head), ("crank", p_crank)):
         if p is None:
             continue
-        r = given.get(chamber) or pressure_phase(p, revs, chamber)
+        r = given.get(chamber) or pressure_phase(p, revs, chamber, machine)
         if not r["ok"]:
             out.refused = (
                 f"p_{chamber}: no polytropic compression and re-expansion found in the "

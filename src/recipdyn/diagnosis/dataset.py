@@ -2,7 +2,8 @@
 
 Design: ``n_conditions`` operating conditions (speed, suction and discharge pressure, rod and
 crosshead masses, the accelerometer's mounting resonance and the sampling rate), drawn
-uniformly from `CONDITIONS` with a seeded generator; at each condition
+uniformly from the machine's ranges (`recipdyn.diagnosis.machine.condition_ranges`; the
+default machine's are `CONDITIONS`) with a seeded generator; at each condition
 every fault class at every severity level (the healthy machine as often as each fault, so the
 classes are balanced), or, with ``severity_range``, at severities drawn uniformly (seeded) in
 that range; each record sensed at the data set's SNR (`recipdyn.sensors`) with its own noise
@@ -46,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .classes import BASELINE, CONDITIONS, MODEL, class_names, get_class
+from .classes import MODEL, class_names, get_class
 
 __all__ = [
     "DatasetSpec",
@@ -106,6 +107,11 @@ class DatasetSpec:
         ``snr_db``. ``fixed``: the one chain every data set used before
         (`recipdyn.chain.legacy_chain`: the condition's resonance, ``snr_db`` or
         ``snr_range``), its records those of earlier versions to the bit.
+    machine : tuple of (str, value)
+        The machine simulated, as its changes from the diagnosis model's defaults
+        (`recipdyn.diagnosis.machine.Machine.changes`; a dict is accepted): its operating
+        ranges, fault ranges and healthy pins are re-derived from it
+        (`recipdyn.diagnosis.machine`). Empty: the default machine.
 
     Notes
     -----
@@ -127,6 +133,7 @@ class DatasetSpec:
     severity_draws: int | None = None
     snr_range: tuple[float, float] | None = None
     chain: str = "drawn"
+    machine: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self):
         if not 0 < self.test_fraction < 1:
@@ -166,6 +173,7 @@ class DatasetSpec:
             raise ParameterError(f"severity_draws = {d!r}; allowed: an integer in [1, 1000]")
         if self.chain not in CHAIN_KINDS:
             raise ParameterError(f"chain = {self.chain!r}; allowed: {', '.join(CHAIN_KINDS)}")
+        object.__setattr__(self, "machine", _machine_pairs(self.machine))
 
     @property
     def chain_ranges(self):
@@ -205,6 +213,8 @@ class DatasetSpec:
                 del d[k]
         if d["chain"] == "fixed":
             del d["chain"]
+        if not d["machine"]:  # the default machine: the store keeps its identity
+            del d["machine"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -213,6 +223,30 @@ class DatasetSpec:
         one without ``chain`` was built with the fixed chain."""
         kw = {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
         return cls(**{"chain": "fixed", **kw})
+
+
+def _machine_pairs(m: Any) -> tuple[tuple[str, Any], ...]:
+    """A spec's machine as sorted ``(name, value)`` pairs (a dict, pairs or a JSON list of
+    pairs), each name a machine parameter."""
+    from .machine import MACHINE_PARAMETERS, NOMINAL, _not_machine
+
+    try:
+        pairs = dict(m.items() if hasattr(m, "items") else ((k, v) for k, v in m))
+    except (TypeError, ValueError):
+        raise ParameterError(f"machine = {m!r}; allowed: pairs (name, value)") from None
+    for k in pairs:
+        if k not in (*MACHINE_PARAMETERS, *NOMINAL):
+            raise ParameterError(_not_machine(k))
+    return tuple(sorted(pairs.items()))
+
+
+def spec_machine(spec: DatasetSpec):
+    """The `recipdyn.diagnosis.machine.Machine` of ``spec`` (None: the default machine)."""
+    if not spec.machine:
+        return None
+    from .machine import Machine
+
+    return Machine.of(spec.machine, source="the data set's machine")
 
 
 def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, float]:
@@ -228,10 +262,13 @@ def _bounds(r: Any, name: str, lo: float, hi: float, what: str) -> tuple[float, 
 
 
 def _conditions(spec: DatasetSpec) -> list[dict[str, float]]:
+    from .machine import condition_ranges
+
+    ranges = condition_ranges(spec_machine(spec))
     rng = np.random.default_rng([spec.seed, 0])
     out = []
     for _ in range(spec.n_conditions):
-        c = {k: r.draw(rng) for k, r in CONDITIONS.items()}
+        c = {k: r.draw(rng) for k, r in ranges.items()}
         c["fs"] = round(c["fs"] / 100.0) * 100.0
         out.append(c)
     return out
@@ -303,15 +340,20 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
     (``level`` numbers a class's records at a condition). With the drawn chain each task
     holds its chain (``chain``, `recipdyn.chain.Chain.to_dict`), whose resonance and SNR are
     the task's ``resonance_hz`` and ``snr_db``."""
+    from .machine import fault_classes, healthy_parameters
+
     tasks = []
     splits = split_of(spec)
+    machine = spec_machine(spec)
+    classes = fault_classes(machine)
     for ci, cond in enumerate(_conditions(spec)):
         for name in spec.classes:
-            fc = get_class(name)
+            fc = get_class(name, classes)
             sev = severities(spec, ci, name)
             for li, (s, snr) in enumerate(zip(sev, snrs(spec, ci, name, len(sev)), strict=True)):
                 idx = len(tasks)
-                params = dict(BASELINE)
+                params = {} if machine is None else dict(machine.pairs())
+                params.update(healthy_parameters(machine))
                 params.update(
                     {
                         k: cond[k]
@@ -337,6 +379,8 @@ def design(spec: DatasetSpec) -> list[dict[str, Any]]:
                         "noise_seed": int(spec.seed * 1_000_003 + idx),
                     }
                 )
+                if machine is not None:  # the features read the machine's geometry
+                    tasks[-1]["machine"] = dict(machine.pairs())
                 if spec.chain == "drawn":
                     ch = chain_draw(spec, ci, name, li, cond["fs"])
                     tasks[-1]["chain"] = ch.to_dict()
@@ -410,20 +454,25 @@ def _revs(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> np.nda
     return (np.arange(channels["accel_guide"].size) / fs - edges[0]) * speed_hz
 
 
-def features_of(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict[str, float]:
-    """A record's features from its sensed channels (the crank angle: `_revs`)."""
+def features_of(
+    channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None
+) -> dict[str, float]:
+    """A record's features from its sensed channels (the crank angle: `_revs`);
+    ``machine``: the changes of the machine the record's cycle features are read against
+    (None: the default machine)."""
     from .evidence import record_features
 
     revs = _revs(channels, fs, speed_hz)
     return record_features(
         channels["accel_guide"], fs, revs, p_head=channels.get("p_head_sensor"),
-        p_crank=channels.get("p_crank_sensor"),
+        p_crank=channels.get("p_crank_sensor"), machine=machine,
     )  # fmt: skip
 
 
-def chamber_fits(channels: dict[str, np.ndarray], fs: float, speed_hz: float) -> dict:
+def chamber_fits(channels: dict[str, np.ndarray], fs: float, speed_hz: float, machine=None) -> dict:
     """Each chamber's `recipdyn.diagnosis.correction.pressure_phase` on the record's crank
-    angle (`_revs`), JSON-able: what the chain correction of a drawn-chain data set reads."""
+    angle (`_revs`), JSON-able: what the chain correction of a drawn-chain data set reads
+    (``machine``: the changes of the machine whose chambers they are; None: the default)."""
     from .correction import pressure_phase
 
     revs = _revs(channels, fs, speed_hz)
@@ -433,15 +482,18 @@ def chamber_fits(channels: dict[str, np.ndarray], fs: float, speed_hz: float) ->
         p = channels.get(f"p_{ch}_sensor")
         if p is not None:
             out[ch] = {k: (float(v) if isinstance(v, (float, np.floating)) else v)
-                       for k, v in pressure_phase(p, revs, ch).items()}  # fmt: skip
+                       for k, v in pressure_phase(p, revs, ch, machine).items()}  # fmt: skip
     return out
 
 
-def corrected_features(channels, fs: float, speed_hz: float, reference, fits, condition=None):
+def corrected_features(
+    channels, fs: float, speed_hz: float, reference, fits, condition=None, machine=None
+):
     """``(features or None, correction)``: the record's chain estimated and corrected as
     `recipdyn diagnose` does (`recipdyn.diagnosis.correction.correct_chain`, against
     ``reference``, from its stored ``fits``, its own ``condition`` left out of the
-    reference), then its features; None where the correction refuses the record."""
+    reference), then its features (``machine``: the changes of the data set's machine);
+    None where the correction refuses the record."""
     from .correction import correct_chain
     from .evidence import record_features
 
@@ -453,12 +505,14 @@ def corrected_features(channels, fs: float, speed_hz: float, reference, fits, co
         reference=reference,
         fits=fits,
         exclude_condition=condition,
+        machine=machine,
     )
     if fix.refused:
         return None, fix
     feats = record_features(
-        channels["accel_guide"], fs, fix.revs, p_head=fix.p_head, p_crank=fix.p_crank
-    )
+        channels["accel_guide"], fs, fix.revs, p_head=fix.p_head, p_crank=fix.p_crank,
+        machine=machine,
+    )  # fmt: skip
     return feats, fix
 
 
@@ -475,9 +529,9 @@ def make_record(task: dict[str, Any]) -> dict[str, Any]:
         out["channels"] = ch
         speed = task["params"]["omega"] / (2 * math.pi)
         chd = {k: v.astype(float) for k, v in ch.items()}
-        out["features"] = features_of(chd, task["fs"], speed)
+        out["features"] = features_of(chd, task["fs"], speed, task.get("machine"))
         if "chain" in task:  # a drawn chain: what its correction reads (_correct_records)
-            out["fits"] = chamber_fits(chd, task["fs"], speed)
+            out["fits"] = chamber_fits(chd, task["fs"], speed, task.get("machine"))
     except Exception as exc:  # noqa: BLE001 - recorded; the data set goes on
         out["error"] = f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)}"
     out["seconds"] = time.perf_counter() - t0
@@ -689,11 +743,11 @@ def recompute_features(folder: str | Path, *, progress: bool = True) -> Path:
             continue
         n = int(g["n_samples"][i])
         ch = {c: np.asarray(g[c][i, :n], float) for c in CHANNELS}
-        f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
+        f = features_of(ch, t["fs"], t["params"]["omega"] / (2 * math.pi), t.get("machine"))
         g["features"][i, :] = np.array([f[k] for k in names], float)
         if spec.chain == "drawn":  # the fits the correction reads (_finish corrects)
             _chain_arrays(g, len(tasks))
-            fit = chamber_fits(ch, t["fs"], t["params"]["omega"] / (2 * math.pi))
+            fit = chamber_fits(ch, t["fs"], t["params"]["omega"] / (2 * math.pi), t.get("machine"))
             g["chain_fits"][i] = json.dumps(fit)
     g.attrs["feature_names"] = names
     card = json.loads((folder / "datacard.json").read_text(encoding="utf-8"))
@@ -807,7 +861,9 @@ def _correct_records(g, tasks, names) -> dict[str, Any]:
     for t in ok:
         i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
         raw = str(g["chain_fits"][i])
-        fits[i] = json.loads(raw) if raw else chamber_fits(channels(i), t["fs"], speed)
+        fits[i] = (
+            json.loads(raw) if raw else chamber_fits(channels(i), t["fs"], speed, t.get("machine"))
+        )
         row = {f"chain.{k}": v for k, v in Chain.from_dict(t["chain"]).columns().items()}
         truth[i] = [known_chain(row, k, speed) for k in (0, 1)]
     ref_fits = []
@@ -834,7 +890,9 @@ def _correct_records(g, tasks, names) -> dict[str, Any]:
     refused = 0
     for t in ok:
         i, speed = t["index"], t["params"]["omega"] / (2 * math.pi)
-        feats, fix = corrected_features(channels(i), t["fs"], speed, ref, fits[i], t["condition"])
+        feats, fix = corrected_features(
+            channels(i), t["fs"], speed, ref, fits[i], t["condition"], t.get("machine")
+        )
         est = {k: [e.value, e.uncertainty, e.status] for k, e in fix.estimates.items()}
         g["chain_estimates"][i] = json.dumps(est)
         g["chain_refused"][i] = fix.refused[:500]
@@ -879,9 +937,13 @@ def _finish(out: Path, g, spec: DatasetSpec, tasks, names, throughput) -> None:
 
 def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str, Any]:
     """The data card: what the data set holds and how it was made."""
+    from .machine import condition_ranges, fault_classes, healthy_parameters
+
+    machine = spec_machine(spec)
+    known = fault_classes(machine)
     classes = []
     for name in spec.classes:
-        fc = get_class(name)
+        fc = get_class(name, known)
         classes.append(
             {
                 "name": fc.name,
@@ -889,6 +951,8 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
                 "meaning": fc.meaning,
                 "unit": fc.unit,
                 "scale": fc.scale,
+                "mild": fc.mild,
+                "severe": fc.severe,
                 "values": [fc.value(s) for s in spec.levels]
                 if fc.parameter and not spec.continuous
                 else [],
@@ -905,12 +969,13 @@ def datacard(spec: DatasetSpec, df, throughput: dict, version: str) -> dict[str,
     return {
         "recipdyn_version": version,
         "model": MODEL,
-        "baseline": BASELINE,
+        "baseline": healthy_parameters(machine),
+        "machine": machine.as_dict if machine is not None else {},
         "spec": asdict(spec),
         "classes": classes,
         "conditions": {
             k: {"lo": r.lo, "hi": r.hi, "unit": r.unit, "meaning": r.meaning}
-            for k, r in CONDITIONS.items()
+            for k, r in condition_ranges(machine).items()
             if not (spec.chain == "drawn" and k == "resonance_hz")  # the chain's, below
         },
         "sensors": _sensors_card(spec),
@@ -992,6 +1057,18 @@ def datacard_markdown(card: dict[str, Any]) -> str:
         f"revolutions after {s['transient']}; accelerometer SNR "
         f"{snr_text(s)} dB; "
         f"seed {s['seed']}. {card['split']}.",
+        "",
+        "Machine: "
+        + (
+            ", ".join(
+                f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                for k, v in s.get("machine") or ()
+            )
+            + " (changed from the diagnosis model's defaults; ranges and fault values "
+            "re-derived for it: recipdyn.diagnosis.machine)"
+            if s.get("machine")
+            else "the diagnosis model's defaults"
+        ),
         "",
         f"| class | parameter | {head} | meaning |",
         "|---|---|---|---|",
@@ -1092,4 +1169,7 @@ def records_done(folder: str | Path) -> np.ndarray:
 
 
 def classes_of(card) -> list:
-    return [get_class(n) for n in card["spec"]["classes"]]
+    from .machine import fault_classes
+
+    known = fault_classes(spec_machine(DatasetSpec.from_dict(card["spec"])))
+    return [get_class(n, known) for n in card["spec"]["classes"]]

@@ -10,6 +10,10 @@ less like the training records than all but a stated share of held-out records
 (`recipdyn.diagnosis.domain`: a conformal novelty p-value); and the best-fitting simulated
 record of the class named must explain it within its noise
 (`recipdyn.diagnosis.consistency`). Otherwise the diagnosis is withheld, with the reason.
+First of all, the record's machine (the user's machine file, or the parameters a simulated
+record carries) must be the diagnoser's within the tolerances of
+`recipdyn.diagnosis.machine`: a record of another machine is refused with the commands that
+build a diagnoser for it.
 """
 
 from __future__ import annotations
@@ -171,6 +175,8 @@ def diagnose(
     model=None,
     out: str | Path | None = None,
     correct: bool = True,
+    machine=None,
+    baseline=None,
 ) -> Diagnosis:
     """Diagnose the record in the file ``record``.
 
@@ -197,6 +203,15 @@ def diagnose(
         features (`recipdyn.diagnosis.correction`); False: trust the tacho's mark, the
         pressures' zero and the channels' alignment, and interpolate the crank angle
         through every tacho pulse, as recipdyn did before (for comparison).
+    machine : path or Machine, optional
+        The machine the record was taken on (a machine file: `recipdyn.diagnosis.machine.
+        read_machine`). Without it, a simulated record's own parameters are read, if it has
+        them. A machine other than the diagnoser's (`recipdyn.diagnosis.machine.refusal`)
+        is refused.
+    baseline : path or Baseline, optional
+        The machine's own healthy baseline for this diagnoser (``recipdyn baseline``:
+        `recipdyn.diagnosis.baseline`): the record's chain is corrected with it and its
+        features referred to the machine's own healthy state.
 
     Returns
     -------
@@ -204,10 +219,15 @@ def diagnose(
         ``refused=True`` with ``reason`` for a record outside the training domain.
     """
     from ..io_signal import check_signal_file, speed_hz
+    from .machine import machine_from_file, record_machine
 
     check_signal_file(record)  # (a file that is not there is said first)
     if (speed is None) == (tacho is None):
         raise ParameterError("speed and tacho: give exactly one (the crank angle is needed)")
+    if machine is None:
+        machine = record_machine(record)
+    elif isinstance(machine, (str, Path)):
+        machine = machine_from_file(machine)
     sig = _read(record, channel, fs)
     x, rate = np.asarray(sig.x, float), float(sig.fs)
     tach = _read(record, tacho, rate).x if tacho is not None else None
@@ -223,6 +243,8 @@ def diagnose(
         model=model,
         out=out,
         correct=correct,
+        machine=machine,
+        baseline=baseline,
     )
 
 
@@ -245,25 +267,48 @@ def diagnose_arrays(
     model=None,
     out=None,
     correct: bool = True,
+    machine=None,
+    baseline=None,
 ) -> Diagnosis:
-    """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed)."""
+    """`diagnose` on arrays (the acceleration ``x`` at ``fs`` Hz, a tacho or a speed);
+    ``machine``: the `recipdyn.diagnosis.machine.Machine` (or a machine file) the record was
+    taken on, if known; ``baseline``: the machine's own healthy baseline (a file or a
+    `recipdyn.diagnosis.baseline.Baseline`)."""
     from .train import one_thread
 
     with one_thread():
         return _diagnose_arrays(x, fs, tacho=tacho, speed_hz=speed_hz, p_head=p_head,
                                 p_crank=p_crank, model=model, out=out,
-                                correct=correct)  # fmt: skip
+                                correct=correct, machine=machine,
+                                baseline=baseline)  # fmt: skip
 
 
 def _diagnose_arrays(
-    x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, correct=True
-) -> Diagnosis:
+    x, fs, *, tacho, speed_hz, p_head, p_crank, model, out, correct=True, machine=None,
+    baseline=None,
+) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
     from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
+    from .machine import machine_from_file, refusal
 
     t0 = time.perf_counter()
     diag = _load(model)
+    if isinstance(machine, (str, Path)):
+        machine = machine_from_file(machine)
+    why = refusal(diag, machine)
+    if why is not None:
+        return _refuse(Diagnosis(refused=True), why, t0)
+    own_chain = {}  # the machine's own chain, from its baseline
+    if baseline is not None:
+        from .baseline import baseline_for
+
+        baseline = baseline_for(diag, baseline)
+        own_chain = baseline.chain
+        if p_head is not None:
+            p_head = np.asarray(p_head, float) - own_chain["p_head_offset"]
+        if p_crank is not None:
+            p_crank = np.asarray(p_crank, float) - own_chain["p_crank_offset"]
     x = np.asarray(x, float)
     jitter = None
     if tacho is not None:
@@ -279,6 +324,8 @@ def _diagnose_arrays(
             revs, jitter = tacho_revolutions(edges, x.size, fs)
         else:
             revs = crank_angle(x.size, fs, pulses=edges)
+        # the tacho mark's angle after outer dead centre (a baseline's chain): re-phased
+        revs = revs + own_chain.get("phase_deg", 0.0) / 360.0
         keep = np.isfinite(revs)
     else:
         if speed_hz is None:
@@ -295,13 +342,16 @@ def _diagnose_arrays(
     chain: dict[str, Any] = {}
     if jitter is not None:
         chain["tacho_jitter"] = jitter
-    if correct and tacho is not None and (ph is not None or pc is not None):
+    machine_pairs = diag.card["spec"].get("machine") or None
+    if correct and baseline is None and tacho is not None and (ph is not None or pc is not None):
+        # (a baseline's chain, fitted on the machine's own healthy records, replaces it)
         fix = correct_chain(
             revs,
             p_head=ph,
             p_crank=pc,
             reference=chain_reference(diag),
             axis_sd_deg=axis_sd(jitter, edges.size) if jitter is not None else 0.0,
+            machine=machine_pairs,
         )
         chain.update(fix.estimates)
         res.evidence["chain"] = _chain_summary(chain)
@@ -315,9 +365,13 @@ def _diagnose_arrays(
         form = "analog" if drawn else "bilinear"
         chain.update(resonance(x, fs, revs if tacho is not None else None, form))
         res.evidence["chain"] = _chain_summary(chain)
-    row = record_features(x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc)
+    row = record_features(
+        x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc, machine=machine_pairs
+    )
     names = diag.names
     X = np.array([[row[n] for n in names]], float)
+    if baseline is not None:  # the machine's own healthy state (speed and ringing kept)
+        X = baseline.refer(X, names)
     st = diag.state
     f_rev = row["speed_hz"]
     lo, hi = st["speed_range"]
@@ -394,7 +448,7 @@ def _diagnose_arrays(
     res.label = classes[k]
     if res.label != "healthy":
         s, slo, shi = diag.severity(X, res.label)
-        fc = get_class(res.label)
+        fc = diag.fault_class(res.label)
         res.severity, res.severity_interval = float(s[0]), (float(slo[0]), float(shi[0]))
         res.value = fc.value(res.severity)
         res.value_interval = (
@@ -410,6 +464,12 @@ def _diagnose_arrays(
             "deciding": _deciding(diag, X[0]),
         }
     )
+    if baseline is not None:
+        res.evidence["baseline"] = {
+            "records": list(baseline.records),
+            "chain": dict(own_chain),
+            "machine": dict(baseline.fit.machine),
+        }
     j = _closest(diag, X[0], res.label)
     if ph is not None and tacho is not None:
         from .train import curve

@@ -191,15 +191,19 @@ CHAMBER_FEATURES = (
 )
 
 
-def _geometry():
+def _geometry(machine=None):
     """The machine's chamber volumes (m**3) and crosshead acceleration per omega**2 (m) at
     each whole degree of crank after outer dead centre (the tacho's mark), from the one
-    model's mechanism and cylinder."""
+    model's mechanism and cylinder; ``machine``: the changes of another machine
+    (`recipdyn.diagnosis.machine.Machine.changes`), its own geometry, masses and clearance
+    volume (the ideal cycle's clearance is then the machine's, not `CLEARANCE`)."""
     from ..model.cycle import cycle_geometry
     from ..model.registry import get_model
     from .classes import MODEL
 
-    v = get_model(MODEL).parameters({})
+    changes = dict(machine or {})
+    v = get_model(MODEL).parameters(changes)
+    clearance = float(v["clearance_fraction"]) if "clearance_fraction" in changes else CLEARANCE
     r, length, d = float(v["r"]), float(v["l"]), float(v["d"])
     g = cycle_geometry(r, length, d, float(v["bore"]), float(v["rod_diameter"]))
     th = g.theta_odc + np.radians(np.arange(360.0))
@@ -211,8 +215,9 @@ def _geometry():
     acc = (x(th + h) - 2 * x(th) + x(th - h)) / h**2  # d2x/dtheta2
     vs_he, vs_ce = g.area_head * g.stroke, g.area_crank * g.stroke
     return {
-        "V_head": CLEARANCE * vs_he + g.area_head * (g.x_max - x(th)),
-        "V_crank": CLEARANCE * vs_ce + g.area_crank * (x(th) - g.x_min),
+        "V_head": clearance * vs_he + g.area_head * (g.x_max - x(th)),
+        "V_crank": clearance * vs_ce + g.area_crank * (x(th) - g.x_min),
+        "clearance": clearance,
         "Vs_head": vs_he,
         "Vs_crank": vs_ce,
         "acc_per_omega2": acc,
@@ -224,7 +229,16 @@ def _geometry():
     }
 
 
-_GEOMETRY: dict | None = None
+#: `_geometry` by machine (the changes as sorted pairs; () the default machine).
+_GEOMETRY: dict[tuple, dict] = {}
+
+
+def geometry(machine=None) -> dict:
+    """`_geometry` of ``machine`` (its changes from the default machine), computed once."""
+    key = tuple(sorted(dict(machine or {}).items()))
+    if key not in _GEOMETRY:
+        _GEOMETRY[key] = _geometry(key)
+    return _GEOMETRY[key]
 
 
 def _first_crossing(y, level, lo, hi, rising) -> float:
@@ -239,7 +253,7 @@ def _first_crossing(y, level, lo, hi, rising) -> float:
     return float(k - 1 + (level - y[k - 1]) / (y[k] - y[k - 1]))
 
 
-def _chamber_cycle(p, V, vs) -> dict[str, float]:
+def _chamber_cycle(p, V, vs, clearance=CLEARANCE) -> dict[str, float]:
     """Valve-event deviations from the ideal cycle, fitted exponents and work ratio of one
     chamber (``p``, ``V``: 360 one-degree samples from outer dead centre)."""
     from ..model.cycle import ideal_indicated_work, indicated_work
@@ -292,22 +306,23 @@ def _chamber_cycle(p, V, vs) -> dict[str, float]:
             k = np.arange(math.ceil(a), math.floor(b) + 1)
             slope = np.polyfit(np.log(V[k]), np.log(p[k]), 1)[0]
             out[name] = float(-slope)
-    ideal_w = ideal_indicated_work(p_lo, p_hi / p_lo, CLEARANCE, N_POLY, vs)
+    ideal_w = ideal_indicated_work(p_lo, p_hi / p_lo, clearance, N_POLY, vs)
     out["work"] = indicated_work(p, V) / ideal_w if ideal_w > 0 else math.nan
     return out
 
 
-def cycle_features(p_head360, p_crank360, energy360, speed_hz: float) -> dict[str, float]:
+def cycle_features(
+    p_head360, p_crank360, energy360, speed_hz: float, machine=None
+) -> dict[str, float]:
     """The ``cycle`` group (module docstring) from the two chamber pressures (Pa) and the
-    high-passed acceleration energy, each at the 360 whole degrees after outer dead centre."""
-    global _GEOMETRY
-    if _GEOMETRY is None:
-        _GEOMETRY = _geometry()
-    g = _GEOMETRY
+    high-passed acceleration energy, each at the 360 whole degrees after outer dead centre;
+    ``machine``: the changes of the machine whose geometry they are read against (None: the
+    default machine)."""
+    g = geometry(machine)
     row = {}
     ph, pc = np.asarray(p_head360, float), np.asarray(p_crank360, float)
-    head = _chamber_cycle(ph, g["V_head"], g["Vs_head"])
-    crank = _chamber_cycle(pc, g["V_crank"], g["Vs_crank"])
+    head = _chamber_cycle(ph, g["V_head"], g["Vs_head"], g["clearance"])
+    crank = _chamber_cycle(pc, g["V_crank"], g["Vs_crank"], g["clearance"])
     for k in CHAMBER_FEATURES:
         row[f"cy_head_{k}"] = head[k]
         row[f"cy_crank_{k}"] = crank[k]
@@ -366,7 +381,7 @@ def feature_groups(names) -> dict[str, list[str]]:
 
 
 def record_features(
-    accel, fs: float, revs, *, angle: bool = True, p_head=None, p_crank=None
+    accel, fs: float, revs, *, angle: bool = True, p_head=None, p_crank=None, machine=None
 ) -> dict[str, float]:
     """Features of one record (see the module docstring).
 
@@ -381,6 +396,9 @@ def record_features(
         pressure features are NaN.
     p_head, p_crank : array, optional
         Chamber pressures, Pa.
+    machine : mapping, optional
+        The changes of the machine the cycle features are read against
+        (`recipdyn.diagnosis.machine.Machine.changes`; None: the default machine).
     """
     from ..features import signal_features
 
@@ -421,9 +439,8 @@ def record_features(
         e360 = _angle_bins(e, r, mask, n_revs, start, 360)
         ph360 = _angle_bins(np.asarray(p_head, float), r, mask, n_revs, start, 360)
         pc360 = _angle_bins(np.asarray(p_crank, float), r, mask, n_revs, start, 360)
-        row.update(cycle_features(ph360, pc360, e360, speed))
+        row.update(cycle_features(ph360, pc360, e360, speed, machine))
     else:
-        row.update(
-            cycle_features(np.full(360, np.nan), np.full(360, np.nan), np.full(360, np.nan), speed)
-        )
+        nan = np.full(360, np.nan)
+        row.update(cycle_features(nan, nan, nan, speed, machine))
     return row

@@ -275,7 +275,9 @@ def expected_calibration_error(proba: np.ndarray, y: np.ndarray, bins: int = 10)
     return float(ece), diagram
 
 
-def detection_limits(labels, levels, severities, predicted, classes, threshold=0.9, bins=None):
+def detection_limits(
+    labels, levels, severities, predicted, classes, threshold=0.9, bins=None, known=None
+):
     """Per fault class: the recall at each severity level and the detection limit, the
     smallest level from which every level's recall is at least ``threshold`` (None: not
     reached).
@@ -284,7 +286,8 @@ def detection_limits(labels, levels, severities, predicted, classes, threshold=0
     ``[edges[i], edges[i + 1])`` (the last bin closed), keyed by the bin's centre, and the
     limit is the lower edge of the lowest bin from which every bin's recall reaches
     ``threshold``; ``recall_bins`` gives the edges and ``n_by_severity`` the records of each
-    bin or level."""
+    bin or level. ``known``: the fault classes the values are read from (default
+    `recipdyn.diagnosis.classes.CLASSES`; a machine's own: `Diagnoser.fault_classes`)."""
     out = {}
     edges = None if bins is None else np.asarray(bins, float)
     for c in classes:
@@ -314,7 +317,7 @@ def detection_limits(labels, levels, severities, predicted, classes, threshold=0
                 limit = lower[lv]
             else:
                 break
-        fc = get_class(c)
+        fc = get_class(c) if known is None else get_class(c, known)
         out[c] = {
             "recall_by_severity": recall,
             "n_by_severity": count,
@@ -362,6 +365,28 @@ class Diagnoser:
     def baseline(self) -> dict | None:
         """The healthy baseline (`fit_baseline`), or None."""
         return self.state.get("baseline")
+
+    @property
+    def machine(self):
+        """The `recipdyn.diagnosis.machine.Machine` the diagnoser was built for: its data
+        set's (the default machine for a data set, or a diagnoser file, without one)."""
+        from .machine import Machine
+
+        changes = self.card["spec"].get("machine") or ()
+        return Machine.of(changes, source="the diagnoser's data set")
+
+    @property
+    def fault_classes(self):
+        """The fault classes of the diagnoser's machine (their values re-derived for it:
+        `recipdyn.diagnosis.machine.fault_classes`)."""
+        from .machine import fault_classes
+
+        changes = self.card["spec"].get("machine")
+        return fault_classes(self.machine if changes else None)
+
+    def fault_class(self, name: str):
+        """The fault class ``name`` of the diagnoser's machine."""
+        return get_class(name, self.fault_classes)
 
     def model_rows(self, X: np.ndarray) -> tuple[np.ndarray, list[str]]:
         """The rows the learners read: ``X`` (columns `names`) and the deviations from the
@@ -788,6 +813,7 @@ def _chain_reference(folder, train_df, seed: int) -> dict | None:
     g = zarr.open_group(str(folder / "signals.zarr"), mode="r")
     if "p_head_sensor" not in g or "p_crank_sensor" not in g:
         return None
+    machine = json.loads(g.attrs["spec_json"]).get("machine") or None  # its chambers
     rng = np.random.default_rng([seed, 7])
     pick = []
     for _, sub in train_df.groupby("label"):
@@ -807,7 +833,8 @@ def _chain_reference(folder, train_df, seed: int) -> dict | None:
         fit = {"condition": int(train_df.condition.iloc[j])}
         row = train_df.iloc[j]
         for k, ch in enumerate(("head", "crank")):
-            f = pressure_phase(np.asarray(g[f"p_{ch}_sensor"][i, :n], float), revs, ch)
+            p = np.asarray(g[f"p_{ch}_sensor"][i, :n], float)
+            f = pressure_phase(p, revs, ch, machine)
             if f["ok"]:  # a drawn chain's own errors off: the reference is the physics'
                 phase, offset, gain = known_chain(row, k, float(row.f_speed_hz))
                 f["phase_deg"] -= phase
@@ -892,6 +919,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
                 np.array(classes)[pred],
                 classes,
                 bins=severity_bins(diag.card),
+                known=diag.fault_classes,
             ),
         }
         # which classes this channel set can name (recipdyn.diagnosis.channels)
@@ -916,7 +944,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
             continue
         s, lo, hi = diag.severity(X[m], c)
         true = test_df.severity.to_numpy()[m]
-        fc = get_class(c)
+        fc = diag.fault_class(c)
         v_hat = np.array([fc.value(v) for v in s])
         v_true = np.array([fc.value(v) for v in true])
         rel = np.abs(v_hat - v_true) / np.abs(v_true - (1.0 if c == "weak_valve_spring" else 0))
