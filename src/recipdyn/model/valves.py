@@ -268,7 +268,11 @@ SCHEMA_PARAMS = (*SCHEMA_PARAMS, *FAULT_PARAMS)
 (V_AREA, V_LIFT, V_MASS, V_K, V_F0, V_C, V_AF, V_CD, V_E, V_R, V_KAPPA, V_TS, V_TD,
  V_NCH, V_CRIT, V_E1, V_E2, V_COEF) = range(18)  # fmt: skip
 V_LEAK, V_SPRING, V_STICK, V_RING, V_PFRAME = 18, 22, 26, 30, 31
-N_VALVE = 32
+#: 1.0 when a real gas's property table follows the valve data (``v[N_VALVE:]``), else 0.0:
+#: the data says so itself, because a kernel's slice of the parameters runs on into the next
+#: component's (a machine's second throw): its length tells nothing
+V_REAL = 32
+N_VALVE = 33
 
 #: Gas states of one chamber: pressure, mass, suction-plate lift and velocity, discharge-plate
 #: lift and velocity.
@@ -325,6 +329,7 @@ def pack_valves(values, cycle_data: np.ndarray) -> np.ndarray:
     out[V_RING] = cd * float(values.get("ring_leak_area", 0.0))
     out[V_PFRAME] = cycle_data[cy.C_PFRAME]
     tab = _gas_table(values)
+    out[V_REAL] = 0.0 if tab is None else 1.0
     if tab is None:
         out[V_CRIT:V_LEAK] = _nozzle_constants(float(values["isentropic_exponent"]))
         return out
@@ -447,7 +452,7 @@ def _chamber(V, dV, y, b, q, c, v, mr, hr, out):
     # a leak is an area in parallel with the plate (0 when healthy: the sum is exact)
     a_s = _area(y[b + 2], y[b + 3], v) + v[V_LEAK + q]
     a_d = _area(y[b + 4], y[b + 5], v) + v[V_LEAK + q + 1]
-    if v.shape[0] > N_VALVE:  # a real gas: the first law with the tabulated properties
+    if v[V_REAL] != 0.0:  # a real gas: the first law with the tabulated properties
         tab = v[N_VALVE:]
         rt = p * V / m
         ms = _mdot(ps, tab[rg.T_RTS], p, rt, a_s, v)
@@ -483,7 +488,7 @@ def _gas_rt(p, m, V, v):
     """``p / rho`` and the specific enthalpy (real gas) or ``R T`` (ideal gas) of a chamber's
     gas, for the ring leak that leaves it."""
     rt = p * V / m
-    if v.shape[0] > N_VALVE:
+    if v[V_REAL] != 0.0:
         return rt, real_properties(p, rt, v[N_VALVE:])[0] + rt
     return rt, rt
 
@@ -496,7 +501,7 @@ def _ring(x, xdot, y, g, c, v):
     (at the frame pressure and the suction temperature) for a single-acting one."""
     area = v[V_RING]
     acting = int(v[V_NCH])
-    if v.shape[0] > N_VALVE:
+    if v[V_REAL] != 0.0:
         tab = v[N_VALVE:]
         rt_f, h_f = tab[rg.T_RTS], tab[rg.T_HS]
     else:

@@ -123,7 +123,10 @@ def _load_columns(th1, w, y, p, k, J):
     """Throw ``k`` with a load with states: the clearance angle's dependence on the load's
     states (through the gas force, in which the equation is linear) and the load's rows, by
     central differences of the load's laws (its stops and regularised nozzles are not smooth
-    everywhere), with each state's step ``1e-7 (|y| (1 + rel) + abs)`` from its slice."""
+    everywhere), with each load state's step ``1e-7 (|y| (1 + rel) + abs)`` from its slice;
+    the clearance angle and its rate by ``1e-6 (|y| + 1)`` (at 1e-7 the rounding of the
+    chamber pressures' derivatives, ~1e6 Pa/s, left 7e-5 of an entry in a leaking valve's
+    rows)."""
     s, m, lo = THROW_STATE[k], THROW_MECH[k], THROW_LOAD[k]
     g, a, ng, na = LOAD_STATE[k], LOAD_AUX[k], LOAD_N[k], LOAD_NAUX[k]
     thk = th1 + p[THROW_PHASE[k]]
@@ -138,7 +141,7 @@ def _load_columns(th1, w, y, p, k, J):
     for c in range(ng + 2):
         j = s + c if c < 2 else g + c - 2
         st = LOAD_STEPS[k] + 2 * (c - 2)
-        h = 1e-7 * (abs(y[j]) + 1.0) if c < 2 else 1e-7 * (abs(y[j]) * (1.0 + p[st]) + p[st + 1])
+        h = 1e-6 * (abs(y[j]) + 1.0) if c < 2 else 1e-7 * (abs(y[j]) * (1.0 + p[st]) + p[st + 1])
         yy[j] = y[j] + h
         x, v = crosshead(thk, yy[s], w, yy[s + 1], p, m)
         load_rhs(x, v, yy, g, a, p, lo, f1)
