@@ -256,3 +256,56 @@ def test_a_throws_placement_is_read_with_units_and_refused_out_of_range(tmp_path
         with pytest.raises(ParameterError) as exc:
             read_machine(f)
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
+
+
+def test_on_a_motor_the_shaking_force_is_minus_the_second_derivative_of_the_mass_moment():
+    """With a free crank the speed varies (a small flywheel, J_drive 2 kg m^2, and a constant
+    motor torque of 0: the throws' inertia torques swing it, alpha1 up to ~60 rad/s^2), so
+    the crank's and rod's accelerations hold ``alpha1`` terms. Independent of the kinematics'
+    chain rule: the frame's force is ``-G"`` with ``G = sum m_i p_i`` the mass moment of every
+    moving part, from the record's positions (crank angle, rod angle, crosshead position),
+    differentiated twice by central differences at h = 0.1 ms: truncation ``h^2/12`` times
+    G's fourth derivative ~ 1e-6 of the peak force (harmonics up to the 4th at 20 rad/s),
+    rounding ``eps |G| / h^2`` ~ 1e-6 N; held to 1e-4 of the peak (measured 1.3e-6). The
+    ``alpha1`` terms weigh more than 10x that (checked), so a force without them fails."""
+    import recipdyn
+    from recipdyn.model.assembler.model import MachineModel
+
+    throws = (_throw("throw1", 0.0), _throw("throw2", math.pi / 2, math.pi, S))
+    shaft = Shaft("motor", "constant",
+                  params=(("omega", 20.0), ("J_drive", 2.0), ("motor_torque", 0.0)))  # fmt: skip
+    m = MachineModel(Machine("shaking-motor", shaft=shaft, throws=throws, stages=(Stage(),)))
+    h = 1e-4
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelValidityWarning)
+        ds = recipdyn.simulate(model=m, params=m.parameters(), revolutions=0.5, fs=1.0 / h)
+    g = np.zeros((2, ds.sizes["time"]))
+    for t, sign in (("throw1", 1.0), ("throw2", -1.0)):  # (throw 2's axes turned by 180 deg)
+        th, th2 = ds[f"{t}.theta1"].values, ds[f"{t}.theta2"].values
+        x3 = ds[f"{t}.x"].values
+        gx = M1 * RS * np.cos(th) + M2 * (R * np.cos(th) + LS * np.cos(th2)) + M3 * x3
+        gy = M1 * RS * np.sin(th) + M2 * (R * np.sin(th) + LS * np.sin(th2))
+        g += sign * np.array([gx, gy])
+    fd = -(g[:, 2:] - 2.0 * g[:, 1:-1] + g[:, :-2]) / h**2
+    got = np.array([ds["shake_x"].values, ds["shake_y"].values])[:, 1:-1]
+    peak = np.max(np.abs(got))
+    assert np.max(np.abs(got - fd)) < 1e-4 * peak
+    alpha = ds["alpha1"].values[1:-1]
+    assert np.max(np.abs(alpha)) * (M1 * RS + M2 * R) > 10 * 1e-4 * peak  # the alpha terms count
+
+
+def test_the_balanced_opposed_example_places_its_throws():
+    """``examples/machines/balanced_opposed.toml``: cranks 180 deg apart, cylinders opposed,
+    650 mm apart; in their own axes the two throws run at the same crank angle, so the
+    example's frame force cancels as the pair's above."""
+    from pathlib import Path
+
+    from recipdyn.model.assembler.model import MachineModel
+    from recipdyn.model.machine import read_machine
+
+    m = read_machine(Path(__file__).parents[1] / "examples" / "machines" / "balanced_opposed.toml")
+    assert [(t.cylinder_angle, t.axial_position) for t in m.throws] == [(0.0, 0.0), (math.pi, 0.65)]
+    model = MachineModel(m)
+    v = model.parameters()
+    assert v["throw2.phase"] == pytest.approx(math.pi)
+    assert [local["phase"] for local in model.throws(v)] == [0.0, 0.0]
