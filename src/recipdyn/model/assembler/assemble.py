@@ -52,7 +52,8 @@ DOF, WORK, COUNTER = "dof", "work", "counter"
 def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[str, Any]:
     """Throw ``k``'s values under the compressor's names: its own, its stage's and the
     shaft's, with its structure (``load``, ``equations``, ``drive``, ``motor``) and its
-    ``phase``. In a machine of one throw: ``values`` themselves (and ``phase`` 0)."""
+    ``phase`` in its own axes (the crank's lead less its ``cylinder_angle``). In a machine of
+    one throw: ``values`` themselves (and ``phase`` 0)."""
     t = machine.throws[k]
     if machine.flat:
         out = {"phase": 0.0, **values}
@@ -70,6 +71,8 @@ def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[st
         out.setdefault(key, value)  # (the compressor of one throw holds them as values)
     if t.crank_joint == "ideal":
         out["rc"] = 0.0
+    if t.cylinder_angle:  # its equations run in its own axes, turned with its cylinder
+        out["phase"] = float(out["phase"]) - t.cylinder_angle
     return out
 
 

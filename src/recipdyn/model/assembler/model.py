@@ -183,6 +183,8 @@ class MachineModel(Model):
         accel = next((s.signal for s in machine.sensors if s.kind == "accelerometer"), None)
         self.vibration_signal = (accel or f"{pre[0]}a", "m/s**2")
         self.section_pair = (f"{pre[0]}v", f"{pre[0]}a")
+        if not machine.flat:
+            self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
         self.validity_bounds = tuple((
             f"{q}contact_force", "N", 0.0,
             "the massless link can only push: a negative joint contact force means the pin "
@@ -437,6 +439,7 @@ class MachineModel(Model):
         a1 = dy[:, st["omega1"]] if motor else None
         out: dict[str, Signal] = {}
         energy = np.zeros(t.shape[0])
+        shake = np.zeros((4, t.shape[0]))  # the frame's F_x, F_y, M_x, M_y
         for k, (th, local) in enumerate(zip(c.machine.throws, self.throws(values), strict=True)):
             pre = c.machine.prefix(th.name)
             p = self.throw_params(local)
@@ -470,7 +473,9 @@ class MachineModel(Model):
                 else:  # (the drive's inertia in the same expression, as before the assembler)
                     energy += mechanism_energy(p, th1, thc, w1, thcd, p.J_drive)
             if not c.machine.flat:
-                own["theta1"] = Signal(th1, "rad", "crank angle of this throw (phase included)")
+                own["theta1"] = Signal(th1, "rad", "crank angle of this throw in its own axes "
+                                       "(the shaft's + phase - cylinder_angle)")  # fmt: skip
+                own.update(_shaking(p, kin, fg, w1, a1, th, shake))
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -484,10 +489,23 @@ class MachineModel(Model):
             })  # fmt: skip
         if not c.machine.flat:
             out["theta1"] = Signal(obs[:, ov["theta1"]], "rad", "crank angle of the shaft")
+            out.update({
+                "shake_x": Signal(shake[0], "N", "shaking force on the frame along x: the sum "
+                                  "over the throws of -(m1 a1 + m2 a2 + m3 a3)"),
+                "shake_y": Signal(shake[1], "N", "shaking force on the frame along y"),
+                "shake_moment_x": Signal(shake[2], "N*m", "shaking moment on the frame about "
+                                         "the x axis through z = 0: -sum z_k F_y,k"),
+                "shake_moment_y": Signal(shake[3], "N*m", "shaking moment on the frame about "
+                                         "the y axis through z = 0: sum z_k F_x,k"),
+            })  # fmt: skip
         return out
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
-        """Per throw, its cylinder's figures (`_throw_summary`) under its name."""
+        """Per throw, its cylinder's figures (`_throw_summary`) and, whatever its load, the
+        API 618 rod load and crosshead-pin reversal over the last revolution, under its name;
+        the frame's combined load (`_frame_summary`)."""
+        from ..cycle import pin_reversal_summary
+
         machine = self.structure(values)
         if machine.flat:
             return self._throw_summary(self.throws(values)[0], ds)
@@ -497,8 +515,12 @@ class MachineModel(Model):
             view = ds[[k for k in ds.data_vars if str(k).startswith(pre)]]
             view = view.rename({k: str(k)[len(pre) :] for k in view.data_vars})
             view = view.assign_attrs(ds.attrs)
-            for k, v in self._throw_summary(local, view).items():
+            own = self._throw_summary(local, view)
+            if "api618_pin_reversal" not in own and {"theta1", "a", "gas_force"} <= set(view):
+                own.update(pin_reversal_summary(local, view))
+            for k, v in own.items():
                 out[pre + k] = v
+        out.update(_frame_summary(ds, float(self._shaft(values, "omega"))))
         return out
 
     @staticmethod
@@ -514,10 +536,67 @@ class MachineModel(Model):
 
     def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
                      ) -> dict[str, Any]:  # fmt: skip
+        machine = self.structure(values)
         out = super().record_attrs(values, y0)
-        out.update({"sign_convention": SIGN_CONVENTION,
-                    "throws": len(self.structure(values).throws)})  # fmt: skip
+        out.update({"sign_convention": SIGN_CONVENTION, "throws": len(machine.throws)})
+        if not machine.flat:  # each throw's placement on the frame (structure, not parameters)
+            for t in machine.throws:
+                out[f"{t.name}.cylinder_angle_deg"] = math.degrees(t.cylinder_angle)
+                out[f"{t.name}.axial_position_m"] = t.axial_position
+            out["frame_axes"] = FRAME_AXES
         return out
+
+
+#: The frame's axes, in which the machine's shaking forces and moments are given.
+FRAME_AXES = (
+    "frame: x along the line of stroke of a throw with cylinder_angle 0 (from the shaft toward "
+    "its cylinder), y up, z along the crankshaft (axial_position); a throw's own axes are the "
+    "frame's turned by its cylinder_angle about z"
+)
+
+
+def _frame_summary(ds: Any, omega: float) -> dict[str, float]:
+    """The frame's combined load over the record's last revolution: the largest shaking
+    force (the magnitude of ``(shake_x, shake_y)``), its largest x and y components, and the
+    largest shaking moment (the magnitude of ``(shake_moment_x, shake_moment_y)``); empty for
+    a record shorter than a revolution."""
+    from ..cycle import covers_revolution, last_revolution
+
+    if not {"theta1", "shake_x"} <= set(ds.variables):
+        return {}
+    part = last_revolution(ds, omega)
+    th = np.asarray(part["theta1"].values, dtype=float)
+    last = th >= th[-1] - 2.0 * math.pi
+    if np.count_nonzero(last) < 8 or not covers_revolution(th):
+        return {}
+    f = {k: np.asarray(part[k].values, dtype=float)[last]
+         for k in ("shake_x", "shake_y", "shake_moment_x", "shake_moment_y")}  # fmt: skip
+    return {
+        "frame_peak_force_N": float(np.max(np.hypot(f["shake_x"], f["shake_y"]))),
+        "frame_peak_force_x_N": float(np.max(np.abs(f["shake_x"]))),
+        "frame_peak_force_y_N": float(np.max(np.abs(f["shake_y"]))),
+        "frame_peak_moment_N_m": float(np.max(np.hypot(f["shake_moment_x"],
+                                                       f["shake_moment_y"]))),
+    }  # fmt: skip
+
+
+def _shaking(p, kin, fg, w1, a1, throw: Throw, total: np.ndarray) -> dict[str, Signal]:
+    """A throw's shaking force on the frame, in the frame's axes, and its rod load at the
+    crosshead pin (`recipdyn.model.mechanism.shaking`); its force and moments added to
+    ``total`` (F_x, F_y, M_x, M_y)."""
+    from ..base import Signal
+    from ..mechanism.shaking import in_frame, rod_load, throw_shaking
+
+    fx, fy = in_frame(*throw_shaking(p, kin, w1, a1), throw.cylinder_angle)
+    z = throw.axial_position
+    total += (fx, fy, -z * fy, z * fx)
+    return {
+        "shake_x": Signal(fx, "N", "this throw's shaking force on the frame along the "
+                          "frame's x: -(m1 a1 + m2 a2 + m3 a3)"),
+        "shake_y": Signal(fy, "N", "this throw's shaking force on the frame along y"),
+        "rod_load": Signal(rod_load(p, kin, fg), "N", "combined rod load at the crosshead "
+                           "pin, m3 a - gas_force (> 0: compression; API 618)"),
+    }  # fmt: skip
 
 
 def _n_cycle() -> int:

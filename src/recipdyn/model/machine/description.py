@@ -34,16 +34,19 @@ A machine file::
     signal = "throw2.a"
 
 The keys that choose a part (a throw's ``load``, ``crank_joint``, ``equations``, ``stage``,
-``name``; the shaft's ``drive`` and ``motor``; a stage's and a sensor's keys) are the
-machine's structure; every other key is a parameter value, with its unit (a number in SI or a
-quantity such as ``"1 mm"``), checked against its range when the machine becomes a model. A
-machine of several throws names its parameters by part: ``throw2.rc``, ``shaft.J_drive``,
-``stage1.suction_pressure``; a machine of one throw keeps the compressor's names (``rc``,
-``omega``), so a one-throw machine and ``--model compressor`` take the same values.
+``name``, and its placement on the frame, ``cylinder_angle``: 0 or 180 deg, and
+``axial_position`` along the crankshaft, with units; the shaft's ``drive`` and ``motor``; a
+stage's and a sensor's keys) are the machine's structure; every other key is a parameter
+value, with its unit (a number in SI or a quantity such as ``"1 mm"``), checked against its
+range when the machine becomes a model. A machine of several throws names its parameters by
+part: ``throw2.rc``, ``shaft.J_drive``, ``stage1.suction_pressure``; a machine of one throw
+keeps the compressor's names (``rc``, ``omega``), so a one-throw machine and ``--model
+compressor`` take the same values.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -54,7 +57,7 @@ from ...errors import ParameterError
 
 __all__ = [
     "Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine", "SHAFT_NAMES",
-    "STAGE_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS",
+    "STAGE_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
 
 #: The parameters of the shaft (its speed, angle and drive) and of a stage (its line
@@ -69,6 +72,10 @@ LOADS = ("paper", "table", "cycle", "valves")
 JOINTS = ("link", "ideal")
 DRIVES = ("prescribed", "motor")
 SENSOR_KINDS = ("accelerometer", "pressure", "tacho")
+#: A throw's line of stroke in the frame, rad: horizontal, on either side of the shaft.
+CYLINDER_ANGLES = (0.0, math.pi)
+#: The largest distance of a throw's plane from the datum along the crankshaft, m.
+AXIAL_MAX = 100.0
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
@@ -99,6 +106,13 @@ class Throw:
     params : tuple of (name, value)
         Its parameter values by local name (``rc``, ``phase``: the angle its crank leads the
         shaft's by), raw (numbers in SI or quantities); the rest take their defaults.
+    cylinder_angle : float
+        The direction of its line of stroke in the frame, rad: 0 (the frame's +x, every
+        throw's before this key) or pi (the opposite side: a balanced-opposed pair). Its
+        equations run in its own axes turned by this angle, so its crank angle there is the
+        shaft's plus ``phase`` minus ``cylinder_angle``.
+    axial_position : float
+        Where its plane sits along the crankshaft, m (the shaking moments' lever arm).
     """
 
     name: str = "throw1"
@@ -107,6 +121,8 @@ class Throw:
     load: str = "paper"
     equations: str = "exact"
     params: tuple[tuple[str, Any], ...] = ()
+    cylinder_angle: float = 0.0
+    axial_position: float = 0.0
 
     @property
     def values(self) -> dict[str, Any]:
@@ -189,6 +205,14 @@ class Machine:
                 raise ParameterError(f"{where}.equations = 'paper-printed' exists for a "
                                      "prescribed crank only; allowed with drive = 'motor': "
                                      "'exact'")  # fmt: skip
+            if t.cylinder_angle not in CYLINDER_ANGLES:
+                raise ParameterError(f"{where}.cylinder_angle = {math.degrees(t.cylinder_angle):g} "
+                                     "deg; allowed: 0 or 180 deg (horizontal cylinders; the "
+                                     "weight of a vertical or V cylinder's parts along their "
+                                     "stroke is not modelled)")  # fmt: skip
+            if not (math.isfinite(t.axial_position) and abs(t.axial_position) <= AXIAL_MAX):
+                raise ParameterError(f"{where}.axial_position = {t.axial_position:g} m; allowed: "
+                                     f"[-{AXIAL_MAX:g}, {AXIAL_MAX:g}] m")  # fmt: skip
             if t.stage not in [s.name for s in self.stages]:
                 raise ParameterError(f"{where}.stage = {t.stage!r}; the machine's stages: "
                                      f"{', '.join(s.name for s in self.stages)}")  # fmt: skip
@@ -232,6 +256,22 @@ class Machine:
 
 _TOP = ("name", "description", "shaft", "throw", "stage", "sensor")
 _THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
+#: A throw's placement on the frame: structure keys with units (not parameters to sweep).
+_PLACEMENT = (("cylinder_angle", "rad"), ("axial_position", "m"))
+
+
+def _placement(raw: dict, where: str) -> dict[str, float]:
+    """A throw's ``cylinder_angle`` (rad; a file gives ``"180 deg"``; within 1e-9 rad of 0 or
+    pi it is that angle) and ``axial_position`` (m), from its table."""
+    from ...quantity import to_unit
+
+    out = {k: to_unit(f"{where}.{k}", raw.pop(k), u) for k, u in _PLACEMENT if k in raw}
+    if "cylinder_angle" in out:
+        a = out["cylinder_angle"] % (2.0 * math.pi)
+        out["cylinder_angle"] = next(
+            (c for c in (*CYLINDER_ANGLES, 2.0 * math.pi) if abs(a - c) < 1e-9), a
+        ) % (2.0 * math.pi)
+    return out
 
 
 def _table(raw: Any, where: str) -> dict[str, Any]:
@@ -275,13 +315,14 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
         keys, params = _split(th, _THROW_KEYS)
         keys = {k: str(v) for k, v in keys.items()}
         keys.setdefault("name", f"throw{i}")
+        place = _placement(params, f"{where}: {keys['name']}")
         keys.setdefault("stage", stages[0].name)
         for k in params:
             if k in SHAFT_NAMES or k in STAGE_NAMES:
                 part = "[shaft]" if k in SHAFT_NAMES else f"its [[stage]] ({keys['stage']})"
                 raise ParameterError(f"{where}: {keys['name']}.{k}: a parameter of {part}, not "
                                      "of a throw")  # fmt: skip
-        throws.append(Throw(**keys, params=_pairs(params)))
+        throws.append(Throw(**keys, params=_pairs(params), **place))
     sensors = []
     for i, se in enumerate(raw.get("sensor", []), 1):
         se = _table(se, f"{where}: sensor {i}")
