@@ -178,7 +178,7 @@ def _import_once() -> None:
     (ImportError: cannot import name 'annotate' from partially initialized module)."""
     import importlib.util
 
-    from ..units import _ureg
+    from ..quantity import _ureg
 
     if importlib.util.find_spec("dask") is not None:
         import dask  # noqa: F401

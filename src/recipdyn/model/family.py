@@ -238,6 +238,16 @@ class Compressor(Model):
                                        for p in impl.schema), impl.schema.aliases,
                                  impl.schema.extras)  # fmt: skip
         self._schema0 = self.schema
+        if self.defaults:  # a preset: its schema's choices default to what it runs (the
+            # implementation's own defaults may be another route's: compressor-guide runs on
+            # the contact route, whose crank_joint defaults to 'contact')
+            ran = self.parameters()
+            self.schema = Schema(tuple(replace(p, default=ran[p.name])
+                                       if p.choices is not None and p.name in ran
+                                       and ran[p.name] != p.default else p
+                                       for p in self.schema), self.schema.aliases,
+                                 self.schema.extras)  # fmt: skip
+            self._schema0 = self.schema
 
     def _adopt(self, impl: Model) -> None:
         """Take the implementation's declarations that do not depend on values."""
