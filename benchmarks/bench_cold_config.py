@@ -80,11 +80,19 @@ def _unpack(rev: str, into: Path) -> Path:
     return into / "src"
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", default=None, help="an earlier revision to time too")
     ap.add_argument("--cases", nargs="*", default=list(CASES), choices=list(CASES))
-    args = ap.parse_args()
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="two cases only (the paper's compressor and the contact pins with valves)",
+    )
+    args = ap.parse_args(argv)
+    if args.quick:
+        pair = [c for c in CASES if "valves" in c and "contact" in c][:1]
+        args.cases = ["compressor", *pair]
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         trees = {"now": ROOT / "src"}

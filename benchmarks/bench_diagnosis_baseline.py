@@ -63,7 +63,7 @@ def _case(rng, kind: str, cond_task: dict, machine_defaults: dict) -> dict:
     return {"params": p, "truth": truth, "chain": chain}
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     from recipdyn.diagnosis import default_model_path, load
     from recipdyn.diagnosis.baseline import build_baseline
     from recipdyn.diagnosis.classes import CLASSES
@@ -82,7 +82,10 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="out/baseline_bench.json")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="1 perturbed and 1 nominal case")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.cases, args.nominal, args.faults = 1, 1, 1
 
     diag = load(default_model_path())
     tasks = [t for t in design(DatasetSpec.from_dict(diag.card["spec"]))

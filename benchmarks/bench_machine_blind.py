@@ -26,7 +26,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     from blind import harness, sources
     from recipdyn.diagnosis import default_model_path, diagnose_arrays, load
     from recipdyn.diagnosis.machine import (
@@ -42,7 +42,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--own-model", default=None)
     ap.add_argument("--own-machine", default=None)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
 
     recs = sources.blind_set(quick=args.quick)
     other = [r for r in recs if r.physics.source == "machine"]

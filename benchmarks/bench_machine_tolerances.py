@@ -71,7 +71,7 @@ def slope_lower(x, y) -> tuple[float, float]:
     return b, max(abs(b) - 2 * se, 0.0)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     from recipdyn.diagnosis import default_model_path, load
     from recipdyn.diagnosis.dataset import DatasetSpec, design
     from recipdyn.diagnosis.machine import (
@@ -92,7 +92,10 @@ def main() -> None:
     ap.add_argument("--params", default=None, help="comma list (default: all numerical)")
     ap.add_argument("--out", default="out/machine_tolerances.json")
     ap.add_argument("--cache", default=None, help="JSON of the records' features (reused)")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="1 condition, 3 parameters")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.conditions, args.params = 1, args.params or "r,clearance_fraction,m3"
 
     diag = load(default_model_path())
     spreads = healthy_spreads(diag)

@@ -29,11 +29,12 @@ def _machine(n: int, drive: str, spread: bool):
     return MachineModel(Machine(f"bench-{n}", shaft=Shaft(drive), throws=throws))
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--throws", type=int, nargs="*", default=[1, 2, 4])
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--revolutions", type=float, default=1.0)
+    ap.add_argument("--quick", action="store_true", help="1 and 2 throws, 2 rounds")
     ap.add_argument(
         "--phases",
         choices=("same", "spread"),
@@ -41,7 +42,9 @@ def main() -> None:
         help="the throws in phase (the same steps as one throw) or spread evenly "
         "over a turn (each throw's fast motion at its own time: more steps)",
     )
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.throws, args.rounds = [1, 2], 2
 
     from recipdyn.integrate import integrate
 
