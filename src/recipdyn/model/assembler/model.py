@@ -656,8 +656,8 @@ class OneThrow(MachineModel):
                 "matrix (Benettin's QR is undefined there); use the signal estimators or "
                 "--model compressor with load=cycle (ideal valves)"
             )
-        else:
-            self.summary_verdicts = ("api618_pin_reversal",)
+        # withheld ('invalid') when the run leaves the massless link's validity, valves too
+        self.summary_verdicts = ("api618_pin_reversal",)
 
     def structure(self, values: Mapping[str, Any]) -> Machine:
         load = "valves" if self.valves else values.get("load", "paper")
