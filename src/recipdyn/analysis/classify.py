@@ -182,8 +182,8 @@ def _signal_exponent(estimates, time_scale, tol, ev, reasons):
     # evidence of "no divergence" either (a lone Wolf of 58 1/s beside two refused slopes of
     # a ringing machine signal would make its harmonic lines "periodic")
     voters = usable + [e for e in unconfirmed if e.exponent > max(lim, 2 * e.stderr)]
-    if not voters:  # (an unconfirmed value below the limit is not "none could be estimated")
-        return None, 0.0, not withheld and not unconfirmed
+    if not voters:
+        return None, 0.0, not withheld
     pos = [e for e in voters if e.exponent > max(lim, 2 * e.stderr)]
     if usable:
         ev["lambda1_signal_median"] = float(np.median([e.exponent for e in usable]))
@@ -339,7 +339,15 @@ def classify(*, lambda1: float | None = None, lambda1_err: float = 0.0, k01: flo
         reasons.append(f"a positive exponent but {n_distinct} distinct section point(s): "
                        "conflicting evidence")  # fmt: skip
         return Verdict("undetermined", ev, reasons)
+    unconfirmed_low = any(k.endswith("_withheld") and k.startswith("lambda1_") for k in ev)
     if all_refused and lambda1 is None:
+        if deterministic and k01 is not None and k01 > 0.8 and not few and unconfirmed_low:
+            # an exponent was estimated, below the positive limit and unconfirmed: the 0-1
+            # test alone does not make it chaos (a ringing quasi-periodic machine signal
+            # reads K ~ 0.9)
+            reasons.append(f"0-1 test K = {k01:.2f} > 0.8, but the signal's exponent could "
+                           "not be confirmed: no verdict of chaos")  # fmt: skip
+            return Verdict("undetermined", ev, reasons)
         if deterministic and k01 is not None and k01 > 0.8 and not few:
             reasons.append(f"deterministic and 0-1 test K = {k01:.2f} > 0.8 (no exponent could "
                            "be estimated)")  # fmt: skip
