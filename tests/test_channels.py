@@ -58,16 +58,19 @@ def test_a_diagnoser_without_a_table_names_with_all_channels_only():
 
 
 def test_the_shipped_diagnosers_channel_sets():
-    """The shipped diagnoser's table (measured on its 360 held-out records): with every
-    channel each class is named (held-out precision >= 0.95); without pressure no valve or
-    ring fault is; with a speed only, no class at all (its accuracy there: 0.375)."""
+    """The shipped (drawn-chain) diagnoser's table, measured on its 350 held-out records:
+    with every channel the classes whose held-out precision reaches the gate are named,
+    all but the worn crosshead pin (0.83: taken for the crank pin) and the sticking plate
+    (0.79: healthy records taken for it); without pressure no valve or ring fault is; with a
+    speed only, no class at all (its accuracy there: 0.323)."""
     from recipdyn.diagnosis.diagnose import default_model_path, naming_of
     from recipdyn.diagnosis.train import load
 
     diag = load(default_model_path())
     table = naming_of(diag)
-    assert table["full"]["accuracy"] == pytest.approx(0.967, abs=1e-3)
-    assert all(gate(table, "full", c)[0] for c in diag.classes)
+    assert table["full"]["accuracy"] == pytest.approx(0.906, abs=1e-3)
+    named = {c for c in diag.classes if gate(table, "full", c)[0]}
+    assert named == set(diag.classes) - {"crosshead_pin_clearance", "sticking_valve"}
     valves = ["suction_valve_leak", "discharge_valve_leak", "weak_valve_spring",
               "sticking_valve", "ring_leak"]  # fmt: skip
     assert not any(gate(table, "no_pressure", c)[0] for c in valves)
