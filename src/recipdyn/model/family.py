@@ -242,12 +242,13 @@ class Compressor(Model):
             # implementation's own defaults may be another route's: compressor-guide runs on
             # the contact route, whose crank_joint defaults to 'contact')
             ran = self.parameters()
-            self.schema = Schema(tuple(replace(p, default=ran[p.name])
-                                       if p.choices is not None and p.name in ran
-                                       and ran[p.name] != p.default else p
-                                       for p in self.schema), self.schema.aliases,
-                                 self.schema.extras)  # fmt: skip
-            self._schema0 = self.schema
+            moved = {p.name for p in self.schema if p.choices is not None and p.name in ran
+                     and p.default is not None and ran[p.name] != p.default}  # fmt: skip
+            if moved:  # (else the implementation's own schema, the very object)
+                self.schema = Schema(tuple(replace(p, default=ran[p.name]) if p.name in moved
+                                           else p for p in self.schema), self.schema.aliases,
+                                     self.schema.extras)  # fmt: skip
+                self._schema0 = self.schema
 
     def _adopt(self, impl: Model) -> None:
         """Take the implementation's declarations that do not depend on values."""
