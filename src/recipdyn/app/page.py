@@ -262,10 +262,15 @@ def build_app(store: str | Path | None = None):
     def form_texts(fv, fi, cv, ci) -> dict[str, Any]:
         return {**_texts(fi, fv), **_texts(ci, cv)}
 
-    @app.callback(Output("page", "value"), Input("url", "hash"))
-    def _open_page(fragment):
-        # a link's fragment (#diagnose) opens its page
-        return page_of(fragment)
+    @app.callback(Output("page", "value"), Input("url", "hash"), State("page", "value"))
+    def _open_page(fragment, shown):
+        # a link's fragment (#diagnose) opens its page; a fragment naming the page already
+        # shown changes nothing, so that the first load's answer (the first page) cannot
+        # arrive after a click on a tab and take the click back
+        name = page_of(fragment)
+        if name == shown:
+            raise PreventUpdate
+        return name
 
     @app.callback(
         Output("simulate-page", "style"), Output("diagnose-tab", "style"),
