@@ -528,6 +528,9 @@ def _record(tmp_path, name, **change):
     )
     task = dict(task, revolutions=10.0, **{k: v for k, v in change.items() if k != "params"})
     task["params"] = dict(task["params"], **change.get("params", {}))
+    if "chain" in task:  # a drawn chain: the accelerometer's SNR and resonance are its own
+        acc = {f"accelerometer.{k}": change[k] for k in ("snr_db", "resonance_hz") if k in change}
+        task["chain"] = dict(task["chain"], **acc)
     rec = simulate_record(task)
     path = tmp_path / f"{name}.nc"
     rec[["accel_guide", "p_head_sensor", "p_crank_sensor", "tacho"]].to_netcdf(path)

@@ -288,6 +288,7 @@ def _diagnose_arrays(
     baseline=None,
 ) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
+    from .chainrange import as_evidence, check_chain, declared_ranges, snr_estimate
     from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
     from .machine import machine_from_file, refusal
@@ -358,7 +359,8 @@ def _diagnose_arrays(
         if fix.refused:
             return _refuse(res, fix.refused, t0)
         revs, ph, pc = fix.revs, fix.p_head, fix.p_crank
-    if correct:
+    declared = declared_ranges(diag)  # None: a diagnoser of one chain (learnt ranges)
+    if correct or declared is not None:
         # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
         # chain's exact (analog) one
         drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
@@ -392,8 +394,20 @@ def _diagnose_arrays(
             "record or train on that rate",
             t0,
         )
-    # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
     floor = noise_floor(diag, X[0])
+    if declared is not None:
+        # the record's chain, estimated from it, against the ranges the diagnoser was trained
+        # under (chainrange.py); the learnt ranges of the statistics are not read
+        read = None if floor is None else (floor[0], floor_kind(diag, X[0]))
+        if read is not None:  # the floor's share, and the SNR it gives
+            res.evidence["noise_floor"] = {"share": floor[0], "training_range": list(floor[1:]),
+                                           "snr_db": list(snr_estimate(*read)[:3])}  # fmt: skip
+        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"])
+        res.evidence["chain_ranges"] = as_evidence(checks)
+        if why:
+            return _refuse(res, why, t0)
+        floor = None  # (checked)
+    # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
     if floor is not None:
         q, lo, hi = floor
         floor_ev = {"share": q, "training_range": [lo, hi]}
@@ -411,7 +425,7 @@ def _diagnose_arrays(
             )
     lo, hi = st["ring_range"]
     ring = row["acc_ring_hz"]
-    if not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
+    if declared is None and not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
         return _refuse(
             res,
             f"the impacts ring at {ring:.0f} Hz, outside the training sensor "
@@ -585,6 +599,14 @@ def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:
     train = st["Z_train"].astype(float)[:, cols] * st["scale"][cols] + st["center"][cols]
     q_train = len(cols) * np.nanmin(train, axis=1)
     return len(cols) * float(a.min()), float(np.nanmin(q_train)), float(np.nanmax(q_train))
+
+
+def floor_kind(diag, row: np.ndarray) -> str:
+    """Which noise floor `noise_floor` read for ``row``: ``"angle"`` (the crank-angle bins,
+    with a tacho) or ``"quiet"`` (the quiet windows, without)."""
+    cols = [i for i, n in enumerate(diag.names) if n.startswith("ang_")]
+    a = np.asarray(row, float)[cols]
+    return "angle" if cols and np.isfinite(a).all() else "quiet"
 
 
 def _refuse(res: Diagnosis, reason: str, t0: float) -> Diagnosis:
