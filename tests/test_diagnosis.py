@@ -593,14 +593,6 @@ def test_diagnose_refuses_another_discharge_pressure_as_out_of_domain(tmp_path):
     assert main(argv) == 2
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "known regression of the drawn-chain diagnoser (shipped 2026-12-07): its noise-floor "
-        "and sensor-band ranges, learnt through drawn chains, no longer catch this record; "
-        "issue 42 note"
-    ),
-)
 def test_diagnose_refuses_another_sensor_band(tmp_path):
     """A mounting resonance at 1.2 kHz (the training set's lie at 3-4.5 kHz): the impacts
     ring there, outside the training sensor band. (The distance over all features does not
@@ -615,17 +607,7 @@ def test_diagnose_refuses_another_sensor_band(tmp_path):
 @pytest.mark.parametrize(
     "snr_db, answered",
     [
-        pytest.param(
-            5.0,
-            False,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason=(
-                    "known regression of the drawn-chain diagnoser: a 5 dB record is answered; "
-                    "issue 42 note"
-                ),
-            ),
-        ),
+        (5.0, False),
         (10.0, True),
         (40.0, True),
     ],
@@ -653,18 +635,7 @@ def test_diagnose_refuses_another_accelerometer_snr(tmp_path, snr_db, answered):
 @pytest.mark.parametrize(
     "snr_db, answered",
     [
-        pytest.param(
-            5.0,
-            False,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason=(
-                    "the drawn-chain diagnoser refuses this record first by its channel gate "
-                    "(no class nameable from acceleration alone), not by the noise floor; issue "
-                    "42 note"
-                ),
-            ),
-        ),
+        (5.0, False),
         (20.0, True),
     ],
 )

@@ -41,17 +41,9 @@ import re
 from dataclasses import asdict, dataclass
 from typing import Any
 
-__all__ = ["ChainCheck", "declared_ranges", "snr_estimate", "check_chain", "SNR_CALIBRATION"]
+from .tolerances import RESONANCE_CHECK_REL, RING_AGREEMENT, SNR_CALIBRATION
 
-#: ``x = 10 log10(1/q - 1)`` -> SNR (dB): ``snr = x + offset``, 95 % of the calibration
-#: records' residuals in ``[lo, hi]`` dB, valid for ``x <= x_max`` (above: a lower bound
-#: only). One set for the crank-angle noise floor (``angle``, with a tacho) and one for the
-#: quiet windows (``quiet``, a constant speed). Measured by ``benchmarks/bench_chain_ranges.py
-#: --part calibrate`` (docs/diagnosis.md: how many records and their scatter).
-SNR_CALIBRATION: dict[str, dict[str, float]] = {
-    "angle": {"offset": -0.14, "lo": -1.24, "hi": 1.75, "x_max": 25.0, "records": 195},
-    "quiet": {"offset": -0.32, "lo": -1.29, "hi": 1.93, "x_max": 25.0, "records": 196},
-}
+__all__ = ["ChainCheck", "declared_ranges", "snr_estimate", "check_chain", "SNR_CALIBRATION"]
 
 #: The chain parameters checked: estimate name -> (declared parameter, channel, words).
 CHECKED = {
@@ -62,11 +54,6 @@ CHECKED = {
     "offset_head": ("pressure.offset", "p_head", "transducer offset"),
     "offset_crank": ("pressure.offset", "p_crank", "transducer offset"),
 }  # fmt: skip
-
-#: The mount's fitted resonance counts as read only where the impacts ring within this share
-#: of it (`check_chain`): a machine's own spectral peak (a worn crosshead pin's, near 2 kHz)
-#: fits a second-order response as well, where the mount's lies above the anti-alias corner.
-RING_AGREEMENT = 0.1
 
 _RANGE = re.compile(r"^\s*([-+0-9.eE]+)\s*\.\.\s*([-+0-9.eE]+)\s*([^\s;(]*)")
 
@@ -174,10 +161,9 @@ def check_chain(
             ok, note = False, (f"the mount's fitted resonance ({r.value:.0f} Hz) is not where "
                                f"the impacts ring ({ring_hz:.0f} Hz): no resonance read with "
                                "confidence")  # fmt: skip
-        checks.append(_check("resonance_hz", r.value if ok else math.nan,
-                             r.value - r.uncertainty if ok else math.nan,
-                             r.value + r.uncertainty if ok else math.nan, declared,
-                             note))  # fmt: skip
+        u = math.hypot(r.uncertainty, RESONANCE_CHECK_REL * r.value) if ok else math.nan
+        checks.append(_check("resonance_hz", r.value if ok else math.nan, r.value - u,
+                             r.value + u, declared, note))  # fmt: skip
     if floor is not None:
         v, lo, hi, note = snr_estimate(*floor)
         checks.append(_check("snr_db", v, lo, hi, declared, note))

@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import ParameterError
 from .channels import _cols, available, gate
 from .classes import get_class
-from .tolerances import FLOOR_SLACK, RANGE_SLACK, RING_SLACK
+from .tolerances import FLOOR_SLACK, RANGE_SLACK, RESONANCE_CHECK_MIN_HZ, RING_SLACK
 
 __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
 
@@ -110,6 +110,10 @@ class Diagnosis:
                 f"10-degree stretch (training records {_db(nf['training_range'][1]):.0f}.."
                 f"{_db(nf['training_range'][0]):.0f} dB)"
             )
+        for c in ev.get("chain_ranges", {}).values():
+            from .chainrange import ChainCheck
+
+            lines.append("chain against its declared range: " + ChainCheck(**c).text())
         if "pressure_deviation" in ev:
             pd_ = ev["pressure_deviation"]
             lines.append(
@@ -358,7 +362,8 @@ def _diagnose_arrays(
         # chain's exact (analog) one
         drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
         form = "analog" if drawn else "bilinear"
-        chain.update(resonance(x, fs, revs if tacho is not None else None, form))
+        low = {} if declared is None else {"min_hz": RESONANCE_CHECK_MIN_HZ}  # (tolerances)
+        chain.update(resonance(x, fs, revs if tacho is not None else None, form, **low))
         res.evidence["chain"] = _chain_summary(chain)
     row = record_features(
         x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc, machine=machine_pairs
