@@ -297,6 +297,11 @@ def refusals(args) -> list[dict]:
         ra = sum(r["after_label"] == r["label"] and not r["after"] for r in g)
         print(f"| {key} | {len(g)} | {cb} | {ca} | {ab} | {aa} | {rb} | {ra} |")
         out.append({"key": key, "n": len(g), "chain_before": cb, "chain_after": ca})
+    print("\nrecords outside the ranges the chain checks let through (after):")
+    for r in rows:
+        if r["key"] != "in domain" and not _chain_refusal(r["after"]):
+            ch = {k: round(v, 1) for k, v in r.items() if k.startswith("accelerometer")}
+            print(f"  {r['key']} {r['label']} {ch}: {r['after'][:160] or r['after_label']}")
     print("\nchain refusals, with their reasons (before | after):")
     for r in rows:
         if _chain_refusal(r["before"]) or _chain_refusal(r["after"]):

@@ -5,7 +5,10 @@ channels by name); the crank angle comes from a once-per-revolution tacho whose 
 outer dead centre, or from a constant speed (then the features that need the angle are left
 out and the diagnosis is less sharp). Before any answer, the record must lie in the
 diagnoser's training domain: its crank speed and sampling rate inside the training ranges,
-the frequency at which its impacts ring inside the training sensor band, its features not
+its measurement chain as estimated from it (the mount's resonance, the SNR, the pressure
+offsets) inside the chain ranges the diagnoser was trained under
+(`recipdyn.diagnosis.chainrange`; a diagnoser of one fixed chain: the noise floor and the
+frequency at which its impacts ring inside its training records' ranges), its features not
 less like the training records than all but a stated share of held-out records
 (`recipdyn.diagnosis.domain`: a conformal novelty p-value); and the best-fitting simulated
 record of the class named must explain it within its noise
