@@ -398,8 +398,12 @@ def _diagnose_arrays(
     floor = noise_floor(diag, X[0])
     if declared is not None:
         # the record's chain, estimated from it, against the ranges the diagnoser was trained
-        # under (chainrange.py); the learnt ranges of the statistics are not read
-        read = None if floor is None else (floor[0], floor_kind(diag, X[0]))
+        # under (chainrange.py); the learnt ranges of the statistics are not read. The floor
+        # of the record's own features (not referred to a baseline: the sensor's, not the
+        # machine's)
+        raw = np.array([row[n] for n in names], float)
+        floor = noise_floor(diag, raw)
+        read = None if floor is None else (floor[0], floor_kind(diag, raw))
         if read is not None:  # the floor's share, and the SNR it gives
             res.evidence["noise_floor"] = {"share": floor[0], "training_range": list(floor[1:]),
                                            "snr_db": list(snr_estimate(*read)[:3])}  # fmt: skip
