@@ -318,7 +318,7 @@ def test_the_jacobians_frame_rows_against_central_differences():
     rows = slice(s, s + 8)
     for i in range(s, s + 8):
         np.testing.assert_allclose(J[i], D[i], atol=1e-6 * max(np.max(np.abs(D[i])), 1e-30))
-    assert np.max(np.abs(J[rows, : 4])) > 0.0  # the throws' states move the frame
+    assert np.max(np.abs(J[rows, :4])) > 0.0  # the throws' states move the frame
 
 
 def test_without_a_frame_nothing_is_bound_and_the_throws_do_not_feel_it():
@@ -356,7 +356,7 @@ def test_a_frame_is_read_with_units_and_refused_in_one_line(tmp_path):
     assert v["frame.z_cm"] == pytest.approx(0.325) and v["frame.mount2.k_x"] == 5e7
     assert model.vibration() == ("throw1.accel", "m/s**2")
     assert model.record_attrs(v)["frame.mount4.z_m"] == pytest.approx(1.325)
-    mount = '[[frame.mount]]\nk_x = 1e6\n'
+    mount = "[[frame.mount]]\nk_x = 1e6\n"
     for text, words in (
         ("[frame]\nmass = 1\n" + mount + "[[throw]]\n", "needs at least 2 [[frame.mount]]"),
         ("[frame]\nheight = 1\n" + 2 * mount + "[[throw]]\n", "frame.height: not a parameter"),
