@@ -199,7 +199,18 @@ class MachineModel(Model):
             f"{q}contact_force", "N", 0.0,
             "the massless link can only push: a negative joint contact force means the pin "
             "would leave the bearing wall, where the permanent-contact model no longer holds",
-            self.validity_bounds_instead) for q in pre)  # fmt: skip
+            self.validity_bounds_instead) for q, t in zip(pre, machine.throws, strict=True)
+            if machine.frame is None or t.crank_joint == "link")  # fmt: skip
+        if machine.frame is not None:  # (a machine with a frame: its ideal pins have no link)
+            from ..frame.body import FEEDBACK_LIMIT
+
+            self.validity_bounds += ((
+                "frame_coupling_margin", "", 0.0,
+                f"the frame's acceleration at a guide moves that throw's parts by more than "
+                f"{FEEDBACK_LIMIT:g} of its shaking force (frame_feedback), and the frame is "
+                "coupled one way (its motion does not act on the throws)",
+                "a stiffer or heavier frame (frame.mount*.k_x, frame.mass), away from its "
+                "resonances; a frame coupled both ways is not modelled yet"),)  # fmt: skip
         if any(t.load == "valves" for t in machine.throws):
             self.lyapunov_refusal = (
                 "valve plates come to rest on their stops in resets with a singular saltation "
@@ -332,7 +343,10 @@ class MachineModel(Model):
         )
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        """The link's bound (it can only push) needs a link: rc > 0 at some throw."""
+        """The link's bound (it can only push) needs a link: rc > 0 at some throw; the
+        frame's one-way coupling (a machine with a frame) always."""
+        if self.structure(values).frame is not None:
+            return True
         return any(float(v["rc"]) > 0.0 for v in self.throws(values))
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
@@ -671,7 +685,7 @@ class _FrameRecord:
         feedback per sample (``frame_feedback``: the largest over the throws of
         ``(m1 + m2 + m3) |a_f|`` over the throw's largest shaking force along its stroke)."""
         from ..base import Signal
-        from ..frame.body import energy
+        from ..frame.body import FEEDBACK_LIMIT, energy
         from ..mechanism.shaking import throw_shaking
 
         mounts = -(self.q @ self.K.T + self.qd @ self.C.T)
@@ -691,6 +705,9 @@ class _FrameRecord:
             "frame_feedback": Signal(feedback, "", "the neglected feedback of the frame on the "
                                      "throws (one-way coupling): max over the throws of "
                                      "(m1+m2+m3)|frame_a| / max|its shaking force along x|"),
+            "frame_coupling_margin": Signal(FEEDBACK_LIMIT - feedback, "", "the validity "
+                                            "bound's margin: FEEDBACK_LIMIT - frame_feedback "
+                                            "(< 0: the one-way coupling no longer holds)"),
         }  # fmt: skip
 
 

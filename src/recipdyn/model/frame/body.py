@@ -40,8 +40,9 @@ q' dt`` less the mounts' dissipation ``int q'^T C q' dt`` (the states ``frame.W_
 frame's motion does not act back on them. The neglected term is the inertial force
 ``-(m1 + m2 + m3) a_f`` on a throw's parts from the frame's acceleration ``a_f`` at its
 guide (and the frame's turning of the throw's axes, of second order in ``psi``); its size
-beside the throw's own shaking force is the run summary's ``frame_feedback_ratio``
-(`feedback_ratio`).
+beside the throw's own shaking force is the record's ``frame_feedback`` and the run summary's
+``frame_feedback_ratio``; beyond `FEEDBACK_LIMIT` the run is outside the model's validity
+(the machine's validity bound ``frame_coupling_margin >= 0``: warned, verdicts withheld).
 
 **The accelerometers.** The frame's motion along a throw's line of stroke at its crosshead
 guide (at ``z_k``) is ``cos(cylinder_angle) (x + psi (z_k - z_cm))`` (a cylinder at 0 or 180
@@ -62,7 +63,14 @@ from ...errors import ParameterError
 from ..protocol import Param
 
 __all__ = ["PARAMS", "MOUNT_PARAMS", "STATES", "WORK", "local_params", "matrices", "pack",
-           "check", "PACKED", "energy", "at_guide", "feedback_ratio"]  # fmt: skip
+           "check", "PACKED", "energy", "at_guide", "FEEDBACK_LIMIT"]  # fmt: skip
+
+#: The largest neglected feedback (`frame_feedback`: a throw's moving mass times the frame's
+#: acceleration at its guide, over its largest shaking force) the one-way coupling allows: the
+#: frame's load, linear in the shaking forces, is then off by at most this fraction of a throw's
+#: (to first order; the throws' own motion, driven by the much larger gas and inertia loads,
+#: far less).
+FEEDBACK_LIMIT = 0.05
 
 _WHY = ("an assumed frame of a mid-size two-throw process compressor (steel bedplate ~3 x 2 m, "
         "8 t; mounts ~25 Hz, ~3 % damping): give your machine's")  # fmt: skip
@@ -166,16 +174,3 @@ def at_guide(throw, local: Mapping[str, Any], q: np.ndarray) -> np.ndarray:
     angle) (x + psi (z_k - z_cm))``."""
     c, _ = _cos_sin(throw.cylinder_angle)
     return c * (q[:, 0] + q[:, 2] * (throw.axial_position - float(local["z_cm"])))
-
-
-def feedback_ratio(masses: list[float], frame_a: list[np.ndarray],
-                   shake: list[np.ndarray]) -> float:  # fmt: skip
-    """The neglected feedback's size (module docstring, one-way coupling): the largest over
-    the throws of ``max |(m1 + m2 + m3) a_f| / max |F_x|`` (its moving mass times the frame's
-    acceleration at its guide, beside its own shaking force along the stroke)."""
-    out = 0.0
-    for m, a, f in zip(masses, frame_a, shake, strict=True):
-        top = float(np.max(np.abs(f)))
-        if top > 0.0:
-            out = max(out, m * float(np.max(np.abs(a))) / top)
-    return out
