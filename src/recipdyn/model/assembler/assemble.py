@@ -9,13 +9,15 @@ drive (`recipdyn.model.assembler.generate`).
 
 The order of the parameter vector: the shaft's drive and torque law, then per throw its
 mechanism (`recipdyn.model.mechanism.link.MECHANISM`), its phase and its load's difference
-steps, then per throw its load's slice (last: a table's length varies, and every offset
-before it stays a constant of the generated module). The order of the state: per throw its
-clearance angle and rate; with a motor the crank's angle and speed and the motor's work, then
-per throw the gas's work on its crosshead; then per throw its load's states; then per throw
-its load's auxiliary states. With one throw this is the order of the compressor's state
-before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves'
-states>, <their counters>``), so records and configs of one throw keep their meaning.
+steps, then the frame's slice (a machine with a ``[frame]``), then per throw its load's slice
+(last: a table's length varies, and every offset before it stays a constant of the generated
+module). The order of the state: per throw its clearance angle and rate; with a motor the
+crank's angle and speed and the motor's work, then per throw the gas's work on its crosshead;
+then the frame's states and work integrals (with a frame); then per throw its load's states;
+then per throw its load's auxiliary states. With one throw this is the order of the
+compressor's state before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor,
+W_gas], <the valves' states>, <their counters>``), so records and configs of one throw keep
+their meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
@@ -40,14 +42,22 @@ from . import generate
 from .layout import Layout, SlicesBuilder
 
 __all__ = ["Configuration", "assemble", "bindings", "throw_values", "load_of", "motor_of",
-           "KERNELS"]  # fmt: skip
+           "frame_values", "KERNELS"]  # fmt: skip
 
 #: The massless-link throw's compiled functions.
 KERNELS = "recipdyn.model.mechanism.link_kernels"
 
 #: A state's kind: a degree of freedom, a work integral (auxiliary and passive: nothing
-#: depends on it), a load's counter (auxiliary).
-DOF, WORK, COUNTER = "dof", "work", "counter"
+#: depends on it), a load's counter (auxiliary), the frame's (passive: the throws do not
+#: depend on it, `recipdyn.model.frame.body`, one-way coupling).
+DOF, WORK, COUNTER, FRAME = "dof", "work", "counter", "frame"
+#: The frame's compiled roles.
+FRAME_KERNELS = "recipdyn.model.frame.kernels"
+
+
+def frame_values(values: Mapping[str, Any]) -> dict[str, Any]:
+    """The frame's values under their names inside ``frame.`` (``mass``, ``mount2.k_x``)."""
+    return {n[len("frame.") :]: v for n, v in values.items() if n.startswith("frame.")}
 
 
 def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[str, Any]:
@@ -179,9 +189,10 @@ class Configuration:
         return n
 
     def passive(self, values_of_throws: list[Mapping[str, Any]]) -> tuple[int, ...]:
-        """The states left out of the tangent space: the work integrals, and with a motor the
-        clearance angle and rate of a throw with an ideal pin (rc = 0: they never move)."""
-        out = [i for i, kind in enumerate(self.kinds) if kind == WORK]
+        """The states left out of the tangent space: the work integrals, the frame's states
+        (nothing depends on them), and with a motor the clearance angle and rate of a throw
+        with an ideal pin (rc = 0: they never move)."""
+        out = [i for i, kind in enumerate(self.kinds) if kind in (WORK, FRAME)]
         if self.motor is not None:
             for t, local in zip(self.machine.throws, values_of_throws, strict=True):
                 if float(local["rc"]) == 0.0:
@@ -240,6 +251,10 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
             [(pre + k, "") for k in MECHANISM])  # fmt: skip
         put(f"{t.name}.phase", [local["phase"]], [(pre + "phase", "rad")])
         put(f"{t.name}.steps", _steps(load, local) if load.states else np.zeros(0))
+    if machine.frame is not None:
+        from ..frame.body import pack as frame_pack
+
+        put("frame", frame_pack(machine, frame_values(values)))
     for t, local in zip(machine.throws, locals_, strict=True):
         put(f"{t.name}.load", load.pack(local))
     params = pv.build()
@@ -261,6 +276,12 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
         place("shaft.work", (("W_motor", "J"),), WORK)
         for t in machine.throws:
             place(f"{t.name}.work", ((machine.prefix(t.name) + "W_gas", "J"),), WORK)
+    if machine.frame is not None:
+        from ..frame.body import STATES as FRAME_STATES
+        from ..frame.body import WORK as FRAME_WORK
+
+        place("frame", ((f"frame.{s}", u) for s, u in FRAME_STATES), FRAME)
+        place("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK), WORK)
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load", ((pre + s, u) for s, u in load.states), DOF)
@@ -294,6 +315,14 @@ def _load_roles(load: Component) -> dict[str, tuple[str, str]]:
             "load_rhs": absent, "load_event": absent, "load_reset": absent}  # fmt: skip
 
 
+def _frame_roles(frame: bool) -> dict[str, tuple[str, str]]:
+    if not frame:
+        absent = ("recipdyn.model.assembler.generate", "absent")
+        return {"shaking": absent, "frame_load": absent, "frame_rhs": absent}
+    return {"shaking": (KERNELS, "shaking"), "frame_load": (FRAME_KERNELS, "throw_load"),
+            "frame_rhs": (FRAME_KERNELS, "frame_rhs")}  # fmt: skip
+
+
 def _kernels(machine: Machine, layout: Layout, load: Component, motor: Component | None,
              drive: Component) -> ModuleType:  # fmt: skip
     """The generated module of the configuration (`bindings`)."""
@@ -311,7 +340,12 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         return np.array([slices.start(f"{t.name}.{suffix}") for t in throws], dtype=np.int64)
 
     has_states = bool(load.states)
+    frame = machine.frame is not None
     constants: dict[str, Any] = {
+        "FRAME": frame,
+        "FRAME_PARAMS": pv.start("frame") if frame else 0,
+        "FRAME_STATE": st.start("frame") if frame else 0,
+        "FRAME_WORK": st.start("frame.work") if frame else 0,
         "LOAD_STATES": has_states,
         "N_THROWS": len(throws),
         "SHAFT": pv.start("shaft.drive"),
@@ -328,6 +362,7 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         "crosshead": (KERNELS, "crosshead"),
         "crank_torque": (KERNELS, "crank_torque"),
         **_load_roles(load),
+        **_frame_roles(frame),
     }
     equations = throws[0].equations
     if motor is None:
@@ -348,7 +383,8 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         for i, name in enumerate(st.names):
             if i in range(*st.parts["shaft.work"].indices(st.size)) or any(
                     i in range(*st.parts[f"{t.name}.{part}"].indices(st.size))
-                    for t in throws for part in ("work", "load_aux")):  # fmt: skip
+                    for t in throws for part in ("work", "load_aux")) or (
+                    frame and i in range(*st.parts["frame.work"].indices(st.size))):  # fmt: skip
                 kinds.append(3)  # nothing depends on it: its column is 0
             elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws):
                 kinds.append(2)
@@ -366,6 +402,6 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
     for c in (load, motor):  # a user's file: its edits give a new module, never stale code
         if c is not None and not c.module.startswith("recipdyn"):
             note += f"{c.family} = {c.module}: {source_digest(c.module)}; "
-    stem = (f"{load.name}_{equations}_{len(throws)}"
-            + ("" if motor is None else f"_{motor.name}")).replace("-", "_")  # fmt: skip
+    stem = (f"{load.name}_{equations}_{len(throws)}" + ("" if motor is None else f"_{motor.name}")
+            + ("_frame" if frame else "")).replace("-", "_")  # fmt: skip
     return template, roles, constants, stem, note

@@ -11,6 +11,6 @@ machine of one throw keeps the compressor's names (``rc``, ``omega``). Nothing h
 numba.
 """
 
-from .description import Machine, Sensor, Shaft, Stage, Throw, read_machine
+from .description import Frame, Machine, Mount, Sensor, Shaft, Stage, Throw, read_machine
 
-__all__ = ["Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine"]
+__all__ = ["Machine", "Shaft", "Throw", "Stage", "Sensor", "Frame", "Mount", "read_machine"]

@@ -28,10 +28,21 @@ A machine file::
     load = "cycle"
     phase = "180 deg"
 
+    [frame]                  # optional: the frame on its elastic mounts (a planar rigid
+    mass = "8 t"             # body in the horizontal plane x-z that the throws shake)
+    inertia = "6000 kg*m**2" # about the vertical axis through its centre of mass
+    z_cm = "325 mm"          # its centre of mass (x_cm, z_cm) in the frame's axes
+
+    [[frame.mount]]          # an elastic mount: its place (x, z; structure) and its
+    x = "-1 m"               # stiffness and damping along x and z (parameters)
+    z = "-0.5 m"
+    k_x = "5e7 N/m"
+    c_x = "2e4 N*s/m"
+
     [[sensor]]               # what a monitoring system records: the model's vibration
     name = "accel_throw2"    # signal is the first accelerometer's
     kind = "accelerometer"
-    signal = "throw2.a"
+    signal = "throw2.a"      # (with a frame, "throw2.accel": the crosshead's + the frame's)
 
 The keys that choose a part (a throw's ``load``, ``crank_joint``, ``equations``, ``stage``,
 ``name``, and its placement on the frame, ``cylinder_angle``: 0 or 180 deg, and
@@ -41,7 +52,8 @@ value, with its unit (a number in SI or a quantity such as ``"1 mm"``), checked 
 range when the machine becomes a model. A machine of several throws names its parameters by
 part: ``throw2.rc``, ``shaft.J_drive``, ``stage1.suction_pressure``; a machine of one throw
 keeps the compressor's names (``rc``, ``omega``), so a one-throw machine and ``--model
-compressor`` take the same values.
+compressor`` take the same values. The frame's parameters are always under ``frame.``
+(``frame.mass``, ``frame.mount2.k_x``); a mount's place (``x``, ``z``) is structure.
 """
 
 from __future__ import annotations
@@ -56,8 +68,9 @@ from typing import Any
 from ...errors import ParameterError
 
 __all__ = [
-    "Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine", "SHAFT_NAMES",
-    "STAGE_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS", "CYLINDER_ANGLES",
+    "Machine", "Shaft", "Throw", "Stage", "Sensor", "Frame", "Mount", "read_machine",
+    "SHAFT_NAMES", "STAGE_NAMES", "FRAME_NAMES", "MOUNT_NAMES", "LOADS", "JOINTS", "DRIVES",
+    "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
 
 #: The parameters of the shaft (its speed, angle and drive) and of a stage (its line
@@ -66,6 +79,9 @@ __all__ = [
 SHAFT_NAMES = ("omega", "theta1_0", "J_drive", "motor_torque", "motor_sync_speed",
                "motor_breakdown_torque", "motor_breakdown_slip")  # fmt: skip
 STAGE_NAMES = ("suction_pressure", "discharge_pressure", "suction_temperature")
+#: The parameters of the frame (`recipdyn.model.frame`) and of each of its mounts.
+FRAME_NAMES = ("mass", "inertia", "x_cm", "z_cm")
+MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
 #: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
 #: crosshead guide's clearance run on one throw through ``--model compressor``).
 LOADS = ("paper", "table", "cycle", "valves")
@@ -168,9 +184,42 @@ class Sensor:
 
 
 @dataclass(frozen=True)
+class Mount:
+    """An elastic mount of the frame: its name (``mount2``: its parameters are
+    ``frame.mount2.k_x``), its place in the frame's axes (``x``, ``z``, m: structure) and its
+    parameter values (stiffness ``k_x``, ``k_z`` and damping ``c_x``, ``c_z`` along x and z,
+    raw)."""
+
+    name: str = "mount1"
+    x: float = 0.0
+    z: float = 0.0
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """The frame on its elastic mounts (`recipdyn.model.frame`): a rigid body moving in the
+    horizontal plane x-z (the plane of the cylinder axes and the crankshaft), shaken by every
+    throw. ``params``: its parameter values (``mass``, ``inertia`` about the vertical axis
+    through its centre of mass, ``x_cm``, ``z_cm``), raw; ``mounts``: its mounts."""
+
+    params: tuple[tuple[str, Any], ...] = ()
+    mounts: tuple[Mount, ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
 class Machine:
-    """A machine: its shaft, its throws (in the order of their namespaces), stages and
-    sensors."""
+    """A machine: its shaft, its throws (in the order of their namespaces), stages, sensors
+    and, optionally, its frame on its mounts (None: the frame is rigid and fixed, as
+    before the frame existed)."""
 
     name: str = "machine"
     description: str = ""
@@ -178,6 +227,7 @@ class Machine:
     throws: tuple[Throw, ...] = (Throw(),)
     stages: tuple[Stage, ...] = (Stage(),)
     sensors: tuple[Sensor, ...] = ()
+    frame: Frame | None = None
     #: Where it was read from (an absolute path: a record and a sweep's workers find it again).
     source: str = ""
 
@@ -232,10 +282,39 @@ class Machine:
         if self.shaft.drive not in DRIVES:
             raise ParameterError(f"machine {self.name!r}: shaft.drive = {self.shaft.drive!r}; "
                                  f"allowed: {', '.join(map(repr, DRIVES))}")  # fmt: skip
+        if self.frame is not None:
+            self._check_frame(self.frame)
         for s in self.sensors:
             if s.kind not in SENSOR_KINDS:
                 raise ParameterError(f"machine {self.name!r}: sensor {s.name!r}: kind = "
                                      f"{s.kind!r}; allowed: {', '.join(SENSOR_KINDS)}")  # fmt: skip
+
+    def _check_frame(self, frame: Frame) -> None:
+        where = f"machine {self.name!r}: frame"
+        if len(frame.mounts) < 2:
+            raise ParameterError(f"{where}: needs at least 2 [[frame.mount]] (one mount leaves "
+                                 "it free to turn about the vertical axis); got "
+                                 f"{len(frame.mounts)}")  # fmt: skip
+        names = [m.name for m in frame.mounts]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"{where}: two mounts named alike: {names}")
+        for m in frame.mounts:
+            if not _NAME.match(m.name):
+                raise ParameterError(f"{where}: mount name {m.name!r}: a letter then letters, "
+                                     "digits or _")  # fmt: skip
+            for k, v in (("x", m.x), ("z", m.z)):
+                if not (math.isfinite(v) and abs(v) <= AXIAL_MAX):
+                    raise ParameterError(f"{where}.{m.name}.{k} = {v:g} m; allowed: "
+                                         f"[-{AXIAL_MAX:g}, {AXIAL_MAX:g}] m")  # fmt: skip
+            for k in m.values:
+                if k not in MOUNT_NAMES:
+                    raise ParameterError(f"{where}.{m.name}.{k}: not a parameter of a "
+                                         f"mount; allowed: name, x, z, "
+                                         f"{', '.join(MOUNT_NAMES)}")  # fmt: skip
+        for k in frame.values:
+            if k not in FRAME_NAMES:
+                raise ParameterError(f"{where}.{k}: not a parameter of the frame; allowed: "
+                                     f"{', '.join(FRAME_NAMES)} and [[frame.mount]]")  # fmt: skip
 
     @property
     def flat(self) -> bool:
@@ -254,7 +333,7 @@ class Machine:
         return replace(self, throws=tuple(throws))
 
 
-_TOP = ("name", "description", "shaft", "throw", "stage", "sensor")
+_TOP = ("name", "description", "shaft", "throw", "stage", "sensor", "frame")
 _THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
 #: A throw's placement on the frame: structure keys with units (not parameters to sweep).
 _PLACEMENT = (("cylinder_angle", "rad"), ("axial_position", "m"))
@@ -336,10 +415,27 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
             )
         sensors.append(Sensor(str(se.get("name", f"sensor{i}")), str(se["kind"]),
                               str(se["signal"])))  # fmt: skip
+    frame = _frame(raw["frame"], where) if "frame" in raw else None
     return Machine(name=str(raw.get("name", Path(source).stem if source else "machine")),
                    description=str(raw.get("description", "")), shaft=shaft,
                    throws=tuple(throws), stages=tuple(stages), sensors=tuple(sensors),
-                   source=source)  # fmt: skip
+                   frame=frame, source=source)  # fmt: skip
+
+
+def _frame(raw: Any, where: str) -> Frame:
+    """The `Frame` of a file's ``[frame]`` table: its parameters and its ``[[frame.mount]]``
+    tables (each a ``name``, its place ``x``, ``z`` with units, and its parameters)."""
+    from ...quantity import to_unit
+
+    raw = dict(_table(raw, f"{where}: [frame]"))
+    mounts = []
+    for i, mo in enumerate(raw.pop("mount", []), 1):
+        mo = dict(_table(mo, f"{where}: frame mount {i}"))
+        name = str(mo.pop("name", f"mount{i}"))
+        place = {k: to_unit(f"{where}: frame.{name}.{k}", mo.pop(k), "m")
+                 for k in ("x", "z") if k in mo}  # fmt: skip
+        mounts.append(Mount(name, params=_pairs(mo), **place))
+    return Frame(params=_pairs(raw), mounts=tuple(mounts))
 
 
 def read_machine(path: str | Path) -> Machine:

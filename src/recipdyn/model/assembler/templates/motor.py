@@ -19,7 +19,8 @@ Constants: ``CRANK``, ``SHAFT`` (the offset of ``J_drive``), ``MOTOR`` (the torq
 slice), ``THROW_WORK``, ``STEP_KIND`` (per state: how the Jacobian's central differences
 step it: ``0`` an angle, absolute 1e-4; ``1`` a rate, 1e-4 max(1, |y|); ``2`` a load's
 state, 1e-7 max(|y|, 1e-3); ``3`` a column left 0, a work integral or a counter nothing
-depends on), and the throws' and loads' as in `prescribed`.
+depends on), and the throws' and loads' as in `prescribed`; a frame on its mounts
+(``FRAME``) as in `prescribed`, shaken by the throws at the crank's acceleration.
 """
 
 import numba as nb
@@ -29,14 +30,21 @@ from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, c
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as frame_load
+from recipdyn.model.assembler.generate import absent as frame_rhs
 from recipdyn.model.assembler.generate import absent as load_event
 from recipdyn.model.assembler.generate import absent as load_reset
 from recipdyn.model.assembler.generate import absent as load_rhs
 from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.assembler.generate import absent as shaking
 from recipdyn.model.components.drive_kernels import induction_torque as torque
 from recipdyn.model.components.load import paper_force as load_force
 from recipdyn.model.mechanism.link_kernels import crank_torque, crosshead, free_contribution
 
+FRAME = False
+FRAME_PARAMS = np.int64(0)
+FRAME_STATE = np.int64(0)
+FRAME_WORK = np.int64(0)
 LOAD_STATES = False
 N_THROWS = np.int64(1)
 CRANK = np.int64(2)
@@ -92,6 +100,23 @@ def _rhs(t, y, p, out):
         out[THROW_WORK[k]] = out[THROW_WORK[k]] * v
         if LOAD_STATES:
             load_rhs(x, v, y, LOAD_STATE[k], LOAD_AUX[k], p, THROW_LOAD[k], out)
+    if FRAME:
+        _frame(th1, w1, a1, y, p, out)
+
+
+@nb.njit(cache=True)
+def _frame(th1, w, a1, y, p, out):
+    """The frame's derivatives: every throw's shaking force, from its state and its
+    clearance angle's acceleration already in ``out``, as generalised forces on the frame."""
+    qx = 0.0
+    qpsi = 0.0
+    for k in range(N_THROWS):
+        s, m = THROW_STATE[k], THROW_MECH[k]
+        fx, fy = shaking(th1 + p[THROW_PHASE[k]], y[s], w, y[s + 1], a1, out[s + 1], p, m)
+        gx, gpsi = frame_load(k, fx, fy, p, FRAME_PARAMS)
+        qx += gx
+        qpsi += gpsi
+    frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
 
 
 @compiled(RHS_SIGNATURE)

@@ -27,6 +27,13 @@ the offsets of its mechanism, phase and load slices (``THROW_MECH``, ``THROW_PHA
 ``LOAD_AUX``), their counts (``LOAD_N``, ``LOAD_NAUX``) and the offset of its load's
 difference steps (``LOAD_STEPS``: per state a relative and an absolute part); ``SHAFT``, the
 offset of the drive's slice; ``N_OBS`` and ``OBS_THROW[k]``, the observer's columns.
+
+A frame on its mounts (``FRAME``; `recipdyn.model.frame`): ``shaking(th1, thc, w, thcd, a1,
+thcdd, p, m) -> (fx, fy)``, a throw's shaking force in its own axes (the mechanism's);
+``frame_load(k, fx, fy, p, o)``, throw ``k``'s as generalised forces on the frame;
+``frame_rhs(qx, qpsi, y, s, w, p, o, out)``, the frame's derivatives; its first state
+``FRAME_STATE``, its work integrals ``FRAME_WORK`` and its slice ``FRAME_PARAMS``. Without a
+frame they are bound to ``absent`` in branches on ``FRAME`` that numba removes.
 """
 
 import numba as nb
@@ -42,16 +49,23 @@ from recipdyn.model.base import (
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as frame_load
+from recipdyn.model.assembler.generate import absent as frame_rhs
 from recipdyn.model.assembler.generate import absent as load_event
 from recipdyn.model.assembler.generate import absent as load_reset
 from recipdyn.model.assembler.generate import absent as load_rhs
 from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.assembler.generate import absent as shaking
 from recipdyn.model.components.drive_kernels import prescribed_crank as crank
 from recipdyn.model.components.load import paper_force as load_force
 from recipdyn.model.mechanism.link_kernels import acceleration as throw_acc
 from recipdyn.model.mechanism.link_kernels import acceleration_jac as throw_acc_jac
 from recipdyn.model.mechanism.link_kernels import crank_torque, crosshead
 
+FRAME = False
+FRAME_PARAMS = np.int64(0)
+FRAME_STATE = np.int64(0)
+FRAME_WORK = np.int64(0)
 LOAD_STATES = False
 N_THROWS = np.int64(1)
 SHAFT = np.int64(0)
@@ -89,11 +103,33 @@ def _throw(th1, w, y, p, k, out):
     out[s + 1] = throw_acc(thk, y[s], y[s + 1], _force(thk, y, p, k), w, p, m)
 
 
-@compiled(RHS_SIGNATURE)
-def rhs(t, y, p, out):
+@nb.njit(cache=True)
+def _frame(th1, w, a1, y, p, out):
+    """The frame's derivatives: every throw's shaking force, from its state and its
+    clearance angle's acceleration already in ``out``, as generalised forces on the frame."""
+    qx = 0.0
+    qpsi = 0.0
+    for k in range(N_THROWS):
+        s, m = THROW_STATE[k], THROW_MECH[k]
+        fx, fy = shaking(th1 + p[THROW_PHASE[k]], y[s], w, y[s + 1], a1, out[s + 1], p, m)
+        gx, gpsi = frame_load(k, fx, fy, p, FRAME_PARAMS)
+        qx += gx
+        qpsi += gpsi
+    frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
+
+
+@nb.njit(cache=True)
+def _rhs(t, y, p, out):
     th1, w = crank(t, y, p, SHAFT)
     for k in range(N_THROWS):
         _throw(th1, w, y, p, k, out)
+    if FRAME:
+        _frame(th1, w, 0.0, y, p, out)
+
+
+@compiled(RHS_SIGNATURE)
+def rhs(t, y, p, out):
+    _rhs(t, y, p, out)
 
 
 @nb.njit(cache=True)
@@ -112,10 +148,13 @@ def _throw_jac(th1, w, y, p, k, out, J):
 @compiled(RHS_JAC_SIGNATURE)
 def rhs_jac(t, y, p, out, J):
     """The right-hand side and the Jacobian in one call, for a configuration whose loads
-    have no states (the assembler hands it out only then)."""
+    have no states and without a frame (the assembler hands it out only then; with a frame
+    its derivatives are right, the frame's rows of ``J`` are not written)."""
     th1, w = crank(t, y, p, SHAFT)
     for k in range(N_THROWS):
         _throw_jac(th1, w, y, p, k, out, J)
+    if FRAME:
+        _frame(th1, w, 0.0, y, p, out)
 
 
 @nb.njit(cache=True)
@@ -171,6 +210,33 @@ def jac(t, y, p, J):
         _throw_jac(th1, w, y, p, k, f, J)
         if LOAD_STATES:
             _load_columns(th1, w, y, p, k, J)
+    if FRAME:
+        _frame_rows(t, y, p, J)
+
+
+@nb.njit(cache=True)
+def _frame_rows(t, y, p, J):
+    """The frame's rows (its states and work integrals) by central differences of the
+    right-hand side, steps ``1e-6 (|y| + 1)``: linear in the frame's own states (exact to
+    rounding, ~eps |f| / h), smooth in the throws' (truncation ~h^2); the work integrals'
+    columns stay 0 (nothing depends on them)."""
+    n = y.shape[0]
+    yy = y.copy()
+    f1 = np.empty(n)
+    f2 = np.empty(n)
+    for j in range(n):
+        if FRAME_WORK <= j < FRAME_WORK + 2:
+            continue
+        h = 1e-6 * (abs(y[j]) + 1.0)
+        yy[j] = y[j] + h
+        _rhs(t, yy, p, f1)
+        yy[j] = y[j] - h
+        _rhs(t, yy, p, f2)
+        yy[j] = y[j]
+        for i in range(6):
+            J[FRAME_STATE + i, j] = (f1[FRAME_STATE + i] - f2[FRAME_STATE + i]) / (2.0 * h)
+        for i in range(2):
+            J[FRAME_WORK + i, j] = (f1[FRAME_WORK + i] - f2[FRAME_WORK + i]) / (2.0 * h)
 
 
 @compiled(EVENT_SIGNATURE)
