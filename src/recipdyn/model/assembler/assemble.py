@@ -9,11 +9,12 @@ drive (`recipdyn.model.assembler.generate`).
 
 The order of the parameter vector: the shaft's drive and torque law, then per throw its
 mechanism (`recipdyn.model.mechanism.link.MECHANISM`), its phase and its load's difference
-steps, then per throw its load's slice (last: a table's length varies, and every offset
-before it stays a constant of the generated module). The order of the state: per throw its
-clearance angle and rate; with a motor the crank's angle and speed and the motor's work, then
-per throw the gas's work on its crosshead; then per throw its load's states; then per throw
-its load's auxiliary states. With one throw this is the order of the compressor's state
+steps, then per interstage volume its slice (`recipdyn.model.components.interstage`), then
+per throw its load's slice (last: a table's length varies, and every offset before it stays a
+constant of the generated module). The order of the state: per throw its clearance angle and
+rate; with a motor the crank's angle and speed and the motor's work, then per throw the gas's
+work on its crosshead; then per throw its load's states; then per interstage its pressure
+(``interstage1.p``); then per throw its load's auxiliary states. With one throw this is the order of the compressor's state
 before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves'
 states>, <their counters>``), so records and configs of one throw keep their meaning.
 
@@ -62,6 +63,10 @@ def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[st
         out = {n[len(pre) :]: v for n, v in values.items() if n.startswith(pre)}
         out.update({n[len(spre) :]: v for n, v in values.items() if n.startswith(spre)})
         out.update({n[len("shaft.") :]: v for n, v in values.items() if n.startswith("shaft.")})
+        fed = machine.interstage_into(t.stage)
+        if fed is not None:  # its suction line: the interstage's (the initial and set values)
+            out["suction_pressure"] = values[f"{fed.upstream}.discharge_pressure"]
+            out["suction_temperature"] = values[f"{fed.name}.cooler_temperature"]
     for key, value in (
         ("load", t.load),
         ("equations", t.equations),
@@ -237,6 +242,15 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
             [(pre + k, "") for k in MECHANISM])  # fmt: skip
         put(f"{t.name}.phase", [local["phase"]], [(pre + "phase", "rad")])
         put(f"{t.name}.steps", _steps(load, local) if load.states else np.zeros(0))
+    for i in machine.interstages:
+        from ..components.interstage import INTERSTAGE
+
+        upstream = next(v for t, v in zip(machine.throws, locals_, strict=True)
+                        if t.stage == i.upstream)  # fmt: skip
+        own = {k[len(i.name) + 1 :]: v for k, v in values.items() if k.startswith(f"{i.name}.")}
+        put(i.name, INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}),
+            [(f"{i.name}.{k}", u) for k, u in (("volume", "m**3"), ("cooler_temperature", "K"),
+                                               ("gas_constant", "J/(kg*K)"))])  # fmt: skip
     for t, local in zip(machine.throws, locals_, strict=True):
         put(f"{t.name}.load", load.pack(local))
     params = pv.build()
@@ -261,6 +275,8 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load", ((pre + s, u) for s, u in load.states), DOF)
+    for i in machine.interstages:
+        place(i.name, ((f"{i.name}.p", "Pa"),), DOF)
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load_aux", ((pre + s, u) for s, u in load.aux_states), COUNTER)
@@ -289,6 +305,42 @@ def _load_roles(load: Component) -> dict[str, tuple[str, str]]:
                 "load_reset": (load.module, load.kernel("reset"))}  # fmt: skip
     return {"load_force": (load.module, load.kernel("force")), "load_state_force": absent,
             "load_rhs": absent, "load_event": absent, "load_reset": absent}  # fmt: skip
+
+
+def _interstage_roles(machine: Machine, load: Component) -> dict[str, tuple[str, str]]:
+    """The roles of the interstage volumes and of the loads between their lines (absent
+    without an interstage)."""
+    from ..components.interstage import INTERSTAGE
+
+    names = ("load_rhs_lines", "load_lines", "load_flows", "interstage_line", "interstage_rate")
+    if not machine.interstages:
+        return dict.fromkeys(names, ("recipdyn.model.assembler.generate", "absent"))
+    return {"load_rhs_lines": (load.module, load.kernel("state_rhs_lines")),
+            "load_lines": (load.module, load.kernel("lines")),
+            "load_flows": (load.module, load.kernel("flows")),
+            "interstage_line": (INTERSTAGE.module, INTERSTAGE.kernel("line")),
+            "interstage_rate": (INTERSTAGE.module, INTERSTAGE.kernel("rate"))}  # fmt: skip
+
+
+def _interstage_constants(machine: Machine, layout: Layout) -> dict[str, Any]:
+    """``INTERSTAGE``, ``N_INTERSTAGES``, each interstage's state and slice, each throw's
+    interstage in and out (``-1``: a set line; an empty array holds one unused ``-1``)."""
+    names = [i.name for i in machine.interstages]
+
+    def index(found) -> int:
+        return -1 if found is None else names.index(found.name)
+
+    def arr(values) -> np.ndarray:
+        return np.array(list(values) or [-1], dtype=np.int64)
+
+    return {
+        "INTERSTAGE": bool(names),
+        "N_INTERSTAGES": len(names),
+        "IS_STATE": arr(layout.state[f"{n}.p"] for n in names),
+        "IS_PARAM": arr(layout.params.start(n) for n in names),
+        "THROW_IN": arr(index(machine.interstage_into(t.stage)) for t in machine.throws),
+        "THROW_OUT": arr(index(machine.interstage_from(t.stage)) for t in machine.throws),
+    }
 
 
 def _kernels(machine: Machine, layout: Layout, load: Component, motor: Component | None,
@@ -320,11 +372,13 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         "LOAD_AUX": starts(st, "load_aux"),
         "N_OBS": layout.outputs.size,
         "OBS_THROW": np.array([layout.outputs.start(t.name) for t in throws], dtype=np.int64),
+        **_interstage_constants(machine, layout),
     }
     roles = {
         "crosshead": (KERNELS, "crosshead"),
         "crank_torque": (KERNELS, "crank_torque"),
         **_load_roles(load),
+        **_interstage_roles(machine, load),
     }
     equations = throws[0].equations
     if motor is None:
@@ -347,7 +401,8 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
                     i in range(*st.parts[f"{t.name}.{part}"].indices(st.size))
                     for t in throws for part in ("work", "load_aux")):  # fmt: skip
                 kinds.append(3)  # nothing depends on it: its column is 0
-            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws):
+            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws) or (
+                    any(i == st[f"{s.name}.p"] for s in machine.interstages)):  # fmt: skip
                 kinds.append(2)
             elif name == "theta1" or name.endswith("theta_c"):
                 kinds.append(0)
@@ -364,5 +419,7 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         if c is not None and not c.module.startswith("recipdyn"):
             note += f"{c.family} = {c.module}: {source_digest(c.module)}; "
     stem = (f"{load.name}_{equations}_{len(throws)}"
-            + ("" if motor is None else f"_{motor.name}")).replace("-", "_")  # fmt: skip
+            + ("" if motor is None else f"_{motor.name}")
+            + (f"_is{len(machine.interstages)}" if machine.interstages else "")
+            ).replace("-", "_")  # fmt: skip
     return template, roles, constants, stem, note
