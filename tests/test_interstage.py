@@ -109,7 +109,7 @@ def _closed_form(values) -> tuple[float, float]:
 
 def test_the_interstage_pressure_of_an_ideal_two_stage_machine_is_its_closed_form():
     """Hypothesis: the interstage pressure settles where stage 2 takes in what stage 1
-    delivers (`_closed_form`: 3.07 bar with these bores and temperatures, 3 % clearance).
+    delivers (`_closed_form`: 3.071 bar with these bores and temperatures, 3 % clearance).
 
     The volume (1 m^3) starts 2 % above it; its time constant (`_closed_form`) is 29
     revolutions, and after 5 of them the start-up left over is 2 % e^-5 ~ 1.3e-4 of the
@@ -118,10 +118,11 @@ def test_the_interstage_pressure_of_an_ideal_two_stage_machine_is_its_closed_for
     stage's mass is the closed form's at some pressure the volume passed through (its intake
     and delivery are monotone in the pressure), so the closed form's pressure lies within the
     revolution's range, as does the mean: |mean - p*| <= ptp, measured 1.05 % of the
-    pressure (the error it leaves scales with it: 0.58 % at half the volume, 0.29 % here);
+    pressure (the error it leaves scales with it: 0.58 % at half the volume, 0.30 % here);
     (b) the valves' departure from ideal ones: 8.8e-4 in each volumetric efficiency
     (`IDEAL_VALVES`), 2e-3 in the pressure; (c) the start-up left over, 1.3e-4, and the
-    integration (rtol 1e-10), negligible beside them. Measured error: 0.29 % of the pressure.
+    integration (rtol 1e-10), negligible beside them. Measured error: 0.30 % of the pressure
+    (3.080 bar against 3.071).
     A model that took stage 1's suction temperature for the cooler's (7 % off) or lost a
     chamber's flow would fail it."""
     p_star = 3.07e5
@@ -143,9 +144,10 @@ def test_the_interstage_mass_changes_by_what_stage_1_delivers_less_what_stage_2_
     balance: ``m_i - (mass stage 1 delivered) + (mass stage 2 took in)`` is a linear
     invariant of the right-hand side, which every Runge-Kutta step keeps to rounding (the
     valves' impacts reset plates only). Over a window of 3 revolutions from the start (the
-    largest swings) the mass changes by ~0.1 kg; rounding over ~1e4 steps on 1 kg is
-    ~1e-12 kg, so 1e-9 of the volume's mass leaves a wide margin and still catches a flow
-    counted twice or a counter left out (0.01 to 1 of the change)."""
+    largest swings) the mass (0.83 kg) changes by 0.064 kg; rounding over ~1e4 steps on 1 kg
+    is ~1e-12 kg (measured: 1.4e-14 kg), so 1e-9 of the volume's mass leaves a wide margin
+    and still catches a flow counted twice or a counter left out (0.01 to 1 of the
+    change)."""
     machine = _machine(volume=0.3, p0=2.5e5)
     ds = _run(machine, revolutions=3, transient=0, fs=4000.0)
     m = ds["interstage1.mass"].values
@@ -155,8 +157,8 @@ def test_the_interstage_mass_changes_by_what_stage_1_delivers_less_what_stage_2_
     assert np.abs(m - m[0]).max() > 0.02  # (the window moves the mass)
     assert np.abs(balance).max() < 1e-9 * m[0], np.abs(balance).max()
     # the recorded flows are the counters' rates: their integral over the window is the same
-    # balance to the trapezoid rule's error (rtol 1e-2 of the change: 4 kHz, ~200 samples a
-    # stroke, the flow's sharp edges at the valves' openings)
+    # balance to the trapezoid rule's error (1e-2 of the change, measured 1.8e-3: 4 kHz, ~200
+    # samples a stroke, the flow's sharp edges at the valves' openings)
     t = ds["time"].values
     net = ds["interstage1.mdot_in"].values - ds["interstage1.mdot_out"].values
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (net[1:] + net[:-1]) * np.diff(t))])
@@ -170,9 +172,9 @@ def test_a_leaking_stage_1_discharge_valve_lowers_the_interstage_pressure():
     settles at a lower interstage pressure (the field rule: a low interstage pressure points
     to stage 1's valves, a high one to stage 2's). Both runs start from the same state and
     run 40 revolutions of a 0.3 m^3 volume (time constant ~9 revolutions); the leak (4 cm^2,
-    a broken plate's piece) lowers the mean of the last 4 revolutions by 8 % (measured),
-    which is asked to exceed the healthy run's ripple (~4 %) so that no phase of the ripple
-    can make it."""
+    a broken plate's piece) lowers the mean of the last 4 revolutions by 20 % (3.10 to 2.48
+    bar, measured), which is asked to exceed the healthy run's ripple (3.5 %) so that no
+    phase of the ripple can make it."""
     runs = {}
     for leak in (0.0, 4e-4):
         ds = _run(_machine(volume=0.3, p0=2.9e5, leak=leak), revolutions=4, transient=36)
