@@ -84,9 +84,6 @@ def test_the_checker_sees_a_violation(tmp_path):
 
 # Inside the model layer: models are assembled from shared parts, never from each other.
 MODEL = SRC / "model"
-#: A dotted module named in a string: the text of generated glue (``from recipdyn.model.X
-#: import``), which the glue's module imports when it is loaded.
-_GLUE_IMPORT = re.compile(r"(?:from|import)\s+recipdyn\.model\.([\w.]+)")
 #: An import string ``recipdyn.model.X:OBJ`` (a routing table: the registry's, family's).
 _IMPORT_STRING = re.compile(r"recipdyn\.model\.([\w.]+):\w+")
 
@@ -101,11 +98,14 @@ def _strings(tree: ast.AST) -> list[str]:
             and isinstance(n.value, str)]  # fmt: skip
 
 
-def _model_graph(root: Path = MODEL) -> dict[str, set[str]]:
-    """Module -> modules of the model package it imports: relative and absolute imports
-    (lazy ones included) and the imports written in the text of generated glue (a string
-    ``from recipdyn.model.X import ...``, run when the glue is loaded). Import strings
-    ``recipdyn.model.X:OBJ`` are routing tables, not edges (`_routes`)."""
+def _model_graph(root: Path = MODEL, package: str = "recipdyn.model") -> dict[str, set[str]]:
+    """Module -> modules of the model package (or of ``package`` at ``root``) it imports:
+    relative and absolute imports (lazy ones included) and the imports written in the text of
+    generated glue (a string ``from recipdyn.model.X import ...``, run when the glue is
+    loaded). Import strings ``recipdyn.model.X:OBJ`` are routing tables, not edges
+    (`_routes`)."""
+    prefix, depth = f"{package}.", len(package.split("."))
+    glue = re.compile(rf"(?:from|import)\s+{re.escape(package)}\.([\w.]+)")
     graph: dict[str, set[str]] = {}
     paths = {p: p.relative_to(root).with_suffix("").parts for p in root.rglob("*.py")}
     names = {_node(rel) for rel in paths.values()} - {""}
@@ -126,20 +126,19 @@ def _model_graph(root: Path = MODEL) -> dict[str, set[str]]:
                     continue  # above the model package
                 mod = package[: len(package) - node.level + 1]
                 mod += node.module.split(".") if node.module else []
-            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
-                    "recipdyn.model."):  # fmt: skip
-                mod = node.module.split(".")[2:]
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith(prefix):
+                mod = node.module.split(".")[depth:]
             elif isinstance(node, ast.Import):
                 for a in node.names:
-                    if a.name.startswith("recipdyn.model."):
-                        deps |= known(a.name.split(".")[2:])
+                    if a.name.startswith(prefix):
+                        deps |= known(a.name.split(".")[depth:])
                 continue
             else:
                 continue
             for a in node.names:
                 deps |= known([*mod, a.name])
         for text in _strings(tree):
-            for m in _GLUE_IMPORT.findall(text):
+            for m in glue.findall(text):
                 deps |= known(m.split("."))
         graph[_node(rel)] = deps - {_node(rel)}
     return graph
@@ -241,6 +240,50 @@ def test_the_model_checker_sees_an_edge(tmp_path):
     graph = _model_graph(root)
     assert _model_edges(graph, {"a", "b", "c", "d", "e"}) == {("c", "b"), ("d", "c"),
                                                                ("e", "a")}  # fmt: skip
+
+
+def _first_cycle(graph: dict[str, set[str]]) -> str | None:
+    """A cycle of ``graph`` as ``a -> b -> a`` (depth-first), None if there is none."""
+    state: dict[str, int] = {}
+
+    def visit(node, path):
+        state[node] = 1
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                return " -> ".join([*path, node, nxt])
+            if nxt not in state and (found := visit(nxt, [*path, node])):
+                return found
+        state[node] = 2
+        return None
+
+    for node in sorted(graph):
+        if node not in state and (found := visit(node, [])):
+            return found
+    return None
+
+
+def test_the_cycle_finder_finds_a_lazy_cycle_and_passes_a_package_import(tmp_path):
+    """A lazy import closes a cycle; ``from . import sub`` inside a package's module is an
+    edge to the submodule, not to the package that holds it."""
+    root = tmp_path / "pkg"
+    (root / "sub").mkdir(parents=True)
+    files = {"__init__.py": "from .a import f\n", "a.py": "from .sub import k\n",
+             "sub/__init__.py": "", "sub/k.py": "def g():\n    from recipdyn.b import h\n",
+             "b.py": "import math\n"}  # fmt: skip
+    for name, text in files.items():
+        (root / name).write_text(text)
+    assert _first_cycle(_model_graph(root, "recipdyn")) is None
+    (root / "b.py").write_text("def h():\n    from .a import f\n")
+    assert _first_cycle(_model_graph(root, "recipdyn")).endswith("a -> sub.k -> b -> a")
+
+
+def test_no_import_cycles_anywhere():
+    """Lazy imports count, across the whole package (issue 43: ``features <-> sweep.run <->
+    sweep.work`` and the diagnosis modules' ``diagnose <-> train <-> machine`` were cycles;
+    the cli's commands imported their package)."""
+    graph = _model_graph(SRC, "recipdyn")
+    assert len(graph) > 100 and "diagnosis.train" in graph
+    assert (cycle := _first_cycle(graph)) is None, cycle
 
 
 def test_no_import_cycles_inside_the_model_layer():

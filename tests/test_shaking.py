@@ -52,7 +52,7 @@ def _throw(name, phase, cylinder=0.0, z=0.0):
                  cylinder_angle=cylinder, axial_position=z)  # fmt: skip
 
 
-def _run(arrangement):
+def _run(arrangement, g=None):
     """A machine of identical throws ``(phase, cylinder_angle, axial_position)`` at a
     prescribed speed, one revolution sampled at ``N`` points."""
     import recipdyn
@@ -61,9 +61,12 @@ def _run(arrangement):
     throws = tuple(_throw(f"throw{k + 1}", *a) for k, a in enumerate(arrangement))
     shaft = Shaft("prescribed", params=(("omega", OMEGA),))
     m = MachineModel(Machine("shaking-test", shaft=shaft, throws=throws, stages=(Stage(),)))
+    params = m.parameters()
+    if g is not None:
+        params = m.parameters({**params, **{f"{t.name}.g": g for t in throws}})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ModelValidityWarning)
-        return recipdyn.simulate(model=m, params=m.parameters(), revolutions=1.0,
+        return recipdyn.simulate(model=m, params=params, revolutions=1.0,
                                  fs=OMEGA * N / (2.0 * math.pi))  # fmt: skip
 
 
@@ -309,3 +312,21 @@ def test_the_balanced_opposed_example_places_its_throws():
     v = model.parameters()
     assert v["throw2.phase"] == pytest.approx(math.pi)
     assert [local["phase"] for local in model.throws(v)] == [0.0, 0.0]
+
+
+def test_the_weight_acts_down_in_the_frame_on_a_throw_at_180_deg():
+    """A throw whose cylinder is turned by 180 deg runs its equations in its own axes, where
+    the weight (down in the frame) points along +y. With ideal pins and a prescribed speed
+    its forces are linear in g: the guide's normal force is ``N(th) = N0(th) + g G(th)``. A
+    throw at cylinder 0 and one at 180 deg with the same angle in its own axes (crank phase
+    180 deg) then have ``N_1 + N_2 = 2 N0``, the force of the same throws without weight,
+    to rounding (1e-9 of the peak); with the weight along its own -y on both (the sign this
+    replaces) ``N_2 = N_1`` and the sum misses ``2 N0`` by twice the weight's share, about
+    (m2 (1 - ls/l) ... + m3) g ~ 500 N here."""
+    with_g = _run(((0.0, 0.0, 0.0), (math.pi, math.pi, S)))
+    n1, n2 = (with_g[f"throw{k}.guide_force"].values for k in (1, 2))
+    weightless = _run(((0.0, 0.0, 0.0), (math.pi, math.pi, S)), g=0.0)
+    n0 = weightless["throw1.guide_force"].values
+    assert np.max(np.abs(weightless["throw2.guide_force"].values - n0)) <= 1e-9 * np.max(np.abs(n0))
+    assert np.max(np.abs(n1 + n2 - 2.0 * n0)) <= 1e-9 * np.max(np.abs(n0))
+    assert np.max(np.abs(n1 - n0)) > 0.5 * M3 * 9.81  # the weight is felt (not a no-op)

@@ -19,7 +19,7 @@ from .analysis.vibration import angle_resample, indicators, order_spectrum_angle
 from .defaults import MAX_MEMORY_SAMPLES
 from .model.parameters import ParameterError
 
-__all__ = ["signal_features", "file_features", "sweep_features", "write_table", "N_ORDERS",
+__all__ = ["signal_features", "file_features", "write_table", "N_ORDERS",
            "feature_units", "record_speed_hz", "write_dictionary", "dictionary_path",
            "COLUMN_DESCRIPTIONS"]  # fmt: skip
 
@@ -408,30 +408,6 @@ def _streamed_rows(path, column, fs, window, speed, chaos, progress,
         raise ParameterError(f"window: {window!r} is {m} samples, longer than the record "
                              f"({start + buf.size})")  # fmt: skip
     return rows
-
-
-def sweep_features(path: str | Path, meta: dict | None = None) -> list[dict[str, Any]]:
-    """One row per computed point of a sweep store: its parameter values and every scalar
-    measure (vector measures such as section points are left out); with the sweep measure
-    ``features``, the vibration signal's features of each point (``feat_*``). Columns: the
-    parameters, then the measures by name."""
-    from .sweep.run import open_sweep
-
-    ds = open_sweep(path)
-    grid = [d for d in ds["done"].dims]
-    scalar = sorted(k for k, v in ds.data_vars.items()
-                    if tuple(v.dims) == tuple(grid) and k != "done")  # fmt: skip
-    if meta is not None:
-        meta.setdefault("store", {"unit": "", "description": COLUMN_DESCRIPTIONS["store"],
-                                  "note": ""})  # fmt: skip
-        for k in grid + scalar:
-            a = ds[k].attrs
-            entry = {"unit": str(a.get("units", "")), "note": "",
-                     "description": str(a.get("long_name", ""))}  # fmt: skip
-            meta.setdefault(k, entry)
-    frame = ds[scalar + ["done"]].to_dataframe().reset_index()
-    frame = frame[frame["done"].astype(bool)].drop(columns=["done"])
-    return frame[grid + scalar].to_dict("records")
 
 
 def write_table(rows: list[dict[str, Any]], path: str | Path) -> Path:

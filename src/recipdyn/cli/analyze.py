@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from ..defaults import ANALYZE
-from . import app, phase, refused_leaves_nothing, report, with_json
+from .common import app, phase, refused_leaves_nothing, report, with_json
 
 
 @app.command()

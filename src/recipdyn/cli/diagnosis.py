@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, refused_leaves_nothing, report, with_json
+from .common import app, refused_leaves_nothing, report, with_json
 
 
 def _levels(text: str, name: str = "levels", example: str = "0.25,0.5,0.75,1"):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, phase, refused_leaves_nothing
+from .common import app, phase, refused_leaves_nothing
 
 
 @app.command()
@@ -60,7 +60,8 @@ def features(
     if tacho is not None and speed is not None:
         raise ParameterError("tacho and speed: give one of them")
     check_rates(fs=fs, speed=speed)
-    from ..features import file_features, sweep_features, write_dictionary, write_table
+    from ..features import file_features, write_dictionary, write_table
+    from ..sweep.run import sweep_features
 
     rows: list[dict] = []
     meta: dict = {}  # column -> unit, description, note: the data dictionary

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import typer
 
-from . import app
+from .common import app
 
 #: From this console width on, the parameter table has a column per field.
 WIDE = 150

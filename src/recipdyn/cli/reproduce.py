@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, refused_leaves_nothing
+from .common import app, refused_leaves_nothing
 
 
 @app.command()

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app, refused_leaves_nothing, report, with_json
+from .common import app, refused_leaves_nothing, report, with_json
 
 _NONE = ("none", "off")
 

@@ -9,7 +9,7 @@ import typer
 
 from ..defaults import SIMULATION
 from ..io import DATASET_FORMATS
-from . import app, phase, refused_leaves_nothing, report, with_json
+from .common import app, phase, refused_leaves_nothing, report, with_json
 
 _SET_HELP = "Set any parameter: NAME=VALUE with units, e.g. --set m3='40 kg' (repeatable)."
 _MEM_HELP = "Refuse runs estimated to need more memory than this, e.g. '4 GB' (default: half " \

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from ..defaults import SWEEP as DEFAULTS
-from . import app, refused_leaves_nothing
+from .common import app, refused_leaves_nothing
 
 
 @app.command()

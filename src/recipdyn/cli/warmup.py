@@ -6,7 +6,7 @@ import time
 
 import typer
 
-from . import app
+from .common import app
 
 
 @app.command()

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from . import app as cli_app
+from .common import app as cli_app
 
 
 @cli_app.command("app")

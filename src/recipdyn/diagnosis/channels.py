@@ -1,7 +1,7 @@
 """Which classes a record's channels can name: measured on held-out conditions, per channel set.
 
 A diagnoser answers each record with the classifier of the channels the record has
-(`recipdyn.diagnosis.train.AVAILABILITY`: all of them, no pressure, or the acceleration with a
+(`AVAILABILITY`: all of them, no pressure, or the acceleration with a
 constant speed). Those classifiers are not equally able: with the acceleration and a speed
 only, the shipped diagnoser's held-out accuracy is 0.38, and a healthy record was called a worn
 guide at p 0.88 with nothing to say that such an answer is right on a third of the records
@@ -24,13 +24,42 @@ from typing import Any
 
 import numpy as np
 
+from .evidence import feature_groups
+
 __all__ = [
+    "AVAILABILITY",
+    "available",
     "naming_table",
     "gate",
     "CHANNEL_TEXT",
     "PRECISION_MIN",
     "ANSWERS_MIN",
 ]
+
+#: Feature subsets by the channels a record has.
+AVAILABILITY = {
+    "full": ("base", "angle", "pressure", "cycle"),
+    "no_pressure": ("base", "angle"),
+    "vibration_only": ("base",),
+}
+
+
+def available(row: np.ndarray, names: list[str]) -> str:
+    """Which availability subset a feature row has (`AVAILABILITY`)."""
+    groups = feature_groups(names)
+    idx = {n: i for i, n in enumerate(names)}
+    has = {g for g, cols in groups.items() if np.isfinite(row[[idx[c] for c in cols]]).any()}
+    for name, keep in AVAILABILITY.items():
+        if set(keep) <= has:
+            return name
+    return "vibration_only"
+
+
+def _cols(names, subset: str) -> np.ndarray:
+    groups = feature_groups(names)
+    keep = [n for g in AVAILABILITY[subset] for n in groups[g]]
+    return np.array([names.index(n) for n in keep])
+
 
 #: What each channel set of `recipdyn.diagnosis.train.AVAILABILITY` is, in words.
 CHANNEL_TEXT = {

@@ -368,7 +368,7 @@ def refusal(diag, row, label, x, fs, revs, p_head, p_crank, *, angle: bool, seve
     """``(check, reason)`` for one record of ``diag`` given the class ``label``: the
     `Consistency.check` result as plain values (None: not checked) and the reason to refuse
     it (empty if the best fit explains it)."""
-    from .train import available
+    from .channels import available
 
     subset = available(row, diag.names)
     if not angle or subset not in OPERATING:

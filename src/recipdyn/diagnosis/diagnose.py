@@ -27,19 +27,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .channels import gate
+from .channels import _cols, available, gate
 from .classes import get_class
+from .tolerances import FLOOR_SLACK, RANGE_SLACK, RING_SLACK
 
 __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
 
-#: Slack on the training range of the crank speed and the sampling rate (relative).
-RANGE_SLACK = 0.02
-#: Slack on the training range of the impacts' ringing frequency (relative; the Welch
-#: spectrum's resolution is fs/1024, ~10 Hz, and the resonance's peak is broad: Q = 10).
-RING_SLACK = 0.1
-#: Factor of slack on the training range of the acceleration's noise floor (`noise_floor`):
-#: x1.5 in the floor's share is about +-1.8 dB of SNR.
-FLOOR_SLACK = 1.5
 #: The smallest spread of the healthy training records a deciding feature's z is measured in,
 #: as a share of the whole training set's interquartile range (`_deciding`).
 HEALTHY_SPREAD_FLOOR = 0.05
@@ -425,8 +418,6 @@ def _diagnose_arrays(
     k = int(np.argmax(proba))
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
     # a class is named only with channels whose held-out answers of it were right
-    from .train import available
-
     subset = available(X[0], diag.names)
     named, why, facts = gate(naming_of(diag), subset, classes[k])
     res.evidence["channels"] = facts
@@ -613,8 +604,6 @@ def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
     interquartile range) is floored at `HEALTHY_SPREAD_FLOOR` of the whole training set's: a
     feature the healthy records hold nearly constant (a count of pin-load reversals) would
     otherwise give a z of 1e14 for an ordinary departure."""
-    from .train import _cols, available
-
     st = diag.state
     cols = _cols(diag.names, available(row, diag.names))
     healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
@@ -629,8 +618,6 @@ def _deciding(diag, row, n: int = 5) -> list[tuple[str, float]]:
 
 
 def _closest(diag, row, label: str) -> int:
-    from .train import _cols, available
-
     st = diag.state
     idx = np.array([i for i, lab in enumerate(st["train_labels"]) if lab == label])
     cols = _cols(diag.names, available(row, diag.names))

@@ -422,12 +422,13 @@ def healthy_spreads(diag) -> dict[str, float]:
     a fixed operating point: the residual standard deviation of an affine fit of the
     diagnoser's healthy training records on the operating point they show (the crank speed,
     the suction and discharge levels: `recipdyn.diagnosis.train.OPERATING`), floored at
-    `recipdyn.diagnosis.train.BASELINE_SPREAD_FLOOR` of the feature's spread over every
+    `recipdyn.diagnosis.tolerances.BASELINE_SPREAD_FLOOR` of the feature's spread over every
     training record (as the healthy baseline's, `recipdyn.diagnosis.train.fit_baseline`, for
     the pressure and cycle features; here for every feature). The unit of the tolerances."""
     import numpy as np
 
-    from .train import BASELINE_SPREAD_FLOOR, OPERATING, _cols
+    from .channels import _cols
+    from .tolerances import BASELINE_SPREAD_FLOOR, OPERATING
 
     st = diag.state
     names = diag.names
@@ -480,9 +481,9 @@ def differences(trained: Machine, other: Machine, drawn: Mapping[str, tuple[floa
     `condition_ranges`); such a parameter may lie anywhere in its range widened by its
     tolerance. A categorical parameter (`CATEGORICAL`) must be equal. The machine's nominal
     operating point (`NOMINAL`) must lie in the ranges the data set drew for it, with the
-    slack `recipdyn.diagnosis.diagnose.RANGE_SLACK` of the crank speed's refusal (a machine
+    slack `recipdyn.diagnosis.tolerances.RANGE_SLACK` of the crank speed's refusal (a machine
     read from a record's attributes has no nominal operating point: `Machine.nominal`)."""
-    from .diagnose import RANGE_SLACK
+    from .tolerances import RANGE_SLACK
 
     a, b = trained.as_dict, other.as_dict
     out = []

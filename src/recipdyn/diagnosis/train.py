@@ -56,10 +56,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .channels import naming_table
+from .channels import AVAILABILITY, _cols, available, naming_table
 from .classes import get_class
 from .dataset import CONDITION_COLUMNS, MIN_TRAIN_CONDITIONS, min_conditions, read_features
 from .evidence import feature_groups
+from .tolerances import BASELINE_SPREAD_FLOOR, OPERATING, RING_SLACK
 
 __all__ = [
     "train",
@@ -79,18 +80,10 @@ __all__ = [
 RING_QUANTILES = (0.05, 0.95)
 #: Nominal coverage of the severity intervals.
 COVERAGE = 0.9
-#: Feature subsets by the channels a record has.
-AVAILABILITY = {
-    "full": ("base", "angle", "pressure", "cycle"),
-    "no_pressure": ("base", "angle"),
-    "vibration_only": ("base",),
-}
 #: Layout version of a diagnoser file (4: the out-of-domain detector, the consistency check
 #: and the severity's conformal residuals by channel set; 3 held a kNN threshold and one
 #: half-width per channel set, and is refused with the command that rebuilds it).
 FORMAT = 4
-#: The operating point the healthy baseline refers features to (`fit_baseline`).
-OPERATING = ("speed_hz", "cy_p_suction", "cy_p_discharge")
 #: Prefix of a feature's deviation from the healthy baseline.
 DEVIATION = "dv_"
 #: Healthy training records, and distinct crank speeds among them (operating points: the
@@ -98,10 +91,6 @@ DEVIATION = "dv_"
 #: and the diagnoser has no baseline (a small data set's reads the raw features only).
 BASELINE_RECORDS_PER_COEF = 5
 BASELINE_POINTS_PER_COEF = 2
-#: Floor of a baseline fit's residual spread, as a fraction of the feature's spread over all
-#: training records: a feature the healthy machine holds constant (a count) would otherwise
-#: turn any departure into an unbounded deviation.
-BASELINE_SPREAD_FLOOR = 0.05
 #: Samples per revolution of the stored angle-domain curves (the overlay's library; 2.8
 #: degrees: the acceleration library, noisy float16, is the largest part of a diagnoser file).
 CURVE_POINTS = 128
@@ -241,23 +230,6 @@ def _scaler(X):
     sd = np.nanstd(X, axis=0)
     scale = np.where(iqr > 0, iqr, np.where(sd > 0, sd, 1.0))
     return med, scale
-
-
-def available(row: np.ndarray, names: list[str]) -> str:
-    """Which availability subset a feature row has (`AVAILABILITY`)."""
-    groups = feature_groups(names)
-    idx = {n: i for i, n in enumerate(names)}
-    has = {g for g, cols in groups.items() if np.isfinite(row[[idx[c] for c in cols]]).any()}
-    for name, keep in AVAILABILITY.items():
-        if set(keep) <= has:
-            return name
-    return "vibration_only"
-
-
-def _cols(names, subset: str) -> np.ndarray:
-    groups = feature_groups(names)
-    keep = [n for g in AVAILABILITY[subset] for n in groups[g]]
-    return np.array([names.index(n) for n in keep])
 
 
 def expected_calibration_error(proba: np.ndarray, y: np.ndarray, bins: int = 10):
@@ -962,8 +934,6 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
     res["severity_coverage"] = float(np.mean(cover_all)) if cover_all else math.nan
     res["condition_only"] = condition_only(train_df, test_df, classes, seed)
     res["importance"] = _importance(diag, X, y, seed)
-    from .diagnose import RING_SLACK
-
     lo, hi = diag.state["ring_range"]
     ring = X[:, names.index("acc_ring_hz")]
     out_band = ~((ring >= lo * (1 - RING_SLACK)) & (ring <= hi * (1 + RING_SLACK)))

@@ -49,7 +49,7 @@ from ..simulate import clean_attrs
 from .spec import SweepSpec
 from .work import N_PEAKS, run_point
 
-__all__ = ["run_sweep", "open_sweep", "BACKENDS"]
+__all__ = ["run_sweep", "open_sweep", "sweep_features", "BACKENDS"]
 
 BACKENDS = ("serial", "processes", "dask")
 
@@ -350,6 +350,30 @@ def open_sweep(path: str | Path) -> xr.Dataset:
     if "spec_json" not in ds.attrs or "done" not in ds:
         raise ParameterError(f"{path}: not a recipdyn sweep store; expected {expected}")
     return ds
+
+
+def sweep_features(path: str | Path, meta: dict | None = None) -> list[dict[str, Any]]:
+    """One row per computed point of a sweep store: its parameter values and every scalar
+    measure (vector measures such as section points are left out); with the sweep measure
+    ``features``, the vibration signal's features of each point (``feat_*``). Columns: the
+    parameters, then the measures by name."""
+    from ..features import COLUMN_DESCRIPTIONS
+
+    ds = open_sweep(path)
+    grid = [d for d in ds["done"].dims]
+    scalar = sorted(k for k, v in ds.data_vars.items()
+                    if tuple(v.dims) == tuple(grid) and k != "done")  # fmt: skip
+    if meta is not None:
+        meta.setdefault("store", {"unit": "", "description": COLUMN_DESCRIPTIONS["store"],
+                                  "note": ""})  # fmt: skip
+        for k in grid + scalar:
+            a = ds[k].attrs
+            entry = {"unit": str(a.get("units", "")), "note": "",
+                     "description": str(a.get("long_name", ""))}  # fmt: skip
+            meta.setdefault(k, entry)
+    frame = ds[scalar + ["done"]].to_dataframe().reset_index()
+    frame = frame[frame["done"].astype(bool)].drop(columns=["done"])
+    return frame[grid + scalar].to_dict("records")
 
 
 def consolidate(store: str | Path) -> None:

@@ -25,6 +25,7 @@ freely.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import ModuleType
@@ -78,6 +79,8 @@ def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[st
         out["rc"] = 0.0
     if t.cylinder_angle:  # its equations run in its own axes, turned with its cylinder
         out["phase"] = float(out["phase"]) - t.cylinder_angle
+        if "g" in out:  # ... where the weight (down in the frame) lies along cos(angle) * -y
+            out["g"] = float(out["g"]) * round(math.cos(t.cylinder_angle))
     return out
 
 

@@ -241,6 +241,11 @@ class MachineModel(Model):
             kw["load"] = "cycle"
         elif is_spec(local.get("load")) or local.get("load") == "table":
             kw.pop("load", None)
+        g = float(kw.get("g", 0.0))
+        if g < 0.0:  # a throw turned by 180 deg: its weight along its own +y (`throw_values`)
+            p = CompressorParams(**{**kw, "g": -g})  # checked as the user gave it
+            object.__setattr__(p, "g", g)
+            return p
         return CompressorParams(**kw)
 
     def plugged(self, local: Mapping[str, Any]) -> dict[str, Any]:
