@@ -80,8 +80,8 @@ values of the cylinder's stage, or, in a machine with an interstage volume betwe
 temperature (`gas_rhs_lines`).
 
 Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: a line's
-pressure is constant or an interstage volume's, uniform), no heat transfer other than through the polytropic exponent, one
-lumped plate per valve group.
+pressure is constant or an interstage volume's, uniform), no heat transfer other than through
+the polytropic exponent, one lumped plate per valve group.
 """
 
 from __future__ import annotations
@@ -101,8 +101,8 @@ from .protocol import Param
 __all__ = [
     "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
     "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "gas_rhs_lines", "valve_event", "valve_reset",
-    "gas_initial", "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
-    "real_properties",
+    "gas_initial", "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary",
+    "state_force", "real_properties",
     "gas_outputs", "gas_scale", "FAULT_PARAMS", "VALVES",
 ]  # fmt: skip
 
@@ -561,9 +561,9 @@ def gas_rhs_lines(x, xdot, y, g, a, c, v, ps, ts, pd, td, out):
     ``c``: the cycle data ([`recipdyn.model.cycle.pack_cycle`][recipdyn.model.cycle.pack_cycle]),
     ``v``: [`pack_valves`][recipdyn.model.valves.pack_valves]; the suction line at pressure
     ``ps`` (Pa) and temperature ``ts`` (K), the discharge line at ``pd`` and, for gas that
-    flows back from it, ``td`` (an interstage volume's state, or the set lines). A chamber that does not compress
-    (single-acting) keeps its states (derivatives 0) and the frame pressure acts on its piston
-    face."""
+    flows back from it, ``td`` (an interstage volume's state, or the set lines). A chamber
+    that does not compress (single-acting) keeps its states (derivatives 0) and the frame
+    pressure acts on its piston face."""
     acting = int(v[V_NCH])
     m0 = h0 = m1 = h1 = 0.0
     if v[V_RING] > 0.0:

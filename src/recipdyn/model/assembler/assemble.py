@@ -14,9 +14,9 @@ per throw its load's slice (last: a table's length varies, and every offset befo
 constant of the generated module). The order of the state: per throw its clearance angle and
 rate; with a motor the crank's angle and speed and the motor's work, then per throw the gas's
 work on its crosshead; then per throw its load's states; then per interstage its pressure
-(``interstage1.p``); then per throw its load's auxiliary states. With one throw this is the order of the compressor's state
-before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves'
-states>, <their counters>``), so records and configs of one throw keep their meaning.
+(``interstage1.p``); then per throw its load's auxiliary states. With one throw this is the
+order of the compressor's state before the assembler (``theta_c, thetadot_c[, theta1,
+omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so records and configs of one throw keep their meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ

@@ -71,7 +71,8 @@ from ...errors import ParameterError
 
 __all__ = [
     "Machine", "Shaft", "Throw", "Stage", "Interstage", "Sensor", "read_machine", "SHAFT_NAMES",
-    "STAGE_NAMES", "INTERSTAGE_NAMES", "FED_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS", "CYLINDER_ANGLES",
+    "STAGE_NAMES", "INTERSTAGE_NAMES", "FED_NAMES", "LOADS", "JOINTS", "DRIVES",
+    "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
 
 #: The parameters of the shaft (its speed, angle and drive) and of a stage (its line
@@ -292,11 +293,15 @@ class Machine:
             if i.upstream == i.downstream or i.upstream in feeding or i.downstream in fed:
                 raise ParameterError(f"{where}: from = {i.upstream!r}, to = {i.downstream!r}: "
                                      "an interstage joins two different stages, and a stage "
-                                     "feeds at most one interstage and is fed by at most one")  # fmt: skip
+                                     "feeds at most one interstage and is fed by at most "
+                                     "one")  # fmt: skip
             feeding.add(i.upstream)
             fed.add(i.downstream)
-            given = [k for k in FED_NAMES
-                     if k in next(s for s in self.stages if s.name == i.downstream).values]
+            given = [
+                k
+                for k in FED_NAMES
+                if k in next(s for s in self.stages if s.name == i.downstream).values
+            ]
             if given:
                 raise ParameterError(f"{where}: {i.downstream}.{given[0]} is set by the "
                                      "interstage (its pressure is a state, its gas at "
@@ -393,7 +398,8 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
         name = str(keys.get("name", f"interstage{i}"))
         if {"from", "to"} - set(keys):
             raise ParameterError(f"{where}: interstage {name!r}: needs from and to (the stage "
-                                 "whose discharge feeds it, the stage whose suction it is)")  # fmt: skip
+                                 "whose discharge feeds it, the stage whose suction it "
+                                 "is)")  # fmt: skip
         for k in params:
             if k not in INTERSTAGE_NAMES:
                 raise ParameterError(f"{where}: interstage {name!r}: {k!r} is not a parameter of "
