@@ -16,7 +16,8 @@ rate; with a motor the crank's angle and speed and the motor's work, then per th
 work on its crosshead; then per throw its load's states; then per interstage its pressure
 (``interstage1.p``); then per throw its load's auxiliary states. With one throw this is the
 order of the compressor's state before the assembler (``theta_c, thetadot_c[, theta1,
-omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so records and configs of one throw keep their meaning.
+omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so records and configs
+of one throw keep their meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
