@@ -9,15 +9,16 @@ drive (`recipdyn.model.assembler.generate`).
 
 The order of the parameter vector: the shaft's drive and torque law, then per throw its
 mechanism (`recipdyn.model.mechanism.link.MECHANISM`), its phase and its load's difference
-steps, then the frame's slice (a machine with a ``[frame]``), then per throw its load's slice
-(last: a table's length varies, and every offset before it stays a constant of the generated
-module). The order of the state: per throw its clearance angle and rate; with a motor the
-crank's angle and speed and the motor's work, then per throw the gas's work on its crosshead;
-then the frame's states and work integrals (with a frame); then per throw its load's states;
-then per throw its load's auxiliary states. With one throw this is the order of the
-compressor's state before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor,
-W_gas], <the valves' states>, <their counters>``), so records and configs of one throw keep
-their meaning.
+steps, then the frame's slice (a machine with a ``[frame]``), then per interstage volume its
+slice (`recipdyn.model.components.interstage`), then per throw its load's slice (last: a
+table's length varies, and every offset before it stays a constant of the generated module).
+The order of the state: per throw its clearance angle and rate; with a motor the crank's
+angle and speed and the motor's work, then per throw the gas's work on its crosshead; then the
+frame's states and work integrals (with a frame); then per throw its load's states; then per
+interstage its pressure (``interstage1.p``); then per throw its load's auxiliary states. With
+one throw this is the order of the compressor's state before the assembler (``theta_c,
+thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so
+records and configs of one throw keep their meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
@@ -73,6 +74,10 @@ def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[st
         out = {n[len(pre) :]: v for n, v in values.items() if n.startswith(pre)}
         out.update({n[len(spre) :]: v for n, v in values.items() if n.startswith(spre)})
         out.update({n[len("shaft.") :]: v for n, v in values.items() if n.startswith("shaft.")})
+        fed = machine.interstage_into(t.stage)
+        if fed is not None:  # its suction line: the interstage's (the initial and set values)
+            out["suction_pressure"] = values[f"{fed.upstream}.discharge_pressure"]
+            out["suction_temperature"] = values[f"{fed.name}.cooler_temperature"]
     for key, value in (
         ("load", t.load),
         ("equations", t.equations),
@@ -255,6 +260,15 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
         from ..frame.body import pack as frame_pack
 
         put("frame", frame_pack(machine, frame_values(values)))
+    for i in machine.interstages:
+        from ..components.interstage import INTERSTAGE
+
+        upstream = next(v for t, v in zip(machine.throws, locals_, strict=True)
+                        if t.stage == i.upstream)  # fmt: skip
+        own = {k[len(i.name) + 1 :]: v for k, v in values.items() if k.startswith(f"{i.name}.")}
+        put(i.name, INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}),
+            [(f"{i.name}.{k}", u) for k, u in (("volume", "m**3"), ("cooler_temperature", "K"),
+                                               ("gas_constant", "J/(kg*K)"))])  # fmt: skip
     for t, local in zip(machine.throws, locals_, strict=True):
         put(f"{t.name}.load", load.pack(local))
     params = pv.build()
@@ -285,6 +299,8 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load", ((pre + s, u) for s, u in load.states), DOF)
+    for i in machine.interstages:
+        place(i.name, ((f"{i.name}.p", "Pa"),), DOF)
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load_aux", ((pre + s, u) for s, u in load.aux_states), COUNTER)
@@ -323,6 +339,42 @@ def _frame_roles(frame: bool) -> dict[str, tuple[str, str]]:
             "frame_rhs": (FRAME_KERNELS, "frame_rhs")}  # fmt: skip
 
 
+def _interstage_roles(machine: Machine, load: Component) -> dict[str, tuple[str, str]]:
+    """The roles of the interstage volumes and of the loads between their lines (absent
+    without an interstage)."""
+    from ..components.interstage import INTERSTAGE
+
+    names = ("load_rhs_lines", "load_lines", "load_flows", "interstage_line", "interstage_rate")
+    if not machine.interstages:
+        return dict.fromkeys(names, ("recipdyn.model.assembler.generate", "absent"))
+    return {"load_rhs_lines": (load.module, load.kernel("state_rhs_lines")),
+            "load_lines": (load.module, load.kernel("lines")),
+            "load_flows": (load.module, load.kernel("flows")),
+            "interstage_line": (INTERSTAGE.module, INTERSTAGE.kernel("line")),
+            "interstage_rate": (INTERSTAGE.module, INTERSTAGE.kernel("rate"))}  # fmt: skip
+
+
+def _interstage_constants(machine: Machine, layout: Layout) -> dict[str, Any]:
+    """``INTERSTAGE``, ``N_INTERSTAGES``, each interstage's state and slice, each throw's
+    interstage in and out (``-1``: a set line; an empty array holds one unused ``-1``)."""
+    names = [i.name for i in machine.interstages]
+
+    def index(found) -> int:
+        return -1 if found is None else names.index(found.name)
+
+    def arr(values) -> np.ndarray:
+        return np.array(list(values) or [-1], dtype=np.int64)
+
+    return {
+        "INTERSTAGE": bool(names),
+        "N_INTERSTAGES": len(names),
+        "IS_STATE": arr(layout.state[f"{n}.p"] for n in names),
+        "IS_PARAM": arr(layout.params.start(n) for n in names),
+        "THROW_IN": arr(index(machine.interstage_into(t.stage)) for t in machine.throws),
+        "THROW_OUT": arr(index(machine.interstage_from(t.stage)) for t in machine.throws),
+    }
+
+
 def _kernels(machine: Machine, layout: Layout, load: Component, motor: Component | None,
              drive: Component) -> ModuleType:  # fmt: skip
     """The generated module of the configuration (`bindings`)."""
@@ -357,12 +409,14 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         "LOAD_AUX": starts(st, "load_aux"),
         "N_OBS": layout.outputs.size,
         "OBS_THROW": np.array([layout.outputs.start(t.name) for t in throws], dtype=np.int64),
+        **_interstage_constants(machine, layout),
     }
     roles = {
         "crosshead": (KERNELS, "crosshead"),
         "crank_torque": (KERNELS, "crank_torque"),
         **_load_roles(load),
         **_frame_roles(frame),
+        **_interstage_roles(machine, load),
     }
     equations = throws[0].equations
     if motor is None:
@@ -386,7 +440,8 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
                     for t in throws for part in ("work", "load_aux")) or (
                     frame and i in range(*st.parts["frame.work"].indices(st.size))):  # fmt: skip
                 kinds.append(3)  # nothing depends on it: its column is 0
-            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws):
+            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws) or (
+                    any(i == st[f"{s.name}.p"] for s in machine.interstages)):  # fmt: skip
                 kinds.append(2)
             elif name == "theta1" or name.endswith("theta_c"):
                 kinds.append(0)
@@ -402,6 +457,9 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
     for c in (load, motor):  # a user's file: its edits give a new module, never stale code
         if c is not None and not c.module.startswith("recipdyn"):
             note += f"{c.family} = {c.module}: {source_digest(c.module)}; "
-    stem = (f"{load.name}_{equations}_{len(throws)}" + ("" if motor is None else f"_{motor.name}")
-            + ("_frame" if frame else "")).replace("-", "_")  # fmt: skip
+    stem = (f"{load.name}_{equations}_{len(throws)}"
+            + ("" if motor is None else f"_{motor.name}")
+            + ("_frame" if frame else "")
+            + (f"_is{len(machine.interstages)}" if machine.interstages else "")
+            ).replace("-", "_")  # fmt: skip
     return template, roles, constants, stem, note

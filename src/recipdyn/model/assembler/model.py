@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import ParameterError
-from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
+from ..machine.description import FED_NAMES, SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
 from ..mechanism.link import (
     PHASE,
     SIGN_CONVENTION,
@@ -132,10 +132,18 @@ def machine_schema(machine: Machine) -> Schema:
                                     machine.shaft.values.get(p.name)))  # fmt: skip
     for st in machine.stages:
         throws = [t for t in machine.throws if t.stage == st.name]
+        fed = machine.interstage_into(st.name) is not None  # (its suction: the interstage's)
         if any(t.load in ("cycle", "valves") for t in throws):
             for name in STAGE_NAMES:
-                params.append(_with_default(SCHEMA[name], machine.prefix(st.name) + name,
-                                            st.values.get(name)))  # fmt: skip
+                if not (fed and name in FED_NAMES):
+                    params.append(_with_default(SCHEMA[name], machine.prefix(st.name) + name,
+                                                st.values.get(name)))  # fmt: skip
+    if machine.interstages:
+        from ..components.interstage import PARAMS as INTERSTAGE_PARAMS
+
+        for i in machine.interstages:
+            params += [_with_default(p, f"{i.name}.{p.name}", i.values.get(p.name))
+                       for p in INTERSTAGE_PARAMS]  # fmt: skip
     for t in machine.throws:
         given = t.values
         own = _throw_params(t, machine.shaft)
@@ -323,6 +331,25 @@ class MachineModel(Model):
             from ..frame.body import check as frame_check
 
             frame_check(machine.frame, frame_values(values))
+        self._check_interstages(machine, values)
+
+    def _check_interstages(self, machine: Machine, values: Mapping[str, Any]) -> None:
+        """An interstage holds the cylinders' ideal gas: its stages' throws take the ideal
+        gas with one gas constant."""
+        locals_ = dict(zip((t.name for t in machine.throws), self.throws(values), strict=True))
+        for i in machine.interstages:
+            joined = [t.name for t in machine.throws if t.stage in (i.upstream, i.downstream)]
+            for name in joined:
+                if locals_[name].get("gas", "ideal") != "ideal":
+                    raise ParameterError(f"{name}.gas = {locals_[name]['gas']!r}: interstage "
+                                         f"{i.name!r} holds an ideal gas (a real gas's line "
+                                         "states are tabulated at set pressures); allowed: "
+                                         "'ideal'")  # fmt: skip
+            r = {float(locals_[n]["gas_constant"]) for n in joined}
+            if len(r) > 1:
+                raise ParameterError(f"interstage {i.name!r}: its stages' throws have gas "
+                                     f"constants {sorted(r)} J/(kg*K): one gas flows through "
+                                     "it; give them one gas_constant")  # fmt: skip
 
     def period(self, values: Mapping[str, Any]) -> float:
         """The crank period at ``omega``: the forcing period with a prescribed crank, the
@@ -433,6 +460,8 @@ class MachineModel(Model):
         if c.motor is not None:
             y[st["theta1"]] = float(self._shaft(values, "theta1_0"))
             y[st["omega1"]] = float(self._shaft(values, "omega"))
+        for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
+            y[st[f"{i.name}.p"]] = float(values[f"{i.upstream}.discharge_pressure"])
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -526,6 +555,7 @@ class MachineModel(Model):
                 "energy": Signal(energy, "J", "kinetic + potential energy of the mechanism and "
                                  "the drive"),
             })  # fmt: skip
+        out.update(_interstage_outputs(c, y, dy))
         if not c.machine.flat:
             out["theta1"] = Signal(obs[:, ov["theta1"]], "rad", "crank angle of the shaft")
             out.update({
@@ -709,6 +739,36 @@ class _FrameRecord:
                                             "bound's margin: FEEDBACK_LIMIT - frame_feedback "
                                             "(< 0: the one-way coupling no longer holds)"),
         }  # fmt: skip
+
+
+def _interstage_outputs(c: Configuration, y: np.ndarray, dy: np.ndarray) -> dict[str, Signal]:
+    """Per interstage volume: its pressure (a state), its gas's mass, and the mass flows its
+    upstream stage delivers into it and its downstream stage takes from it (the cylinders'
+    counters' rates: the flows that were integrated)."""
+    from ..base import Signal
+
+    out: dict[str, Signal] = {}
+    st, pv = c.layout.state, c.layout.params
+    for i in c.machine.interstages:
+        pi = y[:, st[f"{i.name}.p"]]
+        vol, temp, gas_r = (c.params[pv[f"{i.name}.{k}"]]
+                            for k in ("volume", "cooler_temperature", "gas_constant"))  # fmt: skip
+        flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
+        for t in c.machine.throws:
+            a = st.start(f"{t.name}.load_aux")
+            if t.stage == i.upstream:
+                flows["in"] += dy[:, a + 1] + dy[:, a + 3]
+            if t.stage == i.downstream:
+                flows["out"] += dy[:, a] + dy[:, a + 2]
+        out[f"{i.name}.p"] = Signal(pi, "Pa", f"interstage pressure: {i.upstream}'s discharge, "
+                                    f"{i.downstream}'s suction (absolute)")  # fmt: skip
+        out[f"{i.name}.mass"] = Signal(pi * vol / (gas_r * temp), "kg",
+                                       "gas mass in the interstage volume")  # fmt: skip
+        out[f"{i.name}.mdot_in"] = Signal(flows["in"], "kg/s", f"mass flow {i.upstream}'s "
+                                          "discharge valves deliver into the volume")  # fmt: skip
+        out[f"{i.name}.mdot_out"] = Signal(flows["out"], "kg/s", f"mass flow {i.downstream}'s "
+                                           "suction valves take from the volume")  # fmt: skip
+    return out
 
 
 def _n_cycle() -> int:

@@ -16,6 +16,13 @@ A machine file::
     suction_pressure = "1 bar"
     discharge_pressure = "3 bar"
 
+    [[interstage]]           # optional: stage 1's discharge into a cooled volume that is
+    name = "interstage1"     # stage 2's suction (its pressure a state; load = "valves")
+    from = "stage1"
+    to = "stage2"
+    volume = "0.8 m**3"
+    cooler_temperature = "313 K"
+
     [[throw]]                # one crank of the shaft, at its phase angle
     stage = "stage1"
     load = "cycle"           # paper | table | cycle | valves | file.py:OBJ
@@ -54,6 +61,13 @@ part: ``throw2.rc``, ``shaft.J_drive``, ``stage1.suction_pressure``; a machine o
 keeps the compressor's names (``rc``, ``omega``), so a one-throw machine and ``--model
 compressor`` take the same values. The frame's parameters are always under ``frame.``
 (``frame.mass``, ``frame.mount2.k_x``); a mount's place (``x``, ``z``) is structure.
+
+An ``[[interstage]]`` joins two stages: the stage ``from``'s discharge valves deliver into a
+volume (``volume``, m^3) whose gas a cooler holds at ``cooler_temperature``, and the stage
+``to``'s suction valves take in from it; its pressure is a state of the machine (its initial
+value the ``from`` stage's ``discharge_pressure``), so the ``to`` stage has no
+``suction_pressure`` or ``suction_temperature`` of its own. Without an interstage every stage
+works between its set line pressures.
 """
 
 from __future__ import annotations
@@ -68,8 +82,9 @@ from typing import Any
 from ...errors import ParameterError
 
 __all__ = [
-    "Machine", "Shaft", "Throw", "Stage", "Sensor", "Frame", "Mount", "read_machine",
-    "SHAFT_NAMES", "STAGE_NAMES", "FRAME_NAMES", "MOUNT_NAMES", "LOADS", "JOINTS", "DRIVES",
+    "Machine", "Shaft", "Throw", "Stage", "Interstage", "Sensor", "Frame", "Mount",
+    "read_machine", "SHAFT_NAMES", "STAGE_NAMES", "INTERSTAGE_NAMES", "FED_NAMES", "FRAME_NAMES",
+    "MOUNT_NAMES", "LOADS", "JOINTS", "DRIVES",
     "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
 
@@ -82,6 +97,11 @@ STAGE_NAMES = ("suction_pressure", "discharge_pressure", "suction_temperature")
 #: The parameters of the frame (`recipdyn.model.frame`) and of each of its mounts.
 FRAME_NAMES = ("mass", "inertia", "x_cm", "z_cm")
 MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
+
+
+#: The parameters of an interstage volume, and a stage's that an interstage feeding it sets.
+INTERSTAGE_NAMES = ("volume", "cooler_temperature")
+FED_NAMES = ("suction_pressure", "suction_temperature")
 #: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
 #: crosshead guide's clearance run on one throw through ``--model compressor``).
 LOADS = ("paper", "table", "cycle", "valves")
@@ -173,6 +193,23 @@ class Stage:
 
 
 @dataclass(frozen=True)
+class Interstage:
+    """A volume between two stages: the stage ``upstream``'s discharge valves deliver into it,
+    the stage ``downstream``'s suction valves take in from it, and a cooler holds its gas at
+    ``cooler_temperature``; its pressure is a state (``name.p``). Parameters: ``volume``
+    (m^3) and ``cooler_temperature`` (K)."""
+
+    name: str = "interstage1"
+    upstream: str = "stage1"
+    downstream: str = "stage2"
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
 class Sensor:
     """A sensor of the machine: ``kind`` (accelerometer, pressure, tacho) reading the
     recorded ``signal`` (``throw2.a``). The model's vibration signal (peak, RMS and
@@ -228,6 +265,7 @@ class Machine:
     stages: tuple[Stage, ...] = (Stage(),)
     sensors: tuple[Sensor, ...] = ()
     frame: Frame | None = None
+    interstages: tuple[Interstage, ...] = ()
     #: Where it was read from (an absolute path: a record and a sweep's workers find it again).
     source: str = ""
 
@@ -279,6 +317,7 @@ class Machine:
             raise ParameterError(f"machine {self.name!r}: two throws named alike: {names}")
         if len({s.name for s in self.stages}) != len(self.stages):
             raise ParameterError(f"machine {self.name!r}: two stages named alike")
+        self._check_interstages()
         if self.shaft.drive not in DRIVES:
             raise ParameterError(f"machine {self.name!r}: shaft.drive = {self.shaft.drive!r}; "
                                  f"allowed: {', '.join(map(repr, DRIVES))}")  # fmt: skip
@@ -316,6 +355,51 @@ class Machine:
                 raise ParameterError(f"{where}.{k}: not a parameter of the frame; allowed: "
                                      f"{', '.join(FRAME_NAMES)} and [[frame.mount]]")  # fmt: skip
 
+    def _check_interstages(self) -> None:
+        stages = [s.name for s in self.stages]
+        taken = {*stages, "shaft", *(t.name for t in self.throws)}
+        fed, feeding = set(), set()
+        for i in self.interstages:
+            where = f"machine {self.name!r}: interstage {i.name!r}"
+            if not _NAME.match(i.name) or i.name in taken:
+                raise ParameterError(f"{where}: its name is a letter then letters, digits or _, "
+                                     "unlike the shaft's, the stages' and the throws'")  # fmt: skip
+            taken.add(i.name)
+            for key, st in (("from", i.upstream), ("to", i.downstream)):
+                if st not in stages:
+                    raise ParameterError(f"{where}: {key} = {st!r}; the machine's stages: "
+                                         f"{', '.join(stages)}")  # fmt: skip
+                if not any(t.stage == st for t in self.throws):
+                    raise ParameterError(f"{where}: {key} = {st!r} has no throw")
+            if i.upstream == i.downstream or i.upstream in feeding or i.downstream in fed:
+                raise ParameterError(f"{where}: from = {i.upstream!r}, to = {i.downstream!r}: "
+                                     "an interstage joins two different stages, and a stage "
+                                     "feeds at most one interstage and is fed by at most "
+                                     "one")  # fmt: skip
+            feeding.add(i.upstream)
+            fed.add(i.downstream)
+            given = [
+                k
+                for k in FED_NAMES
+                if k in next(s for s in self.stages if s.name == i.downstream).values
+            ]
+            if given:
+                raise ParameterError(f"{where}: {i.downstream}.{given[0]} is set by the "
+                                     "interstage (its pressure is a state, its gas at "
+                                     "cooler_temperature): remove it")  # fmt: skip
+            if self.throws[0].load != "valves":
+                raise ParameterError(f"{where}: the throws' load = {self.throws[0].load!r}; an "
+                                     "interstage needs the mass flows of the cylinders' valves: "
+                                     "load = 'valves'")  # fmt: skip
+
+    def interstage_into(self, stage: str) -> Interstage | None:
+        """The interstage that feeds stage ``stage``'s suction (None: its set line)."""
+        return next((i for i in self.interstages if i.downstream == stage), None)
+
+    def interstage_from(self, stage: str) -> Interstage | None:
+        """The interstage stage ``stage`` delivers into (None: its set line)."""
+        return next((i for i in self.interstages if i.upstream == stage), None)
+
     @property
     def flat(self) -> bool:
         """One throw: the compressor's names, without namespaces."""
@@ -333,7 +417,7 @@ class Machine:
         return replace(self, throws=tuple(throws))
 
 
-_TOP = ("name", "description", "shaft", "throw", "stage", "sensor", "frame")
+_TOP = ("name", "description", "shaft", "throw", "stage", "sensor", "interstage", "frame")
 _THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
 #: A throw's placement on the frame: structure keys with units (not parameters to sweep).
 _PLACEMENT = (("cylinder_angle", "rad"), ("axial_position", "m"))
@@ -388,6 +472,21 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
                                      f"allowed: name, {', '.join(STAGE_NAMES)}")  # fmt: skip
         stages.append(Stage(name=str(keys.get("name", f"stage{i}")), params=_pairs(params)))
     stages = stages or [Stage()]
+    interstages = []
+    for i, raw_i in enumerate(raw.get("interstage", []), 1):
+        raw_i = _table(raw_i, f"{where}: interstage {i}")
+        keys, params = _split(raw_i, ("name", "from", "to"))
+        name = str(keys.get("name", f"interstage{i}"))
+        if {"from", "to"} - set(keys):
+            raise ParameterError(f"{where}: interstage {name!r}: needs from and to (the stage "
+                                 "whose discharge feeds it, the stage whose suction it "
+                                 "is)")  # fmt: skip
+        for k in params:
+            if k not in INTERSTAGE_NAMES:
+                raise ParameterError(f"{where}: interstage {name!r}: {k!r} is not a parameter of "
+                                     "an interstage; allowed: name, from, to, "
+                                     f"{', '.join(INTERSTAGE_NAMES)}")  # fmt: skip
+        interstages.append(Interstage(name, str(keys["from"]), str(keys["to"]), _pairs(params)))
     throws = []
     for i, th in enumerate(raw.get("throw", []), 1):
         th = _table(th, f"{where}: throw {i}")
@@ -419,7 +518,7 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
     return Machine(name=str(raw.get("name", Path(source).stem if source else "machine")),
                    description=str(raw.get("description", "")), shaft=shaft,
                    throws=tuple(throws), stages=tuple(stages), sensors=tuple(sensors),
-                   frame=frame, source=source)  # fmt: skip
+                   interstages=tuple(interstages), frame=frame, source=source)  # fmt: skip
 
 
 def _frame(raw: Any, where: str) -> Frame:
