@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 PLUGIN = str(Path(__file__).resolve().parents[1] / "tests" / "plugin_components.py")
+MACHINES = Path(__file__).resolve().parents[1] / "examples" / "machines"
 #: name -> (model, values)
 CASES = {
     "default": ("compressor", {}),
@@ -61,6 +62,8 @@ CASES = {
                                            "motor": "constant"}),
     "guide-valves": ("compressor-contact-valves", {"guide": "clearance",
                                                    "guide_clearance": 2e-4}),
+    "machine-two-throw": (str(MACHINES / "two_throw.toml"), {}),
+    "machine-balanced-opposed": (str(MACHINES / "balanced_opposed.toml"), {}),
 }  # fmt: skip
 
 

@@ -386,7 +386,8 @@ def test_a_machine_file_is_read_with_its_structure_and_refuses_what_it_cannot_ho
     assert model.parameters()["throw2.phase"] == pytest.approx(math.pi)
     for text, words in (
         ("[[throw]]\nomega = 3\n[[throw]]\n", "throw1.omega: a parameter of [shaft]"),
-        ("[frame]\nmass = 1\n[[throw]]\n", "unknown key 'frame'"),
+        ("[frame]\nmass = 1\n[[throw]]\n", "frame: needs at least 2 [[frame.mount]]"),
+        ("[gearbox]\nmass = 1\n[[throw]]\n", "unknown key 'gearbox'"),
         ('[[throw]]\nload = "nope"\n[[throw]]\n', "load = 'nope'"),
     ):
         f = tmp_path / "m.toml"

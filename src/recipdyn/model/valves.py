@@ -74,9 +74,14 @@ until ``A_F dp - F_0 > F_a`` (oil stiction); a piston-ring leak area between the
 (to the frame, at ``p_frame`` and ``T_s``, for a single-acting cylinder), through the same
 nozzle from the chamber at the higher pressure, its gas's enthalpy carried along.
 
-Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: the line
-pressures are constant), no heat transfer other than through the polytropic exponent, one
-lumped plate per valve group.
+**Lines**: the suction line at ``(p_s, T_s)`` and the discharge line at ``p_d`` are the set
+values of the cylinder's stage, or, in a machine with an interstage volume between two stages
+(`recipdyn.model.components.interstage`), that volume's pressure, a state, at its cooler's
+temperature (`gas_rhs_lines`).
+
+Limits, stated: uniform chamber state (no pulsation in the cylinder or the lines: a line's
+pressure is constant or an interstage volume's, uniform), no heat transfer other than through
+the polytropic exponent, one lumped plate per valve group.
 """
 
 from __future__ import annotations
@@ -95,9 +100,9 @@ from .protocol import Param
 
 __all__ = [
     "N_GAS", "N_AUX", "GAS_STATE_NAMES", "GAS_STATE_UNITS", "AUX_STATE_NAMES",
-    "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "valve_event", "valve_reset", "gas_initial",
-    "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary", "state_force",
-    "real_properties",
+    "AUX_STATE_UNITS", "pack_valves", "gas_rhs", "gas_rhs_lines", "valve_event", "valve_reset",
+    "gas_initial", "flow_function", "V_REST", "EPS_LIN", "SCHEMA_PARAMS", "valve_summary",
+    "state_force", "real_properties",
     "gas_outputs", "gas_scale", "FAULT_PARAMS", "VALVES",
 ]  # fmt: skip
 
@@ -443,12 +448,13 @@ def real_properties(p, rt, tab):
 
 
 @nb.njit(cache=True, inline="always")
-def _chamber(V, dV, y, b, q, c, v, mr, hr, out):
+def _chamber(V, dV, y, b, q, c, v, mr, hr, ps, ts, pd, td, out):
     """Derivatives of one chamber's six states at ``y[b:b+6]`` (its suction valve ``q``, its
     discharge valve ``q + 1``); ``mr``: the ring leak into it, with the enthalpy (real gas) or
-    ``R T`` (ideal gas) of its upstream gas ``hr``. Returns (mdot_s, mdot_d)."""
+    ``R T`` (ideal gas) of its upstream gas ``hr``; the suction line at ``(ps, ts)``, the
+    discharge line at ``(pd, td)`` (``td``: the temperature of gas that flows back from it).
+    Returns (mdot_s, mdot_d)."""
     p, m = y[b], y[b + 1]
-    ps, pd = c[cy.C_PS], c[cy.C_PD]
     # a leak is an area in parallel with the plate (0 when healthy: the sum is exact)
     a_s = _area(y[b + 2], y[b + 3], v) + v[V_LEAK + q]
     a_d = _area(y[b + 4], y[b + 5], v) + v[V_LEAK + q + 1]
@@ -468,12 +474,12 @@ def _chamber(V, dV, y, b, q, c, v, mr, hr, out):
     else:
         R = v[V_R]
         T = p * V / (m * R)
-        ms = _mdot(ps, R * v[V_TS], p, R * T, a_s, v)
-        md = _mdot(pd, R * v[V_TD], p, R * T, a_d, v)
+        ms = _mdot(ps, R * ts, p, R * T, a_s, v)
+        md = _mdot(pd, R * td, p, R * T, a_d, v)
         n = c[cy.C_NC] if dV < 0.0 else c[cy.C_NE]
-        ts = v[V_TS] if ms > 0.0 else T
-        td = v[V_TD] if md > 0.0 else T
-        h_in = ts * ms + td * md
+        t_s = ts if ms > 0.0 else T
+        t_d = td if md > 0.0 else T
+        h_in = t_s * ms + t_d * md
         if mr != 0.0:
             h_in += mr * (hr / R if mr > 0.0 else T)
         out[b] = n / V * (R * h_in - p * dV)
@@ -543,12 +549,21 @@ def _volume(x, xdot, j, c):
 # valves, bit-identical results, ~4 s more compilation on first use (cached).
 @nb.njit(cache=True, inline="always")
 def gas_rhs(x, xdot, y, g, a, c, v, out):
+    """`gas_rhs_lines` between the cylinder's set line pressures and temperatures (``c``
+    and ``v``)."""
+    return gas_rhs_lines(x, xdot, y, g, a, c, v, c[cy.C_PS], v[V_TS], c[cy.C_PD], v[V_TD], out)
+
+
+@nb.njit(cache=True, inline="always")
+def gas_rhs_lines(x, xdot, y, g, a, c, v, ps, ts, pd, td, out):
     """Derivatives of the gas states ``y[g:g+12]`` and the mass counters ``y[a:a+4]`` for the
     crosshead at ``x`` moving at ``xdot``; returns the gas force on the crosshead along +x.
     ``c``: the cycle data ([`recipdyn.model.cycle.pack_cycle`][recipdyn.model.cycle.pack_cycle]),
-    ``v``: [`pack_valves`][recipdyn.model.valves.pack_valves]. A chamber that does not compress
-    (single-acting) keeps its states (derivatives 0) and the frame pressure acts on its piston
-    face."""
+    ``v``: [`pack_valves`][recipdyn.model.valves.pack_valves]; the suction line at pressure
+    ``ps`` (Pa) and temperature ``ts`` (K), the discharge line at ``pd`` and, for gas that
+    flows back from it, ``td`` (an interstage volume's state, or the set lines). A chamber
+    that does not compress (single-acting) keeps its states (derivatives 0) and the frame
+    pressure acts on its piston face."""
     acting = int(v[V_NCH])
     m0 = h0 = m1 = h1 = 0.0
     if v[V_RING] > 0.0:
@@ -563,7 +578,7 @@ def gas_rhs(x, xdot, y, g, a, c, v, out):
             continue
         V, dV = _volume(x, xdot, j, c)
         ms, md = _chamber(V, dV, y, b, 2 * j, c, v, m0 if j == 0 else m1,
-                          h0 if j == 0 else h1, out)  # fmt: skip
+                          h0 if j == 0 else h1, ps, ts, pd, td, out)  # fmt: skip
         out[a + 2 * j] = ms
         out[a + 2 * j + 1] = -md
     return state_force(y, g, c)

@@ -9,13 +9,16 @@ drive (`recipdyn.model.assembler.generate`).
 
 The order of the parameter vector: the shaft's drive and torque law, then per throw its
 mechanism (`recipdyn.model.mechanism.link.MECHANISM`), its phase and its load's difference
-steps, then per throw its load's slice (last: a table's length varies, and every offset
-before it stays a constant of the generated module). The order of the state: per throw its
-clearance angle and rate; with a motor the crank's angle and speed and the motor's work, then
-per throw the gas's work on its crosshead; then per throw its load's states; then per throw
-its load's auxiliary states. With one throw this is the order of the compressor's state
-before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves'
-states>, <their counters>``), so records and configs of one throw keep their meaning.
+steps, then the frame's slice (a machine with a ``[frame]``), then per interstage volume its
+slice (`recipdyn.model.components.interstage`), then per throw its load's slice (last: a
+table's length varies, and every offset before it stays a constant of the generated module).
+The order of the state: per throw its clearance angle and rate; with a motor the crank's
+angle and speed and the motor's work, then per throw the gas's work on its crosshead; then the
+frame's states and work integrals (with a frame); then per throw its load's states; then per
+interstage its pressure (``interstage1.p``); then per throw its load's auxiliary states. With
+one throw this is the order of the compressor's state before the assembler (``theta_c,
+thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so
+records and configs of one throw keep their meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
@@ -40,14 +43,22 @@ from . import generate
 from .layout import Layout, SlicesBuilder
 
 __all__ = ["Configuration", "assemble", "bindings", "throw_values", "load_of", "motor_of",
-           "KERNELS"]  # fmt: skip
+           "frame_values", "KERNELS"]  # fmt: skip
 
 #: The massless-link throw's compiled functions.
 KERNELS = "recipdyn.model.mechanism.link_kernels"
 
 #: A state's kind: a degree of freedom, a work integral (auxiliary and passive: nothing
-#: depends on it), a load's counter (auxiliary).
-DOF, WORK, COUNTER = "dof", "work", "counter"
+#: depends on it), a load's counter (auxiliary), the frame's (passive: the throws do not
+#: depend on it, `recipdyn.model.frame.body`, one-way coupling).
+DOF, WORK, COUNTER, FRAME = "dof", "work", "counter", "frame"
+#: The frame's compiled roles.
+FRAME_KERNELS = "recipdyn.model.frame.kernels"
+
+
+def frame_values(values: Mapping[str, Any]) -> dict[str, Any]:
+    """The frame's values under their names inside ``frame.`` (``mass``, ``mount2.k_x``)."""
+    return {n[len("frame.") :]: v for n, v in values.items() if n.startswith("frame.")}
 
 
 def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[str, Any]:
@@ -63,6 +74,10 @@ def throw_values(machine: Machine, values: Mapping[str, Any], k: int) -> dict[st
         out = {n[len(pre) :]: v for n, v in values.items() if n.startswith(pre)}
         out.update({n[len(spre) :]: v for n, v in values.items() if n.startswith(spre)})
         out.update({n[len("shaft.") :]: v for n, v in values.items() if n.startswith("shaft.")})
+        fed = machine.interstage_into(t.stage)
+        if fed is not None:  # its suction line: the interstage's (the initial and set values)
+            out["suction_pressure"] = values[f"{fed.upstream}.discharge_pressure"]
+            out["suction_temperature"] = values[f"{fed.name}.cooler_temperature"]
     for key, value in (
         ("load", t.load),
         ("equations", t.equations),
@@ -179,9 +194,10 @@ class Configuration:
         return n
 
     def passive(self, values_of_throws: list[Mapping[str, Any]]) -> tuple[int, ...]:
-        """The states left out of the tangent space: the work integrals, and with a motor the
-        clearance angle and rate of a throw with an ideal pin (rc = 0: they never move)."""
-        out = [i for i, kind in enumerate(self.kinds) if kind == WORK]
+        """The states left out of the tangent space: the work integrals, the frame's states
+        (nothing depends on them), and with a motor the clearance angle and rate of a throw
+        with an ideal pin (rc = 0: they never move)."""
+        out = [i for i, kind in enumerate(self.kinds) if kind in (WORK, FRAME)]
         if self.motor is not None:
             for t, local in zip(self.machine.throws, values_of_throws, strict=True):
                 if float(local["rc"]) == 0.0:
@@ -240,6 +256,19 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
             [(pre + k, "") for k in MECHANISM])  # fmt: skip
         put(f"{t.name}.phase", [local["phase"]], [(pre + "phase", "rad")])
         put(f"{t.name}.steps", _steps(load, local) if load.states else np.zeros(0))
+    if machine.frame is not None:
+        from ..frame.body import pack as frame_pack
+
+        put("frame", frame_pack(machine, frame_values(values)))
+    for i in machine.interstages:
+        from ..components.interstage import INTERSTAGE
+
+        upstream = next(v for t, v in zip(machine.throws, locals_, strict=True)
+                        if t.stage == i.upstream)  # fmt: skip
+        own = {k[len(i.name) + 1 :]: v for k, v in values.items() if k.startswith(f"{i.name}.")}
+        put(i.name, INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}),
+            [(f"{i.name}.{k}", u) for k, u in (("volume", "m**3"), ("cooler_temperature", "K"),
+                                               ("gas_constant", "J/(kg*K)"))])  # fmt: skip
     for t, local in zip(machine.throws, locals_, strict=True):
         put(f"{t.name}.load", load.pack(local))
     params = pv.build()
@@ -261,9 +290,17 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
         place("shaft.work", (("W_motor", "J"),), WORK)
         for t in machine.throws:
             place(f"{t.name}.work", ((machine.prefix(t.name) + "W_gas", "J"),), WORK)
+    if machine.frame is not None:
+        from ..frame.body import STATES as FRAME_STATES
+        from ..frame.body import WORK as FRAME_WORK
+
+        place("frame", ((f"frame.{s}", u) for s, u in FRAME_STATES), FRAME)
+        place("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK), WORK)
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load", ((pre + s, u) for s, u in load.states), DOF)
+    for i in machine.interstages:
+        place(i.name, ((f"{i.name}.p", "Pa"),), DOF)
     for t in machine.throws:
         pre = machine.prefix(t.name)
         place(f"{t.name}.load_aux", ((pre + s, u) for s, u in load.aux_states), COUNTER)
@@ -294,6 +331,50 @@ def _load_roles(load: Component) -> dict[str, tuple[str, str]]:
             "load_rhs": absent, "load_event": absent, "load_reset": absent}  # fmt: skip
 
 
+def _frame_roles(frame: bool) -> dict[str, tuple[str, str]]:
+    if not frame:
+        absent = ("recipdyn.model.assembler.generate", "absent")
+        return {"shaking": absent, "frame_load": absent, "frame_rhs": absent}
+    return {"shaking": (KERNELS, "shaking"), "frame_load": (FRAME_KERNELS, "throw_load"),
+            "frame_rhs": (FRAME_KERNELS, "frame_rhs")}  # fmt: skip
+
+
+def _interstage_roles(machine: Machine, load: Component) -> dict[str, tuple[str, str]]:
+    """The roles of the interstage volumes and of the loads between their lines (absent
+    without an interstage)."""
+    from ..components.interstage import INTERSTAGE
+
+    names = ("load_rhs_lines", "load_lines", "load_flows", "interstage_line", "interstage_rate")
+    if not machine.interstages:
+        return dict.fromkeys(names, ("recipdyn.model.assembler.generate", "absent"))
+    return {"load_rhs_lines": (load.module, load.kernel("state_rhs_lines")),
+            "load_lines": (load.module, load.kernel("lines")),
+            "load_flows": (load.module, load.kernel("flows")),
+            "interstage_line": (INTERSTAGE.module, INTERSTAGE.kernel("line")),
+            "interstage_rate": (INTERSTAGE.module, INTERSTAGE.kernel("rate"))}  # fmt: skip
+
+
+def _interstage_constants(machine: Machine, layout: Layout) -> dict[str, Any]:
+    """``INTERSTAGE``, ``N_INTERSTAGES``, each interstage's state and slice, each throw's
+    interstage in and out (``-1``: a set line; an empty array holds one unused ``-1``)."""
+    names = [i.name for i in machine.interstages]
+
+    def index(found) -> int:
+        return -1 if found is None else names.index(found.name)
+
+    def arr(values) -> np.ndarray:
+        return np.array(list(values) or [-1], dtype=np.int64)
+
+    return {
+        "INTERSTAGE": bool(names),
+        "N_INTERSTAGES": len(names),
+        "IS_STATE": arr(layout.state[f"{n}.p"] for n in names),
+        "IS_PARAM": arr(layout.params.start(n) for n in names),
+        "THROW_IN": arr(index(machine.interstage_into(t.stage)) for t in machine.throws),
+        "THROW_OUT": arr(index(machine.interstage_from(t.stage)) for t in machine.throws),
+    }
+
+
 def _kernels(machine: Machine, layout: Layout, load: Component, motor: Component | None,
              drive: Component) -> ModuleType:  # fmt: skip
     """The generated module of the configuration (`bindings`)."""
@@ -311,7 +392,12 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         return np.array([slices.start(f"{t.name}.{suffix}") for t in throws], dtype=np.int64)
 
     has_states = bool(load.states)
+    frame = machine.frame is not None
     constants: dict[str, Any] = {
+        "FRAME": frame,
+        "FRAME_PARAMS": pv.start("frame") if frame else 0,
+        "FRAME_STATE": st.start("frame") if frame else 0,
+        "FRAME_WORK": st.start("frame.work") if frame else 0,
         "LOAD_STATES": has_states,
         "N_THROWS": len(throws),
         "SHAFT": pv.start("shaft.drive"),
@@ -323,11 +409,14 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         "LOAD_AUX": starts(st, "load_aux"),
         "N_OBS": layout.outputs.size,
         "OBS_THROW": np.array([layout.outputs.start(t.name) for t in throws], dtype=np.int64),
+        **_interstage_constants(machine, layout),
     }
     roles = {
         "crosshead": (KERNELS, "crosshead"),
         "crank_torque": (KERNELS, "crank_torque"),
         **_load_roles(load),
+        **_frame_roles(frame),
+        **_interstage_roles(machine, load),
     }
     equations = throws[0].equations
     if motor is None:
@@ -348,9 +437,11 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         for i, name in enumerate(st.names):
             if i in range(*st.parts["shaft.work"].indices(st.size)) or any(
                     i in range(*st.parts[f"{t.name}.{part}"].indices(st.size))
-                    for t in throws for part in ("work", "load_aux")):  # fmt: skip
+                    for t in throws for part in ("work", "load_aux")) or (
+                    frame and i in range(*st.parts["frame.work"].indices(st.size))):  # fmt: skip
                 kinds.append(3)  # nothing depends on it: its column is 0
-            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws):
+            elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws) or (
+                    any(i == st[f"{s.name}.p"] for s in machine.interstages)):  # fmt: skip
                 kinds.append(2)
             elif name == "theta1" or name.endswith("theta_c"):
                 kinds.append(0)
@@ -367,5 +458,8 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         if c is not None and not c.module.startswith("recipdyn"):
             note += f"{c.family} = {c.module}: {source_digest(c.module)}; "
     stem = (f"{load.name}_{equations}_{len(throws)}"
-            + ("" if motor is None else f"_{motor.name}")).replace("-", "_")  # fmt: skip
+            + ("" if motor is None else f"_{motor.name}")
+            + ("_frame" if frame else "")
+            + (f"_is{len(machine.interstages)}" if machine.interstages else "")
+            ).replace("-", "_")  # fmt: skip
     return template, roles, constants, stem, note

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import ParameterError
-from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
+from ..machine.description import FED_NAMES, SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
 from ..mechanism.link import (
     PHASE,
     SIGN_CONVENTION,
@@ -37,7 +37,7 @@ from ..mechanism.link import (
 from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
 from ..protocol import Model, Param, Schema
 from ..registry import absolute_spec, is_spec
-from .assemble import Configuration, assemble, load_of, throw_values
+from .assemble import Configuration, assemble, frame_values, load_of, throw_values
 
 if TYPE_CHECKING:
     from ..base import Event, Signal
@@ -132,10 +132,18 @@ def machine_schema(machine: Machine) -> Schema:
                                     machine.shaft.values.get(p.name)))  # fmt: skip
     for st in machine.stages:
         throws = [t for t in machine.throws if t.stage == st.name]
+        fed = machine.interstage_into(st.name) is not None  # (its suction: the interstage's)
         if any(t.load in ("cycle", "valves") for t in throws):
             for name in STAGE_NAMES:
-                params.append(_with_default(SCHEMA[name], machine.prefix(st.name) + name,
-                                            st.values.get(name)))  # fmt: skip
+                if not (fed and name in FED_NAMES):
+                    params.append(_with_default(SCHEMA[name], machine.prefix(st.name) + name,
+                                                st.values.get(name)))  # fmt: skip
+    if machine.interstages:
+        from ..components.interstage import PARAMS as INTERSTAGE_PARAMS
+
+        for i in machine.interstages:
+            params += [_with_default(p, f"{i.name}.{p.name}", i.values.get(p.name))
+                       for p in INTERSTAGE_PARAMS]  # fmt: skip
     for t in machine.throws:
         given = t.values
         own = _throw_params(t, machine.shaft)
@@ -148,6 +156,14 @@ def machine_schema(machine: Machine) -> Schema:
         params += [_with_default(p, pre + p.name, given.get(p.name)) for p in own]
         if t.load == "table":
             extras.append(pre + "load_table")
+    if machine.frame is not None:  # always under frame. (no compressor name is the frame's)
+        from ..frame.body import local_params
+
+        given = dict(machine.frame.values)
+        for m in machine.frame.mounts:
+            given.update({f"{m.name}.{k}": v for k, v in m.values.items()})
+        params += [_with_default(p, "frame." + p.name, given.get(p.name))
+                   for p in local_params(machine.frame)]  # fmt: skip
     return Schema(tuple(params), extras=tuple(extras))
 
 
@@ -181,7 +197,9 @@ class MachineModel(Model):
             ("theta_c", "rad"), ("thetadot_c", "rad/s"), ("x", "m"), ("v", "m/s"),
             ("a", "m/s**2")))  # fmt: skip
         accel = next((s.signal for s in machine.sensors if s.kind == "accelerometer"), None)
-        self.vibration_signal = (accel or f"{pre[0]}a", "m/s**2")
+        # with a frame, by default the first throw's accelerometer: its crosshead's + the frame's
+        self.vibration_signal = (accel or f"{pre[0]}{'a' if machine.frame is None else 'accel'}",
+                                 "m/s**2")  # fmt: skip
         self.section_pair = (f"{pre[0]}v", f"{pre[0]}a")
         if not machine.flat:
             self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
@@ -189,7 +207,18 @@ class MachineModel(Model):
             f"{q}contact_force", "N", 0.0,
             "the massless link can only push: a negative joint contact force means the pin "
             "would leave the bearing wall, where the permanent-contact model no longer holds",
-            self.validity_bounds_instead) for q in pre)  # fmt: skip
+            self.validity_bounds_instead) for q, t in zip(pre, machine.throws, strict=True)
+            if machine.frame is None or t.crank_joint == "link")  # fmt: skip
+        if machine.frame is not None:  # (a machine with a frame: its ideal pins have no link)
+            from ..frame.body import FEEDBACK_LIMIT
+
+            self.validity_bounds += ((
+                "frame_coupling_margin", "", 0.0,
+                f"the frame's acceleration at a guide moves that throw's parts by more than "
+                f"{FEEDBACK_LIMIT:g} of its shaking force (frame_feedback), and the frame is "
+                "coupled one way (its motion does not act on the throws)",
+                "a stiffer or heavier frame (frame.mount*.k_x, frame.mass), away from its "
+                "resonances; a frame coupled both ways is not modelled yet"),)  # fmt: skip
         if any(t.load == "valves" for t in machine.throws):
             self.lyapunov_refusal = (
                 "valve plates come to rest on their stops in resets with a singular saltation "
@@ -298,6 +327,29 @@ class MachineModel(Model):
                         load.check(local)
             except ParameterError as exc:
                 raise _prefixed_message(machine.prefix(t.name), exc) from None
+        if machine.frame is not None:
+            from ..frame.body import check as frame_check
+
+            frame_check(machine.frame, frame_values(values))
+        self._check_interstages(machine, values)
+
+    def _check_interstages(self, machine: Machine, values: Mapping[str, Any]) -> None:
+        """An interstage holds the cylinders' ideal gas: its stages' throws take the ideal
+        gas with one gas constant."""
+        locals_ = dict(zip((t.name for t in machine.throws), self.throws(values), strict=True))
+        for i in machine.interstages:
+            joined = [t.name for t in machine.throws if t.stage in (i.upstream, i.downstream)]
+            for name in joined:
+                if locals_[name].get("gas", "ideal") != "ideal":
+                    raise ParameterError(f"{name}.gas = {locals_[name]['gas']!r}: interstage "
+                                         f"{i.name!r} holds an ideal gas (a real gas's line "
+                                         "states are tabulated at set pressures); allowed: "
+                                         "'ideal'")  # fmt: skip
+            r = {float(locals_[n]["gas_constant"]) for n in joined}
+            if len(r) > 1:
+                raise ParameterError(f"interstage {i.name!r}: its stages' throws have gas "
+                                     f"constants {sorted(r)} J/(kg*K): one gas flows through "
+                                     "it; give them one gas_constant")  # fmt: skip
 
     def period(self, values: Mapping[str, Any]) -> float:
         """The crank period at ``omega``: the forcing period with a prescribed crank, the
@@ -318,7 +370,10 @@ class MachineModel(Model):
         )
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        """The link's bound (it can only push) needs a link: rc > 0 at some throw."""
+        """The link's bound (it can only push) needs a link: rc > 0 at some throw; the
+        frame's one-way coupling (a machine with a frame) always."""
+        if self.structure(values).frame is not None:
+            return True
         return any(float(v["rc"]) > 0.0 for v in self.throws(values))
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
@@ -349,7 +404,9 @@ class MachineModel(Model):
         return AssembledSystem(
             rhs=c.kernels.rhs,
             jac=c.kernels.jac,
-            rhs_jac=c.kernels.rhs_jac if not (motor or c.has_states) and exact else None,
+            rhs_jac=c.kernels.rhs_jac
+            if not (motor or c.has_states or machine.frame is not None) and exact
+            else None,
             params=c.params,
             state_names=names,
             state_units=units,
@@ -403,6 +460,8 @@ class MachineModel(Model):
         if c.motor is not None:
             y[st["theta1"]] = float(self._shaft(values, "theta1_0"))
             y[st["omega1"]] = float(self._shaft(values, "omega"))
+        for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
+            y[st[f"{i.name}.p"]] = float(values[f"{i.upstream}.discharge_pressure"])
         return y
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -443,6 +502,7 @@ class MachineModel(Model):
         motor = c.motor is not None
         a1 = dy[:, st["omega1"]] if motor else None
         out: dict[str, Signal] = {}
+        frame = None if c.machine.frame is None else _FrameRecord(c, values, y, dy)
         energy = np.zeros(t.shape[0])
         shake = np.zeros((4, t.shape[0]))  # the frame's F_x, F_y, M_x, M_y
         for k, (th, local) in enumerate(zip(c.machine.throws, self.throws(values), strict=True)):
@@ -481,6 +541,9 @@ class MachineModel(Model):
                 own["theta1"] = Signal(th1, "rad", "crank angle of this throw in its own axes "
                                        "(the shaft's + phase - cylinder_angle)")  # fmt: skip
                 own.update(_shaking(p, kin, fg, w1, a1, th, shake))
+            if frame is not None:
+                own.update(frame.at_guide(th, own["a"].values))
+                frame.throws.append((p, own["frame_a"].values, kin, w1, a1))
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -492,6 +555,7 @@ class MachineModel(Model):
                 "energy": Signal(energy, "J", "kinetic + potential energy of the mechanism and "
                                  "the drive"),
             })  # fmt: skip
+        out.update(_interstage_outputs(c, y, dy))
         if not c.machine.flat:
             out["theta1"] = Signal(obs[:, ov["theta1"]], "rad", "crank angle of the shaft")
             out.update({
@@ -503,6 +567,8 @@ class MachineModel(Model):
                 "shake_moment_y": Signal(shake[3], "N*m", "shaking moment on the frame about "
                                          "the y axis through z = 0: sum z_k F_x,k"),
             })  # fmt: skip
+        if frame is not None:
+            out.update(frame.signals())
         return out
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
@@ -512,9 +578,11 @@ class MachineModel(Model):
         from ..cycle import pin_reversal_summary
 
         machine = self.structure(values)
-        if machine.flat:
-            return self._throw_summary(self.throws(values)[0], ds)
         out: dict[str, Any] = {}
+        if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
+            out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
+        if machine.flat:
+            return {**self._throw_summary(self.throws(values)[0], ds), **out}
         for t, local in zip(machine.throws, self.throws(values), strict=True):
             pre = f"{t.name}."
             view = ds[[k for k in ds.data_vars if str(k).startswith(pre)]]
@@ -549,6 +617,11 @@ class MachineModel(Model):
                 out[f"{t.name}.cylinder_angle_deg"] = math.degrees(t.cylinder_angle)
                 out[f"{t.name}.axial_position_m"] = t.axial_position
             out["frame_axes"] = FRAME_AXES
+        if machine.frame is not None:  # its mounts' places (structure, not parameters)
+            for m in machine.frame.mounts:
+                out[f"frame.{m.name}.x_m"] = m.x
+                out[f"frame.{m.name}.z_m"] = m.z
+            out.setdefault("frame_axes", FRAME_AXES)
         return out
 
 
@@ -602,6 +675,100 @@ def _shaking(p, kin, fg, w1, a1, throw: Throw, total: np.ndarray) -> dict[str, S
         "rod_load": Signal(rod_load(p, kin, fg), "N", "combined rod load at the crosshead "
                            "pin, m3 a - gas_force (> 0: compression; API 618)"),
     }  # fmt: skip
+
+
+class _FrameRecord:
+    """The frame's signals of a record (`recipdyn.model.frame.body`): its motion at each
+    throw's guide from the integrated states and the compiled right-hand side's accelerations
+    (``dy``), its energy and its mounts' forces, and the one-way coupling's neglected term."""
+
+    def __init__(self, c: Configuration, values: Mapping[str, Any], y: np.ndarray,
+                 dy: np.ndarray) -> None:  # fmt: skip
+        from ..frame.body import matrices
+
+        self.local = frame_values(values)
+        self.M, self.K, self.C = matrices(c.machine.frame, self.local)
+        s = c.layout.state.start("frame")
+        self.q, self.qd, self.qdd = y[:, s : s + 3], y[:, s + 3 : s + 6], dy[:, s + 3 : s + 6]
+        self.throws: list[tuple] = []
+
+    def at_guide(self, throw: Throw, a: np.ndarray) -> dict[str, Signal]:
+        """Throw ``throw``'s: the frame's motion at its guide along its stroke, and its
+        accelerometer's reading (its crosshead's acceleration ``a`` + the frame's)."""
+        from ..base import Signal
+        from ..frame.body import at_guide
+
+        fa = at_guide(throw, self.local, self.qdd)
+        return {
+            "frame_x": Signal(at_guide(throw, self.local, self.q), "m", "the frame's "
+                              "displacement at this throw's guide along its stroke"),
+            "frame_v": Signal(at_guide(throw, self.local, self.qd), "m/s", "the frame's "
+                              "velocity at this throw's guide along its stroke"),
+            "frame_a": Signal(fa, "m/s**2", "the frame's acceleration at this throw's guide "
+                              "along its stroke"),
+            "accel": Signal(a + fa, "m/s**2", "accelerometer on this throw's crosshead: its "
+                            "acceleration a along the stroke + the frame's at its guide"),
+        }  # fmt: skip
+
+    def signals(self) -> dict[str, Signal]:
+        """The frame's own: its energy, the mounts' force and moment on it, and the neglected
+        feedback per sample (``frame_feedback``: the largest over the throws of
+        ``(m1 + m2 + m3) |a_f|`` over the throw's largest shaking force along its stroke)."""
+        from ..base import Signal
+        from ..frame.body import FEEDBACK_LIMIT, energy
+        from ..mechanism.shaking import throw_shaking
+
+        mounts = -(self.q @ self.K.T + self.qd @ self.C.T)
+        feedback = np.zeros(self.q.shape[0])
+        for p, fa, kin, w1, a1 in self.throws:
+            fx, _ = throw_shaking(p, kin, w1, a1)
+            top = float(np.max(np.abs(fx)))
+            if top > 0.0:
+                feedback = np.maximum(feedback, (p.m1 + p.m2 + p.m3) * np.abs(fa) / top)
+        return {
+            "frame_energy": Signal(energy(self.M, self.K, self.q, self.qd), "J", "the frame's "
+                                   "kinetic energy + its mounts' strain energy"),
+            "frame_mount_force_x": Signal(mounts[:, 0], "N", "the mounts' force on the frame "
+                                          "along x (springs and dampers)"),
+            "frame_mount_moment": Signal(mounts[:, 2], "N*m", "the mounts' moment on the frame "
+                                         "about the vertical axis through its centre of mass"),
+            "frame_feedback": Signal(feedback, "", "the neglected feedback of the frame on the "
+                                     "throws (one-way coupling): max over the throws of "
+                                     "(m1+m2+m3)|frame_a| / max|its shaking force along x|"),
+            "frame_coupling_margin": Signal(FEEDBACK_LIMIT - feedback, "", "the validity "
+                                            "bound's margin: FEEDBACK_LIMIT - frame_feedback "
+                                            "(< 0: the one-way coupling no longer holds)"),
+        }  # fmt: skip
+
+
+def _interstage_outputs(c: Configuration, y: np.ndarray, dy: np.ndarray) -> dict[str, Signal]:
+    """Per interstage volume: its pressure (a state), its gas's mass, and the mass flows its
+    upstream stage delivers into it and its downstream stage takes from it (the cylinders'
+    counters' rates: the flows that were integrated)."""
+    from ..base import Signal
+
+    out: dict[str, Signal] = {}
+    st, pv = c.layout.state, c.layout.params
+    for i in c.machine.interstages:
+        pi = y[:, st[f"{i.name}.p"]]
+        vol, temp, gas_r = (c.params[pv[f"{i.name}.{k}"]]
+                            for k in ("volume", "cooler_temperature", "gas_constant"))  # fmt: skip
+        flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
+        for t in c.machine.throws:
+            a = st.start(f"{t.name}.load_aux")
+            if t.stage == i.upstream:
+                flows["in"] += dy[:, a + 1] + dy[:, a + 3]
+            if t.stage == i.downstream:
+                flows["out"] += dy[:, a] + dy[:, a + 2]
+        out[f"{i.name}.p"] = Signal(pi, "Pa", f"interstage pressure: {i.upstream}'s discharge, "
+                                    f"{i.downstream}'s suction (absolute)")  # fmt: skip
+        out[f"{i.name}.mass"] = Signal(pi * vol / (gas_r * temp), "kg",
+                                       "gas mass in the interstage volume")  # fmt: skip
+        out[f"{i.name}.mdot_in"] = Signal(flows["in"], "kg/s", f"mass flow {i.upstream}'s "
+                                          "discharge valves deliver into the volume")  # fmt: skip
+        out[f"{i.name}.mdot_out"] = Signal(flows["out"], "kg/s", f"mass flow {i.downstream}'s "
+                                           "suction valves take from the volume")  # fmt: skip
+    return out
 
 
 def _n_cycle() -> int:

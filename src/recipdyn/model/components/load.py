@@ -25,6 +25,13 @@ kinematics). A load with states provides, with ``g`` (``a``) the index of its fi
   crosshead at ``x3`` moving at ``x3'``;
 * ``event(y, g, p, o)`` and ``reset(y, g, p, o, out)``: its event factor (positive between
   events, falling through 0 at one) and the state after the event.
+
+A load with states that can run between an interstage volume's lines (a machine's
+``[[interstage]]``; the dynamic valves) adds ``state_rhs_lines(x3, x3', y, g, a, p, o, ps, ts,
+pd, td, out)`` (`state_rhs` with the suction line at ``(ps, ts)`` and the discharge line at
+``pd``, ``td`` for gas that flows back), ``lines(p, o) -> (ps, ts, pd, td)`` (its set lines)
+and ``flows(dy, a) -> (m_in, m_out)`` (the mass flows it takes in and delivers, from its
+auxiliary states' derivatives).
 """
 
 from __future__ import annotations
@@ -39,6 +46,8 @@ import numpy as np
 from .. import valves as va
 from ..base import Signal
 from ..cycle import (
+    C_PD,
+    C_PS,
     N_CYCLE,
     cycle_data,
     cycle_force_kernel,
@@ -120,6 +129,30 @@ def valves_rhs(x, xdot, y, g, a, p, o, out):
 
 
 @nb.njit(cache=True)
+def valves_rhs_lines(x, xdot, y, g, a, p, o, ps, ts, pd, td, out):
+    """`valves_rhs` with the suction line at ``(ps, ts)`` and the discharge line at ``pd``
+    (``td`` for gas flowing back from it): an interstage volume's state
+    (`recipdyn.model.valves.gas_rhs_lines`)."""
+    c = p[o:]
+    va.gas_rhs_lines(x, xdot, y, g, a, c, c[N_CYCLE:], ps, ts, pd, td, out)
+
+
+@nb.njit(cache=True)
+def valves_lines(p, o):
+    """The set line values ``(p_s, T_s, p_d, T_d)`` of the cylinder's slice (what
+    `valves_rhs` runs between)."""
+    v = o + N_CYCLE
+    return p[o + C_PS], p[v + va.V_TS], p[o + C_PD], p[v + va.V_TD]
+
+
+@nb.njit(cache=True)
+def valves_flows(dy, a):
+    """The mass flows (kg/s) the cylinder takes in through its suction valves and delivers
+    through its discharge valves, from its mass counters' derivatives ``dy[a:a+4]``."""
+    return dy[a] + dy[a + 2], dy[a + 1] + dy[a + 3]
+
+
+@nb.njit(cache=True)
 def valves_event(y, g, p, o):
     """The smallest plate factor (`recipdyn.model.valves.valve_event`)."""
     return va.valve_event(y, g, p[o + N_CYCLE :])
@@ -173,7 +206,10 @@ VALVES = Component(
     "load", "valves", "the cylinder gas with dynamic plate valves (pressures, plates as states)",
     module=__name__, pack=_valves, params=va.SCHEMA_PARAMS, steps=_valves_steps,
     kernels={"state_force": "valves_force", "state_rhs": "valves_rhs",
-             "event": "valves_event", "reset": "valves_reset"},
+             "event": "valves_event", "reset": "valves_reset",
+             # a load that can run between an interstage volume's lines (optional roles)
+             "state_rhs_lines": "valves_rhs_lines", "lines": "valves_lines",
+             "flows": "valves_flows"},
     states=tuple(zip(va.GAS_STATE_NAMES, va.GAS_STATE_UNITS, strict=True)),
     aux_states=tuple(zip(va.AUX_STATE_NAMES, va.AUX_STATE_UNITS, strict=True)),
 )  # fmt: skip

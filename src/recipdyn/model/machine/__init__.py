@@ -1,4 +1,5 @@
-"""A machine as a description: its crankshaft and drive, its throws, stages and sensors.
+"""A machine as a description: its crankshaft and drive, its throws, stages, interstage
+volumes and sensors.
 
 `Machine` (`.description`) says what a machine is made of — which part at each place, and the
 values of their parameters — and nothing of how it is computed: the assembler
@@ -11,6 +12,17 @@ machine of one throw keeps the compressor's names (``rc``, ``omega``). Nothing h
 numba.
 """
 
-from .description import Machine, Sensor, Shaft, Stage, Throw, read_machine
+from .description import (
+    Frame,
+    Interstage,
+    Machine,
+    Mount,
+    Sensor,
+    Shaft,
+    Stage,
+    Throw,
+    read_machine,
+)
 
-__all__ = ["Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine"]
+__all__ = ["Machine", "Shaft", "Throw", "Stage", "Interstage", "Sensor", "Frame", "Mount",
+           "read_machine"]  # fmt: skip

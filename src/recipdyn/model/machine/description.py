@@ -16,6 +16,13 @@ A machine file::
     suction_pressure = "1 bar"
     discharge_pressure = "3 bar"
 
+    [[interstage]]           # optional: stage 1's discharge into a cooled volume that is
+    name = "interstage1"     # stage 2's suction (its pressure a state; load = "valves")
+    from = "stage1"
+    to = "stage2"
+    volume = "0.8 m**3"
+    cooler_temperature = "313 K"
+
     [[throw]]                # one crank of the shaft, at its phase angle
     stage = "stage1"
     load = "cycle"           # paper | table | cycle | valves | file.py:OBJ
@@ -28,10 +35,21 @@ A machine file::
     load = "cycle"
     phase = "180 deg"
 
+    [frame]                  # optional: the frame on its elastic mounts (a planar rigid
+    mass = "8 t"             # body in the horizontal plane x-z that the throws shake)
+    inertia = "6000 kg*m**2" # about the vertical axis through its centre of mass
+    z_cm = "325 mm"          # its centre of mass (x_cm, z_cm) in the frame's axes
+
+    [[frame.mount]]          # an elastic mount: its place (x, z; structure) and its
+    x = "-1 m"               # stiffness and damping along x and z (parameters)
+    z = "-0.5 m"
+    k_x = "5e7 N/m"
+    c_x = "2e4 N*s/m"
+
     [[sensor]]               # what a monitoring system records: the model's vibration
     name = "accel_throw2"    # signal is the first accelerometer's
     kind = "accelerometer"
-    signal = "throw2.a"
+    signal = "throw2.a"      # (with a frame, "throw2.accel": the crosshead's + the frame's)
 
 The keys that choose a part (a throw's ``load``, ``crank_joint``, ``equations``, ``stage``,
 ``name``, and its placement on the frame, ``cylinder_angle``: 0 or 180 deg, and
@@ -41,7 +59,15 @@ value, with its unit (a number in SI or a quantity such as ``"1 mm"``), checked 
 range when the machine becomes a model. A machine of several throws names its parameters by
 part: ``throw2.rc``, ``shaft.J_drive``, ``stage1.suction_pressure``; a machine of one throw
 keeps the compressor's names (``rc``, ``omega``), so a one-throw machine and ``--model
-compressor`` take the same values.
+compressor`` take the same values. The frame's parameters are always under ``frame.``
+(``frame.mass``, ``frame.mount2.k_x``); a mount's place (``x``, ``z``) is structure.
+
+An ``[[interstage]]`` joins two stages: the stage ``from``'s discharge valves deliver into a
+volume (``volume``, m^3) whose gas a cooler holds at ``cooler_temperature``, and the stage
+``to``'s suction valves take in from it; its pressure is a state of the machine (its initial
+value the ``from`` stage's ``discharge_pressure``), so the ``to`` stage has no
+``suction_pressure`` or ``suction_temperature`` of its own. Without an interstage every stage
+works between its set line pressures.
 """
 
 from __future__ import annotations
@@ -56,8 +82,10 @@ from typing import Any
 from ...errors import ParameterError
 
 __all__ = [
-    "Machine", "Shaft", "Throw", "Stage", "Sensor", "read_machine", "SHAFT_NAMES",
-    "STAGE_NAMES", "LOADS", "JOINTS", "DRIVES", "SENSOR_KINDS", "CYLINDER_ANGLES",
+    "Machine", "Shaft", "Throw", "Stage", "Interstage", "Sensor", "Frame", "Mount",
+    "read_machine", "SHAFT_NAMES", "STAGE_NAMES", "INTERSTAGE_NAMES", "FED_NAMES", "FRAME_NAMES",
+    "MOUNT_NAMES", "LOADS", "JOINTS", "DRIVES",
+    "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
 
 #: The parameters of the shaft (its speed, angle and drive) and of a stage (its line
@@ -66,6 +94,14 @@ __all__ = [
 SHAFT_NAMES = ("omega", "theta1_0", "J_drive", "motor_torque", "motor_sync_speed",
                "motor_breakdown_torque", "motor_breakdown_slip")  # fmt: skip
 STAGE_NAMES = ("suction_pressure", "discharge_pressure", "suction_temperature")
+#: The parameters of the frame (`recipdyn.model.frame`) and of each of its mounts.
+FRAME_NAMES = ("mass", "inertia", "x_cm", "z_cm")
+MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
+
+
+#: The parameters of an interstage volume, and a stage's that an interstage feeding it sets.
+INTERSTAGE_NAMES = ("volume", "cooler_temperature")
+FED_NAMES = ("suction_pressure", "suction_temperature")
 #: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
 #: crosshead guide's clearance run on one throw through ``--model compressor``).
 LOADS = ("paper", "table", "cycle", "valves")
@@ -157,6 +193,23 @@ class Stage:
 
 
 @dataclass(frozen=True)
+class Interstage:
+    """A volume between two stages: the stage ``upstream``'s discharge valves deliver into it,
+    the stage ``downstream``'s suction valves take in from it, and a cooler holds its gas at
+    ``cooler_temperature``; its pressure is a state (``name.p``). Parameters: ``volume``
+    (m^3) and ``cooler_temperature`` (K)."""
+
+    name: str = "interstage1"
+    upstream: str = "stage1"
+    downstream: str = "stage2"
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
 class Sensor:
     """A sensor of the machine: ``kind`` (accelerometer, pressure, tacho) reading the
     recorded ``signal`` (``throw2.a``). The model's vibration signal (peak, RMS and
@@ -168,9 +221,42 @@ class Sensor:
 
 
 @dataclass(frozen=True)
+class Mount:
+    """An elastic mount of the frame: its name (``mount2``: its parameters are
+    ``frame.mount2.k_x``), its place in the frame's axes (``x``, ``z``, m: structure) and its
+    parameter values (stiffness ``k_x``, ``k_z`` and damping ``c_x``, ``c_z`` along x and z,
+    raw)."""
+
+    name: str = "mount1"
+    x: float = 0.0
+    z: float = 0.0
+    params: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """The frame on its elastic mounts (`recipdyn.model.frame`): a rigid body moving in the
+    horizontal plane x-z (the plane of the cylinder axes and the crankshaft), shaken by every
+    throw. ``params``: its parameter values (``mass``, ``inertia`` about the vertical axis
+    through its centre of mass, ``x_cm``, ``z_cm``), raw; ``mounts``: its mounts."""
+
+    params: tuple[tuple[str, Any], ...] = ()
+    mounts: tuple[Mount, ...] = ()
+
+    @property
+    def values(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
 class Machine:
-    """A machine: its shaft, its throws (in the order of their namespaces), stages and
-    sensors."""
+    """A machine: its shaft, its throws (in the order of their namespaces), stages, sensors
+    and, optionally, its frame on its mounts (None: the frame is rigid and fixed, as
+    before the frame existed)."""
 
     name: str = "machine"
     description: str = ""
@@ -178,6 +264,8 @@ class Machine:
     throws: tuple[Throw, ...] = (Throw(),)
     stages: tuple[Stage, ...] = (Stage(),)
     sensors: tuple[Sensor, ...] = ()
+    frame: Frame | None = None
+    interstages: tuple[Interstage, ...] = ()
     #: Where it was read from (an absolute path: a record and a sweep's workers find it again).
     source: str = ""
 
@@ -229,13 +317,88 @@ class Machine:
             raise ParameterError(f"machine {self.name!r}: two throws named alike: {names}")
         if len({s.name for s in self.stages}) != len(self.stages):
             raise ParameterError(f"machine {self.name!r}: two stages named alike")
+        self._check_interstages()
         if self.shaft.drive not in DRIVES:
             raise ParameterError(f"machine {self.name!r}: shaft.drive = {self.shaft.drive!r}; "
                                  f"allowed: {', '.join(map(repr, DRIVES))}")  # fmt: skip
+        if self.frame is not None:
+            self._check_frame(self.frame)
         for s in self.sensors:
             if s.kind not in SENSOR_KINDS:
                 raise ParameterError(f"machine {self.name!r}: sensor {s.name!r}: kind = "
                                      f"{s.kind!r}; allowed: {', '.join(SENSOR_KINDS)}")  # fmt: skip
+
+    def _check_frame(self, frame: Frame) -> None:
+        where = f"machine {self.name!r}: frame"
+        if len(frame.mounts) < 2:
+            raise ParameterError(f"{where}: needs at least 2 [[frame.mount]] (one mount leaves "
+                                 "it free to turn about the vertical axis); got "
+                                 f"{len(frame.mounts)}")  # fmt: skip
+        names = [m.name for m in frame.mounts]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"{where}: two mounts named alike: {names}")
+        for m in frame.mounts:
+            if not _NAME.match(m.name):
+                raise ParameterError(f"{where}: mount name {m.name!r}: a letter then letters, "
+                                     "digits or _")  # fmt: skip
+            for k, v in (("x", m.x), ("z", m.z)):
+                if not (math.isfinite(v) and abs(v) <= AXIAL_MAX):
+                    raise ParameterError(f"{where}.{m.name}.{k} = {v:g} m; allowed: "
+                                         f"[-{AXIAL_MAX:g}, {AXIAL_MAX:g}] m")  # fmt: skip
+            for k in m.values:
+                if k not in MOUNT_NAMES:
+                    raise ParameterError(f"{where}.{m.name}.{k}: not a parameter of a "
+                                         f"mount; allowed: name, x, z, "
+                                         f"{', '.join(MOUNT_NAMES)}")  # fmt: skip
+        for k in frame.values:
+            if k not in FRAME_NAMES:
+                raise ParameterError(f"{where}.{k}: not a parameter of the frame; allowed: "
+                                     f"{', '.join(FRAME_NAMES)} and [[frame.mount]]")  # fmt: skip
+
+    def _check_interstages(self) -> None:
+        stages = [s.name for s in self.stages]
+        taken = {*stages, "shaft", *(t.name for t in self.throws)}
+        fed, feeding = set(), set()
+        for i in self.interstages:
+            where = f"machine {self.name!r}: interstage {i.name!r}"
+            if not _NAME.match(i.name) or i.name in taken:
+                raise ParameterError(f"{where}: its name is a letter then letters, digits or _, "
+                                     "unlike the shaft's, the stages' and the throws'")  # fmt: skip
+            taken.add(i.name)
+            for key, st in (("from", i.upstream), ("to", i.downstream)):
+                if st not in stages:
+                    raise ParameterError(f"{where}: {key} = {st!r}; the machine's stages: "
+                                         f"{', '.join(stages)}")  # fmt: skip
+                if not any(t.stage == st for t in self.throws):
+                    raise ParameterError(f"{where}: {key} = {st!r} has no throw")
+            if i.upstream == i.downstream or i.upstream in feeding or i.downstream in fed:
+                raise ParameterError(f"{where}: from = {i.upstream!r}, to = {i.downstream!r}: "
+                                     "an interstage joins two different stages, and a stage "
+                                     "feeds at most one interstage and is fed by at most "
+                                     "one")  # fmt: skip
+            feeding.add(i.upstream)
+            fed.add(i.downstream)
+            given = [
+                k
+                for k in FED_NAMES
+                if k in next(s for s in self.stages if s.name == i.downstream).values
+            ]
+            if given:
+                raise ParameterError(f"{where}: {i.downstream}.{given[0]} is set by the "
+                                     "interstage (its pressure is a state, its gas at "
+                                     "cooler_temperature): remove it")  # fmt: skip
+            if self.throws[0].load != "valves":
+                raise ParameterError(f"{where}: the throws' load = {self.throws[0].load!r}; an "
+                                     "interstage needs the mass flows of the cylinders' valves: "
+                                     "load = 'valves'")  # fmt: skip
+
+    def interstage_into(self, stage: str) -> Interstage | None:
+        """The interstage that feeds stage ``stage``'s suction (None: its set line)."""
+        return next((i for i in self.interstages if i.downstream == stage), None)
+
+    def interstage_from(self, stage: str) -> Interstage | None:
+        """The interstage stage ``stage`` delivers into (None: its set line)."""
+        return next((i for i in self.interstages if i.upstream == stage), None)
 
     @property
     def flat(self) -> bool:
@@ -254,7 +417,7 @@ class Machine:
         return replace(self, throws=tuple(throws))
 
 
-_TOP = ("name", "description", "shaft", "throw", "stage", "sensor")
+_TOP = ("name", "description", "shaft", "throw", "stage", "sensor", "interstage", "frame")
 _THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
 #: A throw's placement on the frame: structure keys with units (not parameters to sweep).
 _PLACEMENT = (("cylinder_angle", "rad"), ("axial_position", "m"))
@@ -309,6 +472,21 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
                                      f"allowed: name, {', '.join(STAGE_NAMES)}")  # fmt: skip
         stages.append(Stage(name=str(keys.get("name", f"stage{i}")), params=_pairs(params)))
     stages = stages or [Stage()]
+    interstages = []
+    for i, raw_i in enumerate(raw.get("interstage", []), 1):
+        raw_i = _table(raw_i, f"{where}: interstage {i}")
+        keys, params = _split(raw_i, ("name", "from", "to"))
+        name = str(keys.get("name", f"interstage{i}"))
+        if {"from", "to"} - set(keys):
+            raise ParameterError(f"{where}: interstage {name!r}: needs from and to (the stage "
+                                 "whose discharge feeds it, the stage whose suction it "
+                                 "is)")  # fmt: skip
+        for k in params:
+            if k not in INTERSTAGE_NAMES:
+                raise ParameterError(f"{where}: interstage {name!r}: {k!r} is not a parameter of "
+                                     "an interstage; allowed: name, from, to, "
+                                     f"{', '.join(INTERSTAGE_NAMES)}")  # fmt: skip
+        interstages.append(Interstage(name, str(keys["from"]), str(keys["to"]), _pairs(params)))
     throws = []
     for i, th in enumerate(raw.get("throw", []), 1):
         th = _table(th, f"{where}: throw {i}")
@@ -336,10 +514,27 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
             )
         sensors.append(Sensor(str(se.get("name", f"sensor{i}")), str(se["kind"]),
                               str(se["signal"])))  # fmt: skip
+    frame = _frame(raw["frame"], where) if "frame" in raw else None
     return Machine(name=str(raw.get("name", Path(source).stem if source else "machine")),
                    description=str(raw.get("description", "")), shaft=shaft,
                    throws=tuple(throws), stages=tuple(stages), sensors=tuple(sensors),
-                   source=source)  # fmt: skip
+                   interstages=tuple(interstages), frame=frame, source=source)  # fmt: skip
+
+
+def _frame(raw: Any, where: str) -> Frame:
+    """The `Frame` of a file's ``[frame]`` table: its parameters and its ``[[frame.mount]]``
+    tables (each a ``name``, its place ``x``, ``z`` with units, and its parameters)."""
+    from ...quantity import to_unit
+
+    raw = dict(_table(raw, f"{where}: [frame]"))
+    mounts = []
+    for i, mo in enumerate(raw.pop("mount", []), 1):
+        mo = dict(_table(mo, f"{where}: frame mount {i}"))
+        name = str(mo.pop("name", f"mount{i}"))
+        place = {k: to_unit(f"{where}: frame.{name}.{k}", mo.pop(k), "m")
+                 for k in ("x", "z") if k in mo}  # fmt: skip
+        mounts.append(Mount(name, params=_pairs(mo), **place))
+    return Frame(params=_pairs(raw), mounts=tuple(mounts))
 
 
 def read_machine(path: str | Path) -> Machine:

@@ -24,6 +24,7 @@ __all__ = [
     "crosshead",
     "free_contribution",
     "crank_torque",
+    "shaking",
 ]
 
 # the mechanism slice, in order (link.MECHANISM)
@@ -126,3 +127,33 @@ def crank_torque(th1, thc, w, thcd, thcdd, a1, F, p, m):
         return m00 * a1 - b0
     m00, m10, m11, b0, b1 = link_throw_system((th1, thc, w, thcd), p, m, u)
     return m00 * a1 + m10 * thcdd - b0
+
+
+@nb.njit(cache=True)
+def shaking(th1, thc, w, thcd, a1, thcdd, p, m):
+    """The throw's shaking force on the frame in its own axes, ``(F_x, F_y)`` in N: ``-(m1
+    a1 + m2 a2 + m3 a3)`` (`recipdyn.model.mechanism.shaking`), from the crank's angle, speed
+    ``w`` and acceleration ``a1`` and the clearance angle, rate and acceleration ``thcdd``.
+
+    The rod angle from the closure ``sin theta2 = -(d + r sin theta1 + rc sin theta_c)/l``
+    differentiated twice: ``cos theta2 theta2' = -(r cos theta1 w + rc cos theta_c
+    theta_c')/l`` and ``cos theta2 theta2'' = sin theta2 theta2'^2 - (r (cos theta1 a1 - sin
+    theta1 w^2) + rc (cos theta_c theta_c'' - sin theta_c theta_c'^2))/l``; a point at ``lam``
+    along the rod from its big end, ``r e(theta1) + rc e(theta_c) + lam e(theta2)``,
+    accelerates by the same terms (an implementation independent of
+    `recipdyn.model.kinematics`, which the record's ``shake_x`` uses)."""
+    r, rs, l, ls = p[m + _R], p[m + _RS], p[m + _L], p[m + _LS]
+    m1, m2, m3, rc = p[m + _M1], p[m + _M2], p[m + _M3], p[m + _RC]
+    c1, s1 = math.cos(th1), math.sin(th1)
+    cc, sc = math.cos(thc), math.sin(thc)
+    s2 = -(p[m + _D] + r * s1 + rc * sc) / l
+    c2 = math.sqrt(1.0 - s2 * s2)
+    w2 = -(r * c1 * w + rc * cc * thcd) / (l * c2)
+    pin_x = -r * (c1 * w * w + s1 * a1) - rc * (cc * thcd * thcd + sc * thcdd)
+    pin_y = r * (c1 * a1 - s1 * w * w) + rc * (cc * thcdd - sc * thcd * thcd)
+    a2 = (s2 * w2 * w2 - pin_y / l) / c2
+    rod_x = -(c2 * w2 * w2 + s2 * a2)  # e(theta2)'' per unit length
+    rod_y = c2 * a2 - s2 * w2 * w2
+    fx = -(m1 * rs * (-c1 * w * w - s1 * a1) + m2 * (pin_x + ls * rod_x) + m3 * (pin_x + l * rod_x))
+    fy = -(m1 * rs * (-s1 * w * w + c1 * a1) + m2 * (pin_y + ls * rod_y))
+    return fx, fy

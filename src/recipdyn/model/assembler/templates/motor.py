@@ -14,12 +14,14 @@ is ``theta1'' = (T_m + sum Q) / (J_drive + sum I)`` without a derivation of the 
 
 Roles: ``torque(omega1, p, o)`` (the motor's torque law), ``free_contribution(th1, thc, w,
 thcd, F, p, m) -> (I, Q, k, c)``, ``crosshead``, ``crank_torque``, and the loads' roles as in
-`prescribed`.
+`prescribed` (with interstage volumes, theirs too).
 Constants: ``CRANK``, ``SHAFT`` (the offset of ``J_drive``), ``MOTOR`` (the torque law's
 slice), ``THROW_WORK``, ``STEP_KIND`` (per state: how the Jacobian's central differences
 step it: ``0`` an angle, absolute 1e-4; ``1`` a rate, 1e-4 max(1, |y|); ``2`` a load's
 state, 1e-7 max(|y|, 1e-3); ``3`` a column left 0, a work integral or a counter nothing
-depends on), and the throws' and loads' as in `prescribed`.
+depends on), and the throws', the loads' and the interstage volumes' as in `prescribed`
+(an interstage's pressure is stepped as a load's state); a frame on its mounts (``FRAME``) as
+in `prescribed`, shaken by the throws at the crank's acceleration.
 """
 
 import numba as nb
@@ -29,19 +31,37 @@ from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, c
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as frame_load
+from recipdyn.model.assembler.generate import absent as frame_rhs
+from recipdyn.model.assembler.generate import absent as interstage_line
+from recipdyn.model.assembler.generate import absent as interstage_rate
 from recipdyn.model.assembler.generate import absent as load_event
+from recipdyn.model.assembler.generate import absent as load_flows
+from recipdyn.model.assembler.generate import absent as load_lines
 from recipdyn.model.assembler.generate import absent as load_reset
 from recipdyn.model.assembler.generate import absent as load_rhs
+from recipdyn.model.assembler.generate import absent as load_rhs_lines
 from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.assembler.generate import absent as shaking
 from recipdyn.model.components.drive_kernels import induction_torque as torque
 from recipdyn.model.components.load import paper_force as load_force
 from recipdyn.model.mechanism.link_kernels import crank_torque, crosshead, free_contribution
 
+FRAME = False
+FRAME_PARAMS = np.int64(0)
+FRAME_STATE = np.int64(0)
+FRAME_WORK = np.int64(0)
 LOAD_STATES = False
 N_THROWS = np.int64(1)
 CRANK = np.int64(2)
 SHAFT = np.int64(0)
 MOTOR = np.int64(1)
+INTERSTAGE = False
+N_INTERSTAGES = np.int64(0)
+IS_STATE = np.array([-1], dtype=np.int64)
+IS_PARAM = np.array([-1], dtype=np.int64)
+THROW_IN = np.array([-1], dtype=np.int64)
+THROW_OUT = np.array([-1], dtype=np.int64)
 THROW_STATE = np.array([0], dtype=np.int64)
 THROW_WORK = np.array([5], dtype=np.int64)
 THROW_MECH = np.array([4], dtype=np.int64)
@@ -61,6 +81,36 @@ def _force(th1, y, p, k):
     if LOAD_STATES:
         return load_state_force(y, LOAD_STATE[k], p, THROW_LOAD[k])
     return load_force(th1, p, THROW_LOAD[k])
+
+
+@nb.njit(cache=True)
+def _load_rhs(x, v, y, p, k, out):
+    """Throw ``k``'s load's derivatives, between its set lines or an interstage volume's."""
+    g, a, o = LOAD_STATE[k], LOAD_AUX[k], THROW_LOAD[k]
+    if INTERSTAGE:
+        ps, ts, pd, td = load_lines(p, o)
+        i, j = THROW_IN[k], THROW_OUT[k]
+        if i >= 0:
+            ps, ts = interstage_line(y, IS_STATE[i], p, IS_PARAM[i])
+        if j >= 0:
+            pd, td = interstage_line(y, IS_STATE[j], p, IS_PARAM[j])
+        load_rhs_lines(x, v, y, g, a, p, o, ps, ts, pd, td, out)
+    else:
+        load_rhs(x, v, y, g, a, p, o, out)
+
+
+@nb.njit(cache=True)
+def _interstages(p, out):
+    """Each interstage volume's pressure rate from the flows its stages' loads delivered into
+    ``out`` (after every throw's)."""
+    for i in range(N_INTERSTAGES):
+        mdot = 0.0
+        for k in range(N_THROWS):
+            if THROW_OUT[k] == i:
+                mdot += load_flows(out, LOAD_AUX[k])[1]
+            if THROW_IN[k] == i:
+                mdot -= load_flows(out, LOAD_AUX[k])[0]
+        out[IS_STATE[i]] = interstage_rate(mdot, p, IS_PARAM[i])
 
 
 @nb.njit(cache=True)
@@ -91,7 +141,26 @@ def _rhs(t, y, p, out):
         x, v = crosshead(thk, y[s], w1, y[s + 1], p, m)
         out[THROW_WORK[k]] = out[THROW_WORK[k]] * v
         if LOAD_STATES:
-            load_rhs(x, v, y, LOAD_STATE[k], LOAD_AUX[k], p, THROW_LOAD[k], out)
+            _load_rhs(x, v, y, p, k, out)
+    if INTERSTAGE:
+        _interstages(p, out)
+    if FRAME:
+        _frame(th1, w1, a1, y, p, out)
+
+
+@nb.njit(cache=True)
+def _frame(th1, w, a1, y, p, out):
+    """The frame's derivatives: every throw's shaking force, from its state and its
+    clearance angle's acceleration already in ``out``, as generalised forces on the frame."""
+    qx = 0.0
+    qpsi = 0.0
+    for k in range(N_THROWS):
+        s, m = THROW_STATE[k], THROW_MECH[k]
+        fx, fy = shaking(th1 + p[THROW_PHASE[k]], y[s], w, y[s + 1], a1, out[s + 1], p, m)
+        gx, gpsi = frame_load(k, fx, fy, p, FRAME_PARAMS)
+        qx += gx
+        qpsi += gpsi
+    frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
 
 
 @compiled(RHS_SIGNATURE)
