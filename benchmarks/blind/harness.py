@@ -239,6 +239,7 @@ def _reason_kind(reason: str) -> str:
     r = reason.lower()
     for key, kind in (("crank speed", "speed range"), ("sampling rate", "sampling rate"),
                       ("noise floor", "noise floor"), ("impacts ring", "sensor band"),
+                      ("sensor band", "sensor band"), ("transducer offset", "offset range"),
                       ("features lie", "out of domain"), ("tacho", "tacho")):  # fmt: skip
         if key in r:
             return kind

@@ -33,6 +33,19 @@ def _snrs(text: str):
         ) from None
 
 
+def _chain_range(text: str):
+    from ..errors import ParameterError
+
+    name, _, rest = text.partition("=")
+    try:
+        lo, hi = (float(v) for v in rest.split(","))
+    except ValueError:
+        raise ParameterError(
+            f"chain_range = {text!r}; allowed: NAME=LO,HI, e.g. accelerometer.resonance_hz=800,6000"
+        ) from None
+    return name.strip(), lo, hi
+
+
 def _machine_changes(machine: Path | None, sets: list[str] | None):
     """The machine of ``--machine`` and ``--set`` as its changes from the default machine; the
     names are checked before the model loads."""
@@ -77,6 +90,13 @@ def dataset(
         help="LO,HI: draw each record's accelerometer SNR uniformly in [LO, HI] dB (seeded) "
         "instead of --snr for all.",
     ),
+    chain_range: list[str] = typer.Option(
+        None,
+        "--chain-range",
+        help="NAME=LO,HI: draw the chain parameter NAME (a range of docs/sensors.md, e.g. "
+        "accelerometer.resonance_hz=800,6000) in [LO, HI] instead of its default range "
+        "(repeatable; with --chain drawn).",
+    ),
     revolutions: float = typer.Option(2.0, help="Revolutions recorded per record."),
     transient: float = typer.Option(1.0, help="Revolutions discarded first."),
     classes: str = typer.Option(None, help="Comma list of classes (default: all)."),
@@ -118,6 +138,8 @@ def dataset(
         kw["severity_draws"] = draws
     if snr_range is not None:
         kw["snr_range"] = _snrs(snr_range)
+    if chain_range:
+        kw["chain_spans"] = tuple(_chain_range(item) for item in chain_range)
     if snr is not None and chain != "fixed":
         from ..errors import ParameterError
 

@@ -697,13 +697,16 @@ def _resonance_fit(f, s, f0, fs, response="analog"):
     return sol.x, float(np.sqrt(np.mean(sol.fun**2))), at_bound
 
 
-def resonance(x, fs: float, revs=None, response: str = "analog") -> dict[str, Estimate]:
+def resonance(
+    x, fs: float, revs=None, response: str = "analog", min_hz: float = RESONANCE_MIN_HZ
+) -> dict[str, Estimate]:
     """The accelerometer's mounting resonance: frequency and damping ratio with their 95 %
     half-widths, from the spread of the fit (`_resonance_fit`) over the record's parts (its
     revolutions, or up to eight equal parts without a crank angle) and the fit's own
     systematic error. ``response``: the resonance's form, ``"analog"`` (a real mount) or
     ``"bilinear"`` (`recipdyn.sensors.resonance_filter`, whose warped flank makes an analog
-    fit read the damping low near the Nyquist frequency: 0.05 read as 0.014 at 0.4 fs)."""
+    fit read the damping low near the Nyquist frequency: 0.05 read as 0.014 at 0.4 fs).
+    ``min_hz``: the lowest spectral peak tried (default `RESONANCE_MIN_HZ`)."""
     from scipy.signal import find_peaks, welch
 
     x = np.asarray(x, float)
@@ -712,7 +715,7 @@ def resonance(x, fs: float, revs=None, response: str = "analog") -> dict[str, Es
     f, s = welch(x, fs=fs, nperseg=nper)
     # the candidates: the most prominent peaks above the impacts' high-pass (the largest is
     # `evidence.ringing_hz`); the resonance is the one the second-order response fits best
-    start = int(np.searchsorted(f, RESONANCE_MIN_HZ, side="right"))
+    start = int(np.searchsorted(f, min_hz, side="right"))
     lp = 10 * np.log10(s[start:] + 1e-300)
     peaks, props = find_peaks(lp, prominence=0)
     order = np.argsort(props["prominences"])[::-1][:RESONANCE_CANDIDATES]

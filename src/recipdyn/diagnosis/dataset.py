@@ -107,6 +107,11 @@ class DatasetSpec:
         ``snr_db``. ``fixed``: the one chain every data set used before
         (`recipdyn.chain.legacy_chain`: the condition's resonance, ``snr_db`` or
         ``snr_range``), its records those of earlier versions to the bit.
+    chain_spans : tuple of (str, float, float)
+        With the drawn chain: ranges that replace `recipdyn.chain.DEFAULT_RANGES`'
+        (``(parameter, lo, hi)``, e.g. ``("accelerometer.resonance_hz", 800, 6000)``; applied
+        after ``snr_range``), so that a diagnoser can be trained for a chain the default
+        ranges do not cover. Empty: the default ranges.
     machine : tuple of (str, value)
         The machine simulated, as its changes from the diagnosis model's defaults
         (`recipdyn.diagnosis.machine.Machine.changes`; a dict is accepted): its operating
@@ -134,6 +139,7 @@ class DatasetSpec:
     snr_range: tuple[float, float] | None = None
     chain: str = "drawn"
     machine: tuple[tuple[str, Any], ...] = ()
+    chain_spans: tuple[tuple[str, float, float], ...] = ()
 
     def __post_init__(self):
         if not 0 < self.test_fraction < 1:
@@ -174,6 +180,12 @@ class DatasetSpec:
         if self.chain not in CHAIN_KINDS:
             raise ParameterError(f"chain = {self.chain!r}; allowed: {', '.join(CHAIN_KINDS)}")
         object.__setattr__(self, "machine", _machine_pairs(self.machine))
+        object.__setattr__(self, "chain_spans", _chain_spans(self.chain_spans))
+        if self.chain_spans and self.chain != "drawn":
+            raise ParameterError("chain_spans: sets the drawn chain's ranges; allowed with "
+                                 "chain = drawn")  # fmt: skip
+        if self.chain_spans:
+            self.chain_ranges  # noqa: B018 - a range the chain cannot hold is refused here
 
     @property
     def chain_ranges(self):
@@ -190,6 +202,13 @@ class DatasetSpec:
                     lo, hi, old.unit, old.meaning, "the data set's snr_range"
                 )  # fmt: skip
             )
+        if self.chain_spans:
+            from dataclasses import replace
+
+            ranges = ranges.with_spans(**{
+                k.replace(".", "__"): replace(DEFAULT_RANGES[k], lo=lo, hi=hi,
+                                              source="the data set's chain_spans")
+                for k, lo, hi in self.chain_spans})  # fmt: skip
         return ranges
 
     @property
@@ -215,6 +234,8 @@ class DatasetSpec:
             del d["chain"]
         if not d["machine"]:  # the default machine: the store keeps its identity
             del d["machine"]
+        if not d["chain_spans"]:
+            del d["chain_spans"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -238,6 +259,29 @@ def _machine_pairs(m: Any) -> tuple[tuple[str, Any], ...]:
         if k not in (*MACHINE_PARAMETERS, *NOMINAL):
             raise ParameterError(_not_machine(k))
     return tuple(sorted(pairs.items()))
+
+
+def _chain_spans(spans: Any) -> tuple[tuple[str, float, float], ...]:
+    """A spec's chain ranges as sorted ``(parameter, lo, hi)``, each parameter a range of
+    `recipdyn.chain.DEFAULT_RANGES` (not a choice) and ``lo <= hi``."""
+    if not spans:
+        return ()
+    from ..chain import DEFAULT_RANGES, Span
+
+    out = {}
+    for item in spans.items() if hasattr(spans, "items") else spans:
+        try:
+            k, (lo, hi) = (item[0], item[1]) if len(item) == 2 else (item[0], item[1:])
+            lo, hi = float(lo), float(hi)
+        except (TypeError, ValueError):
+            raise ParameterError(f"chain_spans: {item!r}; allowed: (parameter, lo, hi)") from None
+        if not isinstance(DEFAULT_RANGES.get(k), Span):
+            spans_ = ", ".join(n for n, r in DEFAULT_RANGES.items() if isinstance(r, Span))
+            raise ParameterError(f"chain range {k!r}; allowed: one of {spans_}")
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+            raise ParameterError(f"chain range {k} = {lo:g}..{hi:g}; allowed: LO <= HI")
+        out[k] = (lo, hi)
+    return tuple((k, lo, hi) for k, (lo, hi) in sorted(out.items()))
 
 
 def spec_machine(spec: DatasetSpec):

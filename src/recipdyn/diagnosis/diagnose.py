@@ -5,7 +5,10 @@ channels by name); the crank angle comes from a once-per-revolution tacho whose 
 outer dead centre, or from a constant speed (then the features that need the angle are left
 out and the diagnosis is less sharp). Before any answer, the record must lie in the
 diagnoser's training domain: its crank speed and sampling rate inside the training ranges,
-the frequency at which its impacts ring inside the training sensor band, its features not
+its measurement chain as estimated from it (the mount's resonance, the SNR, the pressure
+offsets) inside the chain ranges the diagnoser was trained under
+(`recipdyn.diagnosis.chainrange`; a diagnoser of one fixed chain: the noise floor and the
+frequency at which its impacts ring inside its training records' ranges), its features not
 less like the training records than all but a stated share of held-out records
 (`recipdyn.diagnosis.domain`: a conformal novelty p-value); and the best-fitting simulated
 record of the class named must explain it within its noise
@@ -29,7 +32,7 @@ import numpy as np
 from ..errors import ParameterError
 from .channels import _cols, available, gate
 from .classes import get_class
-from .tolerances import FLOOR_SLACK, RANGE_SLACK, RING_SLACK
+from .tolerances import FLOOR_SLACK, RANGE_SLACK, RESONANCE_CHECK_MIN_HZ, RING_SLACK
 
 __all__ = ["diagnose", "Diagnosis", "default_model_path", "diagnose_arrays"]
 
@@ -110,6 +113,10 @@ class Diagnosis:
                 f"10-degree stretch (training records {_db(nf['training_range'][1]):.0f}.."
                 f"{_db(nf['training_range'][0]):.0f} dB)"
             )
+        for c in ev.get("chain_ranges", {}).values():
+            from .chainrange import ChainCheck
+
+            lines.append("chain against its declared range: " + ChainCheck(**c).text())
         if "pressure_deviation" in ev:
             pd_ = ev["pressure_deviation"]
             lines.append(
@@ -281,6 +288,7 @@ def _diagnose_arrays(
     baseline=None,
 ) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
+    from .chainrange import as_evidence, check_chain, declared_ranges, snr_estimate
     from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
     from .machine import machine_from_file, refusal
@@ -351,12 +359,14 @@ def _diagnose_arrays(
         if fix.refused:
             return _refuse(res, fix.refused, t0)
         revs, ph, pc = fix.revs, fix.p_head, fix.p_crank
-    if correct:
+    declared = declared_ranges(diag)  # None: a diagnoser of one chain (learnt ranges)
+    if correct or declared is not None:
         # the data set's sensor model: the bilinear resonance of the fixed chain, or a drawn
         # chain's exact (analog) one
         drawn = diag.card["spec"].get("chain", "fixed") == "drawn"
         form = "analog" if drawn else "bilinear"
-        chain.update(resonance(x, fs, revs if tacho is not None else None, form))
+        low = {} if declared is None else {"min_hz": RESONANCE_CHECK_MIN_HZ}  # (tolerances)
+        chain.update(resonance(x, fs, revs if tacho is not None else None, form, **low))
         res.evidence["chain"] = _chain_summary(chain)
     row = record_features(
         x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc, machine=machine_pairs
@@ -385,8 +395,24 @@ def _diagnose_arrays(
             "record or train on that rate",
             t0,
         )
-    # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
     floor = noise_floor(diag, X[0])
+    if declared is not None:
+        # the record's chain, estimated from it, against the ranges the diagnoser was trained
+        # under (chainrange.py); the learnt ranges of the statistics are not read. The floor
+        # of the record's own features (not referred to a baseline: the sensor's, not the
+        # machine's)
+        raw = np.array([row[n] for n in names], float)
+        floor = noise_floor(diag, raw)
+        read = None if floor is None else (floor[0], floor_kind(diag, raw))
+        if read is not None:  # the floor's share, and the SNR it gives
+            res.evidence["noise_floor"] = {"share": floor[0], "training_range": list(floor[1:]),
+                                           "snr_db": list(snr_estimate(*read)[:3])}  # fmt: skip
+        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"])
+        res.evidence["chain_ranges"] = as_evidence(checks)
+        if why:
+            return _refuse(res, why, t0)
+        floor = None  # (checked)
+    # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
     if floor is not None:
         q, lo, hi = floor
         floor_ev = {"share": q, "training_range": [lo, hi]}
@@ -404,7 +430,7 @@ def _diagnose_arrays(
             )
     lo, hi = st["ring_range"]
     ring = row["acc_ring_hz"]
-    if not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
+    if declared is None and not lo * (1 - RING_SLACK) <= ring <= hi * (1 + RING_SLACK):
         return _refuse(
             res,
             f"the impacts ring at {ring:.0f} Hz, outside the training sensor "
@@ -576,6 +602,14 @@ def noise_floor(diag, row: np.ndarray) -> tuple[float, float, float] | None:
     train = st["Z_train"].astype(float)[:, cols] * st["scale"][cols] + st["center"][cols]
     q_train = len(cols) * np.nanmin(train, axis=1)
     return len(cols) * float(a.min()), float(np.nanmin(q_train)), float(np.nanmax(q_train))
+
+
+def floor_kind(diag, row: np.ndarray) -> str:
+    """Which noise floor `noise_floor` read for ``row``: ``"angle"`` (the crank-angle bins,
+    with a tacho) or ``"quiet"`` (the quiet windows, without)."""
+    cols = [i for i, n in enumerate(diag.names) if n.startswith("ang_")]
+    a = np.asarray(row, float)[cols]
+    return "angle" if cols and np.isfinite(a).all() else "quiet"
 
 
 def _refuse(res: Diagnosis, reason: str, t0: float) -> Diagnosis:

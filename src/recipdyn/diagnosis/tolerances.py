@@ -3,7 +3,9 @@
 healthy baseline in `recipdyn.diagnosis.train`). A module of constants only, below every other
 module of the package, so that each reads them without importing another's code."""
 
-__all__ = ["RANGE_SLACK", "RING_SLACK", "FLOOR_SLACK", "OPERATING", "BASELINE_SPREAD_FLOOR"]
+__all__ = ["RANGE_SLACK", "RING_SLACK", "FLOOR_SLACK", "OPERATING", "BASELINE_SPREAD_FLOOR",
+           "SNR_CALIBRATION", "RING_AGREEMENT", "RESONANCE_CHECK_MIN_HZ",
+           "RESONANCE_CHECK_REL"]  # fmt: skip
 
 #: Slack on the training range of the crank speed and the sampling rate (relative).
 RANGE_SLACK = 0.02
@@ -19,3 +21,37 @@ OPERATING = ("speed_hz", "cy_p_suction", "cy_p_discharge")
 #: training records: a feature the healthy machine holds constant (a count) would otherwise
 #: turn any departure into an unbounded deviation.
 BASELINE_SPREAD_FLOOR = 0.05
+
+#: The noise floor's calibration to the accelerometer's SNR (`recipdyn.diagnosis.chainrange.
+#: snr_estimate`): ``x = 10 log10(1/q - 1)`` of the floor's share ``q``, then ``snr = x +
+#: offset`` with a 95 % interval ``[snr + lo, snr + hi]`` dB while ``x <= x_max``; above it the
+#: signal itself fills the quietest bin and ``snr + lo`` is a lower bound only. ``angle``: the
+#: crank-angle floor (a tacho); ``quiet``: the quiet windows (a constant speed). Measured by
+#: ``benchmarks/bench_chain_ranges.py --part calibrate`` on 792 records made with known
+#: chains (99 simulated machines of the shipped data set's training conditions, every class,
+#: each through 8 chains drawn from `recipdyn.chain.DEFAULT_RANGES` with the SNR widened to
+#: 0-50 dB and the resonance to 0.7-7 kHz; 2, 4 and 10 revolutions: 216, 360, 216 records):
+#: ``offset`` the pooled median of ``snr - x`` over the records with ``x <= 25`` dB (424 and
+#: 383 records), ``lo``/``hi`` the widest 2.5 / 97.5 % residuals of any one record length (2
+#: revolutions: the pooled interval covers 95 % of them, 97-100 % at 4 and 10). Above
+#: ``x_max`` the residuals' 2.5 % lay at -1.3 dB or above (angle) and -0.6 dB (quiet), within
+#: ``lo``; their 97.5 % at +6 to +20 dB.
+SNR_CALIBRATION = {
+    "angle": {"offset": -0.05, "lo": -2.5, "hi": 1.93, "x_max": 25.0, "records": 424},
+    "quiet": {"offset": -0.23, "lo": -1.39, "hi": 2.74, "x_max": 25.0, "records": 383},
+}
+#: The mount's fitted resonance counts as read only where the impacts ring within this share
+#: of it (`recipdyn.diagnosis.chainrange.check_chain`): a machine's own spectral peak (a worn
+#: crosshead pin's, near 2 kHz) fits a second-order response as well, where the mount's lies
+#: above the anti-alias corner (docs/diagnosis.md).
+RING_AGREEMENT = 0.1
+#: The lowest spectral peak tried as the mount's resonance when it is checked against the
+#: declared range (`recipdyn.diagnosis.correction.resonance`'s ``min_hz``; above the
+#: impacts' 500 Hz high-pass): from 1 kHz, 85 of 154 resonances at 0.8-2 kHz were read, from
+#: 600 Hz 144, with the same 2 of 145 in-band resonances misread below the band
+#: (``benchmarks/bench_chain_ranges.py --part calibrate``, 4 revolutions).
+RESONANCE_CHECK_MIN_HZ = 600.0
+#: Relative error added (in quadrature) to the resonance's own 95 % half-width before it is
+#: checked: its reported interval covered 87 % of 369 read resonances below 0.45 fs (4 and 10
+#: revolutions; the relative errors' 97.5 % quantile: 0.043); with 5 % added, 98.9 %.
+RESONANCE_CHECK_REL = 0.05
