@@ -54,6 +54,7 @@ MACHINES = [
     str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_frame.toml"),
     str(Path(__file__).parent / "machines" / "two_stage_interstage.toml"),
+    str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_torsion.toml"),
 ]
 MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 
