@@ -48,7 +48,8 @@ PRESETS = {
 # tests/test_contact.py (its section signals name the crank pin's ``ex``: zero there).
 #: Machines of several throws (`recipdyn.model.machine`, by their files): the motor coupling
 #: two throws through the crank, two throws with dynamic valves and a fault on one, two
-#: throws on a frame on its mounts, and two stages joined by an interstage volume.
+#: throws on a frame on its mounts, two stages joined by an interstage volume, and two
+#: throws on a torsionally flexible crankshaft.
 MACHINES = [
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
