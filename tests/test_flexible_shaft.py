@@ -255,7 +255,7 @@ def test_the_run_summary_holds_the_api618_torsional_check():
     the smallest ``|f - n f_run| / (n f_run)`` over the modes and orders 1-10, at the run's
     mean speed; a train tuned onto an order fails."""
     from recipdyn.model.shaft import train_of
-    from recipdyn.model.shaft.flexible import torsion_summary
+    from recipdyn.model.shaft.torsion import torsion_summary
 
     model = _model(read_machine(EXAMPLE))
     v = model.parameters()

@@ -638,7 +638,7 @@ class MachineModel(Model):
         API 618 rod load and crosshead-pin reversal over the last revolution, under its name;
         the frame's combined load (`_frame_summary`); a flexible shaft's natural frequencies
         and API 618's torsional separation at the run's mean speed
-        (`recipdyn.model.shaft.flexible.torsion_summary`)."""
+        (`recipdyn.model.shaft.torsion.torsion_summary`)."""
         from ..cycle import pin_reversal_summary
 
         machine = self.structure(values)
@@ -646,7 +646,7 @@ class MachineModel(Model):
         if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
             out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
         if machine.shaft.torsion:
-            from ..shaft.flexible import torsion_summary
+            from ..shaft.torsion import torsion_summary
 
             speed = (float(np.mean(ds["omega1"].values)) if "omega1" in ds.variables
                      else float(self._shaft(values, "omega")))  # fmt: skip

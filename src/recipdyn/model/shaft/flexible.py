@@ -37,7 +37,7 @@ The energy: the mechanisms', the rotor's and flywheel's ``J w^2 / 2`` and the se
 
 The linearised train (each throw its mean inertia, `recipdyn.model.shaft.torsion`) gives the
 natural frequencies the run summary checks against API 618's separation from orders 1-10 of
-the running speed. What is left out: the throws' inertia between the nodes (the crankshaft's
+the running speed (`recipdyn.model.shaft.torsion.torsion_summary`). What is left out: the throws' inertia between the nodes (the crankshaft's
 own inertia is lumped at the cranks), the motor's electrical dynamics (its torque follows
 Kloss's steady-state curve of the rotor's speed), a gear or belt's own compliance beyond the
 coupling's.
@@ -45,7 +45,6 @@ coupling's.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -55,7 +54,7 @@ from ...errors import ParameterError
 from ..protocol import Param
 
 __all__ = ["PARAMS", "THROW_PARAMS", "order", "nodes", "pack", "check", "static_twists",
-           "state_entries", "section_names", "stiffnesses", "torsion_summary"]  # fmt: skip
+           "state_entries", "section_names", "stiffnesses"]  # fmt: skip
 
 _WHY = ("an assumed drive of the paper's compressor: a 400 kg*m**2 rotor referred to the crank "
         "through a flexible coupling that puts the first torsional mode at ~1.5 x the running "
@@ -169,28 +168,3 @@ def static_twists(machine, values: Mapping[str, Any], torques: Sequence[float]) 
     along = [float(torques[k]) for k in order(machine)]
     carried = [sum(along[i:]) for i in range(len(along))]
     return np.array([sum(along) / ks[0], *(t / k for t, k in zip(carried, ks[1:], strict=True))])
-
-
-def torsion_summary(machine, values: Mapping[str, Any], speed_hz: float) -> dict[str, Any]:
-    """The linearised train's natural frequencies (`recipdyn.model.shaft.train_of`: each
-    throw its mean inertia) and API 618's separation from orders 1-10 of ``speed_hz``:
-    ``torsion_f<i>_hz`` per mode, ``torsion_min_separation`` (the smallest ``|f - n f_run| /
-    (n f_run)`` over the modes and orders) with its mode and order, and the verdict
-    ``api618_torsional`` (``pass``: every mode at least 10 % clear)."""
-    from .torsion import API618_MARGIN, API618_ORDERS, train_of
-
-    pre = machine.prefix("shaft")
-    train = train_of(machine, values, stiffnesses(machine, values),
-                     J_motor=float(values[pre + "J_motor"]),
-                     J_drive=float(values[pre + "J_drive"]))  # fmt: skip
-    f = train.natural_frequencies()
-    out: dict[str, Any] = {f"torsion_f{i}_hz": float(x) for i, x in enumerate(f, 1)}
-    best = (math.inf, 0, 0)
-    for i, x in enumerate(f, 1):
-        for n in API618_ORDERS:
-            sep = abs(x - n * speed_hz) / (n * speed_hz)
-            best = min(best, (sep, i, n))
-    out.update(torsion_running_speed_hz=float(speed_hz), torsion_min_separation=best[0],
-               torsion_min_separation_mode=best[1], torsion_min_separation_order=best[2],
-               api618_torsional="pass" if best[0] >= API618_MARGIN else "FAIL")  # fmt: skip
-    return out
