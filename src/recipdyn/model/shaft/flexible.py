@@ -37,10 +37,10 @@ The energy: the mechanisms', the rotor's and flywheel's ``J w^2 / 2`` and the se
 
 The linearised train (each throw its mean inertia, `recipdyn.model.shaft.torsion`) gives the
 natural frequencies the run summary checks against API 618's separation from orders 1-10 of
-the running speed (`recipdyn.model.shaft.torsion.torsion_summary`). What is left out: the throws' inertia between the nodes (the crankshaft's
-own inertia is lumped at the cranks), the motor's electrical dynamics (its torque follows
-Kloss's steady-state curve of the rotor's speed), a gear or belt's own compliance beyond the
-coupling's.
+the running speed (`recipdyn.model.shaft.torsion.torsion_summary`). What is left out: the
+throws' inertia between the nodes (the crankshaft's own inertia is lumped at the cranks), the
+motor's electrical dynamics (its torque follows Kloss's steady-state curve of the rotor's
+speed), a gear or belt's own compliance beyond the coupling's.
 """
 
 from __future__ import annotations
