@@ -305,3 +305,16 @@ def test_a_flexible_shafts_values_are_checked_in_one_line():
     )
     with pytest.raises(ParameterError, match=r"throw1\.k_shaft .*\[shaft\.torsion\]"):
         _model(rigid)
+
+
+def test_a_bad_flexible_shaft_is_refused_before_the_compiled_code_loads(tmp_path):
+    """``--set shaft.J_motor=4000`` (above ``J_drive``) on the example: one line, exit status
+    2, before numba, xarray, SciPy or the kernels load (a fresh interpreter)."""
+    from test_cli_refusals import _fresh
+
+    args = ["simulate", "--machine", str(EXAMPLE), "--set", "shaft.J_motor=4000 kg*m**2"]
+    res = _fresh([*args, "-o", "o/x.nc"], tmp_path)
+    assert res["code"] == 2, res["err"]
+    assert res["heavy"] == [], res["heavy"]
+    assert len(res["err"].strip().splitlines()) == 1, res["err"]
+    assert "shaft.J_motor" in res["err"] and "J_drive" in res["err"]
