@@ -31,6 +31,9 @@ PRESETS = {
     "compressor[drive=motor,motor=constant,load=cycle]": {"drive": "motor", "motor": "constant",
                                                           "load": "cycle"},
     "compressor[drive=motor,rc=0]": {"drive": "motor", "rc": 0.0},
+    # the dynamic valves with the crank free: the motor template's Jacobian steps a load's
+    # states by the load's own differences (a plate's velocity by its own scale)
+    "compressor-valves[drive=motor]": {"drive": "motor"},
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},

@@ -497,6 +497,11 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
                 kinds.append(0)
             else:
                 kinds.append(1)
+        step_at = np.full(st.size, -1, dtype=np.int64)  # a load's state: its (rel, abs) step
+        if has_states:
+            for t in throws:
+                g, o = st.start(f"{t.name}.load"), pv.start(f"{t.name}.steps")
+                step_at[g : g + len(load.states)] = o + 2 * np.arange(len(load.states))
         constants.update(
             CRANK=st["theta1"],
             MOTOR=pv.start("shaft.motor"),
@@ -504,6 +509,7 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
             **_torsion_constants(machine, layout),
             THROW_WORK=starts(st, "work"),
             STEP_KIND=np.array(kinds, dtype=np.int64),
+            STEP_AT=step_at,
         )
     note = ""
     for c in (load, motor):  # a user's file: its edits give a new module, never stale code

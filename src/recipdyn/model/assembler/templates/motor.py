@@ -18,11 +18,12 @@ thcd, F, p, m) -> (I, Q, k, c)``, ``crosshead``, ``crank_torque``, and the loads
 Constants: ``CRANK``, ``SHAFT`` (the offset of ``J_drive``), ``MOTOR`` (the torque law's
 slice), ``THROW_WORK``, ``STEP_KIND`` (per state: how the Jacobian's central differences
 step it: ``0`` an angle, absolute 1e-4; ``1`` a rate, 1e-4 max(1, |y|); ``2`` a load's
-state, 1e-7 max(|y|, 1e-3); ``3`` a column left 0, a work integral or a counter nothing
-depends on), and the throws', the loads' and the interstage volumes' as in `prescribed`
-(an interstage's pressure is stepped as a load's state); a frame on its mounts (``FRAME``) as
-in `prescribed`, shaken by the throws at the crank's acceleration; ``MOTOR_WORK`` (the motor's
-work's state).
+state, by the load's own differences ``1e-7 (|y| (1 + rel) + abs)`` with ``(rel, abs)`` at
+``p[STEP_AT[i]]`` (its slice of steps, as in `prescribed`; an interstage's pressure, whose
+``STEP_AT`` is ``-1``: 1e-7 max(|y|, 1e-3)); ``3`` a column left 0, a work integral or a
+counter nothing depends on), and the throws', the loads' and the interstage volumes' as in
+`prescribed`; a frame on its mounts (``FRAME``) as in `prescribed`, shaken by the throws at
+the crank's acceleration; ``MOTOR_WORK`` (the motor's work's state).
 
 A torsionally flexible shaft (``TORSION``, `recipdyn.model.shaft.flexible`): the crank's
 states are the rotor's, followed by the other ``N_NODES - 1`` nodes' angles and speeds (the
@@ -90,6 +91,7 @@ THROW_LOAD = np.array([17], dtype=np.int64)
 LOAD_STATE = np.array([6], dtype=np.int64)
 LOAD_AUX = np.array([6], dtype=np.int64)
 STEP_KIND = np.array([0, 1, 0, 1, 3, 3], dtype=np.int64)
+STEP_AT = np.array([-1, -1, -1, -1, -1, -1], dtype=np.int64)
 N_OBS = np.int64(5)
 OBS_THROW = np.array([2], dtype=np.int64)
 # </bindings>
@@ -219,9 +221,10 @@ def jac(t, y, p, J):
     """Central differences with one Richardson step, (4 D(h/2) - D(h)) / 3: truncation
     O(h**4), rounding ~eps |f| / h, with each state's step by its kind (``STEP_KIND``): with
     |f| ~ 1e6 (theta_c'') rounding ~2e-6 and truncation ~1e-10 for the angles and rates; a
-    load's states step by 1e-7 of their size (its stops and regularised nozzles are not
-    smooth everywhere). The work integrals' and counters' columns are 0 (nothing depends on
-    them)."""
+    load's states step by 1e-7 of their own scale (the load's ``steps``: its stops and
+    regularised nozzles are not smooth everywhere, and a plate's velocity needs a step of its
+    own size, not of its value's, which passes through 0). The work integrals' and counters'
+    columns are 0 (nothing depends on them)."""
     n = y.shape[0]
     fp = np.empty(n)
     fm = np.empty(n)
@@ -237,6 +240,9 @@ def jac(t, y, p, J):
             h = 1e-4
         elif kind == 1:
             h = 1e-4 * max(1.0, abs(y[k]))
+        elif STEP_AT[k] >= 0:
+            a = STEP_AT[k]
+            h = 1e-7 * (abs(y[k]) * (1.0 + p[a]) + p[a + 1])
         else:
             h = 1e-7 * max(abs(y[k]), 1e-3)
         for level in range(2):
