@@ -265,6 +265,11 @@ def test_the_run_summary_holds_the_api618_torsional_check():
     f_run = OMEGA / (2 * math.pi)
     sep = min(abs(x - n * f_run) / (n * f_run) for x in f for n in range(1, 11))
     assert s["torsion_min_separation"] == pytest.approx(sep, rel=1e-12)
+    for i, x in enumerate(f, 1):  # each mode's nearest order and its margin
+        n = s[f"torsion_f{i}_order"]
+        assert s[f"torsion_f{i}_separation"] == pytest.approx(abs(x - n * f_run) / (n * f_run))
+        assert all(abs(x - m * f_run) / (m * f_run) >= s[f"torsion_f{i}_separation"]
+                   for m in range(1, 11))  # fmt: skip
     assert s["api618_torsional"] == ("pass" if sep >= 0.1 else "FAIL")
     hit = torsion_summary(model.machine, v, f[0] / 3.02)  # the first mode at 3.02 x the speed
     assert hit["api618_torsional"] == "FAIL" and hit["torsion_min_separation_order"] == 3

@@ -195,24 +195,25 @@ def train_of(
 
 def torsion_summary(machine, values: Mapping[str, Any], speed_hz: float) -> dict[str, Any]:
     """The linearised train's natural frequencies (`recipdyn.model.shaft.train_of`: each
-    throw its mean inertia) and API 618's separation from orders 1-10 of ``speed_hz``:
-    ``torsion_f<i>_hz`` per mode, ``torsion_min_separation`` (the smallest ``|f - n f_run| /
-    (n f_run)`` over the modes and orders) with its mode and order, and the verdict
-    ``api618_torsional`` (``pass``: every mode at least 10 % clear)."""
+    throw its mean inertia) and API 618's separation from orders 1-10 of ``speed_hz``: per
+    mode ``torsion_f<i>_hz``, its nearest order ``torsion_f<i>_order`` and its separation from
+    it ``torsion_f<i>_separation`` (``|f - n f_run| / (n f_run)``); the smallest over the modes,
+    ``torsion_min_separation`` with its mode and order, and the verdict ``api618_torsional``
+    (``pass``: every mode at least 10 % clear of every order)."""
     from .flexible import stiffnesses
 
     pre = machine.prefix("shaft")
     train = train_of(machine, values, stiffnesses(machine, values),
                      J_motor=float(values[pre + "J_motor"]),
                      J_drive=float(values[pre + "J_drive"]))  # fmt: skip
-    f = train.natural_frequencies()
-    out: dict[str, Any] = {f"torsion_f{i}_hz": float(x) for i, x in enumerate(f, 1)}
+    out: dict[str, Any] = {"torsion_running_speed_hz": float(speed_hz)}
     best = (math.inf, 0, 0)
-    for i, x in enumerate(f, 1):
-        for n in API618_ORDERS:
-            sep = abs(x - n * speed_hz) / (n * speed_hz)
-            best = min(best, (sep, i, n))
-    out.update(torsion_running_speed_hz=float(speed_hz), torsion_min_separation=best[0],
-               torsion_min_separation_mode=best[1], torsion_min_separation_order=best[2],
+    for i, x in enumerate(train.natural_frequencies(), 1):
+        sep, n = min((abs(x - n * speed_hz) / (n * speed_hz), n) for n in API618_ORDERS)
+        out.update({f"torsion_f{i}_hz": float(x), f"torsion_f{i}_order": n,
+                    f"torsion_f{i}_separation": float(sep)})  # fmt: skip
+        best = min(best, (sep, i, n))
+    out.update(torsion_min_separation=float(best[0]), torsion_min_separation_mode=best[1],
+               torsion_min_separation_order=best[2],
                api618_torsional="pass" if best[0] >= API618_MARGIN else "FAIL")  # fmt: skip
     return out
