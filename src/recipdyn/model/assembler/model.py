@@ -582,20 +582,19 @@ class MachineModel(Model):
                     y[:, iw], "J", "work done by the gas on the crosshead since t = 0"
                 )
                 own_energy = mechanism_energy(p, th1, thc, wk, thcd)
-                if torsion:  # (the drive's nodes and the springs below)
-                    energy += own_energy
-                    if not c.machine.flat:
-                        own["energy"] = Signal(own_energy, "J", "kinetic + potential energy of "
-                                               "this throw's crank, rod and crosshead")  # fmt: skip
-                elif not c.machine.flat:
+                if not c.machine.flat:
                     own["energy"] = Signal(own_energy, "J", "kinetic + potential energy of this "
                                            "throw's crank, rod and crosshead")  # fmt: skip
+                if torsion:  # (the drive's nodes and the springs: `_torsion_outputs`)
+                    energy += own_energy
+                elif not c.machine.flat:
                     energy += own_energy + 0.5 * p.J_drive * w1 * w1 if k == 0 else own_energy
                 else:  # (the drive's inertia in the same expression, as before the assembler)
                     energy += mechanism_energy(p, th1, thc, w1, thcd, p.J_drive)
             if not c.machine.flat:
                 own["theta1"] = Signal(th1, "rad", "crank angle of this throw in its own axes "
-                                       "(the shaft's + phase - cylinder_angle)")  # fmt: skip
+                                       "(the shaft's, or on a flexible shaft its node's, + "
+                                       "phase - cylinder_angle)")  # fmt: skip
                 own.update(_shaking(p, kin, fg, wk, ak, th, shake))
             if frame is not None:
                 own.update(frame.at_guide(th, own["a"].values))
