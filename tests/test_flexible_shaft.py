@@ -131,13 +131,15 @@ def test_a_free_oscillation_turns_at_the_linear_trains_lowest_natural_frequency(
 
 def test_the_stiff_limit_is_the_rigid_crank():
     """Every stiffness times 1, 4, 16 (no damping; ideal pins, half a revolution): the throws'
-    crank angles depart from the rigid machine's (the same values, one crank) by ``C / k``.
-    Derivation: the sections' twists are the quasi-static ``T(t) / k`` plus the free
-    oscillation the initial state's mismatch with the instantaneous torques starts, also
-    ``O(T / k)`` in angle; the corrections are ``O(1 / k^2)``. So each 4x stiffer shaft
-    divides the largest departure by 4 within 10 % (measured 4.08 and 3.99). The speeds go
-    as ``omega_n / k ~ k^(-1/2)`` (the undamped oscillation's velocity): they shrink, more
-    slowly."""
+    crank angles and the rotor's speed depart from the rigid machine's (the same values, one
+    crank) by ``C / k``. Derivation: the sections' twists are the quasi-static ``T(t) / k``
+    plus a free oscillation; the run starts at the quasi-static twists of its first instant
+    (`recipdyn.model.shaft.flexible.twisted_start`), so what starts the oscillation is the
+    twists' rates, ``T' / k``: an oscillation of angle ``T' / (k w_n)`` and of speed ``T' /
+    k``; the corrections are ``O(1 / k^2)``. So each 4x stiffer shaft divides the largest
+    departure of the angles by 4 within 10 % (measured 4.04 and 4.01) and of the speed within
+    20 % (measured 4.29 and 4.28: a larger ``1 / k^2`` part, the oscillation's frequency
+    ``w_n ~ k^(1/2)`` beside the load's orders)."""
     kw = dict(revolutions=0.5, fs=4000.0)
     rigid_model = _model(_machine(0.0, 0.0, torsion=False))
     rigid = _simulate(model=rigid_model, params=rigid_model.parameters(), **kw)
@@ -151,7 +153,8 @@ def test_the_stiff_limit_is_the_rigid_crank():
         speeds.append(float(np.max(np.abs(ds["omega1"].values - rigid["omega1"].values))))
     ratios = [angles[i] / angles[i + 1] for i in range(2)]
     assert all(3.6 < r < 4.4 for r in ratios), (angles, ratios)
-    assert speeds[0] > speeds[1] > speeds[2], speeds
+    ratios = [speeds[i] / speeds[i + 1] for i in range(2)]
+    assert all(3.2 < r < 4.8 for r in ratios), (speeds, ratios)
 
 
 def test_the_energy_balance_and_each_nodes_torques():

@@ -486,29 +486,21 @@ class MachineModel(Model):
             y[st["theta1"]] = float(self._shaft(values, "theta1_0"))
             y[st["omega1"]] = float(self._shaft(values, "omega"))
         if c.machine.shaft.torsion:  # each node behind the one before by its section's twist
-            from ..shaft.flexible import static_twists
+            from ..base import rhs_series
+            from ..shaft.flexible import stiffnesses, twisted_start
 
-            twists = static_twists(c.machine, values, self._mean_torques(values))
             nodes = st.parts["shaft.nodes"]
-            theta = y[st["theta1"]]
-            for j, i in enumerate(range(nodes.start, nodes.stop, 2)):
-                theta = theta - twists[j]
-                y[i], y[i + 1] = theta, y[st["omega1"]]
+            o = c.layout.params.start("shaft.torsion")
+
+            def rhs(yy):
+                return rhs_series(c.kernels.rhs, c.params, np.zeros(1), yy[None, :])[0]
+
+            y = twisted_start(rhs, y, [st["theta1"], *range(nodes.start, nodes.stop, 2)],
+                              (c.params[o], c.params[o + 1]),
+                              stiffnesses(c.machine, values))  # fmt: skip
         for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
             y[st[f"{i.name}.p"]] = float(values[f"{i.upstream}.discharge_pressure"])
         return y
-
-    def _mean_torques(self, values: Mapping[str, Any]) -> list[float]:
-        """Each throw's mean load torque over a revolution of its ideal mechanism at constant
-        speed (the dynamic valves' as of the ideal-valve cycle of the same cylinder), N m."""
-        from ..components.drive import mean_load_torque
-
-        out = []
-        for v in self.throws(values):
-            if v.get("load") == "valves":
-                v = {**v, "load": "cycle", "gas": "ideal", "load_table": None}
-            out.append(mean_load_torque(v))
-        return out
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """``max(1, |y0|)``; a load's states at their own size (the valves':

@@ -53,7 +53,7 @@ import numpy as np
 from ...errors import ParameterError
 from ..protocol import Param
 
-__all__ = ["PARAMS", "THROW_PARAMS", "order", "nodes", "pack", "check", "static_twists",
+__all__ = ["PARAMS", "THROW_PARAMS", "order", "nodes", "pack", "check", "twisted_start",
            "state_entries", "section_names", "stiffnesses"]  # fmt: skip
 
 _WHY = ("an assumed drive of the paper's compressor: a 400 kg*m**2 rotor referred to the crank "
@@ -159,12 +159,43 @@ def pack(machine, values: Mapping[str, Any]) -> tuple[np.ndarray, list[tuple[str
     return np.asarray(out, dtype=np.float64), names
 
 
-def static_twists(machine, values: Mapping[str, Any], torques: Sequence[float]) -> np.ndarray:
-    """Each section's twist under the throws' mean load torques ``torques`` (in the throws'
-    order, N m): section ``i`` carries the torques of every throw beyond it, ``twist = T /
-    k`` (the initial state starts from it, so a run does not begin with the whole load's
-    torsional transient)."""
-    ks = stiffnesses(machine, values)
-    along = [float(torques[k]) for k in order(machine)]
-    carried = [sum(along[i:]) for i in range(len(along))]
-    return np.array([sum(along) / ks[0], *(t / k for t, k in zip(carried, ks[1:], strict=True))])
+def twisted_start(rhs, y: np.ndarray, angles: Sequence[int], inertias: tuple[float, float],
+                  ks: Sequence[float]) -> np.ndarray:  # fmt: skip
+    """``y`` with the nodes (their angles' states ``angles``, along the shaft; their speeds
+    next to them) twisted as the rigid shaft's motion at that instant asks: the sections'
+    quasi-static twists, so that a run starts without the torsional transient of the whole
+    load (only the twists' rates, ``O(T' / k)``, are left to start one).
+
+    The throws' shares ``(I_k, Q_k)`` come from the right-hand side ``rhs(y) -> dy/dt``
+    itself: with every node at the rotor's angle and speed (no twist) a throw's node
+    accelerates at ``Q_k / I_k``; with its upstream neighbour turned on by ``delta`` the
+    section adds ``k delta`` (the throw's share does not depend on its neighbour), so
+    ``I_k = k delta / (change of its acceleration)``. The rotor's at no twist is ``T_m /
+    J_motor``. Then the rigid shaft's acceleration ``a = (T_m + sum Q) / (J_motor + J_flywheel
+    + sum I)`` and each node's equation ``J_i a = Q_i + T_(i-1) - T_i`` give the sections'
+    torques ``T_i`` along the shaft, and their twists ``T_i / k_i``. ``inertias``: ``(J_motor,
+    J_flywheel)``; ``ks``: the sections' stiffnesses."""
+    y = np.array(y, dtype=np.float64)
+    rotor = angles[0]
+    for i in angles:
+        y[i], y[i + 1] = y[rotor], y[rotor + 1]
+    f0 = rhs(y)
+    delta = 1e-3
+    shares = []
+    for j in range(2, len(angles)):
+        yy = y.copy()
+        yy[angles[j - 1]] += delta
+        a0, a1 = f0[angles[j] + 1], rhs(yy)[angles[j] + 1]
+        inertia = ks[j - 1] * delta / (a1 - a0)
+        shares.append((inertia, inertia * a0))
+    tm = inertias[0] * f0[rotor + 1]
+    alpha = (tm + sum(q for _, q in shares)) / (sum(inertias) + sum(i for i, _ in shares))
+    torque = tm - inertias[0] * alpha  # the coupling's
+    torques = [torque, torque - inertias[1] * alpha]
+    for inertia, q in shares[:-1]:
+        torques.append(torques[-1] + q - inertia * alpha)
+    theta = y[rotor]
+    for j in range(1, len(angles)):
+        theta = theta - torques[j - 1] / ks[j - 1]
+        y[angles[j]] = theta
+    return y
