@@ -16,12 +16,12 @@ a table's length varies, and every offset before it stays a constant of the gene
 module). The order of the state: per throw its clearance angle and rate; with a motor the
 crank's angle and speed (on a flexible shaft the rotor's, then the other nodes' angles and
 speeds along the shaft) and the motor's work (and the shaft's dissipation), then per throw
-the gas's work on its crosshead; then the
-frame's states and work integrals (with a frame); then per throw its load's states; then per
-interstage its pressure (``interstage1.p``); then per throw its load's auxiliary states. With
-one throw this is the order of the compressor's state before the assembler (``theta_c,
-thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so
-records and configs of one throw keep their meaning.
+the gas's work on its crosshead; then the frame's states and work integrals (with a frame);
+then per throw its load's states; then per interstage its pressure (``interstage1.p``); then
+per throw its load's auxiliary states. With one throw this is the order of the compressor's
+state before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the
+valves' states>, <their counters>``), so records and configs of one throw keep their
+meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
@@ -375,11 +375,10 @@ def _torsion_constants(machine: Machine, layout: Layout) -> dict[str, Any]:
         return {"TORSION": False, "N_NODES": 1, "TORSION_PARAMS": 0, "SHAFT_DAMPING": 0,
                 "THROW_NODE": np.full(len(machine.throws), st["theta1"], dtype=np.int64),
                 "OBS_SECTION": 0}  # fmt: skip
-    from ..shaft.flexible import order
-
-    node = np.empty(len(machine.throws), dtype=np.int64)
-    for j, k in enumerate(order(machine)):
-        node[k] = st["theta1"] + 2 * (2 + j)
+    # the role reads node j at CRANK + 2 j: the other nodes follow the rotor's states
+    assert st.start("shaft.nodes") == st["theta1"] + 2, "the nodes are contiguous"
+    node = np.array([st[machine.prefix(t.name) + "theta_shaft"] for t in machine.throws],
+                    dtype=np.int64)  # fmt: skip
     return {"TORSION": True, "N_NODES": 2 + len(machine.throws),
             "TORSION_PARAMS": layout.params.start("shaft.torsion"),
             "SHAFT_DAMPING": st[machine.prefix("shaft") + "W_shaft_damping"],
