@@ -31,6 +31,9 @@ PRESETS = {
     "compressor[drive=motor,motor=constant,load=cycle]": {"drive": "motor", "motor": "constant",
                                                           "load": "cycle"},
     "compressor[drive=motor,rc=0]": {"drive": "motor", "rc": 0.0},
+    # the dynamic valves with the crank free: the motor template's Jacobian steps a load's
+    # states by the load's own differences (a plate's velocity by its own scale)
+    "compressor-valves[drive=motor]": {"drive": "motor"},
     "compressor-contact[crank_joint=lubricated,crosshead_joint=contact]": {
         "crank_joint": "lubricated", "crosshead_joint": "contact", "omega": 150.0,
         "load_amplitude": 2e4},
@@ -48,12 +51,14 @@ PRESETS = {
 # tests/test_contact.py (its section signals name the crank pin's ``ex``: zero there).
 #: Machines of several throws (`recipdyn.model.machine`, by their files): the motor coupling
 #: two throws through the crank, two throws with dynamic valves and a fault on one, two
-#: throws on a frame on its mounts, and two stages joined by an interstage volume.
+#: throws on a frame on its mounts, two stages joined by an interstage volume, and two
+#: throws on a torsionally flexible crankshaft.
 MACHINES = [
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_frame.toml"),
     str(Path(__file__).parent / "machines" / "two_stage_interstage.toml"),
+    str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_torsion.toml"),
 ]
 MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 

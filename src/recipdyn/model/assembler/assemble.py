@@ -10,15 +10,18 @@ drive (`recipdyn.model.assembler.generate`).
 The order of the parameter vector: the shaft's drive and torque law, then per throw its
 mechanism (`recipdyn.model.mechanism.link.MECHANISM`), its phase and its load's difference
 steps, then the frame's slice (a machine with a ``[frame]``), then per interstage volume its
-slice (`recipdyn.model.components.interstage`), then per throw its load's slice (last: a
-table's length varies, and every offset before it stays a constant of the generated module).
-The order of the state: per throw its clearance angle and rate; with a motor the crank's
-angle and speed and the motor's work, then per throw the gas's work on its crosshead; then the
-frame's states and work integrals (with a frame); then per throw its load's states; then per
-interstage its pressure (``interstage1.p``); then per throw its load's auxiliary states. With
-one throw this is the order of the compressor's state before the assembler (``theta_c,
-thetadot_c[, theta1, omega1, W_motor, W_gas], <the valves' states>, <their counters>``), so
-records and configs of one throw keep their meaning.
+slice (`recipdyn.model.components.interstage`), then the flexible shaft's (a machine with a
+``[shaft.torsion]``, `recipdyn.model.shaft.flexible`), then per throw its load's slice (last:
+a table's length varies, and every offset before it stays a constant of the generated
+module). The order of the state: per throw its clearance angle and rate; with a motor the
+crank's angle and speed (on a flexible shaft the rotor's, then the other nodes' angles and
+speeds along the shaft) and the motor's work (and the shaft's dissipation), then per throw
+the gas's work on its crosshead; then the frame's states and work integrals (with a frame);
+then per throw its load's states; then per interstage its pressure (``interstage1.p``); then
+per throw its load's auxiliary states. With one throw this is the order of the compressor's
+state before the assembler (``theta_c, thetadot_c[, theta1, omega1, W_motor, W_gas], <the
+valves' states>, <their counters>``), so records and configs of one throw keep their
+meaning.
 
 The throws of one machine carry one kind of load and one set of equations (the template binds
 one set of load roles); their parameters (geometry, masses, phases, cylinders, faults) differ
@@ -269,6 +272,11 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
         put(i.name, INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}),
             [(f"{i.name}.{k}", u) for k, u in (("volume", "m**3"), ("cooler_temperature", "K"),
                                                ("gas_constant", "J/(kg*K)"))])  # fmt: skip
+    if machine.shaft.torsion:
+        from ..shaft.flexible import pack as torsion_pack
+
+        arr, names = torsion_pack(machine, values)
+        put("shaft.torsion", arr, names)
     for t, local in zip(machine.throws, locals_, strict=True):
         put(f"{t.name}.load", load.pack(local))
     params = pv.build()
@@ -287,7 +295,13 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
         place(f"{t.name}.mechanism", ((pre + s, u) for s, u in STATES), DOF)
     if motor is not None:
         place("shaft", (("theta1", "rad"), ("omega1", "rad/s")), DOF)
-        place("shaft.work", (("W_motor", "J"),), WORK)
+        work = [("W_motor", "J")]
+        if machine.shaft.torsion:
+            from ..shaft.flexible import state_entries
+
+            place("shaft.nodes", state_entries(machine), DOF)
+            work.append((machine.prefix("shaft") + "W_shaft_damping", "J"))
+        place("shaft.work", work, WORK)
         for t in machine.throws:
             place(f"{t.name}.work", ((machine.prefix(t.name) + "W_gas", "J"),), WORK)
     if machine.frame is not None:
@@ -312,6 +326,11 @@ def assemble(machine: Machine, values: Mapping[str, Any]) -> Configuration:
     for t in machine.throws:
         ov.add(t.name, ((f"{t.name}.theta1", "rad"), (f"{t.name}.gas_force", "N"),
                         (f"{t.name}.crank_torque", "N*m")))  # fmt: skip
+    if machine.shaft.torsion:
+        from ..shaft.flexible import section_names
+
+        ov.add("shaft.sections", ((f"{q}{x}", u) for q in section_names(machine)
+                                  for x, u in (("twist", "rad"), ("torque", "N*m"))))  # fmt: skip
     outputs = ov.build()
     layout = Layout(state, params, outputs)
 
@@ -337,6 +356,33 @@ def _frame_roles(frame: bool) -> dict[str, tuple[str, str]]:
         return {"shaking": absent, "frame_load": absent, "frame_rhs": absent}
     return {"shaking": (KERNELS, "shaking"), "frame_load": (FRAME_KERNELS, "throw_load"),
             "frame_rhs": (FRAME_KERNELS, "frame_rhs")}  # fmt: skip
+
+
+def _torsion_roles(torsion: bool) -> dict[str, tuple[str, str]]:
+    if not torsion:
+        absent = ("recipdyn.model.assembler.generate", "absent")
+        return {"shaft_nodes": absent, "shaft_section": absent}
+    kernels = "recipdyn.model.shaft.kernels"
+    return {"shaft_nodes": (kernels, "nodes_rhs"), "shaft_section": (kernels, "section")}
+
+
+def _torsion_constants(machine: Machine, layout: Layout) -> dict[str, Any]:
+    """``TORSION``, ``N_NODES``, the shaft's slice, its dissipation's state, each throw's
+    node (its angle's state; the crank's on a rigid shaft) and the sections' first observer
+    column."""
+    st = layout.state
+    if not machine.shaft.torsion:
+        return {"TORSION": False, "N_NODES": 1, "TORSION_PARAMS": 0, "SHAFT_DAMPING": 0,
+                "THROW_NODE": np.full(len(machine.throws), st["theta1"], dtype=np.int64),
+                "OBS_SECTION": 0}  # fmt: skip
+    # the role reads node j at CRANK + 2 j: the other nodes follow the rotor's states
+    assert st.start("shaft.nodes") == st["theta1"] + 2, "the nodes are contiguous"
+    node = np.array([st[machine.prefix(t.name) + "theta_shaft"] for t in machine.throws],
+                    dtype=np.int64)  # fmt: skip
+    return {"TORSION": True, "N_NODES": 2 + len(machine.throws),
+            "TORSION_PARAMS": layout.params.start("shaft.torsion"),
+            "SHAFT_DAMPING": st[machine.prefix("shaft") + "W_shaft_damping"],
+            "THROW_NODE": node, "OBS_SECTION": layout.outputs.start("shaft.sections")}  # fmt: skip
 
 
 def _interstage_roles(machine: Machine, load: Component) -> dict[str, tuple[str, str]]:
@@ -433,7 +479,10 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         template = "motor"
         roles["torque"] = (motor.module, motor.kernel("torque"))
         roles["free_contribution"] = (KERNELS, "free_contribution")
+        roles.update(_torsion_roles(machine.shaft.torsion))
         kinds = []
+        nodes = st.parts.get("shaft.nodes", slice(0, 0))
+        node_angles = set(range(nodes.start, nodes.stop, 2))  # (a flexible shaft's nodes)
         for i, name in enumerate(st.names):
             if i in range(*st.parts["shaft.work"].indices(st.size)) or any(
                     i in range(*st.parts[f"{t.name}.{part}"].indices(st.size))
@@ -443,15 +492,23 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
             elif any(i in range(*st.parts[f"{t.name}.load"].indices(st.size)) for t in throws) or (
                     any(i == st[f"{s.name}.p"] for s in machine.interstages)):  # fmt: skip
                 kinds.append(2)
-            elif name == "theta1" or name.endswith("theta_c"):
+            elif name == "theta1" or name.endswith("theta_c") or i in node_angles:
                 kinds.append(0)
             else:
                 kinds.append(1)
+        step_at = np.full(st.size, -1, dtype=np.int64)  # a load's state: its (rel, abs) step
+        if has_states:
+            for t in throws:
+                g, o = st.start(f"{t.name}.load"), pv.start(f"{t.name}.steps")
+                step_at[g : g + len(load.states)] = o + 2 * np.arange(len(load.states))
         constants.update(
             CRANK=st["theta1"],
             MOTOR=pv.start("shaft.motor"),
+            MOTOR_WORK=st["W_motor"],
+            **_torsion_constants(machine, layout),
             THROW_WORK=starts(st, "work"),
             STEP_KIND=np.array(kinds, dtype=np.int64),
+            STEP_AT=step_at,
         )
     note = ""
     for c in (load, motor):  # a user's file: its edits give a new module, never stale code
@@ -460,6 +517,7 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
     stem = (f"{load.name}_{equations}_{len(throws)}"
             + ("" if motor is None else f"_{motor.name}")
             + ("_frame" if frame else "")
+            + ("_torsion" if machine.shaft.torsion else "")
             + (f"_is{len(machine.interstages)}" if machine.interstages else "")
             ).replace("-", "_")  # fmt: skip
     return template, roles, constants, stem, note

@@ -26,7 +26,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import ParameterError
-from ..machine.description import FED_NAMES, SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
+from ..machine.description import (
+    FED_NAMES,
+    SHAFT_NAMES,
+    STAGE_NAMES,
+    THROW_TORSION_NAMES,
+    Machine,
+    Shaft,
+    Throw,
+)
 from ..mechanism.link import (
     PHASE,
     SIGN_CONVENTION,
@@ -95,6 +103,10 @@ def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     out = [p for p in base if p.name not in skip and p.group != "drive"]
     if throw.crank_joint == "ideal":
         out = [p for p in out if p.name != "rc"]
+    if shaft.torsion:  # the crankshaft section that ends at its crank
+        from ..shaft.flexible import THROW_PARAMS
+
+        out += THROW_PARAMS
     return (*out, PHASE)
 
 
@@ -105,6 +117,10 @@ def _shaft_params(shaft: Shaft) -> tuple[Param, ...]:
     out = [SCHEMA["omega"], SCHEMA["theta1_0"]]
     if shaft.drive == "motor":
         out += list(MOTOR.params) + list(resolve_component("motor", shaft.motor, MOTORS).params)
+    if shaft.torsion:
+        from ..shaft.flexible import PARAMS
+
+        out += PARAMS
     return tuple(out)
 
 
@@ -150,8 +166,13 @@ def machine_schema(machine: Machine) -> Schema:
         known = {p.name for p in own} | {"load_table"}
         for k in given:
             if k not in known:
+                hint = (
+                    ""
+                    if k not in THROW_TORSION_NAMES
+                    else " (a crankshaft section's: the shaft needs a [shaft.torsion] table)"
+                )
                 raise ParameterError(f"machine {machine.name!r}: {t.name}.{k} is not a parameter "
-                                     f"of a throw with load = {t.load!r}")  # fmt: skip
+                                     f"of a throw with load = {t.load!r}{hint}")  # fmt: skip
         pre = machine.prefix(t.name)
         params += [_with_default(p, pre + p.name, given.get(p.name)) for p in own]
         if t.load == "table":
@@ -331,6 +352,10 @@ class MachineModel(Model):
             from ..frame.body import check as frame_check
 
             frame_check(machine.frame, frame_values(values))
+        if machine.shaft.torsion:
+            from ..shaft.flexible import check as torsion_check
+
+            torsion_check(machine, values)
         self._check_interstages(machine, values)
 
     def _check_interstages(self, machine: Machine, values: Mapping[str, Any]) -> None:
@@ -460,6 +485,19 @@ class MachineModel(Model):
         if c.motor is not None:
             y[st["theta1"]] = float(self._shaft(values, "theta1_0"))
             y[st["omega1"]] = float(self._shaft(values, "omega"))
+        if c.machine.shaft.torsion:  # each node behind the one before by its section's twist
+            from ..base import rhs_series
+            from ..shaft.flexible import stiffnesses, twisted_start
+
+            nodes = st.parts["shaft.nodes"]
+            o = c.layout.params.start("shaft.torsion")
+
+            def rhs(yy):
+                return rhs_series(c.kernels.rhs, c.params, np.zeros(1), yy[None, :])[0]
+
+            y = twisted_start(rhs, y, [st["theta1"], *range(nodes.start, nodes.stop, 2)],
+                              (c.params[o], c.params[o + 1]),
+                              stiffnesses(c.machine, values))  # fmt: skip
         for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
             y[st[f"{i.name}.p"]] = float(values[f"{i.upstream}.discharge_pressure"])
         return y
@@ -501,6 +539,7 @@ class MachineModel(Model):
         w1 = obs[:, ov["omega1"]]
         motor = c.motor is not None
         a1 = dy[:, st["omega1"]] if motor else None
+        torsion = c.machine.shaft.torsion
         out: dict[str, Signal] = {}
         frame = None if c.machine.frame is None else _FrameRecord(c, values, y, dy)
         energy = np.zeros(t.shape[0])
@@ -512,7 +551,11 @@ class MachineModel(Model):
             thc, thcd, thcdd = y[:, s], y[:, s + 1], dy[:, s + 1]
             th1 = obs[:, ov[f"{th.name}.theta1"]]
             fg = obs[:, ov[f"{th.name}.gas_force"]]
-            kin = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=w1, alpha1=a1)
+            wk, ak = w1, a1  # its crank's speed and acceleration: the crank's or its node's
+            if torsion:
+                n = st[f"{pre}theta_shaft"]
+                wk, ak = y[:, n + 1], dy[:, n + 1]
+            kin = kinematics(p, t, thc, thcd, thcdd, theta1=th1, omega1=wk, alpha1=ak)
             own = mechanism_outputs(p, kin, thc, thcd, thcdd, fg)
             own["crank_torque"] = Signal(
                 obs[:, ov[f"{th.name}.crank_torque"]],
@@ -526,24 +569,28 @@ class MachineModel(Model):
             else:
                 own.update(cycle_outputs(local, th1))
             if motor:
-                wk = st.start(f"{th.name}.work")
+                iw = st.start(f"{th.name}.work")
                 own["W_gas"] = Signal(
-                    y[:, wk], "J", "work done by the gas on the crosshead since t = 0"
+                    y[:, iw], "J", "work done by the gas on the crosshead since t = 0"
                 )
-                own_energy = mechanism_energy(p, th1, thc, w1, thcd)
+                own_energy = mechanism_energy(p, th1, thc, wk, thcd)
                 if not c.machine.flat:
                     own["energy"] = Signal(own_energy, "J", "kinetic + potential energy of this "
                                            "throw's crank, rod and crosshead")  # fmt: skip
+                if torsion:  # (the drive's nodes and the springs: `_torsion_outputs`)
+                    energy += own_energy
+                elif not c.machine.flat:
                     energy += own_energy + 0.5 * p.J_drive * w1 * w1 if k == 0 else own_energy
                 else:  # (the drive's inertia in the same expression, as before the assembler)
                     energy += mechanism_energy(p, th1, thc, w1, thcd, p.J_drive)
             if not c.machine.flat:
                 own["theta1"] = Signal(th1, "rad", "crank angle of this throw in its own axes "
-                                       "(the shaft's + phase - cylinder_angle)")  # fmt: skip
-                own.update(_shaking(p, kin, fg, w1, a1, th, shake))
+                                       "(the shaft's, or on a flexible shaft its node's, + "
+                                       "phase - cylinder_angle)")  # fmt: skip
+                own.update(_shaking(p, kin, fg, wk, ak, th, shake))
             if frame is not None:
                 own.update(frame.at_guide(th, own["a"].values))
-                frame.throws.append((p, own["frame_a"].values, kin, w1, a1))
+                frame.throws.append((p, own["frame_a"].values, kin, wk, ak))
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -555,6 +602,12 @@ class MachineModel(Model):
                 "energy": Signal(energy, "J", "kinetic + potential energy of the mechanism and "
                                  "the drive"),
             })  # fmt: skip
+        if torsion:
+            shaft = _torsion_outputs(c, y, dy, obs)
+            energy += shaft.pop("_energy").values
+            out.update(shaft)
+            out["energy"] = Signal(energy, "J", "kinetic + potential energy of the mechanisms, "
+                                   "the drive's nodes and the shaft's sections")  # fmt: skip
         out.update(_interstage_outputs(c, y, dy))
         if not c.machine.flat:
             out["theta1"] = Signal(obs[:, ov["theta1"]], "rad", "crank angle of the shaft")
@@ -574,13 +627,21 @@ class MachineModel(Model):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """Per throw, its cylinder's figures (`_throw_summary`) and, whatever its load, the
         API 618 rod load and crosshead-pin reversal over the last revolution, under its name;
-        the frame's combined load (`_frame_summary`)."""
+        the frame's combined load (`_frame_summary`); a flexible shaft's natural frequencies
+        and API 618's torsional separation at the run's mean speed
+        (`recipdyn.model.shaft.torsion.torsion_summary`)."""
         from ..cycle import pin_reversal_summary
 
         machine = self.structure(values)
         out: dict[str, Any] = {}
         if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
             out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
+        if machine.shaft.torsion:
+            from ..shaft.torsion import torsion_summary
+
+            speed = (float(np.mean(ds["omega1"].values)) if "omega1" in ds.variables
+                     else float(self._shaft(values, "omega")))  # fmt: skip
+            out.update(torsion_summary(machine, values, speed / (2.0 * math.pi)))
         if machine.flat:
             return {**self._throw_summary(self.throws(values)[0], ds), **out}
         for t, local in zip(machine.throws, self.throws(values), strict=True):
@@ -739,6 +800,43 @@ class _FrameRecord:
                                             "bound's margin: FEEDBACK_LIMIT - frame_feedback "
                                             "(< 0: the one-way coupling no longer holds)"),
         }  # fmt: skip
+
+
+def _torsion_outputs(c: Configuration, y: np.ndarray, dy: np.ndarray,
+                     obs: np.ndarray) -> dict[str, Signal]:  # fmt: skip
+    """A flexible shaft's: each section's twist and torque (the observer's columns: the
+    functions that were integrated), each throw's node's acceleration, the flywheel's, and
+    (under ``_energy``, for the machine's) the rotor's, the flywheel's and the sections'
+    energy."""
+    from ..base import Signal
+    from ..shaft.flexible import nodes, section_names
+
+    m = c.machine
+    st, ov, pv = c.layout.state, c.layout.outputs, c.layout.params
+    o = pv.start("shaft.torsion")
+    j_motor, j_fly = c.params[o], c.params[o + 1]
+    fly = st[m.prefix("shaft") + "theta_flywheel"]
+    energy = 0.5 * (j_motor * y[:, st["omega1"]] ** 2 + j_fly * y[:, fly + 1] ** 2)
+    out: dict[str, Signal] = {}
+    names = nodes(m)
+    for i, q in enumerate(section_names(m)):
+        twist, torque = obs[:, ov[q + "twist"]], obs[:, ov[q + "torque"]]
+        energy = energy + 0.5 * c.params[o + 2 + 2 * i] * twist**2
+        ends = f"between the {names[i]} and the {names[i + 1]}"
+        out[q + "twist"] = Signal(twist, "rad", f"twist of the shaft {ends} (the first's angle "
+                                  "less the second's)")  # fmt: skip
+        out[q + "torque"] = Signal(torque, "N*m", f"torque the shaft carries {ends} (spring "
+                                   "and damper)")  # fmt: skip
+    out[m.prefix("shaft") + "alpha_flywheel"] = Signal(
+        dy[:, fly + 1], "rad/s**2", "the flywheel's angular acceleration"
+    )
+    for t in m.throws:
+        n = st[m.prefix(t.name) + "theta_shaft"]
+        out[m.prefix(t.name) + "alpha_shaft"] = Signal(dy[:, n + 1], "rad/s**2", "angular "
+                                                       "acceleration of this throw's crank "
+                                                       "(its node of the shaft)")  # fmt: skip
+    out["_energy"] = Signal(energy, "J", "")
+    return out
 
 
 def _interstage_outputs(c: Configuration, y: np.ndarray, dy: np.ndarray) -> dict[str, Signal]:

@@ -11,6 +11,11 @@ A machine file::
     omega = "20 rad/s"       # the shaft's parameters: omega, theta1_0, J_drive, motor_*
     J_drive = "3000 kg*m**2"
 
+    [shaft.torsion]          # optional (drive = "motor"): a torsionally flexible shaft, the
+    J_motor = "400 kg*m**2"  # rotor, the flywheel (J_drive less J_motor) and each throw a
+    k_coupling = "3e6 N*m/rad"  # node with its own angle; the coupling between rotor and
+    c_coupling = "1e3 N*m*s/rad" # flywheel, each throw's k_shaft, c_shaft in its [[throw]]
+
     [[stage]]                # a compression stage: its line pressures and temperature
     name = "stage1"
     suction_pressure = "1 bar"
@@ -62,6 +67,14 @@ keeps the compressor's names (``rc``, ``omega``), so a one-throw machine and ``-
 compressor`` take the same values. The frame's parameters are always under ``frame.``
 (``frame.mass``, ``frame.mount2.k_x``); a mount's place (``x``, ``z``) is structure.
 
+A ``[shaft.torsion]`` table (needs ``drive = "motor"``) makes the crankshaft torsionally
+flexible (`recipdyn.model.shaft.flexible`): the motor's rotor (``J_motor``), the flywheel
+(``J_drive`` less ``J_motor``) and each throw's crank are nodes with their own angle and
+speed, joined by the coupling (``k_coupling``, ``c_coupling``, rotor to flywheel) and the
+crankshaft's sections (a throw's ``k_shaft``, ``c_shaft``: between it and its neighbour toward
+the flywheel, the throws in the order of their ``axial_position`` from the flywheel's end).
+Its parameters are the shaft's (``shaft.J_motor``) and the throws' (``throw2.k_shaft``).
+
 An ``[[interstage]]`` joins two stages: the stage ``from``'s discharge valves deliver into a
 volume (``volume``, m^3) whose gas a cooler holds at ``cooler_temperature``, and the stage
 ``to``'s suction valves take in from it; its pressure is a state of the machine (its initial
@@ -83,7 +96,8 @@ from ...errors import ParameterError
 
 __all__ = [
     "Machine", "Shaft", "Throw", "Stage", "Interstage", "Sensor", "Frame", "Mount",
-    "read_machine", "SHAFT_NAMES", "STAGE_NAMES", "INTERSTAGE_NAMES", "FED_NAMES", "FRAME_NAMES",
+    "read_machine", "SHAFT_NAMES", "STAGE_NAMES", "TORSION_NAMES", "THROW_TORSION_NAMES",
+    "INTERSTAGE_NAMES", "FED_NAMES", "FRAME_NAMES",
     "MOUNT_NAMES", "LOADS", "JOINTS", "DRIVES",
     "SENSOR_KINDS", "CYLINDER_ANGLES",
 ]  # fmt: skip
@@ -94,6 +108,10 @@ __all__ = [
 SHAFT_NAMES = ("omega", "theta1_0", "J_drive", "motor_torque", "motor_sync_speed",
                "motor_breakdown_torque", "motor_breakdown_slip")  # fmt: skip
 STAGE_NAMES = ("suction_pressure", "discharge_pressure", "suction_temperature")
+#: The parameters of a torsionally flexible shaft (`recipdyn.model.shaft.flexible`): the
+#: shaft's (in ``[shaft.torsion]``) and each throw's (its crankshaft section's).
+TORSION_NAMES = ("J_motor", "k_coupling", "c_coupling")
+THROW_TORSION_NAMES = ("k_shaft", "c_shaft")
 #: The parameters of the frame (`recipdyn.model.frame`) and of each of its mounts.
 FRAME_NAMES = ("mass", "inertia", "x_cm", "z_cm")
 MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
@@ -168,11 +186,15 @@ class Throw:
 @dataclass(frozen=True)
 class Shaft:
     """The crankshaft and its drive: ``prescribed`` (it turns at ``omega``) or ``motor`` (its
-    angle and speed are states, driven by the torque law ``motor`` on ``J_drive``)."""
+    angle and speed are states, driven by the torque law ``motor`` on ``J_drive``);
+    ``torsion``: torsionally flexible (a motor only; its parameters ``J_motor``,
+    ``k_coupling``, ``c_coupling`` among ``params``, each throw's ``k_shaft``, ``c_shaft``
+    among the throw's), else one rigid body."""
 
     drive: str = "prescribed"
     motor: str = "induction"
     params: tuple[tuple[str, Any], ...] = ()
+    torsion: bool = False
 
     @property
     def values(self) -> dict[str, Any]:
@@ -321,6 +343,11 @@ class Machine:
         if self.shaft.drive not in DRIVES:
             raise ParameterError(f"machine {self.name!r}: shaft.drive = {self.shaft.drive!r}; "
                                  f"allowed: {', '.join(map(repr, DRIVES))}")  # fmt: skip
+        if self.shaft.torsion and self.shaft.drive != "motor":
+            raise ParameterError(f"machine {self.name!r}: [shaft.torsion] needs drive = 'motor' "
+                                 f"(got {self.shaft.drive!r}: a prescribed speed turns every "
+                                 "crank at omega, leaving the shaft nothing to twist); allowed: "
+                                 "drive = 'motor', or no [shaft.torsion]")  # fmt: skip
         if self.frame is not None:
             self._check_frame(self.frame)
         for s in self.sensors:
@@ -455,13 +482,29 @@ def machine_from_dict(raw: Mapping[str, Any], where: str = "machine",
     for k in raw:
         if k not in _TOP:
             raise ParameterError(f"{where}: unknown key {k!r}; allowed: {', '.join(_TOP)}")
-    shaft_raw = _table(raw.get("shaft", {}), f"{where}: [shaft]")
+    shaft_raw = dict(_table(raw.get("shaft", {}), f"{where}: [shaft]"))
+    torsion = shaft_raw.pop("torsion", None)
     shaft_keys, shaft_params = _split(shaft_raw, ("drive", "motor"))
     for k in shaft_params:
         if k not in SHAFT_NAMES:
-            raise ParameterError(f"{where}: [shaft] {k!r} is not a parameter of the shaft; "
-                                 f"allowed: drive, motor, {', '.join(SHAFT_NAMES)}")  # fmt: skip
-    shaft = Shaft(**{k: str(v) for k, v in shaft_keys.items()}, params=_pairs(shaft_params))
+            hint = " (in [shaft.torsion])" if k in TORSION_NAMES else ""
+            raise ParameterError(f"{where}: [shaft] {k!r} is not a parameter of the shaft"
+                                 f"{hint}; allowed: drive, motor, {', '.join(SHAFT_NAMES)}, "
+                                 "and a [shaft.torsion] table")  # fmt: skip
+    if torsion is not None:
+        torsion = _table(torsion, f"{where}: [shaft.torsion]")
+        for k in torsion:
+            if k not in TORSION_NAMES:
+                raise ParameterError(f"{where}: [shaft.torsion] {k!r} is not a parameter of "
+                                     "the flexible shaft; allowed: "
+                                     f"{', '.join(TORSION_NAMES)} (each throw's k_shaft, "
+                                     "c_shaft in its [[throw]])")  # fmt: skip
+        shaft_params = {**shaft_params, **torsion}
+    shaft = Shaft(
+        **{k: str(v) for k, v in shaft_keys.items()},
+        params=_pairs(shaft_params),
+        torsion=torsion is not None,
+    )
     stages = []
     for i, st in enumerate(raw.get("stage", []), 1):
         st = _table(st, f"{where}: stage {i}")

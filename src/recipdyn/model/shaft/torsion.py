@@ -22,9 +22,10 @@ API 618 (5th ed., 2007, sec. 7.9.2.5 and 7.9.2.6) asks that the train's torsiona
 frequencies lie at least 10 % away from every order of the running speed up to the 10th
 (`TorsionalTrain.interference`): the orders of the gas and inertia torque excite them.
 
-What this module does not do: integrate the flexible shaft in time (the machine's crank is
-one rigid body in `recipdyn.model.assembler`), nor damping. The independent check is
-openTorsion's lumped model (`tests/test_torsion.py`).
+What this module does not do: damping, or the time integration of the flexible shaft (a
+machine with a ``[shaft.torsion]``: `recipdyn.model.shaft.flexible`, whose run summary gives
+`torsion_summary`). The independent check is openTorsion's lumped model
+(`tests/test_torsion.py`).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ import numpy as np
 
 from ...errors import ParameterError
 
-__all__ = ["TorsionalTrain", "throw_inertia", "train_of", "API618_MARGIN", "API618_ORDERS"]
+__all__ = ["TorsionalTrain", "throw_inertia", "train_of", "torsion_summary", "API618_MARGIN",
+           "API618_ORDERS"]  # fmt: skip
 
 #: API 618's separation margin of a torsional natural frequency from an excitation order.
 API618_MARGIN = 0.10
@@ -189,3 +191,29 @@ def train_of(
         names.append(machine.throws[k].name)
         inertias.append(throw_inertia(locals_[k]))
     return TorsionalTrain(tuple(names), tuple(inertias), tuple(float(k) for k in stiffness))
+
+
+def torsion_summary(machine, values: Mapping[str, Any], speed_hz: float) -> dict[str, Any]:
+    """The linearised train's natural frequencies (`recipdyn.model.shaft.train_of`: each
+    throw its mean inertia) and API 618's separation from orders 1-10 of ``speed_hz``: per
+    mode ``torsion_f<i>_hz``, its nearest order ``torsion_f<i>_order`` and its separation from
+    it ``torsion_f<i>_separation`` (``|f - n f_run| / (n f_run)``); the smallest over the modes,
+    ``torsion_min_separation`` with its mode and order, and the verdict ``api618_torsional``
+    (``pass``: every mode at least 10 % clear of every order)."""
+    from .flexible import stiffnesses
+
+    pre = machine.prefix("shaft")
+    train = train_of(machine, values, stiffnesses(machine, values),
+                     J_motor=float(values[pre + "J_motor"]),
+                     J_drive=float(values[pre + "J_drive"]))  # fmt: skip
+    out: dict[str, Any] = {"torsion_running_speed_hz": float(speed_hz)}
+    best = (math.inf, 0, 0)
+    for i, x in enumerate(train.natural_frequencies(), 1):
+        sep, n = min((abs(x - n * speed_hz) / (n * speed_hz), n) for n in API618_ORDERS)
+        out.update({f"torsion_f{i}_hz": float(x), f"torsion_f{i}_order": n,
+                    f"torsion_f{i}_separation": float(sep)})  # fmt: skip
+        best = min(best, (sep, i, n))
+    out.update(torsion_min_separation=float(best[0]), torsion_min_separation_mode=best[1],
+               torsion_min_separation_order=best[2],
+               api618_torsional="pass" if best[0] >= API618_MARGIN else "FAIL")  # fmt: skip
+    return out

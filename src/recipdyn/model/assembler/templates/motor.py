@@ -6,7 +6,7 @@ constants. As it stands the block binds the reference configuration: one throw o
 compressor on the induction motor.
 
 The crank angle and speed are states (``y[CRANK]``, ``y[CRANK + 1]``), the motor's work
-``y[CRANK + 2]``, and each throw's gas work ``y[THROW_WORK[k]]``. The throws share the crank:
+``y[MOTOR_WORK]``, and each throw's gas work ``y[THROW_WORK[k]]``. The throws share the crank:
 each one's equations ``M (theta1'', theta_c'') = b`` give its clearance angle's
 acceleration affine in the crank's, ``theta_c'' = c - k theta1''``, and with it the throw's
 share ``(I, Q)`` of the crank's equation (``free_contribution``), so the crank's acceleration
@@ -18,10 +18,22 @@ thcd, F, p, m) -> (I, Q, k, c)``, ``crosshead``, ``crank_torque``, and the loads
 Constants: ``CRANK``, ``SHAFT`` (the offset of ``J_drive``), ``MOTOR`` (the torque law's
 slice), ``THROW_WORK``, ``STEP_KIND`` (per state: how the Jacobian's central differences
 step it: ``0`` an angle, absolute 1e-4; ``1`` a rate, 1e-4 max(1, |y|); ``2`` a load's
-state, 1e-7 max(|y|, 1e-3); ``3`` a column left 0, a work integral or a counter nothing
-depends on), and the throws', the loads' and the interstage volumes' as in `prescribed`
-(an interstage's pressure is stepped as a load's state); a frame on its mounts (``FRAME``) as
-in `prescribed`, shaken by the throws at the crank's acceleration.
+state, by the load's own differences ``1e-7 (|y| (1 + rel) + abs)`` with ``(rel, abs)`` at
+``p[STEP_AT[i]]`` (its slice of steps, as in `prescribed`; an interstage's pressure, whose
+``STEP_AT`` is ``-1``: 1e-7 max(|y|, 1e-3)); ``3`` a column left 0, a work integral or a
+counter nothing depends on), and the throws', the loads' and the interstage volumes' as in
+`prescribed`; a frame on its mounts (``FRAME``) as in `prescribed`, shaken by the throws at
+the crank's acceleration; ``MOTOR_WORK`` (the motor's work's state).
+
+A torsionally flexible shaft (``TORSION``, `recipdyn.model.shaft.flexible`): the crank's
+states are the rotor's, followed by the other ``N_NODES - 1`` nodes' angles and speeds (the
+flywheel, then the throws along the shaft); each throw's crank turns with its node
+(``THROW_NODE[k]``: its angle's state) and its share ``(I, Q)`` goes to its node's equation
+instead of the one crank's; the role ``shaft_nodes`` gives the nodes' accelerations from
+their shares, the motor's torque and the sections' springs (its slice ``TORSION_PARAMS``, its
+dissipation's state ``SHAFT_DAMPING``), ``shaft_section`` a section's twist and torque (the
+observer's columns from ``OBS_SECTION``). Without it (``TORSION`` False) the branches are
+pruned and the module computes what it did before, to the bit.
 """
 
 import numba as nb
@@ -42,6 +54,8 @@ from recipdyn.model.assembler.generate import absent as load_reset
 from recipdyn.model.assembler.generate import absent as load_rhs
 from recipdyn.model.assembler.generate import absent as load_rhs_lines
 from recipdyn.model.assembler.generate import absent as load_state_force
+from recipdyn.model.assembler.generate import absent as shaft_nodes
+from recipdyn.model.assembler.generate import absent as shaft_section
 from recipdyn.model.assembler.generate import absent as shaking
 from recipdyn.model.components.drive_kernels import induction_torque as torque
 from recipdyn.model.components.load import paper_force as load_force
@@ -56,6 +70,13 @@ N_THROWS = np.int64(1)
 CRANK = np.int64(2)
 SHAFT = np.int64(0)
 MOTOR = np.int64(1)
+MOTOR_WORK = np.int64(4)
+TORSION = False
+N_NODES = np.int64(1)
+TORSION_PARAMS = np.int64(0)
+SHAFT_DAMPING = np.int64(0)
+THROW_NODE = np.array([2], dtype=np.int64)
+OBS_SECTION = np.int64(0)
 INTERSTAGE = False
 N_INTERSTAGES = np.int64(0)
 IS_STATE = np.array([-1], dtype=np.int64)
@@ -70,6 +91,7 @@ THROW_LOAD = np.array([17], dtype=np.int64)
 LOAD_STATE = np.array([6], dtype=np.int64)
 LOAD_AUX = np.array([6], dtype=np.int64)
 STEP_KIND = np.array([0, 1, 0, 1, 3, 3], dtype=np.int64)
+STEP_AT = np.array([-1, -1, -1, -1, -1, -1], dtype=np.int64)
 N_OBS = np.int64(5)
 OBS_THROW = np.array([2], dtype=np.int64)
 # </bindings>
@@ -114,49 +136,75 @@ def _interstages(p, out):
 
 
 @nb.njit(cache=True)
+def _crank(th1, w1, y, p, k):
+    """Throw ``k``'s crank angle and speed: the crank's (``th1``, ``w1``) or, on a flexible
+    shaft, its node's, with its phase."""
+    if TORSION:
+        n = THROW_NODE[k]
+        return y[n] + p[THROW_PHASE[k]], y[n + 1]
+    return th1 + p[THROW_PHASE[k]], w1
+
+
+@nb.njit(cache=True)
+def _alpha(f, k):
+    """Throw ``k``'s crank's acceleration in the derivatives ``f``: the crank's or its
+    node's."""
+    if TORSION:
+        return f[THROW_NODE[k] + 1]
+    return f[CRANK + 1]
+
+
+@nb.njit(cache=True)
 def _rhs(t, y, p, out):
     th1 = y[CRANK]
     w1 = y[CRANK + 1]
     Tm = torque(w1, p, MOTOR)
     inertia = p[SHAFT]
     load = Tm
-    for k in range(N_THROWS):  # each throw's share of the crank's equation
+    for k in range(N_THROWS):  # each throw's share of its crank's equation
         s, m = THROW_STATE[k], THROW_MECH[k]
-        thk = th1 + p[THROW_PHASE[k]]
+        thk, wk = _crank(th1, w1, y, p, k)
         F = _force(thk, y, p, k)
-        inertia_k, load_k, out[s], out[s + 1] = free_contribution(thk, y[s], w1, y[s + 1], F,
+        inertia_k, load_k, out[s], out[s + 1] = free_contribution(thk, y[s], wk, y[s + 1], F,
                                                                   p, m)  # fmt: skip
-        inertia += inertia_k
-        load += load_k
+        if TORSION:  # (held at its node's place until the nodes' equations)
+            out[THROW_NODE[k]] = inertia_k
+            out[THROW_NODE[k] + 1] = load_k
+        else:
+            inertia += inertia_k
+            load += load_k
         out[THROW_WORK[k]] = F  # (held here until the crosshead's speed is known)
-    a1 = load / inertia
-    out[CRANK] = w1
-    out[CRANK + 1] = a1
-    out[CRANK + 2] = Tm * w1
+    if TORSION:
+        shaft_nodes(Tm, N_NODES, y, CRANK, SHAFT_DAMPING, p, TORSION_PARAMS, out)
+    else:
+        out[CRANK] = w1
+        out[CRANK + 1] = load / inertia
+    out[MOTOR_WORK] = Tm * w1
     for k in range(N_THROWS):  # each throw's own accelerations, its gas work, its load
         s, m = THROW_STATE[k], THROW_MECH[k]
-        thk = th1 + p[THROW_PHASE[k]]
-        out[s + 1] = out[s + 1] - out[s] * a1
+        thk, wk = _crank(th1, w1, y, p, k)
+        out[s + 1] = out[s + 1] - out[s] * _alpha(out, k)
         out[s] = y[s + 1]
-        x, v = crosshead(thk, y[s], w1, y[s + 1], p, m)
+        x, v = crosshead(thk, y[s], wk, y[s + 1], p, m)
         out[THROW_WORK[k]] = out[THROW_WORK[k]] * v
         if LOAD_STATES:
             _load_rhs(x, v, y, p, k, out)
     if INTERSTAGE:
         _interstages(p, out)
     if FRAME:
-        _frame(th1, w1, a1, y, p, out)
+        _frame(y, p, out)
 
 
 @nb.njit(cache=True)
-def _frame(th1, w, a1, y, p, out):
+def _frame(y, p, out):
     """The frame's derivatives: every throw's shaking force, from its state and its
     clearance angle's acceleration already in ``out``, as generalised forces on the frame."""
     qx = 0.0
     qpsi = 0.0
     for k in range(N_THROWS):
         s, m = THROW_STATE[k], THROW_MECH[k]
-        fx, fy = shaking(th1 + p[THROW_PHASE[k]], y[s], w, y[s + 1], a1, out[s + 1], p, m)
+        thk, wk = _crank(y[CRANK], y[CRANK + 1], y, p, k)
+        fx, fy = shaking(thk, y[s], wk, y[s + 1], _alpha(out, k), out[s + 1], p, m)
         gx, gpsi = frame_load(k, fx, fy, p, FRAME_PARAMS)
         qx += gx
         qpsi += gpsi
@@ -173,9 +221,10 @@ def jac(t, y, p, J):
     """Central differences with one Richardson step, (4 D(h/2) - D(h)) / 3: truncation
     O(h**4), rounding ~eps |f| / h, with each state's step by its kind (``STEP_KIND``): with
     |f| ~ 1e6 (theta_c'') rounding ~2e-6 and truncation ~1e-10 for the angles and rates; a
-    load's states step by 1e-7 of their size (its stops and regularised nozzles are not
-    smooth everywhere). The work integrals' and counters' columns are 0 (nothing depends on
-    them)."""
+    load's states step by 1e-7 of their own scale (the load's ``steps``: its stops and
+    regularised nozzles are not smooth everywhere, and a plate's velocity needs a step of its
+    own size, not of its value's, which passes through 0). The work integrals' and counters'
+    columns are 0 (nothing depends on them)."""
     n = y.shape[0]
     fp = np.empty(n)
     fm = np.empty(n)
@@ -191,6 +240,9 @@ def jac(t, y, p, J):
             h = 1e-4
         elif kind == 1:
             h = 1e-4 * max(1.0, abs(y[k]))
+        elif STEP_AT[k] >= 0:
+            a = STEP_AT[k]
+            h = 1e-7 * (abs(y[k]) * (1.0 + p[a]) + p[a + 1])
         else:
             h = 1e-7 * max(abs(y[k]), 1e-3)
         for level in range(2):
@@ -230,9 +282,10 @@ def reset(t, y, p, out):
 
 @nb.njit(cache=True)
 def observe(t, y, p):
-    """The crank's angle and speed (columns 0, 1), then per throw its crank angle, its gas
-    force and the torque the shaft applies to its crank (columns ``OBS_THROW[k]`` to ``+
-    2``), by the functions that were integrated."""
+    """The crank's angle and speed (columns 0, 1: on a flexible shaft the rotor's), then per
+    throw its crank angle, its gas force and the torque the shaft applies to its crank
+    (columns ``OBS_THROW[k]`` to ``+ 2``), then on a flexible shaft each section's twist and
+    torque (from ``OBS_SECTION``), by the functions that were integrated."""
     out = np.empty((t.shape[0], N_OBS))
     f = np.empty(y.shape[1])
     for i in range(t.shape[0]):
@@ -244,10 +297,15 @@ def observe(t, y, p):
         out[i, 1] = w1
         for k in range(N_THROWS):
             s, m, c = THROW_STATE[k], THROW_MECH[k], OBS_THROW[k]
-            thk = th1 + p[THROW_PHASE[k]]
+            thk, wk = _crank(th1, w1, yi, p, k)
             F = _force(thk, yi, p, k)
             out[i, c] = thk
             out[i, c + 1] = F
-            out[i, c + 2] = crank_torque(thk, yi[s], w1, yi[s + 1], f[s + 1], f[CRANK + 1], F,
+            out[i, c + 2] = crank_torque(thk, yi[s], wk, yi[s + 1], f[s + 1], _alpha(f, k), F,
                                          p, m)  # fmt: skip
+        if TORSION:
+            for j in range(N_NODES - 1):
+                twist, _, tq = shaft_section(yi, CRANK, j, p, TORSION_PARAMS)
+                out[i, OBS_SECTION + 2 * j] = twist
+                out[i, OBS_SECTION + 2 * j + 1] = tq
     return out
