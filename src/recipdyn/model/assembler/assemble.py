@@ -43,7 +43,7 @@ from . import generate
 from .layout import Layout, SlicesBuilder
 
 __all__ = ["Configuration", "assemble", "bindings", "throw_values", "load_of", "motor_of",
-           "frame_values", "KERNELS"]  # fmt: skip
+           "frame_values", "KERNELS", "FAMILIES", "family_of"]  # fmt: skip
 
 #: The massless-link throw's compiled functions.
 KERNELS = "recipdyn.model.mechanism.link_kernels"
@@ -54,6 +54,28 @@ KERNELS = "recipdyn.model.mechanism.link_kernels"
 DOF, WORK, COUNTER, FRAME = "dof", "work", "counter", "frame"
 #: The frame's compiled roles.
 FRAME_KERNELS = "recipdyn.model.frame.kernels"
+
+
+#: A throw's mechanism family by its ``crank_joint``: the massless link (an ideal pin is the
+#: link with rc = 0: `KERNELS`, template ``prescribed`` or ``motor``) or the contact joints
+#: (`recipdyn.model.assembler.contact_throws`, template ``contact_throws``).
+FAMILIES = {"link": "link", "ideal": "link", "contact": "contact", "lubricated": "contact"}
+
+
+def family_of(machine: Machine) -> str:
+    """The mechanism family of the machine's throws; refused in one line when they differ
+    (the templates bind one family's roles for every throw)."""
+    kinds = {FAMILIES[t.crank_joint] for t in machine.throws}
+    if len(kinds) > 1:
+        first = machine.throws[0]
+        other = next(t for t in machine.throws if FAMILIES[t.crank_joint] != FAMILIES[
+            first.crank_joint])  # fmt: skip
+        raise ParameterError(
+            f"machine {machine.name!r}: {other.name}.crank_joint = {other.crank_joint!r} beside "
+            f"{first.name}.crank_joint = {first.crank_joint!r}: the throws of a machine carry "
+            "one family of crank pins today (link | ideal, or contact | lubricated)"
+        )
+    return kinds.pop()
 
 
 def frame_values(values: Mapping[str, Any]) -> dict[str, Any]:

@@ -37,7 +37,15 @@ from ..mechanism.link import (
 from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
 from ..protocol import Model, Param, Schema
 from ..registry import absolute_spec, is_spec
-from .assemble import Configuration, assemble, frame_values, load_of, throw_values
+from .assemble import (
+    FAMILIES,
+    Configuration,
+    assemble,
+    family_of,
+    frame_values,
+    load_of,
+    throw_values,
+)
 
 if TYPE_CHECKING:
     from ..base import Event, Signal
@@ -79,7 +87,12 @@ _CYCLE_GROUP = "cycle"
 def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
-    adds its own) without the shaft's, the stages' and the selectors, with its ``phase``."""
+    adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
+    throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
+    if FAMILIES[throw.crank_joint] == "contact":
+        from .contact_throws import contact_throw_params
+
+        return contact_throw_params(throw)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -181,6 +194,15 @@ class MachineModel(Model):
     """A machine of any number of throws (module docstring)."""
 
     validity_bounds_instead = "the contact-impact joint (--model compressor-contact)"
+
+    def __new__(cls, machine: Machine | None = None, *args: Any, **kw: Any):
+        """A machine of contact throws is a `.contact_throws.ContactMachine` (the family
+        `.assemble.FAMILIES` maps its ``crank_joint`` to; ``machine`` None: unpickling)."""
+        if cls is MachineModel and machine is not None and family_of(machine) == "contact":
+            from .contact_throws import ContactMachine
+
+            cls = ContactMachine
+        return super().__new__(cls)
 
     def __init__(self, machine: Machine, schema: Schema | None = None) -> None:
         self.machine = machine

@@ -26,7 +26,7 @@ A machine file::
     [[throw]]                # one crank of the shaft, at its phase angle
     stage = "stage1"
     load = "cycle"           # paper | table | cycle | valves | file.py:OBJ
-    crank_joint = "link"     # link (the massless link of length rc) | ideal
+    crank_joint = "link"     # link (the massless link of length rc) | ideal | contact | lubricated
     phase = "0 deg"
     rc = "1 mm"              # any parameter of the throw: its mechanism, its cylinder
 
@@ -102,10 +102,12 @@ MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
 #: The parameters of an interstage volume, and a stage's that an interstage feeding it sets.
 INTERSTAGE_NAMES = ("volume", "cooler_temperature")
 FED_NAMES = ("suction_pressure", "suction_temperature")
-#: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
-#: crosshead guide's clearance run on one throw through ``--model compressor``).
+#: The parts a throw may hold on the assembler (the crosshead pin's and the guide's clearance
+#: run on one throw through ``--model compressor``; the contact and lubricated crank pins on a
+#: machine take a prescribed crank and the paper's load or the cycle,
+#: `recipdyn.model.assembler.contact_throws`).
 LOADS = ("paper", "table", "cycle", "valves")
-JOINTS = ("link", "ideal")
+JOINTS = ("link", "ideal", "contact", "lubricated")
 DRIVES = ("prescribed", "motor")
 SENSOR_KINDS = ("accelerometer", "pressure", "tacho")
 #: A throw's line of stroke in the frame, rad: horizontal, on either side of the shaft.
@@ -132,8 +134,10 @@ class Throw:
         ``throw2.a`` in a machine of several throws.
     stage : str
         The stage it compresses for (its cylinder's line pressures are the stage's).
-    crank_joint : {"link", "ideal"}
-        The crank pin: the paper's massless link of length ``rc``, or ideal (rc = 0).
+    crank_joint : {"link", "ideal", "contact", "lubricated"}
+        The crank pin: the paper's massless link of length ``rc``, ideal (rc = 0), or a
+        contact-impact joint of radial clearance ``rc``, dry or lubricated (the family of
+        `recipdyn.model.assembler.contact_throws`; every throw of a machine of one family).
     load : str
         The gas force on its crosshead: ``paper``, ``table``, ``cycle``, ``valves`` or a load
         component of a user's file (``file.py:OBJ``).
@@ -280,9 +284,7 @@ class Machine:
                                      "or _, unlike the shaft's and the stages'")  # fmt: skip
             if t.crank_joint not in JOINTS:
                 raise ParameterError(f"{where}.crank_joint = {t.crank_joint!r}; allowed: "
-                                     f"{', '.join(map(repr, JOINTS))} (the contact and "
-                                     "lubricated pins run on one throw: --model compressor "
-                                     "--set crank_joint=contact)")  # fmt: skip
+                                     f"{', '.join(map(repr, JOINTS))}")  # fmt: skip
             if t.load not in LOADS and ":" not in t.load:
                 raise ParameterError(f"{where}.load = {t.load!r}; allowed: "
                                      f"{', '.join(map(repr, LOADS))} or file.py:OBJ")  # fmt: skip
