@@ -395,7 +395,7 @@ class ContactMachine(MachineModel):
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             pre = f"{th.name}."
             ev = f"impact_{pre}"
-            rename = {}
+            rename = {"impact_time": "impact_time"} if "impact_time" in ds.data_vars else {}
             for k in map(str, ds.data_vars):
                 if k.startswith(pre):
                     rename[k] = k[len(pre) :]
