@@ -51,8 +51,8 @@ if TYPE_CHECKING:
 __all__ = ["ContactMachine", "ContactConfiguration", "assemble_contact", "contact_throw_params",
            "LOADS"]  # fmt: skip
 
-#: The loads a contact throw of a machine takes today (loads without states).
-LOADS = ("paper", "cycle")
+#: The loads a contact throw of a machine takes today.
+LOADS = ("paper", "cycle", "valves")
 #: The one-throw model's parameters a throw of a machine does not take: the shaft's, the
 #: stage's, the structure (the throw's load and pins: its ``crank_joint``), the crosshead
 #: pin's and the guide's clearance (not yet), the drive's.
@@ -60,18 +60,30 @@ _STRUCTURE = ("load", "drive", "motor", "equations", "clearance_joints", "joint"
               "crosshead_joint", "guide", "rs", "m1", "J1")  # fmt: skip
 
 
+def one_model(throw: Throw):
+    """The one-throw model of a contact throw: ``compressor-contact``, or with the dynamic
+    valves ``compressor-contact-valves``."""
+    if throw.load == "valves":
+        from ..compressor_contact_valves import COMPRESSOR_CONTACT_VALVES
+
+        return COMPRESSOR_CONTACT_VALVES
+    from ..compressor_contact import COMPRESSOR_CONTACT
+
+    return COMPRESSOR_CONTACT
+
+
 def contact_throw_params(throw: Throw) -> tuple[Param, ...]:
-    """A contact throw's parameters under their local names (the one-throw contact model's,
+    """A contact throw's parameters under their local names (its one-throw model's,
     without the shaft's, the stage's and the structure's; the cycle's with ``load = cycle``
-    only, the paper load's with ``load = paper`` only), with its ``phase``."""
-    from ..components.contact_model import SCHEMA
+    or ``valves`` only, the paper load's with ``load = paper`` only), with its ``phase``."""
     from ..components.guide import GUIDE_PARAMS
 
     skip = {*SHAFT_NAMES, *STAGE_NAMES, *_STRUCTURE, *(p.name for p in GUIDE_PARAMS)}
-    out = [p for p in SCHEMA if p.name not in skip and p.group not in ("drive", "guide")]
+    schema = one_model(throw).schema
+    out = [p for p in schema if p.name not in skip and p.group not in ("drive", "guide")]
     out = [p for p in out if p.name not in ("rc_crosshead", "K_crosshead",
                                             "crosshead_pin_radius", "e0_angle_crosshead")]
-    if throw.load != "cycle":
+    if throw.load == "paper":
         out = [p for p in out if p.group != "cycle" and p.name != "gas"]
     if throw.load != "paper":
         out = [p for p in out if p.name not in ("load_amplitude", "load_sign")]
@@ -141,7 +153,7 @@ class ContactConfiguration:
         slices = [pv.parts[t.name] for t in throws]
         mod = self.throw_module.__name__
         roles = {f"throw_{r}": (mod, r) for r in ("rhs", "jac", "event", "reset")}
-        phased = _tracks_separations(self.locals[0])
+        phased = one_model(throws[0]).tracks_separations(self.locals[0])
         constants = {
             "CFG": _literal(CFG[self.locals[0]["clearance_joints"]]),
             "N_THROWS": len(throws),
@@ -171,26 +183,20 @@ def _literal(k: int):
     return Literal(k)
 
 
-def _tracks_separations(local: Mapping[str, Any]) -> bool:
-    from ..compressor_contact import COMPRESSOR_CONTACT
-
-    return COMPRESSOR_CONTACT.tracks_separations(local)
-
-
 def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any]
                          ) -> dict[str, Any]:  # fmt: skip
     """A throw's values as the one-throw contact model takes them (validated there, refused
     with the throw's namespace): its own and the shaft's, its pins, its crank angle at ``t =
     0`` the shaft's plus its phase."""
-    from ..compressor_contact import COMPRESSOR_CONTACT
-
-    names = set(COMPRESSOR_CONTACT.schema.names)
+    model = one_model(throw)
+    names = set(model.schema.names)
     v = {k: val for k, val in local.items() if k in names}
     v.update(crank_joint=throw.crank_joint, crosshead_joint="ideal", guide="ideal",
-             drive="prescribed", load=throw.load,
-             theta1_0=float(local["theta1_0"]) + float(local["phase"]))  # fmt: skip
+             drive="prescribed", theta1_0=float(local["theta1_0"]) + float(local["phase"]))
+    if "load" in names:
+        v["load"] = throw.load
     try:
-        return COMPRESSOR_CONTACT.parameters(v)
+        return model.parameters(v)
     except ParameterError as exc:
         raise _prefixed_message(machine.prefix(throw.name), exc) from None
 
@@ -198,10 +204,10 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
 def assemble_contact(machine: Machine, locals_: list[dict]) -> ContactConfiguration:
     """Resolve a machine of contact throws: each throw's one-throw vector and state, one
     after another (module docstring)."""
-    from ..compressor_contact import COMPRESSOR_CONTACT
     from ..components.contact_model import pack
 
-    modules = [COMPRESSOR_CONTACT.kernels(v) for v in locals_]
+    models = [one_model(t) for t in machine.throws]
+    modules = [m.kernels(v) for m, v in zip(models, locals_, strict=True)]
     for t, m in zip(machine.throws[1:], modules[1:], strict=True):
         if m is not modules[0]:
             raise ParameterError(
@@ -211,12 +217,12 @@ def assemble_contact(machine: Machine, locals_: list[dict]) -> ContactConfigurat
             )
     pv, sv = SlicesBuilder(), SlicesBuilder()
     chunks = []
-    for t, v in zip(machine.throws, locals_, strict=True):
-        vec = pack(v, COMPRESSOR_CONTACT.load_part(v))
+    for t, v, model in zip(machine.throws, locals_, models, strict=True):
+        vec = pack(v, model.load_part(v))
         chunks.append(vec)
         pv.reserve(t.name, vec.size)
         pre = machine.prefix(t.name)
-        sv.add(f"{t.name}.mechanism", ((pre + n, u) for n, u in COMPRESSOR_CONTACT.states(v)))
+        sv.add(f"{t.name}.mechanism", ((pre + n, u) for n, u in model.states(v)))
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
     return ContactConfiguration(machine, tuple(locals_), layout, np.concatenate(chunks),
                                 modules[0])  # fmt: skip
@@ -291,23 +297,21 @@ class ContactMachine(MachineModel):
         return False
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
-        from ..compressor_contact import COMPRESSOR_CONTACT
-
-        if len(self.structure(values).throws) > 1:
+        machine = self.structure(values)
+        if len(machine.throws) > 1:
             return False
-        return COMPRESSOR_CONTACT.lyapunov_supported(self.contact_values(values)[0])
+        return one_model(machine.throws[0]).lyapunov_supported(self.contact_values(values)[0])
 
     def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
         return self.contact(values).layout.state.named()
 
     def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
         from ..base import Event
-        from ..compressor_contact import COMPRESSOR_CONTACT
 
         c = self.contact(values)
         k = c.kernels
         if len(c.locals) == 1:  # the one-throw model's event, on the machine's module
-            (own,) = COMPRESSOR_CONTACT.events(c.locals[0])
+            (own,) = one_model(c.machine.throws[0]).events(c.locals[0])
             return (Event(own.name, k.event, direction=own.direction, action=own.action,
                           reset=k.reset, description=own.description),)  # fmt: skip
         return (Event("impact", k.event, direction=-1, action="reset", reset=k.reset,
@@ -325,6 +329,7 @@ class ContactMachine(MachineModel):
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             s = st.start(f"{t.name}.mechanism")
             passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
+        own = one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -337,7 +342,7 @@ class ContactMachine(MachineModel):
             name=self.system_name(values),
             attrs=self.system_attrs(values),
             events=self.events(values),
-            aux_states=4,
+            aux_states=own.aux_states,
             passive=tuple(sorted(passive)),
             model=self,
             values=Frozen(values),
@@ -347,34 +352,35 @@ class ContactMachine(MachineModel):
         """Each throw's one-throw initial state (the pin along its rod load at its own crank
         angle, `CompressorContact.initial_state`); with several throws each recorded approach
         velocity carries its pin's phase (+ in contact, - in free flight)."""
-        from ..compressor_contact import COMPRESSOR_CONTACT
-
         c = self.contact(values)
         parts = []
-        for v in c.locals:
-            y = COMPRESSOR_CONTACT.initial_state(v)
-            if len(c.locals) > 1 and not _tracks_separations(v):
+        for t, v in zip(c.machine.throws, c.locals, strict=True):
+            model = one_model(t)
+            y = model.initial_state(v)
+            if len(c.locals) > 1 and not model.tracks_separations(v):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
-        return np.maximum(1.0, np.abs(self.initial_state(values)))
+        """Each throw's one-throw scales (the gas states at their own size)."""
+        c = self.contact(values)
+        return np.concatenate([one_model(t).state_scale(v)
+                               for t, v in zip(c.machine.throws, c.locals, strict=True)])
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         """Each throw's signals, the one-throw contact model's of its states (its crank angle
         its own: the shaft's plus its phase), under its name; the shaft's crank angle."""
         from ..base import Signal
-        from ..compressor_contact import COMPRESSOR_CONTACT
 
         c = self.contact(values)
         y = np.asarray(y, dtype=np.float64)
         out: dict[str, Signal] = {}
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
-            own = COMPRESSOR_CONTACT.outputs(v, t, y[:, part])
+            own = one_model(th).outputs(v, t, np.ascontiguousarray(y[:, part]))
             pre = c.machine.prefix(th.name)
             out.update({pre + k: s for k, s in own.items()})
         if not c.machine.flat:
@@ -386,11 +392,9 @@ class ContactMachine(MachineModel):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """Each throw's figures (`CompressorContact.run_summary` of its signals and of the
         events at which its own pin changed phase), under its name."""
-        from ..compressor_contact import COMPRESSOR_CONTACT
-
         c = self.contact(values)
         if c.machine.flat:
-            return COMPRESSOR_CONTACT.run_summary(c.locals[0], ds)
+            return one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
         out: dict[str, Any] = {}
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             pre = f"{th.name}."
@@ -402,9 +406,11 @@ class ContactMachine(MachineModel):
                 elif k.startswith(ev):
                     rename[k] = "impact_" + k[len(ev) :]
             view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
-            if "impact_v_impact" in view:  # its own pin's events: where its phase changed
-                moved = view["impact_v_impact"].values != view["impact_v_impact_after"].values
-                view = view.isel(impact_event=np.flatnonzero(moved))
-            for k, val in COMPRESSOR_CONTACT.run_summary(v, view).items():
+            if "impact_time" in view:  # its own events: where its reset moved its states
+                names = [n for n, _ in one_model(th).states(v)]
+                moved = np.column_stack([view[f"impact_{n}"].values
+                                         != view[f"impact_{n}_after"].values for n in names])
+                view = view.isel(impact_event=np.flatnonzero(moved.any(axis=1)))
+            for k, val in one_model(th).run_summary(v, view).items():
                 out[pre + k] = val
         return out
