@@ -100,19 +100,23 @@ def event(t, y, p):
 
 @compiled(RHS_SIGNATURE)
 def reset(t, y, p, out):
-    """The reset of the throw whose factor is the smallest (at the event); the other throws'
-    states unchanged."""
-    best, low = 0, np.inf
+    """The reset of every throw whose factor is the smallest (at the event) or below 0: two
+    throws whose events coincide (identical throws in phase) change phase together; reset
+    one by one, the other's factor would stay below 0 after the first reset and the event
+    function, their minimum, would never cross 0 again. The other throws' states
+    unchanged."""
+    low = np.inf
     for k in range(N_THROWS):
-        f = _factor(t, y, p, k)
-        if f < low:
-            best, low = k, f
+        low = min(low, _factor(t, y, p, k))
     for i in range(y.shape[0]):
         out[i] = y[i]
-    s, n, o, m = THROW_STATE[best], THROW_N[best], THROW_PARAMS[best], THROW_NP[best]
-    if OWN_EVENT:
-        throw_reset(t, y[s : s + n], p[o : o + m], out[s : s + n])
-    else:
-        yk = y[s : s + n]
-        pk = p[o : o + m]
-        _flip(yk, contact_factor(yk, pk, CFG)[1], pk, out[s : s + n])
+    for k in range(N_THROWS):
+        if _factor(t, y, p, k) > max(low, 0.0):
+            continue
+        s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        if OWN_EVENT:
+            throw_reset(t, y[s : s + n], p[o : o + m], out[s : s + n])
+        else:
+            yk = y[s : s + n]
+            pk = p[o : o + m]
+            _flip(yk, contact_factor(yk, pk, CFG)[1], pk, out[s : s + n])
