@@ -172,25 +172,30 @@ def test_throws_of_two_families_and_contact_throws_on_a_motor_are_refused_in_one
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
 
 
-def test_throws_with_the_dynamic_valves_are_each_a_one_throw_run():
-    """Two throws with contact crank pins and the dynamic valves (their pressures and plates
-    states of each throw's slice), at 0 and 90 deg with clearances 1 and 0.5 mm: each throw's
-    pin, crosshead and chamber pressures are a one-throw ``compressor-contact-valves`` run's
-    with its crank angle at t = 0 and its clearance, to the integration's error (module
-    docstring), over a quarter revolution; each throw's events are its own (the same count of
-    onsets)."""
-    m = _machine(Throw("throw1", crank_joint="contact", load="valves"),
-                 Throw("throw2", crank_joint="contact", load="valves",
+@pytest.mark.parametrize("load", ["valves", "cycle"])
+def test_throws_with_the_cycle_or_the_dynamic_valves_are_each_a_one_throw_run(load):
+    """Two throws with contact crank pins and the compression cycle (ideal valves) or the
+    dynamic valves (their pressures and plates states of each throw's slice), at 0 and 90 deg
+    with clearances 1 and 0.5 mm: each throw's pin, crosshead (and with the valves its chamber
+    pressures) are a one-throw ``compressor-contact`` (``-valves``) run's with its crank angle
+    at t = 0 and its clearance, to the integration's error (module docstring), over a quarter
+    revolution at 20 rad/s (the rod load reverses: impacts); each throw's events are its own
+    (the same count of onsets)."""
+    m = _machine(Throw("throw1", crank_joint="contact", load=load),
+                 Throw("throw2", crank_joint="contact", load=load,
                        params=(("phase", math.pi / 2), ("rc", 0.5e-3))), omega=20.0)  # fmt: skip
     kw = dict(revolutions=0.25, fs=4000.0)
     a = _simulate(model=m, rtol=RTOL, **kw)
     got = m.run_summary(m.parameters(), a)
-    c = get_model("compressor-contact-valves")
+    if load == "valves":
+        c, own, names = get_model("compressor-contact-valves"), {}, ("p_head", "p_crank")
+    else:
+        c, own, names = get_model("compressor-contact"), {"load": "cycle"}, ()
     for name, th, rc in (("throw1", 0.0, 1e-3), ("throw2", math.pi / 2, 0.5e-3)):
-        v = c.parameters({"omega": 20.0, "theta1_0": th, "rc": rc})
+        v = c.parameters({"omega": 20.0, "theta1_0": th, "rc": rc, **own})
         run = _simulate(model=c, params=v, rtol=RTOL, **kw)
         ref = _simulate(model=c, params=v, rtol=RTOL_REF, atol=1e-14, **kw)
-        for k in ("ex", "ey", "x", "p_head", "p_crank"):
+        for k in ("ex", "ey", "x", *names):
             err = np.abs(a[f"{name}.{k}"].values - ref[k].values).max()
             assert err <= _bound(run, ref, k), (name, k, err, _bound(run, ref, k))
         assert got[f"{name}.impacts"] == c.run_summary(v, run)["impacts"], name
