@@ -163,13 +163,24 @@ def test_the_contact_throws_template_binds_its_reference_configuration():
 
 
 def test_throws_of_two_families_and_contact_throws_on_a_motor_are_refused_in_one_line():
+    """Throws of two families (the link beside a contact pin, or beside an ideal crank pin
+    with a worn crosshead pin), the link with a worn crosshead pin, contact throws on a
+    motor, and contact throws whose pins differ (a worn crosshead pin on one only)."""
+    worn = Throw("throw2", crank_joint="ideal", crosshead_joint="contact")
     for throws, drive, words in (
         ((_throw("throw1"), Throw("throw2")), "prescribed", "throw2.crank_joint = 'link'"),
+        ((Throw("throw1"), worn), "prescribed", "crosshead_joint = 'contact'"),
+        ((Throw("throw1", crosshead_joint="contact"),), "prescribed", "beside crank_joint"),
         ((_throw("throw1"), _throw("throw2")), "motor", "drive = 'motor'"),
     ):
         with pytest.raises(ParameterError) as exc:
             _machine(*throws, drive=drive)
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
+    m = _machine(_throw("throw1"), Throw("throw2", crosshead_joint="contact",
+                                         crank_joint="contact"))  # fmt: skip
+    with pytest.raises(ParameterError) as exc:
+        m.parameters()
+    assert "throw2: its pins, guide" in str(exc.value) and "\n" not in str(exc.value)
 
 
 @pytest.mark.parametrize("load", ["valves", "cycle"])
@@ -199,3 +210,42 @@ def test_throws_with_the_cycle_or_the_dynamic_valves_are_each_a_one_throw_run(lo
             err = np.abs(a[f"{name}.{k}"].values - ref[k].values).max()
             assert err <= _bound(run, ref, k), (name, k, err, _bound(run, ref, k))
         assert got[f"{name}.impacts"] == c.run_summary(v, run)["impacts"], name
+
+
+@pytest.mark.parametrize(
+    ("pins", "signals"),
+    [
+        ({"crank_joint": "ideal", "crosshead_joint": "contact"},
+         ("ex_crosshead", "ey_crosshead", "x")),
+        ({"crank_joint": "ideal", "guide": "clearance"}, ("guide_y", "tilt", "x")),
+    ],
+    ids=["crosshead-pin", "guide"],
+)  # fmt: skip
+def test_throws_with_a_worn_crosshead_pin_or_the_guides_clearance_are_each_a_one_throw_run(
+    pins, signals
+):
+    """Two throws with a worn crosshead pin, or with the crosshead in its guide's clearance
+    (0.2 mm), at 0 and 90 deg: each throw's crosshead pin or lateral position and tilt, and
+    its crosshead's travel, are a one-throw ``compressor-contact`` run's with the same pins
+    and its crank angle at t = 0, to the integration's error (module docstring), over a
+    quarter revolution; the same impacts at the crosshead pin, each throw's energy balance."""
+    extra = (("guide_clearance", 2e-4),) if pins.get("guide") == "clearance" else ()
+    m = _machine(*(Throw(f"throw{k + 1}", **pins, params=(("load_amplitude", LOAD),
+                                                          ("phase", k * math.pi / 2), *extra))
+                   for k in range(2)))  # fmt: skip
+    kw = dict(revolutions=0.25, fs=20000.0)
+    a = _simulate(model=m, rtol=RTOL, **kw)
+    got = m.run_summary(m.parameters(), a)
+    c = get_model("compressor-contact")
+    for k, name in enumerate(("throw1", "throw2")):
+        v = c.parameters({"omega": OMEGA, "load_amplitude": LOAD, "theta1_0": k * math.pi / 2,
+                          **pins, **dict(extra)})  # fmt: skip
+        run = _simulate(model=c, params=v, rtol=RTOL, **kw)
+        ref = _simulate(model=c, params=v, rtol=RTOL_REF, atol=1e-14, **kw)
+        for s in signals:
+            err = np.abs(a[f"{name}.{s}"].values - ref[s].values).max()
+            assert err <= _bound(run, ref, s), (name, s, err, _bound(run, ref, s))
+        own = c.run_summary(v, run)
+        if "impacts_crosshead" in own:
+            assert got[f"{name}.impacts_crosshead"] == own["impacts_crosshead"], name
+        assert got[f"{name}.energy_balance_residual"] < 1e-8, name

@@ -62,18 +62,32 @@ FRAME_KERNELS = "recipdyn.model.frame.kernels"
 FAMILIES = {"link": "link", "ideal": "link", "contact": "contact", "lubricated": "contact"}
 
 
+def throw_family(t) -> str:
+    """A throw's mechanism family: its crank pin's (`FAMILIES`); a worn crosshead pin or
+    the guide's clearance make it the contact joints' whatever its crank pin."""
+    if (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
+        return "contact"
+    return FAMILIES[t.crank_joint]
+
+
 def family_of(machine: Machine) -> str:
     """The mechanism family of the machine's throws; refused in one line when they differ
     (the templates bind one family's roles for every throw)."""
-    kinds = {FAMILIES[t.crank_joint] for t in machine.throws}
+    kinds = {throw_family(t) for t in machine.throws}
     if len(kinds) > 1:
         first = machine.throws[0]
-        other = next(t for t in machine.throws if FAMILIES[t.crank_joint] != FAMILIES[
-            first.crank_joint])  # fmt: skip
+        other = next(t for t in machine.throws if throw_family(t) != throw_family(first))
+
+        def pins(t) -> str:
+            out = f"{t.name}.crank_joint = {t.crank_joint!r}"
+            if (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
+                out += f" (crosshead_joint = {t.crosshead_joint!r}, guide = {t.guide!r})"
+            return out
+
         raise ParameterError(
-            f"machine {machine.name!r}: {other.name}.crank_joint = {other.crank_joint!r} beside "
-            f"{first.name}.crank_joint = {first.crank_joint!r}: the throws of a machine carry "
-            "one family of crank pins today (link | ideal, or contact | lubricated)"
+            f"machine {machine.name!r}: {pins(other)} beside {pins(first)}: the throws of a "
+            "machine carry one family of pins today (the massless link or ideal pins, or "
+            "contact | lubricated pins and the guide's clearance)"
         )
     return kinds.pop()
 

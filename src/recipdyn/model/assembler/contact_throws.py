@@ -51,8 +51,8 @@ if TYPE_CHECKING:
     from ..protocol import Param
 
 __all__ = ["ContactConfiguration", "assemble_contact", "contact_configuration",
-           "contact_throw_params", "one_model", "refusal", "throw_contact_values",
-           "LOADS"]  # fmt: skip
+           "contact_throw_params", "one_model", "refusal", "throw_contact_values", "joints_key",
+           "same_joints", "LOADS"]  # fmt: skip
 
 #: The loads a contact throw of a machine takes today.
 LOADS = ("paper", "cycle", "valves")
@@ -85,15 +85,22 @@ def contact_throw_params(throw: Throw) -> tuple[Param, ...]:
     or ``valves`` only, the paper load's with ``load = paper`` only), with its ``phase``."""
     from ..components.guide import GUIDE_PARAMS
 
-    skip = {*SHAFT_NAMES, *STAGE_NAMES, *_STRUCTURE, *(p.name for p in GUIDE_PARAMS)}
+    skip = {*SHAFT_NAMES, *STAGE_NAMES, *_STRUCTURE}
+    if throw.guide != "clearance":
+        skip |= {p.name for p in GUIDE_PARAMS}
     schema = one_model(throw).schema
-    out = [p for p in schema if p.name not in skip and p.group not in ("drive", "guide")]
-    out = [
-        p
-        for p in out
-        if p.name
-        not in ("rc_crosshead", "K_crosshead", "crosshead_pin_radius", "e0_angle_crosshead")
-    ]
+    out = [p for p in schema if p.name not in skip and p.group != "drive"]
+    if throw.crank_joint == "ideal":
+        out = [p for p in out if p.name not in ("rc", "K", "journal_radius", "e0_angle")]
+    if throw.crosshead_joint == "ideal":
+        out = [
+            p
+            for p in out
+            if p.name
+            not in ("rc_crosshead", "K_crosshead", "crosshead_pin_radius", "e0_angle_crosshead")
+        ]
+    if throw.crank_joint == "ideal" and throw.crosshead_joint == "ideal":  # (the guide's only)
+        out = [p for p in out if p.group != "joint" or p.name == "v_impact_min"]
     if throw.load == "paper":
         out = [p for p in out if p.group != "cycle" and p.name != "gas"]
     if throw.load != "paper":
@@ -204,10 +211,12 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
     model = one_model(throw)
     names = set(model.schema.names)
     v = {k: val for k, val in local.items() if k in names}
+    if throw.crank_joint == "ideal":  # (`throw_values` gives the link's rc = 0 then)
+        v.pop("rc", None)
     v.update(
         crank_joint=throw.crank_joint,
-        crosshead_joint="ideal",
-        guide="ideal",
+        crosshead_joint=throw.crosshead_joint,
+        guide=throw.guide,
         drive="prescribed",
         theta1_0=float(local["theta1_0"]) + float(local["phase"]),
     )
@@ -219,20 +228,41 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         raise ParameterError(f"{machine.prefix(throw.name)}{exc}") from None
 
 
+def joints_key(throw: Throw, local: Mapping[str, Any]) -> tuple:
+    """What chooses a contact throw's kernels module (`CompressorContact.kernels`): which
+    pins are worn, the load, the guide, the contact law of a user's file, the friction laws;
+    throws of one machine share it (`same_joints`)."""
+    from ..components import contact_model as cm
+
+    guide = cm.has_guide(local)
+    shoes = cm.FRICTION_ROLES[local["guide_friction_law"]] if guide else ""
+    part = one_model(throw).load_part(local)
+    return (local["clearance_joints"], cm._load_key(local, part), guide, cm.law_spec(local),
+            cm.friction_part(local), shoes)  # fmt: skip
+
+
+def same_joints(machine: Machine, locals_: list[dict]) -> None:
+    """Refuse, in one line, throws whose joints' configurations differ (`joints_key`)."""
+    first = joints_key(machine.throws[0], locals_[0])
+    for t, v in zip(machine.throws[1:], locals_[1:], strict=True):
+        if joints_key(t, v) != first:
+            raise ParameterError(
+                f"{t.name}: its pins, guide, laws or load differ from "
+                f"{machine.throws[0].name}'s (which pins are worn, the guide's clearance, "
+                "friction_law, a contact law of a file, load): the throws of a machine share "
+                "one configuration of the joints today (their values differ freely)"
+            )
+
+
 def assemble_contact(machine: Machine, locals_: list[dict]) -> ContactConfiguration:
     """Resolve a machine of contact throws: each throw's one-throw vector and state, one
     after another (module docstring)."""
     from ..components.contact_model import pack
 
     models = [one_model(t) for t in machine.throws]
+    same_joints(machine, locals_)
     modules = [m.kernels(v) for m, v in zip(models, locals_, strict=True)]
-    for t, m in zip(machine.throws[1:], modules[1:], strict=True):
-        if m is not modules[0]:
-            raise ParameterError(
-                f"{t.name}: its pins' laws or load differ from {machine.throws[0].name}'s "
-                "(contact_law, friction_law or load): the throws of a machine share one "
-                "configuration of the joints today (their values differ freely)"
-            )
+    assert all(m is modules[0] for m in modules), "joints_key misses a choice of the module"
     pv, sv = SlicesBuilder(), SlicesBuilder()
     chunks = []
     for t, v, model in zip(machine.throws, locals_, models, strict=True):

@@ -41,12 +41,12 @@ from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
 from ..protocol import Model, Param, Schema
 from ..registry import absolute_spec, is_spec
 from .assemble import (
-    FAMILIES,
     Configuration,
     assemble,
     family_of,
     frame_values,
     load_of,
+    throw_family,
     throw_values,
 )
 
@@ -94,7 +94,7 @@ def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
     adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
     throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
-    if FAMILIES[throw.crank_joint] == "contact":
+    if throw_family(throw) == "contact":
         from .contact_throws import contact_throw_params
 
         return contact_throw_params(throw)
@@ -706,11 +706,12 @@ class ContactMachine(MachineModel):
     # -- what MachineModel does for the massless link ----------------------------------
     def check(self, values: Mapping[str, Any]) -> None:
         """Each throw's checks (its one-throw model's), refused with its namespace."""
-        from .contact_throws import throw_contact_values
+        from .contact_throws import same_joints, throw_contact_values
 
         machine = self.structure(values)
-        for t, v in zip(machine.throws, self.throws(values), strict=True):
-            throw_contact_values(machine, t, v)
+        locals_ = [throw_contact_values(machine, t, v)
+                   for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
+        same_joints(machine, locals_)
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return True
