@@ -20,11 +20,13 @@ several throws the event is the smallest of the throws' phased contact factors (
 separations, `recipdyn.model.joints.pins.phased_factor`): the recorded approach velocity's
 sign is then each pin's phase (negative in free flight).
 
-Not yet (refused in one line): a motor (the joints' share of a free crank's equation), the
-dynamic valves or a load of a user's file, a load table, the crosshead pin's clearance and the
-guide's (per throw: ``crosshead_joint``, ``guide``), a frame, an interstage volume, a throw on
-the other side of the shaft (``cylinder_angle``), and throws of different families in one
-machine (`recipdyn.model.assembler.assemble.family_of`).
+A throw's ``crosshead_joint`` and ``guide`` (structure keys of the machine's description)
+choose the rest of its joints: a worn crosshead pin, the guide's clearance (the family's
+whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. Not yet (refused in
+one line): a motor (the joints' share of a free crank's equation), a load of a user's file or
+a table, a frame, an interstage volume, a throw on the other side of the shaft
+(``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and throws
+of different families in one machine (`recipdyn.model.assembler.assemble.family_of`).
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
