@@ -1,4 +1,4 @@
-r"""Throws whose crank pins are contact-impact (or lubricated) joints: their family of the machine.
+r"""Throws with contact-impact (or lubricated) pins or the guide's clearance: their family.
 
 A throw with ``crank_joint = contact | lubricated`` is one configuration of the contact joints
 (`recipdyn.model.components.contact_model`, the model of ``--model compressor-contact``): its
@@ -59,8 +59,8 @@ __all__ = ["ContactConfiguration", "assemble_contact", "contact_configuration",
 #: The loads a contact throw of a machine takes today.
 LOADS = ("paper", "cycle", "valves")
 #: The one-throw model's parameters a throw of a machine does not take: the shaft's, the
-#: stage's, the structure (the throw's load and pins: its ``crank_joint``), the crosshead
-#: pin's and the guide's clearance (not yet), the drive's.
+#: stage's, the structure (the throw's load, pins and guide: keys of its description), the
+#: drive's.
 _STRUCTURE = ("load", "drive", "motor", "equations", "clearance_joints", "joint", "crank_joint",
               "crosshead_joint", "guide", "rs", "m1", "J1")  # fmt: skip
 
@@ -115,16 +115,18 @@ def refusal(machine: Machine) -> str | None:
     where = f"machine {machine.name!r}"
     if machine.shaft.drive != "prescribed":
         return (
-            f"{where}: drive = {machine.shaft.drive!r} with contact crank pins is not "
+            f"{where}: drive = {machine.shaft.drive!r} with contact pins is not "
             "modelled yet (the joints' share of a free crank's equation); allowed: "
             "'prescribed', or one throw: --model compressor-contact --set drive=motor"
         )
     if machine.frame is not None:
-        return (f"{where}: a [frame] with contact crank pins is not modelled yet; allowed: "
-                "crank_joint = 'link' | 'ideal'")  # fmt: skip
+        return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
+                "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
+                "and guides")  # fmt: skip
     if machine.interstages:
-        return (f"{where}: an [[interstage]] with contact crank pins is not modelled yet; "
-                "allowed: crank_joint = 'link' | 'ideal'")  # fmt: skip
+        return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
+                "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
+                "pins and guides")  # fmt: skip
     for t in machine.throws:
         if t.load not in LOADS:
             return (f"{where}: {t.name}.load = {t.load!r} with crank_joint = "

@@ -667,7 +667,7 @@ class ContactMachine(MachineModel):
         super().__init__(machine, schema)
         self.description = machine.description or (
             f"{len(machine.throws)} throws on one crankshaft (prescribed drive), contact-impact "
-            "crank pins"
+            "pins"
         )
         pre = [machine.prefix(t.name) for t in machine.throws]
         self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
