@@ -51,14 +51,16 @@ PRESETS = {
 # tests/test_contact.py (its section signals name the crank pin's ``ex``: zero there).
 #: Machines of several throws (`recipdyn.model.machine`, by their files): the motor coupling
 #: two throws through the crank, two throws with dynamic valves and a fault on one, two
-#: throws on a frame on its mounts, two stages joined by an interstage volume, and two
-#: throws on a torsionally flexible crankshaft.
+#: throws on a frame on its mounts, two stages joined by an interstage volume, two throws on
+#: a torsionally flexible crankshaft, and two throws with contact-impact crank pins (dry and
+#: lubricated, different clearances).
 MACHINES = [
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_frame.toml"),
     str(Path(__file__).parent / "machines" / "two_stage_interstage.toml"),
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_torsion.toml"),
+    str(Path(__file__).parent / "machines" / "two_throw_contact.toml"),
 ]
 MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 

@@ -46,7 +46,7 @@ from . import generate
 from .layout import Layout, SlicesBuilder
 
 __all__ = ["Configuration", "assemble", "bindings", "throw_values", "load_of", "motor_of",
-           "frame_values", "KERNELS"]  # fmt: skip
+           "frame_values", "KERNELS", "FAMILIES", "family_of"]  # fmt: skip
 
 #: The massless-link throw's compiled functions.
 KERNELS = "recipdyn.model.mechanism.link_kernels"
@@ -57,6 +57,42 @@ KERNELS = "recipdyn.model.mechanism.link_kernels"
 DOF, WORK, COUNTER, FRAME = "dof", "work", "counter", "frame"
 #: The frame's compiled roles.
 FRAME_KERNELS = "recipdyn.model.frame.kernels"
+
+
+#: A throw's mechanism family by its ``crank_joint``: the massless link (an ideal pin is the
+#: link with rc = 0: `KERNELS`, template ``prescribed`` or ``motor``) or the contact joints
+#: (`recipdyn.model.assembler.contact_throws`, template ``contact_throws``).
+FAMILIES = {"link": "link", "ideal": "link", "contact": "contact", "lubricated": "contact"}
+
+
+def throw_family(t) -> str:
+    """A throw's mechanism family: its crank pin's (`FAMILIES`); a worn crosshead pin or
+    the guide's clearance make it the contact joints' whatever its crank pin."""
+    if (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
+        return "contact"
+    return FAMILIES[t.crank_joint]
+
+
+def family_of(machine: Machine) -> str:
+    """The mechanism family of the machine's throws; refused in one line when they differ
+    (the templates bind one family's roles for every throw)."""
+    kinds = {throw_family(t) for t in machine.throws}
+    if len(kinds) > 1:
+        first = machine.throws[0]
+        other = next(t for t in machine.throws if throw_family(t) != throw_family(first))
+
+        def pins(t) -> str:
+            out = f"{t.name}.crank_joint = {t.crank_joint!r}"
+            if (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
+                out += f" (crosshead_joint = {t.crosshead_joint!r}, guide = {t.guide!r})"
+            return out
+
+        raise ParameterError(
+            f"machine {machine.name!r}: {pins(other)} beside {pins(first)}: the throws of a "
+            "machine carry one family of pins today (the massless link or ideal pins, or "
+            "contact | lubricated pins and the guide's clearance)"
+        )
+    return kinds.pop()
 
 
 def frame_values(values: Mapping[str, Any]) -> dict[str, Any]:

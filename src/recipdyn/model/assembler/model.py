@@ -7,6 +7,9 @@ file's value, else the compressor's); `system` assembles it (`.assemble`) and it
 hold every throw's signals under the throw's name (``throw2.a``) and the crank's (``theta1``,
 ``omega1``, ``energy``).
 
+`ContactMachine` is a machine whose throws have contact or lubricated crank pins (the
+family `.contact_throws`); `MachineModel(machine)` builds one for such a machine.
+
 `OneThrow` is the compressor of one throw with the massless link or an ideal crank pin, as
 ``--model compressor`` (and ``compressor-valves``) take it: the compressor's names
 (``rc``, ``omega``) and selectors (``load``, ``drive``, ``motor``, ``equations``) choose the
@@ -45,14 +48,24 @@ from ..mechanism.link import (
 from ..parameters import PLUGGABLE, SCHEMA, CompressorParams
 from ..protocol import Model, Param, Schema
 from ..registry import absolute_spec, is_spec
-from .assemble import Configuration, assemble, frame_values, load_of, throw_values
+from .assemble import (
+    Configuration,
+    assemble,
+    family_of,
+    frame_values,
+    load_of,
+    throw_family,
+    throw_values,
+)
 
 if TYPE_CHECKING:
     from ..base import Event, Signal
+    from .contact_throws import ContactConfiguration
     from .system import AssembledSystem
 
 __all__ = [
     "MachineModel",
+    "ContactMachine",
     "OneThrow",
     "LINK",
     "LINK_VALVES",  # noqa: F822 (built on first use, __getattr__)
@@ -87,7 +100,12 @@ _CYCLE_GROUP = "cycle"
 def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
-    adds its own) without the shaft's, the stages' and the selectors, with its ``phase``."""
+    adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
+    throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
+    if throw_family(throw) == "contact":
+        from .contact_throws import contact_throw_params
+
+        return contact_throw_params(throw)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -202,6 +220,13 @@ class MachineModel(Model):
     """A machine of any number of throws (module docstring)."""
 
     validity_bounds_instead = "the contact-impact joint (--model compressor-contact)"
+
+    def __new__(cls, machine: Machine | None = None, *args: Any, **kw: Any):
+        """A machine of contact throws is a `.contact_throws.ContactMachine` (the family
+        `.assemble.FAMILIES` maps its ``crank_joint`` to; ``machine`` None: unpickling)."""
+        if cls is MachineModel and machine is not None and family_of(machine) == "contact":
+            cls = ContactMachine
+        return super().__new__(cls)
 
     def __init__(self, machine: Machine, schema: Schema | None = None) -> None:
         self.machine = machine
@@ -684,6 +709,203 @@ class MachineModel(Model):
                 out[f"frame.{m.name}.z_m"] = m.z
             out.setdefault("frame_axes", FRAME_AXES)
         return out
+
+
+class ContactMachine(MachineModel):
+    """A machine whose throws have contact-impact or lubricated crank pins
+    (`.contact_throws`: their parameters, layout and kernels; each throw's signals and
+    summary its one-throw model's under its name): `MachineModel` builds one for such a
+    machine."""
+
+    validity_bounds = ()
+
+    def __init__(self, machine: Machine, schema: Schema | None = None) -> None:
+        from .contact_throws import refusal
+
+        why = refusal(machine)
+        if why is not None:
+            raise ParameterError(why)
+        super().__init__(machine, schema)
+        self.description = machine.description or (
+            f"{len(machine.throws)} throws on one crankshaft (prescribed drive), contact-impact "
+            "pins"
+        )
+        pre = [machine.prefix(t.name) for t in machine.throws]
+        self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
+            ("ex", "m"), ("ey", "m"), ("x", "m"), ("v", "m/s"), ("a", "m/s**2")))  # fmt: skip
+        self.validity_bounds = ()
+        self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
+        self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in pre)
+        self.max_signals = tuple((f"{q}eccentricity_ratio", f"{q}max_eccentricity_ratio", "1")
+                                 for q in pre)  # fmt: skip
+        self.event_example = {
+            "shaft.omega" if not machine.flat else "omega": 150.0,
+            **{
+                f"{q}load_amplitude": 2e4
+                for q, t in zip(pre, machine.throws, strict=True)
+                if t.load == "paper"
+            },
+        }
+        if len(machine.throws) > 1:
+            self.lyapunov_refusal = (
+                "the recorded approach velocities of all but the last throw sit among the "
+                "degrees of freedom of a machine of several contact throws (Benettin's method "
+                "would count them); one throw: --model compressor-contact"
+            )
+
+    def contact(self, values: Mapping[str, Any]) -> ContactConfiguration:
+        """The machine resolved at validated ``values`` (remembered per values,
+        `.contact_throws.contact_configuration`)."""
+        from .contact_throws import contact_configuration
+
+        return contact_configuration(self.structure(values), tuple(sorted(values.items())))
+
+    def contact_values(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
+        """Each throw's values as the one-throw contact model takes them."""
+        return list(self.contact(values).locals)
+
+    # -- what MachineModel does for the massless link ----------------------------------
+    def check(self, values: Mapping[str, Any]) -> None:
+        """Each throw's checks (its one-throw model's), refused with its namespace."""
+        from .contact_throws import same_joints, throw_contact_values
+
+        machine = self.structure(values)
+        locals_ = [throw_contact_values(machine, t, v)
+                   for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
+        same_joints(machine, locals_)
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        return True
+
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        return False
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        machine = self.structure(values)
+        if len(machine.throws) > 1:
+            return False
+        return _one_model(machine.throws[0]).lyapunov_supported(self.contact_values(values)[0])
+
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        return self.contact(values).layout.state.named()
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        from ..base import Event
+
+        c = self.contact(values)
+        k = c.kernels
+        if len(c.locals) == 1:  # the one-throw model's event, on the machine's module
+            (own,) = _one_model(c.machine.throws[0]).events(c.locals[0])
+            return (Event(own.name, k.event, direction=own.direction, action=own.action,
+                          reset=k.reset, description=own.description),)  # fmt: skip
+        return (Event("impact", k.event, direction=-1, action="reset", reset=k.reset,
+                      description="contact onset or separation at a throw's worn crank pin "
+                      "(the smallest of the throws' phased factors falls through 0): at an "
+                      "onset the approach velocity is recorded for the damping law"),)  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> AssembledSystem:
+        from ..joints.pins import I_WIN, I_WLOSS, RIGID
+        from .system import AssembledSystem, Frozen
+
+        c = self.contact(values)
+        st = c.layout.state
+        passive = []
+        for t, v in zip(c.machine.throws, c.locals, strict=True):
+            s = st.start(f"{t.name}.mechanism")
+            passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
+        own = _one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
+        names, units = zip(*st.named(), strict=True)
+        return AssembledSystem(
+            rhs=c.kernels.rhs,
+            jac=c.kernels.jac,
+            rhs_jac=None,
+            params=c.params,
+            state_names=names,
+            state_units=units,
+            period=self.period(values),
+            name=self.system_name(values),
+            attrs=self.system_attrs(values),
+            events=self.events(values),
+            aux_states=own.aux_states,
+            passive=tuple(sorted(passive)),
+            model=self,
+            values=Frozen(values),
+        )
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Each throw's one-throw initial state (the pin along its rod load at its own crank
+        angle, `CompressorContact.initial_state`); with several throws each recorded approach
+        velocity carries its pin's phase (+ in contact, - in free flight)."""
+        c = self.contact(values)
+        parts = []
+        for t, v in zip(c.machine.throws, c.locals, strict=True):
+            model = _one_model(t)
+            y = model.initial_state(v)
+            if len(c.locals) > 1 and not model.tracks_separations(v):
+                sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
+                y[8] = y[9] = sign * v["v_impact_min"]
+            parts.append(y)
+        return np.concatenate(parts)
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """Each throw's one-throw scales (the gas states at their own size)."""
+        c = self.contact(values)
+        return np.concatenate(
+            [_one_model(t).state_scale(v) for t, v in zip(c.machine.throws, c.locals, strict=True)]
+        )
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """Each throw's signals, the one-throw contact model's of its states (its crank angle
+        its own: the shaft's plus its phase), under its name; the shaft's crank angle."""
+        from ..base import Signal
+
+        c = self.contact(values)
+        y = np.asarray(y, dtype=np.float64)
+        out: dict[str, Signal] = {}
+        for th, v in zip(c.machine.throws, c.locals, strict=True):
+            part = c.layout.state.parts[f"{th.name}.mechanism"]
+            own = _one_model(th).outputs(v, t, np.ascontiguousarray(y[:, part]))
+            pre = c.machine.prefix(th.name)
+            out.update({pre + k: s for k, s in own.items()})
+        if not c.machine.flat:
+            w = float(self._shaft(values, "omega"))
+            th1 = float(self._shaft(values, "theta1_0")) + w * np.asarray(t, dtype=np.float64)
+            out["theta1"] = Signal(th1, "rad", "crank angle of the shaft")
+        return out
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """Each throw's figures (`CompressorContact.run_summary` of its signals and of the
+        events at which its own pin changed phase), under its name."""
+        c = self.contact(values)
+        if c.machine.flat:
+            return _one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
+        out: dict[str, Any] = {}
+        for th, v in zip(c.machine.throws, c.locals, strict=True):
+            pre = f"{th.name}."
+            ev = f"impact_{pre}"
+            rename = {"impact_time": "impact_time"} if "impact_time" in ds.data_vars else {}
+            for k in map(str, ds.data_vars):
+                if k.startswith(pre):
+                    rename[k] = k[len(pre) :]
+                elif k.startswith(ev):
+                    rename[k] = "impact_" + k[len(ev) :]
+            view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
+            if "impact_time" in view:  # its own events: where its reset moved its states
+                names = [n for n, _ in _one_model(th).states(v)]
+                moved = np.column_stack(
+                    [view[f"impact_{n}"].values != view[f"impact_{n}_after"].values for n in names]
+                )
+                view = view.isel(impact_event=np.flatnonzero(moved.any(axis=1)))
+            for k, val in _one_model(th).run_summary(v, view).items():
+                out[pre + k] = val
+        return out
+
+
+def _one_model(throw: Throw):
+    from .contact_throws import one_model
+
+    return one_model(throw)
 
 
 #: The frame's axes, in which the machine's shaking forces and moments are given.

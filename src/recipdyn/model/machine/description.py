@@ -31,7 +31,9 @@ A machine file::
     [[throw]]                # one crank of the shaft, at its phase angle
     stage = "stage1"
     load = "cycle"           # paper | table | cycle | valves | file.py:OBJ
-    crank_joint = "link"     # link (the massless link of length rc) | ideal
+    crank_joint = "link"     # link (the massless link of length rc) | ideal | contact | lubricated
+    # crosshead_joint = "ideal"  # ideal | contact | lubricated (with contact crank pins' family)
+    # guide = "ideal"        # ideal | clearance (the crosshead between the guide's shoes)
     phase = "0 deg"
     rc = "1 mm"              # any parameter of the throw: its mechanism, its cylinder
 
@@ -120,10 +122,14 @@ MOUNT_NAMES = ("k_x", "k_z", "c_x", "c_z")
 #: The parameters of an interstage volume, and a stage's that an interstage feeding it sets.
 INTERSTAGE_NAMES = ("volume", "cooler_temperature")
 FED_NAMES = ("suction_pressure", "suction_temperature")
-#: The parts a throw may hold today on the assembler (the contact and lubricated pins and the
-#: crosshead guide's clearance run on one throw through ``--model compressor``).
+#: The parts a throw may hold on the assembler (the crosshead pin's and the guide's clearance
+#: run on one throw through ``--model compressor``; the contact and lubricated crank pins on a
+#: machine take a prescribed crank and the paper's load or the cycle,
+#: `recipdyn.model.assembler.contact_throws`).
 LOADS = ("paper", "table", "cycle", "valves")
-JOINTS = ("link", "ideal")
+JOINTS = ("link", "ideal", "contact", "lubricated")
+CROSSHEAD_JOINTS = ("ideal", "contact", "lubricated")
+GUIDES = ("ideal", "clearance")
 DRIVES = ("prescribed", "motor")
 SENSOR_KINDS = ("accelerometer", "pressure", "tacho")
 #: A throw's line of stroke in the frame, rad: horizontal, on either side of the shaft.
@@ -150,8 +156,16 @@ class Throw:
         ``throw2.a`` in a machine of several throws.
     stage : str
         The stage it compresses for (its cylinder's line pressures are the stage's).
-    crank_joint : {"link", "ideal"}
-        The crank pin: the paper's massless link of length ``rc``, or ideal (rc = 0).
+    crank_joint : {"link", "ideal", "contact", "lubricated"}
+        The crank pin: the paper's massless link of length ``rc``, ideal (rc = 0), or a
+        contact-impact joint of radial clearance ``rc``, dry or lubricated (the family of
+        `recipdyn.model.assembler.contact_throws`; every throw of a machine of one family).
+    crosshead_joint : {"ideal", "contact", "lubricated"}
+        The crosshead pin: ideal, or a contact-impact joint of radial clearance
+        ``rc_crosshead`` (the contact joints' family, as the guide's clearance).
+    guide : {"ideal", "clearance"}
+        The crosshead's guide: rigid, or with clearance (the crosshead moves sideways and
+        tilts between the shoes, ``guide_clearance``).
     load : str
         The gas force on its crosshead: ``paper``, ``table``, ``cycle``, ``valves`` or a load
         component of a user's file (``file.py:OBJ``).
@@ -173,6 +187,8 @@ class Throw:
     stage: str = "stage1"
     crank_joint: str = "link"
     load: str = "paper"
+    crosshead_joint: str = "ideal"
+    guide: str = "ideal"
     equations: str = "exact"
     params: tuple[tuple[str, Any], ...] = ()
     cylinder_angle: float = 0.0
@@ -302,9 +318,19 @@ class Machine:
                                      "or _, unlike the shaft's and the stages'")  # fmt: skip
             if t.crank_joint not in JOINTS:
                 raise ParameterError(f"{where}.crank_joint = {t.crank_joint!r}; allowed: "
-                                     f"{', '.join(map(repr, JOINTS))} (the contact and "
-                                     "lubricated pins run on one throw: --model compressor "
-                                     "--set crank_joint=contact)")  # fmt: skip
+                                     f"{', '.join(map(repr, JOINTS))}")  # fmt: skip
+            if t.crosshead_joint not in CROSSHEAD_JOINTS:
+                raise ParameterError(f"{where}.crosshead_joint = {t.crosshead_joint!r}; allowed: "
+                                     f"{', '.join(map(repr, CROSSHEAD_JOINTS))}")  # fmt: skip
+            if t.guide not in GUIDES:
+                raise ParameterError(f"{where}.guide = {t.guide!r}; allowed: "
+                                     f"{', '.join(map(repr, GUIDES))}")  # fmt: skip
+            if t.crank_joint == "link" and (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
+                raise ParameterError(f"{where}: crosshead_joint = {t.crosshead_joint!r}, guide = "
+                                     f"{t.guide!r} beside crank_joint = 'link': the massless "
+                                     "link runs with an ideal crosshead pin and guide; "
+                                     "allowed: crank_joint = 'ideal' | 'contact' | "
+                                     "'lubricated'")  # fmt: skip
             if t.load not in LOADS and ":" not in t.load:
                 raise ParameterError(f"{where}.load = {t.load!r}; allowed: "
                                      f"{', '.join(map(repr, LOADS))} or file.py:OBJ")  # fmt: skip
@@ -445,7 +471,7 @@ class Machine:
 
 
 _TOP = ("name", "description", "shaft", "throw", "stage", "sensor", "interstage", "frame")
-_THROW_KEYS = ("name", "stage", "crank_joint", "load", "equations")
+_THROW_KEYS = ("name", "stage", "crank_joint", "crosshead_joint", "guide", "load", "equations")
 #: A throw's placement on the frame: structure keys with units (not parameters to sweep).
 _PLACEMENT = (("cylinder_angle", "rad"), ("axial_position", "m"))
 

@@ -1,0 +1,181 @@
+r"""The model of the contact joints with the dynamic valves, shared by the model modules that
+use it: ``compressor-contact-valves`` (`recipdyn.model.compressor_contact_valves`, whose
+docstring describes it) and a machine's throws with contact crank pins and the dynamic valves
+(`recipdyn.model.assembler.contact_throws`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .. import cycle as cy
+from .. import valves as va
+from ..base import Event, ODESystem, Signal
+from ..joints import pins
+from ..protocol import Schema
+from . import contact_model as cm
+from .load import VALVES
+
+__all__ = ["CompressorContactValves", "SCHEMA", "STATE_NAMES", "STATE_UNITS", "P_VALVE", "pack"]
+
+G0, A0 = pins.G_GAS, pins.G_AUX
+STATE_NAMES = (*pins.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
+#: The gas states' and the counters' names and units (after the guide's, with its clearance).
+_GAS = tuple(zip((*va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES),
+                 (*va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS), strict=True))  # fmt: skip
+STATE_UNITS = (*pins.STATE_UNITS, *va.GAS_STATE_UNITS, *va.AUX_STATE_UNITS)
+N_STATE = len(STATE_NAMES)
+#: The valve data in the parameter vector: after the joints' and the cycle's.
+P_VALVE = pins.N_PACKED + cy.N_CYCLE
+
+
+def _layout(values: Mapping[str, Any]) -> tuple[int, int, int]:
+    """The first gas state, the first mass counter, and the load's offset in the parameter
+    vector (after a user's contact law's slice, and the guide's states and slice, with its
+    clearance)."""
+    g = cm.first_load_state(values)
+    lo = pins.N_PACKED + cm.law_size(values) + (pins.N_GUIDE if cm.has_guide(values) else 0)
+    if cm.has_motor(values):  # the free crank's and the torque law's slices
+        lo += cm.N_CRANK + cm.motor_size(values)
+    return g, g + va.N_GAS, lo
+
+
+_DROP = {"load", "load_amplitude", "load_sign", "gas"}
+SCHEMA = Schema((*(p for p in cm.SCHEMA if p.name not in _DROP), *va.SCHEMA_PARAMS),
+                aliases=dict(cm.SCHEMA.aliases))  # fmt: skip
+_LOAD = {"load": "cycle", "load_amplitude": 0.0, "load_sign": "physical", "gas": "ideal"}
+
+
+def pack(values: Mapping[str, Any]) -> np.ndarray:
+    """The contact model's vector, then the cycle data and the valve data (the load component
+    `recipdyn.model.components.load.VALVES`)."""
+    return cm.pack(values, load=VALVES)
+
+
+class CompressorContactValves(cm.CompressorContact):
+    """The contact-impact joint with the cylinder gas and dynamic valves (module docstring)."""
+
+    name = "compressor-contact-valves"
+    description = ("compressor with contact-impact clearance joints driven by the compression "
+                   "cycle with dynamic plate valves (pressures and valves as states)")  # fmt: skip
+    state_names = STATE_NAMES
+    state_units = STATE_UNITS
+    schema = SCHEMA
+    event_example = {}  # the valves hit their stops at the defaults
+    lyapunov_refusal = (
+        "the valve plates come to rest on their stops in resets with a singular saltation "
+        "matrix (Benettin's QR is undefined there); use the signal estimators, or --model "
+        "compressor-contact with load=cycle (ideal valves)"
+    )
+
+    def load_part(self, values: Mapping[str, Any]):
+        return VALVES
+
+    @staticmethod
+    def _table(values: Mapping[str, Any], table: Any, ptab: Any) -> None:
+        if table is not None or ptab is not None:
+            from ...errors import ParameterError
+
+            raise ParameterError(
+                f"{'load_table' if table is not None else 'pressure_table'}: not for the "
+                "dynamic valves, whose gas force follows the chamber pressures; use --model "
+                "compressor-contact for a table load"
+            )
+
+    def _values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return {**values, **_LOAD}
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        k = self.kernels(values)
+        return (Event("impact", k.event, direction=-1, action="reset", reset=k.reset,
+                      description="a contact onset or separation, or a valve plate reaching "
+                      "its seat or guard (one event function: the minimum of the factors): "
+                      "an onset records the approach velocity, a plate rebounds or "
+                      "rests"),)  # fmt: skip
+
+    def _load_states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        """The gas states and the four mass counters, after the contact model's (the
+        joints', the guide's with its clearance; with a motor the crank's follow)."""
+        return _GAS
+
+    def system(self, values: Mapping[str, Any]) -> ODESystem:
+        if cm.has_motor(values):
+            return self._motor_system(values)
+        k = self.kernels(values)
+        if cm.has_guide(values):
+            names, units = zip(*self.states(values), strict=True)
+            return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=names,
+                             state_units=units, period=self.period(values), name=self.name,
+                             events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
+        return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=STATE_NAMES,
+                         state_units=STATE_UNITS, period=self.period(values), name=self.name,
+                         events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        super().check(self._values(values))
+
+    def tracks_separations(self, values: Mapping[str, Any]) -> bool:
+        return True
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The contact model's initial state (journal along the ideal cycle's rod load), the
+        ideal cycle's gas states at the initial crank angle, plates closed, counters 0."""
+        g0, a0, _ = _layout(values)
+        own = super().initial_state(self._values(values))
+        y = np.zeros(a0 + va.N_AUX)
+        y[:g0] = own[:g0]
+        y[g0:a0] = va.gas_initial(values, cy.cycle_data(values), float(values["theta1_0"]))
+        return np.concatenate([y, own[g0:]])  # (with a motor, the crank's states)
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        """The contact model's scales for its states; the gas states at their own size."""
+        y0 = self.initial_state(values)
+        g0, a0, _ = _layout(values)
+        return va.gas_scale(values, y0, g0, a0, super().state_scale(values))
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        """The contact model's outputs (its gas force is the pressures'), then the chambers'
+        pressures, volumes (from the recorded crosshead), temperatures and mass flows."""
+        from ..base import rhs_series
+
+        sig = super().outputs(values, t, y)
+        s = self.system(values)
+        dy = rhs_series(s.rhs, s.params, t, y)
+        g0, a0, lo = _layout(values)
+        sig.update(va.gas_outputs(values, sig["x"].values, y, dy, g0, a0,
+                                  s.params[lo:lo + cy.N_CYCLE]))  # fmt: skip
+        return sig
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        """The contact model's figures over the contact events and the valves' over the valve
+        events (each event is assigned to the factor of the event function on its surface)."""
+        if "impact_time" in ds:
+            p = self.system(values).params
+            names = [k for k, _ in self.states(values)]
+            ev = np.ascontiguousarray(np.column_stack([ds[f"impact_{k}"].values
+                                                       for k in names]))  # fmt: skip
+            cfg = pins.CFG[values["clearance_joints"]]
+            g0, _, lo = _layout(values)
+            contact = np.array([abs(pins.contact_factor(e, p, cfg)[0]) if cfg < 3 else np.inf
+                                for e in ev])  # fmt: skip
+            valve = np.array([abs(va.valve_event(e, g0, p[lo + cy.N_CYCLE :])) for e in ev])
+            is_valve = valve < contact
+            if cm.has_guide(values):  # a guide's event: its corners changed phase
+                after = np.column_stack([ds[f"impact_v_impact_guide_{k}_after"].values
+                                         for k in range(1, 5)])  # fmt: skip
+                before = np.column_stack([ds[f"impact_v_impact_guide_{k}"].values
+                                          for k in range(1, 5)])  # fmt: skip
+                is_valve &= ~(before != after).any(axis=1)
+            ds_contact = ds.isel(impact_event=np.flatnonzero(~is_valve))
+            ds_valve = ds.isel(impact_event=np.flatnonzero(is_valve))
+        else:
+            ds_contact = ds_valve = ds
+        out = super().run_summary(self._values(values), ds_contact)
+        for k in [k for k in out if k.startswith(("volumetric_efficiency", "indicated_power"))]:
+            del out[k]  # the ideal cycle's figures: the valves' own are below
+        out.update(va.valve_summary(values, ds_valve))
+        return out
