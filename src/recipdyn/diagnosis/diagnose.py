@@ -395,7 +395,6 @@ def _diagnose_arrays(
             "record or train on that rate",
             t0,
         )
-    floor = noise_floor(diag, X[0])
     if declared is not None:
         # the record's chain, estimated from it, against the ranges the diagnoser was trained
         # under (chainrange.py); the learnt ranges of the statistics are not read. The floor
@@ -412,6 +411,8 @@ def _diagnose_arrays(
         if why:
             return _refuse(res, why, t0)
         floor = None  # (checked)
+    else:  # the learnt range of the floor (of the features as the classifiers read them)
+        floor = noise_floor(diag, X[0])
     # the noise floor first: a noisier sensor than trained also blurs the ringing frequency
     if floor is not None:
         q, lo, hi = floor
