@@ -20,13 +20,28 @@ several throws the event is the smallest of the throws' phased contact factors (
 separations, `recipdyn.model.joints.pins.phased_factor`): the recorded approach velocity's
 sign is then each pin's phase (negative in free flight).
 
+With a motor (``drive = motor``) each throw is its joints' configuration with the crank free
+(``--model compressor-contact --set drive=motor``): its slice of the state ends with its own
+crank's angle (the shaft's plus its phase), the crank's speed and a work integral. A machine
+of one throw is that model itself. With several, each throw's slice holds its own crank's
+inertia and static moment (``J1 + m1 rs^2``, ``m1 rs``: its values ``J_drive`` 0) and the
+machine's the drive's (``J_drive``, the torque law's; part ``shaft``): the template's
+``_shaft`` turns the crank at ``(T_m + sum_k tau_k) / (J_drive + sum_k I_k)`` from each
+throw's torque on its crank, which a worn crank pin's force (a function of the states) gives,
+and corrects each throw's crank-pin eccentricity to it (template ``contact_throws``). Each
+throw's work integral there (``throwK.W_crank``) is the shaft's work on its crank, and the
+motor's is the machine's last state, ``W_motor``. A throw with an ideal crank pin (a worn
+crosshead pin or the guide's clearance only) takes a share of the crank's inertia too (the
+rod turns with the crank): not yet on a machine of several throws with a motor.
+
 A throw's ``crosshead_joint`` and ``guide`` (structure keys of the machine's description)
 choose the rest of its joints: a worn crosshead pin, the guide's clearance (the family's
 whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. Not yet (refused in
-one line): a motor (the joints' share of a free crank's equation), a load of a user's file or
-a table, a frame, an interstage volume, a throw on the other side of the shaft
-(``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and throws
-of different families in one machine (`recipdyn.model.assembler.assemble.family_of`).
+one line): a motor with throws of ideal crank pins (several throws), a flexible shaft, a load
+of a user's file or a table, a frame, an interstage volume, a throw on the other side of the
+shaft (``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and
+throws of different families in one machine
+(`recipdyn.model.assembler.assemble.family_of`).
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
@@ -45,7 +60,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import ParameterError
-from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Throw
+from ..machine.description import SHAFT_NAMES, STAGE_NAMES, Machine, Shaft, Throw
 from ..mechanism.link import PHASE
 from .layout import Layout, SlicesBuilder
 
@@ -81,17 +96,27 @@ def _models():
     return CompressorContact(), CompressorContactValves()
 
 
-def contact_throw_params(throw: Throw) -> tuple[Param, ...]:
+#: A free crank's own parameters (its mass, centroid and inertia), a throw's with a motor.
+_CRANK = ("rs", "m1", "J1")
+
+
+def contact_throw_params(throw: Throw, shaft: Shaft | None = None) -> tuple[Param, ...]:
     """A contact throw's parameters under their local names (its one-throw model's,
     without the shaft's, the stage's and the structure's; the cycle's with ``load = cycle``
-    or ``valves`` only, the paper load's with ``load = paper`` only), with its ``phase``."""
+    or ``valves`` only, the paper load's with ``load = paper`` only; with a motor its
+    crank's ``rs``, ``m1``, ``J1``), with its ``phase``."""
     from ..components.guide import GUIDE_PARAMS
 
-    skip = {*SHAFT_NAMES, *STAGE_NAMES, *_STRUCTURE}
+    motor = shaft is not None and shaft.drive == "motor"
+    skip = {*SHAFT_NAMES, *STAGE_NAMES, *(n for n in _STRUCTURE if not (motor and n in _CRANK))}
     if throw.guide != "clearance":
         skip |= {p.name for p in GUIDE_PARAMS}
     schema = one_model(throw).schema
-    out = [p for p in schema if p.name not in skip and p.group != "drive"]
+    out = [
+        p
+        for p in schema
+        if p.name not in skip and (p.group != "drive" or (motor and p.name in _CRANK))
+    ]
     if throw.crank_joint == "ideal":
         out = [p for p in out if p.name not in ("rc", "K", "journal_radius", "e0_angle")]
     if throw.crosshead_joint == "ideal":
@@ -113,12 +138,18 @@ def contact_throw_params(throw: Throw) -> tuple[Param, ...]:
 def refusal(machine: Machine) -> str | None:
     """Why a machine of contact throws cannot be assembled yet (one line), or None."""
     where = f"machine {machine.name!r}"
-    if machine.shaft.drive != "prescribed":
-        return (
-            f"{where}: drive = {machine.shaft.drive!r} with contact pins is not "
-            "modelled yet (the joints' share of a free crank's equation); allowed: "
-            "'prescribed', or one throw: --model compressor-contact --set drive=motor"
-        )
+    if machine.shaft.torsion:
+        return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
+                "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
+                "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
+    if machine.shaft.drive == "motor" and len(machine.throws) > 1:
+        for t in machine.throws:
+            if t.crank_joint not in ("contact", "lubricated"):
+                return (f"{where}: {t.name}.crank_joint = {t.crank_joint!r} (a worn crosshead "
+                        "pin or the guide's clearance only) on a motor with several throws is "
+                        "not modelled yet (its rod turns with the crank: a share of the "
+                        "crank's inertia); allowed: crank_joint = 'contact' | 'lubricated', "
+                        "drive = 'prescribed', or one throw")  # fmt: skip
     if machine.frame is not None:
         return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
@@ -177,17 +208,36 @@ class ContactConfiguration:
         slices = [pv.parts[t.name] for t in throws]
         mod = self.throw_module.__name__
         roles = {f"throw_{r}": (mod, r) for r in ("rhs", "jac", "event", "reset")}
+        roles["torque"] = ("recipdyn.model.assembler.generate", "absent")
+        motor = self.machine.shaft.drive == "motor"
+        if motor:
+            from .assemble import motor_of
+
+            law = motor_of(self.machine)
+            roles["torque"] = (law.module, law.kernel("torque"))
         phased = one_model(throws[0]).tracks_separations(self.locals[0])
+        m = self.throw_module
+        end = slices[-1].stop
         constants = {
             "CFG": _literal(CFG[self.locals[0]["clearance_joints"]]),
+            "MOTOR": motor,
             "N_THROWS": len(throws),
             "OWN_EVENT": len(throws) == 1 or phased,
+            "SCALE": pv.start("jacobian") if "jacobian" in pv.parts else end,
+            "SHAFT": end,
+            "SHARED": shared(self.machine),
+            "THROW_CO": int(m.CO),
+            "THROW_M": int(m.M),
+            "THROW_MO": int(m.MO),
             "THROW_N": arr(s.stop - s.start for s in parts),
             "THROW_NP": arr(s.stop - s.start for s in slices),
             "THROW_PARAMS": arr(s.start for s in slices),
             "THROW_STATE": arr(s.start for s in parts),
+            "W_MOTOR": st["W_motor"] if "W_motor" in st else parts[-1].stop,
         }
         stem = f"{self.locals[0]['clearance_joints']}_{len(throws)}"
+        if motor:
+            stem += f"_motor_{self.machine.shaft.motor}".replace("-", "_")
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -221,15 +271,60 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         crank_joint=throw.crank_joint,
         crosshead_joint=throw.crosshead_joint,
         guide=throw.guide,
-        drive="prescribed",
+        drive=machine.shaft.drive,
         theta1_0=float(local["theta1_0"]) + float(local["phase"]),
     )
+    if machine.shaft.drive == "motor":
+        v["motor"] = machine.shaft.motor
+        if shared(machine):  # its own crank; the drive's inertia is the machine's
+            v["J_drive"] = 0.0
     if "load" in names:
         v["load"] = throw.load
     try:
-        return model.parameters(v)
+        out = model.parameters(v)
     except ParameterError as exc:  # with the throw's namespace: ``throw2.rc = ...``
-        raise ParameterError(f"{machine.prefix(throw.name)}{exc}") from None
+        part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
+        raise ParameterError(f"{machine.prefix(part)}{exc}") from None
+    if shared(machine) and not out["J1"] + out["m1"] * out["rs"] ** 2 > 0.0:
+        raise ParameterError(
+            f"{machine.prefix(throw.name)}J1 + m1 rs**2 = 0 kg*m**2 is out of range with "
+            "drive = 'motor' and several throws; allowed: > 0 (a worn crank pin's crank turns "
+            "apart from its rod: its own inertia)"
+        )
+    return out
+
+
+def shared(machine: Machine) -> bool:
+    """Whether the throws share a free crank's acceleration (a motor, several throws)."""
+    return machine.shaft.drive == "motor" and len(machine.throws) > 1
+
+
+#: A free crank's state names in a throw's one-throw state, then in its slice of a machine's
+#: of several throws (its crank angle, the crank's speed, the shaft's work on its crank).
+_CRANK_STATES = {"theta1": "theta1", "omega1": "omega1", "W_motor": "W_crank"}
+
+
+def fd_scales(local: Mapping[str, Any], n: int) -> np.ndarray:
+    """A throw's difference-step scales, its one-throw module's (template ``contact``,
+    ``_fd_columns``): its clearance for the eccentricities, the clearance times the speed for
+    the rates, 1 J for the work integrals, 0.1 for the guide's lateral position, tilt and
+    corners, 1e-3 for the rest (``n`` states)."""
+    from ..components.contact_model import has_guide
+    from ..joints.pins import G_GUIDE
+
+    guide = has_guide(local)
+    joints = local["clearance_joints"]
+    rc, rc2 = float(local["rc"]), float(local["rc_crosshead"])
+    c = min(rc, rc2) if guide or joints == "both" else (rc if joints == "crank" else rc2)
+    out = np.full(n, 1e-3)
+    out[:4] = c
+    out[4:10] = c * float(local["omega"])
+    out[10:12] = 1.0
+    if guide:
+        g = G_GUIDE
+        out[g : g + 2] = 0.1
+        out[g + 4 : g + 8] = 0.1
+    return out
 
 
 def joints_key(throw: Throw, local: Mapping[str, Any]) -> tuple:
@@ -258,9 +353,11 @@ def same_joints(machine: Machine, locals_: list[dict]) -> None:
             )
 
 
-def assemble_contact(machine: Machine, locals_: list[dict]) -> ContactConfiguration:
+def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
+                     ) -> ContactConfiguration:  # fmt: skip
     """Resolve a machine of contact throws: each throw's one-throw vector and state, one
-    after another (module docstring)."""
+    after another (module docstring); with a motor and several throws then the drive's slice
+    (its inertia ``J_drive`` and the torque law's) and the machine's work of the motor."""
     from ..components.contact_model import pack
 
     models = [one_model(t) for t in machine.throws]
@@ -268,15 +365,32 @@ def assemble_contact(machine: Machine, locals_: list[dict]) -> ContactConfigurat
     modules = [m.kernels(v) for m, v in zip(models, locals_, strict=True)]
     assert all(m is modules[0] for m in modules), "joints_key misses a choice of the module"
     pv, sv = SlicesBuilder(), SlicesBuilder()
-    chunks = []
+    chunks, scales = [], []
+    crank = _CRANK_STATES if shared(machine) else {}
     for t, v, model in zip(machine.throws, locals_, models, strict=True):
         vec = pack(v, model.load_part(v))
         chunks.append(vec)
         pv.reserve(t.name, vec.size)
         pre = machine.prefix(t.name)
-        sv.add(f"{t.name}.mechanism", ((pre + n, u) for n, u in model.states(v)))
+        names = model.states(v)
+        sv.add(f"{t.name}.mechanism", ((pre + crank.get(n, n), u) for n, u in names))
+        scales.append(fd_scales(v, len(names)))
+    if shared(machine):  # the drive's inertia and torque law; the difference steps' scales
+        from ..components.drive import MOTOR
+        from .assemble import _torque_values, motor_of
+
+        law = motor_of(machine)
+        drive = np.concatenate([MOTOR.pack({"J_drive": J_drive}),
+                                law.pack(_torque_values(machine, locals_, law))])  # fmt: skip
+        chunks.append(drive)
+        pv.reserve("shaft", drive.size)
+        sv.add("shaft.work", (("W_motor", "J"),))
+        scales.append(np.ones(1))
+        chunks.append(np.concatenate(scales))
+        pv.reserve("jacobian", chunks[-1].size)
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
-    return ContactConfiguration(machine, tuple(locals_), layout, np.concatenate(chunks),
+    return ContactConfiguration(machine, tuple(locals_), layout,
+                                np.concatenate(chunks).astype(np.float64),
                                 modules[0])  # fmt: skip
 
 
@@ -286,6 +400,7 @@ def contact_configuration(machine: Machine, items: tuple) -> ContactConfiguratio
     from .assemble import throw_values
 
     values = dict(items)
-    locals_ = [throw_contact_values(machine, t, throw_values(machine, values, k))
-               for k, t in enumerate(machine.throws)]  # fmt: skip
-    return assemble_contact(machine, locals_)
+    own = [throw_values(machine, values, k) for k in range(len(machine.throws))]
+    locals_ = [throw_contact_values(machine, t, v)
+               for t, v in zip(machine.throws, own, strict=True)]  # fmt: skip
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)))

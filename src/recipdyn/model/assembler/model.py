@@ -105,7 +105,7 @@ def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
     if throw_family(throw) == "contact":
         from .contact_throws import contact_throw_params
 
-        return contact_throw_params(throw)
+        return contact_throw_params(throw, shaft)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -727,8 +727,8 @@ class ContactMachine(MachineModel):
             raise ParameterError(why)
         super().__init__(machine, schema)
         self.description = machine.description or (
-            f"{len(machine.throws)} throws on one crankshaft (prescribed drive), contact-impact "
-            "pins"
+            f"{len(machine.throws)} throws on one crankshaft ({machine.shaft.drive} drive), "
+            "contact-impact pins"
         )
         pre = [machine.prefix(t.name) for t in machine.throws]
         self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
@@ -805,15 +805,22 @@ class ContactMachine(MachineModel):
 
     def system(self, values: Mapping[str, Any]) -> AssembledSystem:
         from ..joints.pins import I_WIN, I_WLOSS, RIGID
+        from .contact_throws import shared
         from .system import AssembledSystem, Frozen
 
         c = self.contact(values)
         st = c.layout.state
-        passive = []
+        passive, aux = [], ()
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             s = st.start(f"{t.name}.mechanism")
             passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
         own = _one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
+        if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
+            pre = [c.machine.prefix(t.name) for t in c.machine.throws]
+            passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
+            aux = tuple(sorted(st[q + n] for q, v in zip(pre, c.locals, strict=True)
+                               for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
+                               if i not in RIGID[v["clearance_joints"]]))  # fmt: skip
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -826,7 +833,8 @@ class ContactMachine(MachineModel):
             name=self.system_name(values),
             attrs=self.system_attrs(values),
             events=self.events(values),
-            aux_states=own.aux_states,
+            aux_states=1 if shared(c.machine) else own.aux_states,
+            aux=aux,
             passive=tuple(sorted(passive)),
             model=self,
             values=Frozen(values),
@@ -845,20 +853,25 @@ class ContactMachine(MachineModel):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
+        if "W_motor" in c.layout.state:  # the motor's work, the machine's last state
+            parts.append(np.zeros(1))
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """Each throw's one-throw scales (the gas states at their own size)."""
         c = self.contact(values)
-        return np.concatenate(
-            [_one_model(t).state_scale(v) for t, v in zip(c.machine.throws, c.locals, strict=True)]
-        )
+        own = [_one_model(t).state_scale(v)
+               for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
+        if "W_motor" in c.layout.state:
+            own.append(np.ones(1))
+        return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         """Each throw's signals, the one-throw contact model's of its states (its crank angle
         its own: the shaft's plus its phase), under its name; the shaft's crank angle."""
         from ..base import Signal
+        from .contact_throws import shared
 
         c = self.contact(values)
         y = np.asarray(y, dtype=np.float64)
@@ -868,7 +881,17 @@ class ContactMachine(MachineModel):
             own = _one_model(th).outputs(v, t, np.ascontiguousarray(y[:, part]))
             pre = c.machine.prefix(th.name)
             out.update({pre + k: s for k, s in own.items()})
-        if not c.machine.flat:
+        if shared(c.machine):
+            for k, sig in _shared_crank(c, values, t, y, out).items():
+                if sig is None:
+                    out.pop(k, None)
+                else:
+                    out[k] = sig
+        elif not c.machine.flat and c.machine.shaft.drive == "motor":  # (one throw, named)
+            pre, phase = c.machine.prefix(c.machine.throws[0].name), self.throws(values)[0]["phase"]
+            out["theta1"] = Signal(out[pre + "theta1"].values - float(phase), "rad",
+                                   "crank angle of the shaft")  # fmt: skip
+        elif not c.machine.flat:
             w = float(self._shaft(values, "omega"))
             th1 = float(self._shaft(values, "theta1_0")) + w * np.asarray(t, dtype=np.float64)
             out["theta1"] = Signal(th1, "rad", "crank angle of the shaft")
@@ -892,7 +915,8 @@ class ContactMachine(MachineModel):
                     rename[k] = "impact_" + k[len(ev) :]
             view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
             if "impact_time" in view:  # its own events: where its reset moved its states
-                names = [n for n, _ in _one_model(th).states(v)]
+                part = c.layout.state.parts[f"{th.name}.mechanism"]
+                names = [n[len(pre) :] for n in c.layout.state.names[part]]
                 moved = np.column_stack(
                     [view[f"impact_{n}"].values != view[f"impact_{n}_after"].values for n in names]
                 )
@@ -906,6 +930,44 @@ def _one_model(throw: Throw):
     from .contact_throws import one_model
 
     return one_model(throw)
+
+
+def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndarray,
+                  y: np.ndarray, out: Mapping[str, Signal]) -> dict[str, Signal]:  # fmt: skip
+    """The signals of a motor's crank that several contact throws share: the shaft's angle,
+    speed and acceleration, the motor's torque and work, the machine's energy (each throw's,
+    its own crank's included, and the drive's) and per throw the shaft's torque on its crank
+    (``crank_torque``) and work (``W_crank``), in place of its one-throw model's crank
+    signals (its own ``alpha1``, ``motor_torque``, ``W_motor``, ``omega1``)."""
+    from ..base import Signal, rhs_series
+
+    st = c.layout.state
+    machine = c.machine
+    pre = [machine.prefix(th.name) for th in machine.throws]
+    dy = rhs_series(c.kernels.rhs, c.params, t, y)
+    w = y[:, st[pre[0] + "omega1"]]
+    sig: dict[str, Signal] = {}
+    for q in pre:
+        for k in ("alpha1", "motor_torque", "W_motor", "omega1"):
+            sig[q + k] = None  # (dropped below)
+        sig[q + "crank_torque"] = Signal(dy[:, st[q + "W_crank"]] / w, "N*m",
+                                         "torque of the shaft on the throw's crank")  # fmt: skip
+        sig[q + "W_crank"] = Signal(y[:, st[q + "W_crank"]], "J", "work of the shaft on the "
+                                    "throw's crank since t = 0")  # fmt: skip
+    j_drive = float(c.params[c.layout.params.start("shaft")])
+    phase = float(throw_values(machine, values, 0)["phase"])
+    energy = 0.5 * j_drive * w**2 + sum(out[q + "energy"].values for q in pre)
+    sig.update({
+        "theta1": Signal(y[:, st[pre[0] + "theta1"]] - phase, "rad", "crank angle of the shaft"),
+        "omega1": Signal(w, "rad/s", "crank speed"),
+        "alpha1": Signal(dy[:, st[pre[0] + "omega1"]], "rad/s**2",
+                         "crank angular acceleration"),
+        "motor_torque": Signal(dy[:, st["W_motor"]] / w, "N*m", "motor torque at the crank"),
+        "W_motor": Signal(y[:, st["W_motor"]], "J", "work done by the motor since t = 0"),
+        "energy": Signal(energy, "J", "the machine's energy: the drive's kinetic energy and "
+                         "each throw's (its crank, rod and crosshead, contact elastic)"),
+    })  # fmt: skip
+    return sig
 
 
 #: The frame's axes, in which the machine's shaking forces and moments are given.

@@ -27,29 +27,92 @@ pins worn, or the guide's clearance) or there is one throw; else the machine's e
 smallest of the throws' phased contact factors (``CFG``: the joints' configuration code, a
 literal), since an onset factor alone (``|e| - c``) is negative in contact and would hide
 the other throws' onsets in a minimum.
+
+With a motor (``MOTOR``) each throw's module is its joints' configuration with the crank free
+(template `contact`, the crank's angle, speed and work the last three states of its slice at
+``THROW_M``: its own angle, the shaft's plus its phase, and the shaft's speed). A machine of
+one throw is then the one-throw module itself. With several (``SHARED``) each throw's slice
+holds its own crank's inertia (``J1 + m1 rs^2``, at ``THROW_CO``, the drive's left out) and
+the throws share the crank's acceleration: with a worn crank pin the crank and the rod are
+bodies apart, joined by the pin's force, which depends on the states only, so the throw's
+crank equation ``I_k alpha_k = T + tau_k`` (its module's, at the torque ``T`` of its torque
+law's slice ``THROW_MO``) gives the torque ``tau_k = I_k alpha_k - T`` the rod, the joint and
+the crank's weight put on its crank, and the crank turns as
+
+    alpha = (T_m + sum_k tau_k) / (J_drive + sum_k I_k)
+
+(``T_m`` the motor's torque, ``torque`` at the shaft's slice ``SHAFT``: ``J_drive`` then the
+torque law's). The rod's big end's acceleration ``B'' = A''(alpha) + e1''`` does not depend on
+the crank's (the rod moves under the pin's force), so each throw's crank-pin eccentricity's
+acceleration is its own less the crank pin's change, ``e1'' += r (sin, -cos)(theta) (alpha -
+alpha_k)``, its other states' unchanged. The throw's work integrals then hold the shaft's
+torque on its crank, ``T_k = T + I_k (alpha - alpha_k)``; the motor's work is the last state,
+``W_MOTOR``. The Jacobian: fourth-order central differences of the whole right-hand side, the
+steps ``1e-5 max(|y_i|, s_i)``, the scales ``s_i`` in the parameter vector at ``SCALE``.
 """
+
+import math
 
 import numba as nb
 import numpy as np
 
 from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, compiled
-from recipdyn.model.joints.pins import _flip, contact_factor
+from recipdyn.model.joints.pins import I_WIN, P_R, _flip, contact_factor
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as torque
 from recipdyn.model.assembler.templates.contact import event as throw_event
 from recipdyn.model.assembler.templates.contact import jac as throw_jac
 from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
+MOTOR = False
 N_THROWS = np.int64(1)
 OWN_EVENT = True
+SCALE = np.int64(33)
+SHAFT = np.int64(33)
+SHARED = False
+THROW_CO = np.int64(31)
+THROW_M = np.int64(12)
+THROW_MO = np.int64(33)
 THROW_N = np.array([12], dtype=np.int64)
 THROW_NP = np.array([33], dtype=np.int64)
 THROW_PARAMS = np.array([0], dtype=np.int64)
 THROW_STATE = np.array([0], dtype=np.int64)
+W_MOTOR = np.int64(12)
 # </bindings>
+
+
+@nb.njit(cache=True)
+def _shaft(y, p, out):
+    """With a motor and several throws: the crank's acceleration from the throws' torques on
+    their cranks, and each throw's derivatives at it (module docstring); ``out`` holds each
+    throw's own derivatives at its own crank acceleration on entry."""
+    w = y[THROW_STATE[0] + THROW_M + 1]
+    tm = torque(w, p, SHAFT + 1)
+    num = tm
+    den = p[SHAFT]
+    for k in range(N_THROWS):
+        s, o = THROW_STATE[k], THROW_PARAMS[k]
+        ic = p[o + THROW_CO]
+        num += ic * out[s + THROW_M + 1] - torque(w, p, o + THROW_MO)
+        den += ic
+    alpha = num / den
+    for k in range(N_THROWS):
+        s, o = THROW_STATE[k], THROW_PARAMS[k]
+        ic = p[o + THROW_CO]
+        da = alpha - out[s + THROW_M + 1]
+        th = y[s + THROW_M]
+        r = p[o + P_R]
+        out[s + 4] += r * math.sin(th) * da
+        out[s + 5] -= r * math.cos(th) * da
+        tk = torque(w, p, o + THROW_MO) + ic * da  # the shaft's torque on its crank
+        out[s + I_WIN] += ic * da * w
+        out[s + THROW_M + 1] = alpha
+        out[s + THROW_M + 2] = tk * w
+    out[W_MOTOR] = tm * w
 
 
 @nb.njit(cache=True)
@@ -57,6 +120,8 @@ def _rhs(t, y, p, out):
     for k in range(N_THROWS):
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
         throw_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
+    if SHARED:
+        _shaft(y, p, out)
 
 
 @compiled(RHS_SIGNATURE)
@@ -64,10 +129,32 @@ def rhs(t, y, p, out):
     _rhs(t, y, p, out)
 
 
+@nb.njit(cache=True)
+def _fd_jac(t, y, p, J):
+    """Fourth-order central differences of the whole right-hand side (truncation O(h^4)),
+    steps ``1e-5 max(|y_i|, s_i)`` (the scales at ``SCALE``: each throw's own module's)."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    for k in range(n):
+        h = 1e-5 * max(abs(y[k]), p[SCALE + k])
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in range(n):
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+
+
 @compiled(JAC_SIGNATURE, allocates=True)
 def jac(t, y, p, J):
     """Block-diagonal: each throw's own Jacobian (its module's ``jac``) on its states; the
-    throws do not interact with the crank prescribed."""
+    throws do not interact with the crank prescribed (or with one throw). With a motor and
+    several throws, which share the crank's acceleration: central differences of the whole
+    right-hand side (`_fd_jac`)."""
+    if SHARED:
+        _fd_jac(t, y, p, J)
+        return
     for i in range(y.shape[0]):
         for j in range(y.shape[0]):
             J[i, j] = 0.0
