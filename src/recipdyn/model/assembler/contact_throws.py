@@ -233,7 +233,7 @@ class ContactConfiguration:
             "THROW_NP": arr(s.stop - s.start for s in slices),
             "THROW_PARAMS": arr(s.start for s in slices),
             "THROW_STATE": arr(s.start for s in parts),
-            "W_MOTOR": st["W_motor"] if "W_motor" in st else parts[-1].stop,
+            "W_MOTOR": st.start("shaft.work") if "shaft.work" in st.parts else parts[-1].stop,
         }
         stem = f"{self.locals[0]['clearance_joints']}_{len(throws)}"
         if motor:

@@ -853,7 +853,7 @@ class ContactMachine(MachineModel):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
-        if "W_motor" in c.layout.state:  # the motor's work, the machine's last state
+        if "shaft.work" in c.layout.state.parts:  # the motor's work, the machine's last state
             parts.append(np.zeros(1))
         return np.concatenate(parts)
 
@@ -862,7 +862,7 @@ class ContactMachine(MachineModel):
         c = self.contact(values)
         own = [_one_model(t).state_scale(v)
                for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
-        if "W_motor" in c.layout.state:
+        if "shaft.work" in c.layout.state.parts:
             own.append(np.ones(1))
         return np.concatenate(own)
 
