@@ -166,7 +166,8 @@ def test_throws_of_two_families_and_what_a_motor_does_not_take_are_refused_in_on
     """Throws of two families (the link beside a contact pin, or beside an ideal crank pin
     with a worn crosshead pin), the link with a worn crosshead pin, throws with an ideal crank
     pin (a worn crosshead pin) on a motor with several throws, and contact throws whose pins
-    differ (a worn crosshead pin on one only)."""
+    differ (a worn crosshead pin on one only); the held motor and a flexible shaft with
+    contact pins."""
     worn = Throw("throw2", crank_joint="ideal", crosshead_joint="contact")
     worn1 = Throw("throw1", crank_joint="ideal", crosshead_joint="contact")
     for throws, drive, words in (
@@ -174,15 +175,27 @@ def test_throws_of_two_families_and_what_a_motor_does_not_take_are_refused_in_on
         ((Throw("throw1"), worn), "prescribed", "crosshead_joint = 'contact'"),
         ((Throw("throw1", crosshead_joint="contact"),), "prescribed", "beside crank_joint"),
         ((worn1, worn), "motor", "throw1.crank_joint = 'ideal'"),
+        ((_throw("throw1"), _throw("throw2")), "held", "motor = 'held'"),
+        ((_throw("throw1"),), "torsion", "[shaft.torsion]"),
     ):
         with pytest.raises(ParameterError) as exc:
-            _machine(*throws, drive=drive)
+            if drive == "held":
+                _motor_machine(*throws, motor="held")
+            elif drive == "torsion":
+                _motor_machine(*throws, torsion=True)
+            else:
+                _machine(*throws, drive=drive)
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
     m = _machine(_throw("throw1"), Throw("throw2", crosshead_joint="contact",
                                          crank_joint="contact"))  # fmt: skip
     with pytest.raises(ParameterError) as exc:
         m.parameters()
     assert "throw2: its pins, guide" in str(exc.value) and "\n" not in str(exc.value)
+    # on a motor with several throws a worn crank pin's crank needs its own inertia
+    bare = Throw("throw2", crank_joint="contact", params=(("m1", 0.0), ("J1", 0.0)))
+    with pytest.raises(ParameterError) as exc:
+        _motor_machine(_throw("throw1"), bare).parameters()
+    assert "throw2.J1 + m1 rs**2 = 0" in str(exc.value) and "\n" not in str(exc.value)
 
 
 @pytest.mark.parametrize("load", ["valves", "cycle"])
@@ -259,12 +272,13 @@ def test_throws_with_a_worn_crosshead_pin_or_the_guides_clearance_are_each_a_one
 SYNC = 160.0
 
 
-def _motor_machine(*throws, **shaft):
+def _motor_machine(*throws, motor="induction", torsion=False, **shaft):
     from recipdyn.model.assembler.model import MachineModel
 
     params = {"omega": OMEGA, "motor_sync_speed": SYNC, **shaft}
-    return MachineModel(Machine("contact-motor-test", shaft=Shaft("motor", params=tuple(
-        params.items())), throws=tuple(throws), stages=(Stage(),)))  # fmt: skip
+    return MachineModel(Machine("contact-motor-test", shaft=Shaft(
+        "motor", motor, params=tuple(params.items()), torsion=torsion), throws=tuple(throws),
+        stages=(Stage(),)))  # fmt: skip
 
 
 def test_one_contact_throw_on_a_motor_is_the_contact_model_on_a_motor_to_the_bit(tmp_path):

@@ -52,8 +52,9 @@ PRESETS = {
 #: Machines of several throws (`recipdyn.model.machine`, by their files): the motor coupling
 #: two throws through the crank, two throws with dynamic valves and a fault on one, two
 #: throws on a frame on its mounts, two stages joined by an interstage volume, two throws on
-#: a torsionally flexible crankshaft, and two throws with contact-impact crank pins (dry and
-#: lubricated, different clearances).
+#: a torsionally flexible crankshaft, two throws with contact-impact crank pins (dry and
+#: lubricated, different clearances), and two with dry contact-impact crank pins on a motor
+#: (they share the crank's acceleration).
 MACHINES = [
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_valves.toml"),
@@ -61,6 +62,7 @@ MACHINES = [
     str(Path(__file__).parent / "machines" / "two_stage_interstage.toml"),
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_torsion.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_contact.toml"),
+    str(Path(__file__).parent / "machines" / "two_throw_contact_motor.toml"),
 ]
 MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 

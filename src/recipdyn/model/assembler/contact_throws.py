@@ -142,6 +142,11 @@ def refusal(machine: Machine) -> str | None:
         return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
                 "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
+    if machine.shaft.drive == "motor" and machine.shaft.motor == "held":
+        return (f"{where}: motor = 'held' with contact pins or the guide's clearance is not "
+                "modelled yet; allowed: 'induction' or 'constant', or drive = 'prescribed' "
+                "(a held rotor on a rigid shaft turns the crank as a prescribed speed "
+                "does)")  # fmt: skip
     if machine.shaft.drive == "motor" and len(machine.throws) > 1:
         for t in machine.throws:
             if t.crank_joint not in ("contact", "lubricated"):
