@@ -44,6 +44,10 @@ CASES = {
     "two-throw (machine file)": (str(ROOT / "examples" / "machines" / "two_throw.toml"), {}),
     "two-stage four-throw (machine file)": (
         str(ROOT / "examples" / "machines" / "two_stage_4_throw.toml"), {}),
+    # after contact-motor, whose joints' module (the crank free) its throws share: only the
+    # machine's own module is new
+    "two contact throws, motor (file)": (
+        str(ROOT / "examples" / "machines" / "two_throw_contact_motor.toml"), {}),
 }  # fmt: skip
 
 _RUN = """

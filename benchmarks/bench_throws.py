@@ -10,14 +10,17 @@ right-hand side of N throws against N of one throw; spread, each throw's fast mo
 its own time and the runs take more steps (printed). Target: at most 1.1.
 
 With ``--joint contact`` the throws have contact-impact crank pins (the template
-``contact_throws``; a prescribed crank only, at 150 rad/s with a tenth of the paper's load:
-impacts several times a revolution), one throw being ``compressor-contact`` at the same values.
-Measured (3 rounds): in phase 1424, 1418, 1418 steps a revolution for 1, 2, 4 throws, ratios
-0.90 and 0.78; spread, 5548 and 12774 steps (each throw's impacts at their own times, and the
-machine's event locates the pins' separations too), ratios per step 0.71 and 0.58.
+``contact_throws``; at 150 rad/s with a tenth of the paper's load: impacts several times a
+revolution), one throw being ``compressor-contact`` at the same values. Measured (3 rounds): in
+phase 1424, 1418, 1418 steps a revolution for 1, 2, 4 throws, ratios 0.90 and 0.78; spread,
+5548 and 12774 steps (each throw's impacts at their own times, and the machine's event locates
+the pins' separations too), ratios per step 0.71 and 0.58. With ``--drive motor`` the crank
+is free (the induction motor, synchronous at 157 rad/s): N throws get N times the drive's
+inertia and the motor's torque, so that in phase each throw moves as the one throw
+(``compressor-contact --set drive=motor``) does.
 
     python benchmarks/bench_throws.py [--throws 1 2 4] [--rounds 5] [--revolutions 1]
-                                      [--joint link|contact]
+                                      [--joint link|contact] [--drive prescribed|motor|both]
 """
 
 from __future__ import annotations
@@ -28,6 +31,9 @@ import time
 
 #: The contact pins' case: impacts several times a revolution (the contact model's example).
 CONTACT = {"omega": 150.0, "load_amplitude": 2e4}
+#: The contact pins' motor, per throw: the drive's inertia and Kloss's breakdown torque (N
+#: throws: N times both), synchronous above the speed.
+CONTACT_MOTOR = {"J_drive": 3000.0, "motor_breakdown_torque": 5000.0, "motor_sync_speed": 157.0}
 
 
 def _machine(n: int, drive: str, spread: bool, joint: str = "link"):
@@ -36,6 +42,9 @@ def _machine(n: int, drive: str, spread: bool, joint: str = "link"):
 
     extra = (("load_amplitude", CONTACT["load_amplitude"]),) if joint == "contact" else ()
     shaft = Shaft(drive, params=(("omega", CONTACT["omega"]),) if joint == "contact" else ())
+    if joint == "contact" and drive == "motor":
+        scaled = {k: (n * v if k != "motor_sync_speed" else v) for k, v in CONTACT_MOTOR.items()}
+        shaft = Shaft(drive, params=(("omega", CONTACT["omega"]), *scaled.items()))
     throws = tuple(Throw(f"throw{k + 1}", crank_joint=joint,
                          params=(("phase", 2 * math.pi * k / n if spread else 0.0), *extra))
                    for k in range(n))  # fmt: skip
@@ -61,13 +70,21 @@ def main(argv: list[str] | None = None) -> None:
         default="link",
         help="the crank pins: the massless link, or contact-impact joints",
     )
+    ap.add_argument(
+        "--drive",
+        choices=("prescribed", "motor", "both"),
+        default=None,
+        help="the crank prescribed or free on the induction motor (default: both for the "
+        "link, prescribed for contact pins)",
+    )
     args = ap.parse_args(argv)
     if args.quick:
         args.throws, args.rounds = [1, 2], 2
 
     from recipdyn.integrate import integrate
 
-    drives = ("prescribed",) if args.joint == "contact" else ("prescribed", "motor")
+    drive_arg = args.drive or ("prescribed" if args.joint == "contact" else "both")
+    drives = ("prescribed", "motor") if drive_arg == "both" else (drive_arg,)
     for drive in drives:
         cases = {}
         for n in args.throws:
@@ -77,7 +94,8 @@ def main(argv: list[str] | None = None) -> None:
 
                 if args.joint == "contact":
                     m = get_model("compressor-contact")
-                    v = m.parameters(CONTACT)
+                    motor = {"drive": "motor", **CONTACT_MOTOR} if drive == "motor" else {}
+                    v = m.parameters({**CONTACT, **motor})
                 else:
                     m = get_model("compressor")
                     v = m.parameters({"drive": drive})
