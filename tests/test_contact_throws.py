@@ -424,6 +424,8 @@ def test_the_energy_of_a_machine_of_contact_throws_on_a_motor_balances():
     summary = model.run_summary(v, ds)
     for q in ("throw1", "throw2"):
         assert summary[f"{q}.energy_balance_residual"] < 1e-8, q
+    own = residual / max(np.abs(E).max(), np.abs(Wm).max())  # (the summary's, summed apart)
+    assert summary["energy_balance_residual"] == pytest.approx(own, rel=1e-3, abs=1e-16)
     shaft = ds["motor_torque"].values - 30.0 * ds["alpha1"].values
     cranks = ds["throw1.crank_torque"].values + ds["throw2.crank_torque"].values
     assert np.abs(cranks - shaft).max() <= 1e-9 * np.abs(ds["motor_torque"].values).max()

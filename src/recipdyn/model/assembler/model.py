@@ -924,7 +924,20 @@ class ContactMachine(MachineModel):
                 view = view.isel(impact_event=np.flatnonzero(moved.any(axis=1)))
             for k, val in _one_model(th).run_summary(v, view).items():
                 out[pre + k] = val
+        if "W_motor" in ds.data_vars and "shaft.work" in c.layout.state.parts:
+            out["energy_balance_residual"] = _energy_residual(c, ds)
         return out
+
+
+def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
+    """The machine's energy balance over the record, ``W_motor + sum_k W_gas,k = dE + sum_k
+    W_loss,k``: its largest residual over the largest of the energy and the motor's work."""
+    pre = [c.machine.prefix(th.name) for th in c.machine.throws]
+    E, Wm = ds["energy"].values, ds["W_motor"].values
+    Wg = sum(ds[q + "W_gas"].values for q in pre)
+    Wl = sum(ds[q + "W_loss"].values for q in pre)
+    bal = (Wm - Wm[0]) + (Wg - Wg[0]) - (E - E[0]) - (Wl - Wl[0])
+    return float(np.abs(bal).max() / max(np.abs(E).max(), np.abs(Wm).max(), 1e-300))
 
 
 def _one_model(throw: Throw):
