@@ -345,3 +345,16 @@ def test_the_last_revolution_of_a_slower_crank_is_a_whole_revolution():
     values = {"omega": omega, "drive": "motor"}
     assert mean_speed(values, ds) == pytest.approx(0.9 * omega, rel=1e-9)
     assert mean_speed({**values, "drive": "prescribed"}, ds) == omega
+
+
+@pytest.mark.slow
+def test_generated_share_of_an_ideal_crank_pin_is_up_to_date():
+    """``_compressor_contact_share.py`` (the rod's and crosshead's mass matrix with an ideal
+    crank pin, for a machine of several throws on a motor) is what ``python -m
+    recipdyn.model.compressor_contact`` writes (sympy, ~15 s)."""
+    from pathlib import Path
+
+    from recipdyn.model import compressor_contact
+
+    committed = Path(compressor_contact.__file__).with_name("_compressor_contact_share.py")
+    assert committed.read_text() == compressor_contact.generate_share()

@@ -147,14 +147,6 @@ def refusal(machine: Machine) -> str | None:
                 "modelled yet; allowed: 'induction' or 'constant', or drive = 'prescribed' "
                 "(a held rotor on a rigid shaft turns the crank as a prescribed speed "
                 "does)")  # fmt: skip
-    if machine.shaft.drive == "motor" and len(machine.throws) > 1:
-        for t in machine.throws:
-            if t.crank_joint not in ("contact", "lubricated"):
-                return (f"{where}: {t.name}.crank_joint = {t.crank_joint!r} (a worn crosshead "
-                        "pin or the guide's clearance only) on a motor with several throws is "
-                        "not modelled yet (its rod turns with the crank: a share of the "
-                        "crank's inertia); allowed: crank_joint = 'contact' | 'lubricated', "
-                        "drive = 'prescribed', or one throw")  # fmt: skip
     if machine.frame is not None:
         return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
@@ -225,6 +217,7 @@ class ContactConfiguration:
         end = slices[-1].stop
         constants = {
             "CFG": _literal(CFG[self.locals[0]["clearance_joints"]]),
+            "HAS_GUIDE": self.locals[0].get("guide", "ideal") == "clearance",
             "MOTOR": motor,
             "N_THROWS": len(throws),
             "OWN_EVENT": len(throws) == 1 or phased,
@@ -290,7 +283,8 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
     except ParameterError as exc:  # with the throw's namespace: ``throw2.rc = ...``
         part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
         raise ParameterError(f"{machine.prefix(part)}{exc}") from None
-    if shared(machine) and not out["J1"] + out["m1"] * out["rs"] ** 2 > 0.0:
+    worn = throw.crank_joint != "ideal"  # (an ideal crank pin's rod turns with its crank)
+    if shared(machine) and worn and not out["J1"] + out["m1"] * out["rs"] ** 2 > 0.0:
         raise ParameterError(
             f"{machine.prefix(throw.name)}J1 + m1 rs**2 = 0 kg*m**2 is out of range with "
             "drive = 'motor' and several throws; allowed: > 0 (a worn crank pin's crank turns "

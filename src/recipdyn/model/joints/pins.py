@@ -38,6 +38,11 @@ from .._compressor_contact_drive import (
     crosshead_guide_free_accelerations,
     ideal_guide_free_accelerations,
 )
+from .._compressor_contact_share import (
+    crosshead_free_mass,
+    crosshead_guide_free_mass,
+    ideal_guide_free_mass,
+)
 from ..base import EVENT_SIGNATURE, RHS_SIGNATURE, compiled
 from ..components.guide import CLEARANCE
 from .contact import short_bearing_forces  # noqa: F401 (the joints' template reads it here)
@@ -209,6 +214,43 @@ def _accelerate_free(y, p, out, cfg, j, fg, m, tm, co):
     out[m + 1] = a0
     out[m + 2] = tm * w1
     return v3, c2
+
+
+@nb.njit(cache=True)
+def ideal_share(y, p, cfg, guide, m, gy):
+    """With an ideal crank pin (``cfg`` 1: the crosshead pin worn; 3: both ideal, with the
+    guide's clearance ``guide``) the rod turns with the crank: from the mass matrix of rod and
+    crosshead (generated, `recipdyn.model._compressor_contact_share`) at the crank angle
+    ``y[m]``, the throw's share of the crank's inertia, the Schur complement ``I = m00 - m_0r
+    M_rr^-1 m_r0``, and ``k = M_rr^-1 m_r0``, by which its other accelerations (the crosshead
+    pin's ``e2x'', e2y''``, the guide's ``yg''``; with both pins ideal ``yg''`` alone) fall
+    per unit of the crank's: ``q_r'' = M_rr^-1 (b_r - m_r0 theta1'')``. Returns ``(I, k0, k1,
+    k2)`` (unused ``k`` 0). No arrays allocated."""
+    if cfg == 3:
+        m00, m10, m11 = ideal_guide_free_mass((y[m], y[gy]), p)
+        k0 = m10 / m11
+        return m00 - m10 * k0, k0, 0.0, 0.0
+    if not guide:
+        m00, m10, m11, m20, m21, m22 = crosshead_free_mass((y[m], y[2], y[3]), p)
+        det = m11 * m22 - m21 * m21
+        k0 = (m22 * m10 - m21 * m20) / det
+        k1 = (m11 * m20 - m21 * m10) / det
+        return m00 - m10 * k0 - m20 * k1, k0, k1, 0.0
+    m00, m10, m11, m20, m21, m22, m30, m31, m32, m33 = crosshead_guide_free_mass(
+        (y[m], y[2], y[3], y[gy]), p
+    )
+    # the symmetric 3 x 3 M_rr by its cofactors (Cramer's rule)
+    c11 = m22 * m33 - m32 * m32
+    c12 = m32 * m31 - m21 * m33
+    c13 = m21 * m32 - m22 * m31
+    c22 = m11 * m33 - m31 * m31
+    c23 = m21 * m31 - m11 * m32
+    c33 = m11 * m22 - m21 * m21
+    det = m11 * c11 + m21 * c12 + m31 * c13
+    k0 = (c11 * m10 + c12 * m20 + c13 * m30) / det
+    k1 = (c12 * m10 + c22 * m20 + c23 * m30) / det
+    k2 = (c13 * m10 + c23 * m20 + c33 * m30) / det
+    return m00 - m10 * k0 - m20 * k1 - m30 * k2, k0, k1, k2
 
 
 # ---- the guide's clearance (`recipdyn.model.components.guide`): the crosshead pin's lateral

@@ -45,7 +45,12 @@ the crank's weight put on its crank, and the crank turns as
 torque law's). The rod's big end's acceleration ``B'' = A''(alpha) + e1''`` does not depend on
 the crank's (the rod moves under the pin's force), so each throw's crank-pin eccentricity's
 acceleration is its own less the crank pin's change, ``e1'' += r (sin, -cos)(theta) (alpha -
-alpha_k)``, its other states' unchanged. The throw's work integrals then hold the shaft's
+alpha_k)``, its other states' unchanged. With an ideal crank pin (``CFG`` 1 or 3: a worn
+crosshead pin, the guide's clearance) the rod turns with the crank: the throw's share of the
+crank's inertia adds the Schur complement of its rod's and crosshead's mass matrix,
+``I_k = J1 + m1 rs^2 + m00 - m_0r M_rr^-1 m_r0``, its torque is ``I_k alpha_k - T``, and its
+other accelerations fall by ``k = M_rr^-1 m_r0`` per unit of the crank's
+(`recipdyn.model.joints.pins.ideal_share`). The throw's work integrals then hold the shaft's
 torque on its crank, ``T_k = T + I_k (alpha - alpha_k)``; the motor's work is the last state,
 ``W_MOTOR``. The Jacobian: fourth-order central differences of the whole right-hand side, the
 steps ``1e-5 max(|y_i|, s_i)``, the scales ``s_i`` in the parameter vector at ``SCALE``.
@@ -57,7 +62,7 @@ import numba as nb
 import numpy as np
 
 from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, compiled
-from recipdyn.model.joints.pins import I_WIN, P_R, _flip, contact_factor
+from recipdyn.model.joints.pins import G_GUIDE, I_WIN, P_R, _flip, contact_factor, ideal_share
 
 # isort: split
 # <bindings>
@@ -68,6 +73,7 @@ from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
+HAS_GUIDE = False
 MOTOR = False
 N_THROWS = np.int64(1)
 OWN_EVENT = True
@@ -85,6 +91,21 @@ W_MOTOR = np.int64(12)
 # </bindings>
 
 
+#: The throws' rods turn with their cranks (an ideal crank pin).
+IDEAL_CRANK = CFG == 1 or CFG == 3
+
+
+@nb.njit(cache=True)
+def _share(y, p, k):
+    """Throw ``k``'s share of the crank's inertia beyond its crank's own, and ``k`` of its
+    other accelerations (`recipdyn.model.joints.pins.ideal_share`); none with a worn crank
+    pin."""
+    if IDEAL_CRANK:
+        s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        return ideal_share(y[s : s + n], p[o : o + m], CFG, HAS_GUIDE, THROW_M, G_GUIDE)
+    return 0.0, 0.0, 0.0, 0.0
+
+
 @nb.njit(cache=True)
 def _shaft(y, p, out):
     """With a motor and several throws: the crank's acceleration from the throws' torques on
@@ -96,18 +117,27 @@ def _shaft(y, p, out):
     den = p[SHAFT]
     for k in range(N_THROWS):
         s, o = THROW_STATE[k], THROW_PARAMS[k]
-        ic = p[o + THROW_CO]
+        ic = p[o + THROW_CO] + _share(y, p, k)[0]
         num += ic * out[s + THROW_M + 1] - torque(w, p, o + THROW_MO)
         den += ic
     alpha = num / den
     for k in range(N_THROWS):
         s, o = THROW_STATE[k], THROW_PARAMS[k]
-        ic = p[o + THROW_CO]
+        share = _share(y, p, k)
+        ic = p[o + THROW_CO] + share[0]
         da = alpha - out[s + THROW_M + 1]
-        th = y[s + THROW_M]
-        r = p[o + P_R]
-        out[s + 4] += r * math.sin(th) * da
-        out[s + 5] -= r * math.cos(th) * da
+        if CFG == 3:  # the guide's lateral position alone
+            out[s + G_GUIDE + 2] -= share[1] * da
+        elif CFG == 1:  # the crosshead pin (and the guide's lateral position)
+            out[s + 6] -= share[1] * da
+            out[s + 7] -= share[2] * da
+            if HAS_GUIDE:
+                out[s + G_GUIDE + 2] -= share[3] * da
+        else:  # the crank pin's eccentricity: the rod's big end does not depend on alpha
+            th = y[s + THROW_M]
+            r = p[o + P_R]
+            out[s + 4] += r * math.sin(th) * da
+            out[s + 5] -= r * math.cos(th) * da
         tk = torque(w, p, o + THROW_MO) + ic * da  # the shaft's torque on its crank
         out[s + I_WIN] += ic * da * w
         out[s + THROW_M + 1] = alpha
