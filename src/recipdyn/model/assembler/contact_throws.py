@@ -31,13 +31,14 @@ throw's torque on its crank, which a worn crank pin's force (a function of the s
 and corrects each throw's crank-pin eccentricity to it (template ``contact_throws``). Each
 throw's work integral there (``throwK.W_crank``) is the shaft's work on its crank, and the
 motor's is the machine's last state, ``W_motor``. A throw with an ideal crank pin (a worn
-crosshead pin or the guide's clearance only) takes a share of the crank's inertia too (the
-rod turns with the crank): not yet on a machine of several throws with a motor.
+crosshead pin or the guide's clearance only) takes a share of the crank's inertia too (its rod
+turns with the crank: the Schur complement of its mass matrix,
+`recipdyn.model.joints.pins.ideal_share`).
 
 A throw's ``crosshead_joint`` and ``guide`` (structure keys of the machine's description)
 choose the rest of its joints: a worn crosshead pin, the guide's clearance (the family's
 whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. Not yet (refused in
-one line): a motor with throws of ideal crank pins (several throws), a flexible shaft, a load
+one line): the held motor, a flexible shaft, a load
 of a user's file or a table, a frame, an interstage volume, a throw on the other side of the
 shaft (``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and
 throws of different families in one machine
