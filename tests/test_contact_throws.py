@@ -284,7 +284,7 @@ def test_one_contact_throw_on_a_motor_is_the_contact_model_on_a_motor_to_the_bit
     """A machine file of one throw with ``crank_joint = contact`` and ``drive = motor`` is
     ``--model compressor-contact --set drive=motor`` at the same values: the same module (the
     template calls it on the whole vector and adds nothing with one throw), every signal and
-    event to the bit."""
+    event to the bit, and the same auxiliary and passive states (Lyapunov's tangent space)."""
     f = tmp_path / "one.toml"
     f.write_text(f'[shaft]\ndrive = "motor"\nomega = "{OMEGA} rad/s"\nmotor_sync_speed = '
                  f'"{SYNC} rad/s"\n\n[[throw]]\ncrank_joint = "contact"\nload_amplitude = '
@@ -296,6 +296,8 @@ def test_one_contact_throw_on_a_motor_is_the_contact_model_on_a_motor_to_the_bit
                         "motor_sync_speed": SYNC})  # fmt: skip
     assert values.pop("phase") == 0.0
     assert values == {k: ref[k] for k in values}
+    s, own = machine.system(machine.parameters()), c.system(ref)  # (Lyapunov's tangent space)
+    assert (s.passive, s.aux, s.aux_states) == (own.passive, own.aux, own.aux_states)
     kw = dict(revolutions=0.5, fs=4000.0)
     a = _simulate(model=machine, **kw)
     b = _simulate(model=c, params=ref, **kw)

@@ -816,6 +816,8 @@ class ContactMachine(MachineModel):
             s = st.start(f"{t.name}.mechanism")
             passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
         own = _one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
+        if len(c.locals) == 1 and c.machine.shaft.drive == "motor":  # the model's own
+            passive, aux = list(own.passive), own.aux
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             pre = [c.machine.prefix(t.name) for t in c.machine.throws]
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
