@@ -201,3 +201,45 @@ def test_an_offset_outside_the_declared_range_names_the_channel():
     # a range the diagnoser does not declare is not checked
     assert check_chain({}, est, None) == ([], None)
     assert np.isfinite(checks[0].value)
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        # the shipped data set's chain with one parameter far outside its declared range
+        ({"accelerometer.full_scale": 40 * 9.80665}, ["accelerometer clipped", "re-record"]),
+        ({"accelerometer.hum_db": 0.0, "accelerometer.mains_hz": 60.0,
+          "pressure.mains_hz": 60.0}, ["accelerometer: mains hum at 60 Hz", "re-record"]),
+        ({"accelerometer.bits": 8}, ["accelerometer: converter step", "finer converter"]),
+        ({"tacho.angle": math.radians(10.0)}, ["tacho: mark's angle", "outer dead centre"]),
+    ],
+)  # fmt: skip
+def test_a_chain_far_outside_its_ranges_is_refused_naming_channel_and_remedy(
+    healthy_record, change, words
+):
+    """The healthy test record through its own drawn chain (inside every range: answered
+    without a chain refusal) and through that chain with one parameter changed far outside
+    the declared ranges: a clipped accelerometer (range 40 g against healthy peaks of ~150
+    g), 60 Hz hum at 0 dB (20 dB above the -20 dB top), an 8-bit converter (its step 32x the
+    coarsest declared), a keyphasor 10 degrees off (the declared +-2 degrees widened by the
+    pressures' delay, < 1 degree at this speed): each refused in one line naming the channel,
+    the estimate, the range and what to do."""
+    from recipdyn import sensors
+    from recipdyn.chain import Chain
+    from recipdyn.diagnosis.diagnose import diagnose_arrays
+
+    task, ds = healthy_record
+
+    def run(d):
+        rec = sensors.record(ds, chain=Chain.from_dict(d), seed=task["noise_seed"])
+        return diagnose_arrays(rec["accel_guide"].values, task["fs"], tacho=rec["tacho"].values,
+                               p_head=rec["p_head_sensor"].values,
+                               p_crank=rec["p_crank_sensor"].values)  # fmt: skip
+
+    base = dict(task["chain"], **{"accelerometer.snr_db": 25.0})
+    res = run(base)
+    assert "trained under" not in (res.reason or "") and "clipped" not in (res.reason or "")
+    res = run(dict(base, **change))
+    assert res.refused and "\n" not in res.reason, res.reason
+    for w in words:
+        assert w in res.reason, res.reason

@@ -336,14 +336,15 @@ def _signal_checks(declared, signals) -> list[ChainCheck | None]:
     for name, (parameter, _ch, _) in CHECKED.items():
         if name.startswith("hum_") and name in signals and parameter in declared:
             h = signals[name]
-            a, b, unit = declared[parameter]
+            # only the top of the range bounds a hum (no hum at all is in every range)
+            b, unit = declared[parameter][1:]
             k = HARMONIC[name]
             rel = declared.get(f"accelerometer.hum_h{k}", (0.0, 1.0, ""))[1] if k > 1 else 1.0
             top = b + 20 * math.log10(rel) if rel > 0 else -math.inf
             note = h.note
             lo = h.db_lo if math.isfinite(h.db) else math.nan
             out.append(_check(name, h.db, lo, h.db_hi, declared, note,
-                              span=(a if k == 1 else -math.inf, top, unit)))  # fmt: skip
+                              span=(-math.inf, top, unit)))  # fmt: skip
     for ch in ("accelerometer", "p_head", "p_crank"):
         q = signals.get(f"step_{ch}")
         name = f"step_{ch}"
