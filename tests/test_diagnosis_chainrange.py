@@ -243,3 +243,36 @@ def test_a_chain_far_outside_its_ranges_is_refused_naming_channel_and_remedy(
     assert res.refused and "\n" not in res.reason, res.reason
     for w in words:
         assert w in res.reason, res.reason
+
+
+def test_an_accelerometer_clipped_inside_its_declared_full_scale_is_answered():
+    """The default ranges draw the accelerometer's converter range at 250-1000 g so that the
+    worn pins' impacts (~450 g) sometimes clip: such a record lies inside the data set, and
+    its flat tops give the full scale (the extreme over g, to a converter step). A sine
+    clipped at 300 g is therefore not refused (the evidence says where it clipped), at 40 g
+    it is, naming the range; a clipped pressure is refused whatever the ranges (no drawn
+    transducer range lets the pressure clip); a diagnoser that declares no converter range
+    refuses a clipped accelerometer."""
+    from recipdyn.analysis.channel import clipping
+    from recipdyn.diagnosis.chainrange import clipping_refusal
+    from recipdyn.sensors import G0
+
+    t = np.arange(20000) / 10240.0
+    wave = np.sin(2 * np.pi * 7.0 * t)
+    declared = {"accelerometer.full_scale_g": (250.0, 1000.0, "g")}
+
+    def clipped_at(g):
+        step = 2 * g * G0 / 2**16  # a 16-bit converter spanning +-g
+        return {"clip_accelerometer": clipping(np.round(np.clip(1.5 * g * G0 * wave, -g * G0,
+                                                                g * G0) / step) * step)}
+
+    why, ev = clipping_refusal(clipped_at(300.0), declared)
+    assert why is None and "inside the declared" in ev["accelerometer_clipping"]["status"]
+    assert ev["accelerometer_clipping"]["full_scale_g"] == pytest.approx(300.0, rel=1e-3)
+    why, _ = clipping_refusal(clipped_at(40.0), declared)
+    assert "outside the declared accelerometer.full_scale_g 250..1000 g" in why, why
+    assert "\n" not in why
+    assert "declares no converter range" in clipping_refusal(clipped_at(300.0), None)[0]
+    p = np.clip(3e5 + 2e5 * wave, 0, 4e5)
+    why, _ = clipping_refusal({"clip_p_head": clipping(np.round(p / 10.0) * 10.0)}, declared)
+    assert why.startswith("p_head clipped"), why

@@ -280,17 +280,57 @@ def read_channels(x, fs: float, revs, p_head=None, p_crank=None, n_pulses: int =
     return out
 
 
-def clipping_refusal(signals: dict[str, Any]) -> str | None:
-    """The refusal of a record with a clipped channel (`read_channels`), naming it: a
-    clipped record lies in no data set's chain ranges (its waveform beyond the converter's
-    range is lost), whatever a diagnoser's ranges say; None if none clipped."""
-    bad = [(ch, signals[f"clip_{ch}"]) for ch in ("accelerometer", "p_head", "p_crank")
-           if f"clip_{ch}" in signals and signals[f"clip_{ch}"].clipped]  # fmt: skip
+def clipping_refusal(
+    signals: dict[str, Any], declared: dict[str, tuple[float, float, str]] | None = None
+) -> tuple[str | None, dict[str, Any]]:
+    """``(refusal, evidence)`` of the record's clipped channels (`read_channels`).
+
+    A clipped **pressure** is refused: no data set's chain lets one clip (its transducer's
+    range is at least ``pressure.range_margin`` >= 1.1 times the peak pressure, and the
+    waveform beyond it is lost). A clipped **accelerometer** is a chain parameter like the
+    others: its flat tops sit at the converter's full scale, so the record gives
+    ``full_scale_g`` (the larger extreme over g, to a converter step), and a diagnoser whose
+    data set drew ``accelerometer.full_scale_g`` has learnt records clipped anywhere in that
+    range (the default ranges let the worn pins' impacts clip: `recipdyn.chain`). It is
+    refused when the full scale lies outside the declared range, or when the diagnoser
+    declares none (it cannot say it has seen such records); otherwise the evidence says the
+    record clipped where its data set's records clip."""
+    from ..sensors import G0
+
+    evidence: dict[str, Any] = {}
+    bad = []
+    for ch in ("accelerometer", "p_head", "p_crank"):
+        c = signals.get(f"clip_{ch}")
+        if c is None or not c.clipped:
+            continue
+        if ch != "accelerometer":
+            bad.append(f"{ch} clipped: {c.text()} ({c.samples} samples); no data set's "
+                       "pressure transducer range lets the pressure clip")  # fmt: skip
+            continue
+        full = max(c.top, -c.bottom) / G0
+        half = max(c.step, 0.0) / G0
+        entry = {"clipped_samples": c.samples, "full_scale_g": full, "interval_g": half}
+        span = (declared or {}).get("accelerometer.full_scale_g")
+        if span is None:
+            bad.append(f"accelerometer clipped: {c.text()} ({c.samples} samples), a full "
+                       f"scale of {full:.4g} g; this diagnoser declares no converter range "
+                       "its records were drawn with, so it cannot vouch for a clipped "
+                       "record")  # fmt: skip
+        elif full + half < span[0] or full - half > span[1]:
+            bad.append(f"accelerometer clipped at a full scale of {full:.4g} g ({c.text()}, "
+                       f"{c.samples} samples), outside the declared accelerometer.full_scale_g "
+                       f"{span[0]:g}..{span[1]:g} g")  # fmt: skip
+        else:
+            entry["status"] = (f"clipped at {full:.4g} g, inside the declared full scale "
+                               f"{span[0]:g}..{span[1]:g} g (its data set's records clip "
+                               "there too)")  # fmt: skip
+        evidence["accelerometer_clipping"] = entry
     if not bad:
-        return None
-    what = "; ".join(f"{ch} clipped: {c.text()} ({c.samples} samples)" for ch, c in bad)
-    return (what + "; re-record with the channel's range set so that the signal does not "
-            "clip (a larger converter range or a less sensitive transducer)")  # fmt: skip
+        return None, evidence
+    return ("; ".join(bad) + "; re-record with the channel's range set so that the signal "
+            "does not clip (a larger converter range or a less sensitive transducer), or "
+            "build a data set with that range (recipdyn dataset --chain-range "
+            "accelerometer.full_scale_g=LO,HI)"), evidence  # fmt: skip
 
 
 def _tacho_checks(declared, estimates, signals) -> list[ChainCheck | None]:

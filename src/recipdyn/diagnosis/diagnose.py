@@ -346,9 +346,11 @@ def _diagnose_arrays(
     ph = None if p_head is None else np.asarray(p_head, float)[sl]
     pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
     res = Diagnosis(refused=False)
-    # the channels' own samples: a clipped channel is refused outright (chainrange.py)
+    # the channels' own samples: a clipped pressure, or an accelerometer clipped outside the
+    # converter ranges the diagnoser's data set drew, is refused (chainrange.py)
     signals = read_channels(x, fs, revs, ph, pc, edges.size if tacho is not None else 0)
-    why = clipping_refusal(signals)
+    why, clip = clipping_refusal(signals, declared_ranges(diag))
+    res.evidence.update(clip)
     if why:
         return _refuse(res, why, t0)
     # the measurement chain, estimated from the record and corrected before any feature
