@@ -263,8 +263,11 @@ def test_an_accelerometer_clipped_inside_its_declared_full_scale_is_answered():
 
     def clipped_at(g):
         step = 2 * g * G0 / 2**16  # a 16-bit converter spanning +-g
-        return {"clip_accelerometer": clipping(np.round(np.clip(1.5 * g * G0 * wave, -g * G0,
-                                                                g * G0) / step) * step)}
+        return {
+            "clip_accelerometer": clipping(
+                np.round(np.clip(1.5 * g * G0 * wave, -g * G0, g * G0) / step) * step
+            )
+        }
 
     why, ev = clipping_refusal(clipped_at(300.0), declared)
     assert why is None and "inside the declared" in ev["accelerometer_clipping"]["status"]
