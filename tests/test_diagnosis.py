@@ -720,7 +720,8 @@ def test_cli_refuses_bad_settings_in_one_line(capsys, tmp_path):
     assert main(["dataset", "--conditions", "1", "-o", "unused-folder"]) == 2
     assert main(["diagnose", str(rec)]) == 2  # neither --speed nor --tacho
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 2 and "n_conditions" in err[0] and "speed and tacho" in err[1]
+    # the refusal names the option the user typed, not the spec's field behind it
+    assert len(err) == 2 and "--conditions = 1" in err[0] and "speed and tacho" in err[1]
 
 
 def _simulated_record(path, sensed: bool = False):
@@ -1113,7 +1114,7 @@ def test_a_data_set_too_small_to_train_on_is_refused_when_asked_for(tmp_path, ca
     assert main(["dataset", "-o", str(out), "--conditions", "2", "--classes",
                  "healthy,crank_pin_clearance", "--backend", "serial"]) == 2  # fmt: skip
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "n_conditions >= 3" in err[0] and not out.exists()
+    assert len(err) == 1 and "--conditions >= 3" in err[0] and not out.exists()
     assert DatasetSpec(n_conditions=3).n_conditions == 3
     assert (min_conditions(0.25), min_conditions(0.5), min_conditions(0.75)) == (3, 4, 6)
 

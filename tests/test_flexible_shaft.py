@@ -39,12 +39,12 @@ J_MOTOR, J_DRIVE = 400.0, 3000.0
 
 
 def _machine(k_coupling, k_shaft, c_coupling=0.0, c_shaft=0.0, torsion=True, extra=(),
-             positions=(0.0, 0.3)):  # fmt: skip
+             positions=(0.0, 0.3), motor="constant", joint="ideal"):  # fmt: skip
     """Two throws of the paper's compressor at 0 and 180 deg with ideal crank pins (no
     clearance dynamics: the shaft's alone), a constant motor torque (the mean load torque:
     no damping from a torque-speed slope), the drive 3000 kg m² of which 400 the rotor."""
     throws = tuple(
-        Throw(f"throw{i + 1}", crank_joint="ideal", axial_position=z,
+        Throw(f"throw{i + 1}", crank_joint=joint, axial_position=z,
               params=(("phase", ph), *((("k_shaft", k_shaft), ("c_shaft", c_shaft))
                                        if torsion else ()), *extra))
         for i, (ph, z) in enumerate(zip((0.0, math.pi), positions, strict=True))
@@ -52,7 +52,7 @@ def _machine(k_coupling, k_shaft, c_coupling=0.0, c_shaft=0.0, torsion=True, ext
     params = (("omega", OMEGA), ("J_drive", J_DRIVE))
     if torsion:
         params += (("J_motor", J_MOTOR), ("k_coupling", k_coupling), ("c_coupling", c_coupling))
-    return Machine("torsion-test", shaft=Shaft("motor", "constant", params, torsion=torsion),
+    return Machine("torsion-test", shaft=Shaft("motor", motor, params, torsion=torsion),
                    throws=throws, stages=(Stage(),))  # fmt: skip
 
 
@@ -344,3 +344,112 @@ def test_the_flexible_shaft_composes_with_the_other_parts(name):
     work = work + sum(ds[f"{t.name}.W_gas"].values for t in m.throws)
     total = ds["energy"].values - ds["energy"].values[0]
     assert np.max(np.abs(total - work)) < 1e-7 * np.max(np.abs(ds["W_motor"].values))
+
+
+def test_a_held_rotor_on_a_rigid_shaft_turns_the_crank_at_the_prescribed_speed():
+    """``motor = 'held'`` on a rigid shaft: the crank's acceleration is 0 exactly (the torque
+    is the throws' shares' with the sign turned: ``x + (-x)`` is 0 in floating point), so its
+    speed stays ``omega`` to the bit, the motor's torque is the sum of the throws' crank
+    torques (to rounding: 1e-9 of the largest), and the throws move as with ``drive =
+    'prescribed'`` (massless links with the default clearance, half a revolution). The two
+    runs solve the same equations by two paths (a free crank's share at ``alpha = 0``, the
+    prescribed crank's own equation) through the same integrator at rtol 1e-10: each clearance
+    angle agrees to 1e-6 rad (a few thousand steps of local error ~1e-10 relative; the impacts
+    of the link's clearance make the error grow, not the equations differ: measured ~1e-11)."""
+    held = _model(_machine(0.0, 0.0, torsion=False, motor="held", joint="link"))
+    prescribed = Machine(
+        "torsion-test", shaft=Shaft("prescribed", params=(("omega", OMEGA),)),
+        throws=tuple(Throw(f"throw{i + 1}", crank_joint="link", params=(("phase", ph),))
+                     for i, ph in enumerate((0.0, math.pi))),
+        stages=(Stage(),),
+    )  # fmt: skip
+    kw = dict(revolutions=0.5, fs=4000.0, rtol=1e-10, atol=1e-12)
+    a = _simulate(model=held, params=held.parameters(), **kw)
+    b = _simulate(model=_model(prescribed), params=_model(prescribed).parameters(), **kw)
+    assert np.all(a["omega1"].values == OMEGA)
+    torque = a["throw1.crank_torque"].values + a["throw2.crank_torque"].values
+    assert np.max(np.abs(a["motor_torque"].values - torque)) < 1e-9 * np.max(np.abs(torque))
+    for k in (1, 2):
+        thc_a, thc_b = a[f"throw{k}.theta_c"].values, b[f"throw{k}.theta_c"].values
+        assert np.max(np.abs(thc_a - thc_b)) < 1e-6, np.max(np.abs(thc_a - thc_b))
+        assert np.ptp(thc_b) > 0.1  # (the clearance angle moves: not a trivial agreement)
+
+
+def test_a_grounded_train_is_the_limit_of_a_heavy_rotor():
+    """A train whose first node is held (``grounded``) has the natural frequencies of the same
+    train with that node's inertia 1e9 times larger (a separate path: the full eigenproblem
+    with one rigid mode left out); the difference is O(1e-9) relatively (the heavy node's
+    motion ~ J_others / J_heavy), bound 1e-6."""
+    from recipdyn.model.shaft import TorsionalTrain
+
+    names = ("motor", "flywheel", "throw1", "throw2")
+    inertias, ks = (400.0, 2600.0, 55.0, 70.0), (3e5, 2.5e6, 1.8e6)
+    held = TorsionalTrain(names, inertias, ks, grounded=True).natural_frequencies()
+    heavy = TorsionalTrain(names, (4e11, *inertias[1:]), ks).natural_frequencies()
+    assert held.size == 3
+    assert held == pytest.approx(heavy, rel=1e-6)
+    assert held[0] < TorsionalTrain(names, inertias, ks).natural_frequencies()[0]
+
+
+def test_a_held_rotors_shaft_twists_at_the_grounded_trains_frequency_and_balances_energy():
+    """A held rotor (``motor = 'held'``) on the flexible shaft, the flywheel started 0.01 rad
+    ahead of its quasi-static twist, no damping, 1 % of the paper's load: the rotor turns at
+    ``omega`` to the bit, and the coupling's twist oscillates at the lowest natural frequency
+    of the train with the rotor grounded (`train_of(..., held=True)`; a different mode from
+    the free train's, ~7 Hz against ~20 Hz here), within the half bin of the record's FFT and
+    the band of the throws' inertia over a revolution (as the free train's test). Then with
+    damped sections and the full load, half a revolution: ``E(t) - E(0) = W_motor + sum W_gas
+    - W_shaft_damping`` to 1e-7 of the motor's work (the integration's tolerance), the motor's
+    work being the coupling's torque times ``omega``."""
+    from recipdyn.integrate import integrate
+    from recipdyn.model.shaft import TorsionalTrain, train_of
+
+    kc, ks = 5.5e6, 2.5e6
+    model = _model(_machine(kc, ks, extra=(("load_amplitude", 2000.0),), motor="held"))
+    v = model.parameters()
+    st = model.configuration(v).layout.state
+    y0 = model.initial_state(v)
+    y0[st["shaft.theta_flywheel"]] += 0.01
+    fs, T = 2000.0, 2.5
+    t = np.arange(int(T * fs)) / fs
+    sol = integrate(model.system(v), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-12)
+    assert np.all(sol.y[:, st["omega1"]] == OMEGA)
+    twist = sol.y[:, st["theta1"]] - sol.y[:, st["shaft.theta_flywheel"]]
+    spectrum = np.abs(np.fft.rfft((twist - twist.mean()) * np.hanning(t.size)))
+    freqs = np.fft.rfftfreq(t.size, 1.0 / fs)
+    f_sim = freqs[1 + np.argmax(spectrum[1:])]
+    f_held = train_of(model.machine, v, (kc, ks, ks), J_motor=J_MOTOR,
+                      held=True).natural_frequencies()[0]  # fmt: skip
+    f_free = train_of(model.machine, v, (kc, ks, ks), J_motor=J_MOTOR).natural_frequencies()[0]
+    lo, hi = _inertia_range(model.throws(v)[0])
+
+    def f_at(j):
+        names = ("motor", "flywheel", "throw1", "throw2")
+        return TorsionalTrain(names, (J_MOTOR, J_DRIVE - J_MOTOR, j, j), (kc, ks, ks),
+                              grounded=True).natural_frequencies()[0]  # fmt: skip
+
+    band = (f_at(hi), f_at(lo))
+    half_bin = 0.5 * fs / t.size
+    assert band[0] - half_bin <= f_sim <= band[1] + half_bin, (f_sim, f_held, band)
+    assert abs(f_free - f_held) > 10 * half_bin  # (the grounded mode, not the free one)
+
+    damped = _model(_machine(3e5, 2.5e6, c_coupling=1e3, c_shaft=40.0, motor="held"))
+    ds = _simulate(model=damped, params=damped.parameters(), revolutions=0.5, fs=4000.0)
+    total = ds["energy"].values - ds["energy"].values[0]
+    loss = ds["shaft.W_shaft_damping"].values
+    work = ds["W_motor"].values + ds["throw1.W_gas"].values + ds["throw2.W_gas"].values
+    assert loss[-1] > 0.0 and np.all(ds["omega1"].values == OMEGA)
+    assert np.max(np.abs(total - (work - loss))) < 1e-7 * np.max(np.abs(ds["W_motor"].values))
+    coupling = ds["shaft.coupling_torque"].values
+    err = np.max(np.abs(ds["motor_torque"].values - coupling))
+    assert err < 1e-9 * np.max(np.abs(coupling)), err
+
+
+def test_a_held_rotor_with_the_contact_joints_is_refused_in_one_line():
+    """``--model compressor-contact --set drive=motor --set motor=held``: not modelled yet,
+    one line naming what is allowed."""
+    from recipdyn.model.registry import get_model
+
+    with pytest.raises(ParameterError, match=r"^motor = 'held' with the contact joints") as e:
+        get_model("compressor-contact").parameters({"drive": "motor", "motor": "held"})
+    assert "\n" not in str(e.value)

@@ -59,6 +59,38 @@ def _machine_changes(machine: Path | None, sets: list[str] | None):
     return m.pairs()
 
 
+#: The data-set spec's fields by the option of `dataset` that sets them (for its refusals).
+_SPEC_OPTIONS = {
+    "n_conditions": "--conditions",
+    "levels": "--levels",
+    "snr_db": "--snr",
+    "severity_range": "--severity-range",
+    "severity_draws": "--draws",
+    "snr_range": "--snr-range",
+    "chain_spans": "--chain-range",
+    "test_fraction": "--test-fraction",
+    "revolutions": "--revolutions",
+    "transient": "--transient",
+    "classes": "--classes",
+    "chain": "--chain",
+    "seed": "--seed",
+}
+
+
+def _as_options(make, **kw):
+    """``make(**kw)``, its refusal naming the command's options rather than the spec's fields
+    (``--conditions = 0; allowed: ...`` for ``n_conditions``)."""
+    import re
+
+    from ..errors import ParameterError
+
+    try:
+        return make(**kw)
+    except ParameterError as e:
+        pattern = r"\b(" + "|".join(sorted(_SPEC_OPTIONS, key=len, reverse=True)) + r")\b"
+        raise ParameterError(re.sub(pattern, lambda m: _SPEC_OPTIONS[m[1]], str(e))) from None
+
+
 @app.command()
 def dataset(
     out: Path = typer.Option(Path("out/dataset"), "--out", "-o", help="Data set folder."),
@@ -147,7 +179,8 @@ def dataset(
             "snr: sets the fixed chain's accelerometer SNR; allowed with --chain fixed, or "
             "give the drawn chain's range with --snr-range LO,HI"
         )
-    spec = DatasetSpec(
+    spec = _as_options(
+        DatasetSpec,
         n_conditions=conditions,
         levels=_levels(levels),
         snr_db=20.0 if snr is None else snr,

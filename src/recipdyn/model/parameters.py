@@ -158,7 +158,8 @@ SCHEMA = Schema((
           "'motor' (crank angle and speed as states; omega is the initial speed)",
           choices=tuple(DRIVES), group="drive"),
     Param("motor", "", "induction", "the motor's torque law (drive = motor): 'induction' "
-          "(Kloss's curve) or 'constant'", choices=tuple(MOTORS), group="drive"),
+          "(Kloss's curve), 'constant', or 'held' (the rotor turns at omega: an ideal "
+          "speed-controlled drive)", choices=tuple(MOTORS), group="drive"),
     *MOTOR.params, *CONSTANT_TORQUE.params, *INDUCTION.params,
 ), extras=("load_table",), aliases={
     "clearance": "rc", "subsidence": "d", "speed": "omega", "crank_speed": "omega",

@@ -513,7 +513,9 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
         )
     else:
         template = "motor"
-        roles["torque"] = (motor.module, motor.kernel("torque"))
+        held = motor.name == "held"  # (no torque law: the template finds the torque)
+        roles["torque"] = (("recipdyn.model.assembler.generate", "absent") if held
+                           else (motor.module, motor.kernel("torque")))  # fmt: skip
         roles["free_contribution"] = (KERNELS, "free_contribution")
         roles.update(_torsion_roles(machine.shaft.torsion))
         kinds = []
@@ -541,6 +543,7 @@ def bindings(machine: Machine, layout: Layout, load: Component, motor: Component
             CRANK=st["theta1"],
             MOTOR=pv.start("shaft.motor"),
             MOTOR_WORK=st["W_motor"],
+            HELD=held,
             **_torsion_constants(machine, layout),
             THROW_WORK=starts(st, "work"),
             STEP_KIND=np.array(kinds, dtype=np.int64),

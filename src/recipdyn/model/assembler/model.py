@@ -522,7 +522,8 @@ class MachineModel(Model):
 
             y = twisted_start(rhs, y, [st["theta1"], *range(nodes.start, nodes.stop, 2)],
                               (c.params[o], c.params[o + 1]),
-                              stiffnesses(c.machine, values))  # fmt: skip
+                              stiffnesses(c.machine, values),
+                              held=c.motor.name == "held")  # fmt: skip
         for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
             y[st[f"{i.name}.p"]] = float(values[f"{i.upstream}.discharge_pressure"])
         return y

@@ -738,6 +738,12 @@ class CompressorContact(Model):
             raise ParameterError(f"v1 = {values['v1']!r} m/s must exceed v0 = "
                                  f"{values['v0']!r} m/s")  # fmt: skip
         if has_motor(values):
+            if values.get("motor") == "held":
+                raise ParameterError(
+                    "motor = 'held' with the contact joints is not modelled yet; allowed: "
+                    "'induction' or 'constant', or drive = 'prescribed' (a held rotor on a "
+                    "rigid shaft turns the crank as a prescribed speed does)"
+                )
             check = _motor_parts(values)[1].check
             if check is not None:
                 check(values)

@@ -13,7 +13,14 @@ r"""Drive components: what turns the crank.
     ``T = 2 T_b s s_b / (s**2 + s_b**2)`` with the slip ``s = (omega_s - omega1)/omega_s``,
     the breakdown torque ``T_b`` and breakdown slip ``s_b`` (e.g. Fitzgerald & Kingsley,
     *Electric Machinery*, 6th ed., 2003, Sec. 6.5; the steady-state curve, without the
-    electrical transients).
+    electrical transients);
+  - ``held``: the rotor turns at ``omega`` whatever the load asks (an ideal speed-controlled
+    drive: a synchronous motor on a stiff grid, a drive whose speed loop is much faster than
+    the shaft): its torque is the one that keeps the rotor from accelerating, found by the
+    machine's kernels from the shaft's state (the crank's equation on a rigid shaft, the
+    coupling's torque on a torsionally flexible one). On a rigid shaft the crank then turns
+    as with ``drive = prescribed``; on a flexible one the flywheel and the throws turn and
+    twist behind the held rotor.
 
 The motor adds the states ``theta1`` (rad), ``omega1`` (rad/s) and the work integral
 ``W_motor`` (J, auxiliary); the mechanism adds ``W_gas``, the work of the gas on the
@@ -35,7 +42,7 @@ from .contract import Component
 #: Where the drive components' compiled functions live (numba loads only when a run does).
 KERNELS = "recipdyn.model.components.drive_kernels"
 
-__all__ = ["PRESCRIBED", "MOTOR", "CONSTANT_TORQUE", "INDUCTION", "DRIVES", "MOTORS",
+__all__ = ["PRESCRIBED", "MOTOR", "CONSTANT_TORQUE", "INDUCTION", "HELD", "DRIVES", "MOTORS",
            "mean_load_torque"]  # fmt: skip
 
 _INF = math.inf
@@ -126,6 +133,16 @@ INDUCTION = Component(
     ),
 )  # fmt: skip
 
+
+def _held(values: Mapping[str, Any]) -> np.ndarray:
+    return np.zeros(0, dtype=np.float64)
+
+
+HELD = Component(
+    "motor", "held", "the rotor's speed held at omega (an ideal speed-controlled drive); its "
+    "torque is what the shaft asks", module=KERNELS, kernels={}, pack=_held,
+)  # fmt: skip
+
 #: The drive family and the motor's torque laws, by name.
 DRIVES = {c.name: c for c in (PRESCRIBED, MOTOR)}
-MOTORS = {c.name: c for c in (CONSTANT_TORQUE, INDUCTION)}
+MOTORS = {c.name: c for c in (CONSTANT_TORQUE, INDUCTION, HELD)}

@@ -373,7 +373,9 @@ class Machine:
             raise ParameterError(f"machine {self.name!r}: [shaft.torsion] needs drive = 'motor' "
                                  f"(got {self.shaft.drive!r}: a prescribed speed turns every "
                                  "crank at omega, leaving the shaft nothing to twist); allowed: "
-                                 "drive = 'motor', or no [shaft.torsion]")  # fmt: skip
+                                 "drive = 'motor' (with motor = 'held' the rotor turns at "
+                                 "omega and the shaft twists behind it), or no "
+                                 "[shaft.torsion]")  # fmt: skip
         if self.frame is not None:
             self._check_frame(self.frame)
         for s in self.sensors:

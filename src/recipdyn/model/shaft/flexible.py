@@ -160,7 +160,7 @@ def pack(machine, values: Mapping[str, Any]) -> tuple[np.ndarray, list[tuple[str
 
 
 def twisted_start(rhs, y: np.ndarray, angles: Sequence[int], inertias: tuple[float, float],
-                  ks: Sequence[float]) -> np.ndarray:  # fmt: skip
+                  ks: Sequence[float], held: bool = False) -> np.ndarray:  # fmt: skip
     """``y`` with the nodes (their angles' states ``angles``, along the shaft; their speeds
     next to them) twisted as the rigid shaft's motion at that instant asks: the sections'
     quasi-static twists, so that a run starts without the torsional transient of the whole
@@ -174,7 +174,9 @@ def twisted_start(rhs, y: np.ndarray, angles: Sequence[int], inertias: tuple[flo
     J_motor``. Then the rigid shaft's acceleration ``a = (T_m + sum Q) / (J_motor + J_flywheel
     + sum I)`` and each node's equation ``J_i a = Q_i + T_(i-1) - T_i`` give the sections'
     torques ``T_i`` along the shaft, and their twists ``T_i / k_i``. ``inertias``: ``(J_motor,
-    J_flywheel)``; ``ks``: the sections' stiffnesses."""
+    J_flywheel)``; ``ks``: the sections' stiffnesses. ``held``: the rotor is held at its
+    speed (the torque law ``held``): the shaft's acceleration is then 0 and the rotor's
+    torque the one the shares ask, ``-sum Q``."""
     y = np.array(y, dtype=np.float64)
     rotor = angles[0]
     for i in angles:
@@ -188,8 +190,11 @@ def twisted_start(rhs, y: np.ndarray, angles: Sequence[int], inertias: tuple[flo
         a0, a1 = f0[angles[j] + 1], rhs(yy)[angles[j] + 1]
         inertia = ks[j - 1] * delta / (a1 - a0)
         shares.append((inertia, inertia * a0))
-    tm = inertias[0] * f0[rotor + 1]
-    alpha = (tm + sum(q for _, q in shares)) / (sum(inertias) + sum(i for i, _ in shares))
+    if held:
+        tm, alpha = -sum(q for _, q in shares), 0.0
+    else:
+        tm = inertias[0] * f0[rotor + 1]
+        alpha = (tm + sum(q for _, q in shares)) / (sum(inertias) + sum(i for i, _ in shares))
     torque = tm - inertias[0] * alpha  # the coupling's
     torques = [torque, torque - inertias[1] * alpha]
     for inertia, q in shares[:-1]:

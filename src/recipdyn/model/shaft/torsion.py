@@ -64,11 +64,16 @@ class TorsionalTrain:
         Each node's moment of inertia about the shaft's axis, kg m² (> 0).
     stiffnesses : tuple of float
         The springs between consecutive nodes, N m/rad (> 0; one fewer than the nodes).
+    grounded : bool
+        The first node is held at a constant speed (a rotor held by its drive, the torque law
+        ``held``): it does not take part in the vibration, and the train has no rigid
+        turning; its inertia is then left out.
     """
 
     names: tuple[str, ...]
     inertias: tuple[float, ...]
     stiffnesses: tuple[float, ...]
+    grounded: bool = False
 
     def __post_init__(self) -> None:
         n = len(self.inertias)
@@ -98,10 +103,14 @@ class TorsionalTrain:
 
     def modes(self) -> tuple[np.ndarray, np.ndarray]:
         """``(f, phi)``: the natural frequencies in Hz, ascending, the rigid turning (0 Hz)
-        left out, and their mode shapes (columns, mass-normalised)."""
+        left out, and their mode shapes (columns, mass-normalised; a grounded train's over
+        the nodes after the first)."""
         from scipy.linalg import eigh
 
         m, k = self.matrices()
+        if self.grounded:  # the first node's angle is given: its row and column go
+            w2, phi = eigh(k[1:, 1:], m[1:, 1:])
+            return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * math.pi), phi
         w2, phi = eigh(k, m)
         return np.sqrt(np.clip(w2[1:], 0.0, None)) / (2.0 * math.pi), phi[:, 1:]
 
@@ -161,6 +170,7 @@ def train_of(
     stiffness: Sequence[float],
     J_motor: float | None = None,
     J_drive: float | None = None,
+    held: bool = False,
 ) -> TorsionalTrain:
     """The torsional train of ``machine`` (a `recipdyn.model.machine.Machine`) at its
     validated ``values``: the motor's rotor (``J_motor``, if given), the flywheel (the drive's
@@ -168,7 +178,8 @@ def train_of(
     given here with a prescribed speed, whose drive has no inertia of its own), then each
     throw's equivalent inertia (`throw_inertia`) in the order of their ``axial_position``;
     ``stiffness`` the springs between them in that order, N m/rad (the coupling, the shaft to
-    the first throw, then between neighbouring throws)."""
+    the first throw, then between neighbouring throws). ``held``: the rotor is held at its
+    speed (`TorsionalTrain`'s ``grounded``; needs ``J_motor``)."""
     from ..assembler.assemble import throw_values
 
     locals_ = [throw_values(machine, values, k) for k in range(len(machine.throws))]
@@ -190,7 +201,11 @@ def train_of(
     for k in order:
         names.append(machine.throws[k].name)
         inertias.append(throw_inertia(locals_[k]))
-    return TorsionalTrain(tuple(names), tuple(inertias), tuple(float(k) for k in stiffness))
+    if held and J_motor is None:
+        raise ParameterError("held: a held rotor needs its node, J_motor; allowed: J_motor in "
+                             "(0, J_drive) kg*m**2")  # fmt: skip
+    return TorsionalTrain(tuple(names), tuple(inertias), tuple(float(k) for k in stiffness),
+                          grounded=held)  # fmt: skip
 
 
 def torsion_summary(machine, values: Mapping[str, Any], speed_hz: float) -> dict[str, Any]:
@@ -205,7 +220,8 @@ def torsion_summary(machine, values: Mapping[str, Any], speed_hz: float) -> dict
     pre = machine.prefix("shaft")
     train = train_of(machine, values, stiffnesses(machine, values),
                      J_motor=float(values[pre + "J_motor"]),
-                     J_drive=float(values[pre + "J_drive"]))  # fmt: skip
+                     J_drive=float(values[pre + "J_drive"]),
+                     held=machine.shaft.motor == "held")  # fmt: skip
     out: dict[str, Any] = {"torsion_running_speed_hz": float(speed_hz)}
     best = (math.inf, 0, 0)
     for i, x in enumerate(train.natural_frequencies(), 1):

@@ -12,6 +12,11 @@ acceleration affine in the crank's, ``theta_c'' = c - k theta1''``, and with it 
 share ``(I, Q)`` of the crank's equation (``free_contribution``), so the crank's acceleration
 is ``theta1'' = (T_m + sum Q) / (J_drive + sum I)`` without a derivation of the whole machine.
 
+A held rotor (``HELD``, the torque law ``held``, `recipdyn.model.components.drive`) has no
+torque law: its torque is the one that keeps its speed, the throws' shares' (their sum with
+the sign turned) on a rigid shaft, the coupling's on a flexible one, so its acceleration is
+0 exactly and ``MOTOR_WORK`` integrates that torque.
+
 Roles: ``torque(omega1, p, o)`` (the motor's torque law), ``free_contribution(th1, thc, w,
 thcd, F, p, m) -> (I, Q, k, c)``, ``crosshead``, ``crank_torque``, and the loads' roles as in
 `prescribed` (with interstage volumes, theirs too).
@@ -71,6 +76,7 @@ CRANK = np.int64(2)
 SHAFT = np.int64(0)
 MOTOR = np.int64(1)
 MOTOR_WORK = np.int64(4)
+HELD = False
 TORSION = False
 N_NODES = np.int64(1)
 TORSION_PARAMS = np.int64(0)
@@ -158,7 +164,10 @@ def _alpha(f, k):
 def _rhs(t, y, p, out):
     th1 = y[CRANK]
     w1 = y[CRANK + 1]
-    Tm = torque(w1, p, MOTOR)
+    if HELD:  # the rotor's torque is the one that holds its speed: found below
+        Tm = 0.0
+    else:
+        Tm = torque(w1, p, MOTOR)
     inertia = p[SHAFT]
     load = Tm
     for k in range(N_THROWS):  # each throw's share of its crank's equation
@@ -175,8 +184,13 @@ def _rhs(t, y, p, out):
             load += load_k
         out[THROW_WORK[k]] = F  # (held here until the crosshead's speed is known)
     if TORSION:
+        if HELD:  # the coupling's torque: the rotor's equation then gives it no acceleration
+            Tm = shaft_section(y, CRANK, 0, p, TORSION_PARAMS)[2]
         shaft_nodes(Tm, N_NODES, y, CRANK, SHAFT_DAMPING, p, TORSION_PARAMS, out)
     else:
+        if HELD:  # the torque the throws' shares ask: the crank does not accelerate
+            Tm = -load
+            load = 0.0
         out[CRANK] = w1
         out[CRANK + 1] = load / inertia
     out[MOTOR_WORK] = Tm * w1
