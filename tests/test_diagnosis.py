@@ -351,7 +351,7 @@ def test_cli_refuses_a_bad_severity_range_in_one_line(capsys):
 
     assert main(["dataset", "--severity-range", "0.8,0.2", "-o", "unused-folder"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "severity_range" in err[0]
+    assert len(err) == 1 and "--severity-range = (0.8, 0.2)" in err[0]
 
 
 # ---- training (at reduced size) -------------------------------------------------------------
