@@ -445,6 +445,38 @@ def test_training_on_a_subset_of_the_classes(small):
             train(out, classes=bad)
 
 
+def test_renaming_measures_the_trained_naming_tables_again(small, trained):
+    """`renaming` recomputes a diagnoser's naming tables from its own data set (for a
+    diagnoser trained before the held-out answers' probabilities were kept): on the data set
+    it was trained on, through its own reading of the split, it gives the tables `train`
+    stored, each class's answers' probabilities and rightness included; a diagnoser of
+    another data set is refused, saying so."""
+    import copy
+    import json
+
+    from recipdyn.diagnosis.train import Diagnoser, renaming
+
+    out, *_ = small
+    diag, _ = trained
+    for t in diag.state["naming"].values():
+        for e in t["classes"].values():
+            assert len(e["p"]) == len(e["right"]) == e["answers"]
+    old = copy.copy(diag.state)
+    old["naming"] = {k: {**t, "classes": {c: {kk: vv for kk, vv in e.items()
+                                               if kk not in ("p", "right")}
+                                           for c, e in t["classes"].items()}}
+                     for k, t in diag.state["naming"].items()}  # fmt: skip
+    again = renaming(Diagnoser(old), out)
+    dump = lambda t: json.dumps(t, sort_keys=True, default=float)  # noqa: E731
+    assert dump(again.state["naming"]) == dump(diag.state["naming"])
+    other = copy.copy(diag.state)
+    card = json.loads(other["datacard_json"])
+    card["spec"]["seed"] = card["spec"]["seed"] + 1
+    other["datacard_json"] = json.dumps(card)
+    with pytest.raises(ParameterError, match="data card is not the one"):
+        renaming(Diagnoser(other), out)
+
+
 def test_expected_calibration_error_of_known_cases():
     """Perfectly calibrated bins give 0; always 90 % sure and always right gives 0.1."""
     from recipdyn.diagnosis.train import expected_calibration_error

@@ -460,7 +460,7 @@ def _diagnose_arrays(
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
     # a class is named only with channels whose held-out answers of it were right
     subset = available(X[0], diag.names)
-    named, why, facts = gate(naming_of(diag), subset, classes[k])
+    named, why, facts = gate(naming_of(diag), subset, classes[k], proba[k])
     res.evidence["channels"] = facts
     if not named:
         return _refuse(res, why, t0)
