@@ -68,6 +68,11 @@ def test_tables_count_outcomes_and_check_the_targets():
     assert grp["machine"]["met"] is False  # one answered: not refused 100 %
     rows.append(_row("A", "chain", "confidently wrong"))  # 2 of 101: above 1 %
     assert H.group_table(rows)["chain"]["met"] is False
+    gate = "on the held-out conditions, 'sticking_valve' from the acceleration ... was right"
+    below = gate + " ...; this record's p 0.856 is below that threshold: not sure enough"
+    rows = [_row("C", "chain", "refused", reason=r) for r in (gate, below)]
+    kinds = H.family_table(rows)["C"]["refusals"]
+    assert kinds == {"channel gate": 1, "confidence threshold": 1}
 
 
 def test_the_blind_set_is_seeded_and_holds_every_family():

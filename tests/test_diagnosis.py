@@ -351,7 +351,7 @@ def test_cli_refuses_a_bad_severity_range_in_one_line(capsys):
 
     assert main(["dataset", "--severity-range", "0.8,0.2", "-o", "unused-folder"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "severity_range" in err[0]
+    assert len(err) == 1 and "--severity-range = (0.8, 0.2)" in err[0]
 
 
 # ---- training (at reduced size) -------------------------------------------------------------
@@ -443,6 +443,38 @@ def test_training_on_a_subset_of_the_classes(small):
     for bad in (("ring_leak",), ("healthy", "crosshead_guide_clearance")):
         with pytest.raises(ParameterError, match="classes"):
             train(out, classes=bad)
+
+
+def test_renaming_measures_the_trained_naming_tables_again(small, trained):
+    """`renaming` recomputes a diagnoser's naming tables from its own data set (for a
+    diagnoser trained before the held-out answers' probabilities were kept): on the data set
+    it was trained on, through its own reading of the split, it gives the tables `train`
+    stored, each class's answers' probabilities and rightness included; a diagnoser of
+    another data set is refused, saying so."""
+    import copy
+    import json
+
+    from recipdyn.diagnosis.train import Diagnoser, renaming
+
+    out, *_ = small
+    diag, _ = trained
+    for t in diag.state["naming"].values():
+        for e in t["classes"].values():
+            assert len(e["p"]) == len(e["right"]) == e["answers"]
+    old = copy.copy(diag.state)
+    old["naming"] = {k: {**t, "classes": {c: {kk: vv for kk, vv in e.items()
+                                               if kk not in ("p", "right")}
+                                           for c, e in t["classes"].items()}}
+                     for k, t in diag.state["naming"].items()}  # fmt: skip
+    again = renaming(Diagnoser(old), out)
+    dump = lambda t: json.dumps(t, sort_keys=True, default=float)  # noqa: E731
+    assert dump(again.state["naming"]) == dump(diag.state["naming"])
+    other = copy.copy(diag.state)
+    card = json.loads(other["datacard_json"])
+    card["spec"]["seed"] = card["spec"]["seed"] + 1
+    other["datacard_json"] = json.dumps(card)
+    with pytest.raises(ParameterError, match="data card is not the one"):
+        renaming(Diagnoser(other), out)
 
 
 def test_expected_calibration_error_of_known_cases():

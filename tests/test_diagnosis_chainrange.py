@@ -201,3 +201,81 @@ def test_an_offset_outside_the_declared_range_names_the_channel():
     # a range the diagnoser does not declare is not checked
     assert check_chain({}, est, None) == ([], None)
     assert np.isfinite(checks[0].value)
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        # the shipped data set's chain with one parameter far outside its declared range
+        ({"accelerometer.full_scale": 40 * 9.80665}, ["accelerometer clipped", "re-record"]),
+        ({"accelerometer.hum_db": 0.0, "accelerometer.mains_hz": 60.0,
+          "pressure.mains_hz": 60.0}, ["accelerometer: mains hum at 60 Hz", "re-record"]),
+        ({"accelerometer.bits": 8}, ["accelerometer: converter step", "finer converter"]),
+        ({"tacho.angle": math.radians(10.0)}, ["tacho: mark's angle", "outer dead centre"]),
+    ],
+)  # fmt: skip
+def test_a_chain_far_outside_its_ranges_is_refused_naming_channel_and_remedy(
+    healthy_record, change, words
+):
+    """The healthy test record through its own drawn chain (inside every range: answered
+    without a chain refusal) and through that chain with one parameter changed far outside
+    the declared ranges: a clipped accelerometer (range 40 g against healthy peaks of ~150
+    g), 60 Hz hum at 0 dB (20 dB above the -20 dB top), an 8-bit converter (its step 32x the
+    coarsest declared), a keyphasor 10 degrees off (the declared +-2 degrees widened by the
+    pressures' delay, < 1 degree at this speed): each refused in one line naming the channel,
+    the estimate, the range and what to do."""
+    from recipdyn import sensors
+    from recipdyn.chain import Chain
+    from recipdyn.diagnosis.diagnose import diagnose_arrays
+
+    task, ds = healthy_record
+
+    def run(d):
+        rec = sensors.record(ds, chain=Chain.from_dict(d), seed=task["noise_seed"])
+        return diagnose_arrays(rec["accel_guide"].values, task["fs"], tacho=rec["tacho"].values,
+                               p_head=rec["p_head_sensor"].values,
+                               p_crank=rec["p_crank_sensor"].values)  # fmt: skip
+
+    base = dict(task["chain"], **{"accelerometer.snr_db": 25.0})
+    res = run(base)
+    assert "trained under" not in (res.reason or "") and "clipped" not in (res.reason or "")
+    res = run(dict(base, **change))
+    assert res.refused and "\n" not in res.reason, res.reason
+    for w in words:
+        assert w in res.reason, res.reason
+
+
+def test_an_accelerometer_clipped_inside_its_declared_full_scale_is_answered():
+    """The default ranges draw the accelerometer's converter range at 250-1000 g so that the
+    worn pins' impacts (~450 g) sometimes clip: such a record lies inside the data set, and
+    its flat tops give the full scale (the extreme over g, to a converter step). A sine
+    clipped at 300 g is therefore not refused (the evidence says where it clipped), at 40 g
+    it is, naming the range; a clipped pressure is refused whatever the ranges (no drawn
+    transducer range lets the pressure clip); a diagnoser that declares no converter range
+    refuses a clipped accelerometer."""
+    from recipdyn.analysis.channel import clipping
+    from recipdyn.diagnosis.chainrange import clipping_refusal
+    from recipdyn.sensors import G0
+
+    t = np.arange(20000) / 10240.0
+    wave = np.sin(2 * np.pi * 7.0 * t)
+    declared = {"accelerometer.full_scale_g": (250.0, 1000.0, "g")}
+
+    def clipped_at(g):
+        step = 2 * g * G0 / 2**16  # a 16-bit converter spanning +-g
+        return {
+            "clip_accelerometer": clipping(
+                np.round(np.clip(1.5 * g * G0 * wave, -g * G0, g * G0) / step) * step
+            )
+        }
+
+    why, ev = clipping_refusal(clipped_at(300.0), declared)
+    assert why is None and "inside the declared" in ev["accelerometer_clipping"]["status"]
+    assert ev["accelerometer_clipping"]["full_scale_g"] == pytest.approx(300.0, rel=1e-3)
+    why, _ = clipping_refusal(clipped_at(40.0), declared)
+    assert "outside the declared accelerometer.full_scale_g 250..1000 g" in why, why
+    assert "\n" not in why
+    assert "declares no converter range" in clipping_refusal(clipped_at(300.0), None)[0]
+    p = np.clip(3e5 + 2e5 * wave, 0, 4e5)
+    why, _ = clipping_refusal({"clip_p_head": clipping(np.round(p / 10.0) * 10.0)}, declared)
+    assert why.startswith("p_head clipped"), why

@@ -238,7 +238,8 @@ def run_records(records: list[RecordSpec], *, model=None, cache=None, workers: i
 def _reason_kind(reason: str) -> str:
     r = reason.lower()
     if r.startswith("on the held-out conditions,"):  # the channel gate (names the channels)
-        return "channel gate"
+        # below the class's confidence threshold (channels.selective_threshold), or not at all
+        return "confidence threshold" if "below that threshold" in r else "channel gate"
     for key, kind in (("crank speed", "speed range"), ("sampling rate", "sampling rate"),
                       ("noise floor", "noise floor"), ("impacts ring", "sensor band"),
                       ("sensor band", "sensor band"), ("transducer offset", "offset range"),

@@ -88,7 +88,9 @@ EVIDENCE: dict[str, tuple[str, str, Any]] = {
     "channels": (
         "channels the answer rests on",
         "a class is named only from channels whose answers of it were right often enough "
-        "on held-out conditions (docs/diagnosis.md): how often, for the class named",
+        "on held-out conditions, or, for a class short of that, where the record's "
+        "probability is above the threshold from which its held-out answers were "
+        "(docs/diagnosis.md): how often, for the class named",
         lambda v: (
             v["channels"]
             + (
@@ -96,6 +98,13 @@ EVIDENCE: dict[str, tuple[str, str, Any]] = {
                 f"conditions (recall {v['recall']:.0%}; all classes {v['accuracy']:.0%} of "
                 f"{v['n']} records)"
                 if v.get("measured")
+                else ""
+            )
+            + (
+                f"; its confidence threshold p {c['threshold']:.3f} (this record "
+                f"{c['p']:.3f}): the held-out answers above it right for {c['precision']:.0%} "
+                f"of {c['answers']}"
+                if (c := v.get("confidence")) and v.get("measured")
                 else ""
             )
         ),

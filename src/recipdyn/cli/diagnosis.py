@@ -87,7 +87,10 @@ def _as_options(make, **kw):
     try:
         return make(**kw)
     except ParameterError as e:
-        pattern = r"\b(" + "|".join(sorted(_SPEC_OPTIONS, key=len, reverse=True)) + r")\b"
+        # a field's name where it is given a value or a bound ("n_conditions = 0",
+        # "n_conditions >= 3", "classes: ..."), never the same word in the prose
+        names = "|".join(sorted(_SPEC_OPTIONS, key=len, reverse=True))
+        pattern = r"(?<![\w-])(" + names + r")(?=\s*(?:=|>=|<=|:))"
         raise ParameterError(re.sub(pattern, lambda m: _SPEC_OPTIONS[m[1]], str(e))) from None
 
 

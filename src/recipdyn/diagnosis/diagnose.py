@@ -288,7 +288,14 @@ def _diagnose_arrays(
     baseline=None,
 ) -> Diagnosis:  # fmt: skip
     from ..analysis.vibration import crank_angle, tacho_times
-    from .chainrange import as_evidence, check_chain, declared_ranges, snr_estimate
+    from .chainrange import (
+        as_evidence,
+        check_chain,
+        clipping_refusal,
+        declared_ranges,
+        read_channels,
+        snr_estimate,
+    )
     from .correction import axis_sd, correct_chain, resonance, tacho_revolutions
     from .evidence import impacts, record_features
     from .machine import machine_from_file, refusal
@@ -339,6 +346,13 @@ def _diagnose_arrays(
     ph = None if p_head is None else np.asarray(p_head, float)[sl]
     pc = None if p_crank is None else np.asarray(p_crank, float)[sl]
     res = Diagnosis(refused=False)
+    # the channels' own samples: a clipped pressure, or an accelerometer clipped outside the
+    # converter ranges the diagnoser's data set drew, is refused (chainrange.py)
+    signals = read_channels(x, fs, revs, ph, pc, edges.size if tacho is not None else 0)
+    why, clip = clipping_refusal(signals, declared_ranges(diag))
+    res.evidence.update(clip)
+    if why:
+        return _refuse(res, why, t0)
     # the measurement chain, estimated from the record and corrected before any feature
     chain: dict[str, Any] = {}
     if jitter is not None:
@@ -406,7 +420,7 @@ def _diagnose_arrays(
         if read is not None:  # the floor's share, and the SNR it gives
             res.evidence["noise_floor"] = {"share": floor[0], "training_range": list(floor[1:]),
                                            "snr_db": list(snr_estimate(*read)[:3])}  # fmt: skip
-        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"])
+        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"], signals)
         res.evidence["chain_ranges"] = as_evidence(checks)
         if why:
             return _refuse(res, why, t0)
@@ -446,7 +460,7 @@ def _diagnose_arrays(
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
     # a class is named only with channels whose held-out answers of it were right
     subset = available(X[0], diag.names)
-    named, why, facts = gate(naming_of(diag), subset, classes[k])
+    named, why, facts = gate(naming_of(diag), subset, classes[k], proba[k])
     res.evidence["channels"] = facts
     if not named:
         return _refuse(res, why, t0)

@@ -69,6 +69,7 @@ __all__ = [
     "save",
     "load",
     "recalibrate",
+    "renaming",
     "expected_calibration_error",
     "detection_limits",
     "severity_bins",
@@ -736,6 +737,42 @@ def recalibrate(diag: Diagnoser, *folders: str | Path) -> Diagnoser:
     return Diagnoser(state)
 
 
+def renaming(diag: Diagnoser, folder: str | Path, *, seed: int = 0) -> Diagnoser:
+    """``diag`` with its naming tables (`recipdyn.diagnosis.channels`: what each channel set
+    can name) measured anew by `evaluate` on the test conditions of the data set in
+    ``folder``, which must be the one ``diag`` was trained on (its data card and training
+    records; refused otherwise, saying which differs): e.g. to add the held-out answers'
+    probabilities to the table of a diagnoser trained before they were kept, without
+    retraining its models. ``seed``: `train`'s (the evaluation's permutation importance and
+    condition-only classifier; the naming tables do not depend on it)."""
+    import copy
+
+    folder = Path(folder)
+    with one_thread():
+        df, card = read_features(folder)
+        if json.loads(json.dumps(card, default=float)) != json.loads(diag.state["datacard_json"]):
+            raise ParameterError(
+                f"{folder}: its data card is not the one this diagnoser was trained on; "
+                "give the diagnoser's own data set (its test conditions are held out)"
+            )
+        if "chain_refused" in df.columns:  # as _train: records the correction refused
+            df = df[df.chain_refused.fillna("") == ""].reset_index(drop=True)
+        df = df[df.label.isin(diag.classes)].reset_index(drop=True)
+        train_df = df[df.split == "train"].reset_index(drop=True)
+        test_df = df[df.split == "test"].reset_index(drop=True)
+        if not np.array_equal(
+            train_df.record.to_numpy(int), np.asarray(diag.state["train_records"], int)
+        ):
+            raise ParameterError(
+                f"{folder}: its training records are not this diagnoser's; give the "
+                "diagnoser's own data set"
+            )
+        ev = evaluate(diag, test_df, train_df, seed=seed)
+    state = copy.copy(diag.state)
+    state["naming"] = {k: ev[k]["naming"] for k in AVAILABILITY}
+    return Diagnoser(state)
+
+
 def _noise_floor_range(X: np.ndarray, names: list[str]) -> list[float] | None:
     """The training records' noise floors (`recipdyn.diagnosis.diagnose.noise_floor`: the
     quietest crank-angle bin's share of the mean bin), least and largest; None without the
@@ -901,6 +938,7 @@ def evaluate(diag: Diagnoser, test_df, train_df, *, seed: int = 0) -> dict[str, 
             test_df.severity.to_numpy(),
             classes,
             res[subset]["detection"],
+            top=proba.max(axis=1),
         )
         if subset == "full":
             res["predicted"] = np.array(classes)[pred].tolist()
