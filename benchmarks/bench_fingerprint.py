@@ -42,6 +42,7 @@ def _one(folder, index, machine):
         split=row["split"],
         hp_hz=row.get("chain.accelerometer.highpass_hz", math.nan),
         hp_order=row.get("chain.accelerometer.highpass_order", math.nan),
+        snr=row.get("chain.accelerometer.snr_db", math.nan),
         gain=row.get("chain.accelerometer.gain", 1.0),
         drift=row.get("chain.accelerometer.drift", 0.0),
     )
@@ -63,6 +64,7 @@ def main(argv=None):
     ap.add_argument("folder")
     ap.add_argument("--limit", type=int, default=0, help="every k-th record only (0: all)")
     ap.add_argument("--csv", default=None, help="write the per-record estimates here")
+    ap.add_argument("--min-revs", action="store_true", help="only records of 2 whole revolutions")
     a = ap.parse_args(argv)
     df, card = read_features(a.folder)
     machine = card["spec"].get("machine") or None
@@ -81,9 +83,20 @@ def main(argv=None):
     r["lam_err"] = r.lam / r.lam_ref - 1
     r["lam_raw_err"] = r.lam_raw / r.lam_ref - 1
     r["r_err"] = r.r / r.r_ref - 1
-    r["r_corrected_err"] = r.r_corrected / r.r_ref - 1
-    r["r_err_gain"] = r.r / (r.r_ref * r.gain) - 1  # with the drawn gain known
-    for col in ("lam_raw_err", "lam_err", "r_err", "r_corrected_err", "r_err_gain"):
+    r["r_raw_err"] = r.r_raw / r.r_ref - 1
+    r = r[r.revolutions >= 2] if a.min_revs else r
+    r["r_lead_err"] = r.r_lead / r.r_ref - 1
+    r["lam_lead_err"] = r.lam_lead / r.lam_ref - 1
+    r["r_err_gain"] = r.r_lead / (r.r_ref * r.gain) - 1  # with the drawn gain known
+    for col in (
+        "lam_raw_err",
+        "lam_err",
+        "lam_lead_err",
+        "r_err",
+        "r_corrected_err",
+        "r_lead_err",
+        "r_err_gain",
+    ):
         print(f"{col:12s} all  {_q(r[col])}")
         print(f"{col:12s} test {_q(r[r.split == 'test'][col])}")
         print(f"{col:12s} signed median {np.nanmedian(r[col]):+.4f}")
