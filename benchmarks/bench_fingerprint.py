@@ -7,8 +7,10 @@ estimated, and r/l and r (times the accelerometer's gain) compared with its mach
 records are the diagnoser's own machine, so every departure is the estimator's error:
 the gas force, the joints' impacts, the chain (the AC coupling's high-pass, drift, noise).
 Printed: quantiles of ``|lam/lam0 - 1|`` and ``|r/r0 - 1|`` raw and corrected for the AC
-coupling, by class, by the drawn coupling's corner, and over the held-out (test) split,
-from which `recipdyn.diagnosis.tolerances.FINGERPRINT` is set.
+coupling, of ``|lam/lam0 - 1|`` over the record's own uncertainty (``lam_z``), by class, by
+the drawn coupling's corner, and over the held-out (test) split, from which
+`recipdyn.diagnosis.tolerances.FINGERPRINT` is set (``--min-revs``: the records of 2 whole
+revolutions, as `recipdyn.diagnosis.fingerprint.check` requires).
 
     python benchmarks/bench_fingerprint.py DATASET_FOLDER [--limit N] [--csv OUT]
 """
@@ -79,24 +81,20 @@ def main(argv=None):
         except ValueError as exc:  # a record without whole revolutions or tacho pulses
             print(f"record {i}: {exc}")
     r = pd.DataFrame(rows)
+    if a.csv:
+        r.to_csv(a.csv, index=False)
     print(f"{len(r)} records in {time.perf_counter() - t0:.0f} s")
     r["lam_err"] = r.lam / r.lam_ref - 1
     r["lam_raw_err"] = r.lam_raw / r.lam_ref - 1
     r["r_err"] = r.r / r.r_ref - 1
     r["r_raw_err"] = r.r_raw / r.r_ref - 1
-    r = r[r.revolutions >= 2] if a.min_revs else r
-    r["r_lead_err"] = r.r_lead / r.r_ref - 1
-    r["lam_lead_err"] = r.lam_lead / r.lam_ref - 1
-    r["r_err_gain"] = r.r_lead / (r.r_ref * r.gain) - 1  # with the drawn gain known
-    for col in (
-        "lam_raw_err",
-        "lam_err",
-        "lam_lead_err",
-        "r_err",
-        "r_corrected_err",
-        "r_lead_err",
-        "r_err_gain",
-    ):
+    # r/l's error in units of the record's own uncertainty (the orders 3-6)
+    r["lam_z"] = r.lam_err / np.hypot(r.resid_12, r.resid_2)
+    r["r_err_gain"] = r.r / (r.r_ref * r.gain) - 1  # with the drawn gain known
+    if a.min_revs:
+        r = r[r.revolutions >= 2].copy()
+    print(f"{len(r)} records used ({(r.split == 'test').sum()} of held-out conditions)")
+    for col in ("lam_raw_err", "lam_err", "lam_z", "r_err", "r_raw_err", "r_err_gain"):
         print(f"{col:12s} all  {_q(r[col])}")
         print(f"{col:12s} test {_q(r[r.split == 'test'][col])}")
         print(f"{col:12s} signed median {np.nanmedian(r[col]):+.4f}")
@@ -106,16 +104,17 @@ def main(argv=None):
             f"  {lab:26s} {np.nanquantile(g.lam_err.abs(), 0.95):.4f} "
             f"{np.nanquantile(g.r_err.abs(), 0.95):.4f} {np.nanmedian(g.lam_err):+.4f}"
         )
-    print("by the coupling's corner (Hz), order: |lam_raw_err| and |lam_err| 0.95")
+    print("by the coupling's corner (Hz), order: 0.95 quantiles of |lam_raw_err|, |lam_err|,")
+    print("|r_raw_err|, |r_err|")
     bins = pd.cut(r.hp_hz, [0, 0.3, 0.7, 1.2, 2.1])
     for (b, o), g in r.groupby([bins, "hp_order"], observed=True):
         print(
             f"  {b} order {o:.0f}: n={len(g)} raw {np.nanquantile(g.lam_raw_err.abs(), 0.95):.4f}"
-            f" corrected {np.nanquantile(g.lam_err.abs(), 0.95):.4f}; corner read "
+            f" corrected {np.nanquantile(g.lam_err.abs(), 0.95):.4f}; r raw "
+            f"{np.nanquantile(g.r_raw_err.abs(), 0.95):.4f} corrected "
+            f"{np.nanquantile(g.r_err.abs(), 0.95):.4f}; corner read "
             f"{np.nanmedian(g.corner_hz):.2f} Hz"
         )
-    if a.csv:
-        r.to_csv(a.csv, index=False)
 
 
 if __name__ == "__main__":

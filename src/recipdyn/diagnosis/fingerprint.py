@@ -4,39 +4,39 @@ A diagnoser belongs to one machine (`recipdyn.diagnosis.machine`); a record that
 without its machine's description must still not be answered for another one. The
 crosshead's axial acceleration carries the mechanism's geometry in its lowest crank orders:
 the slider-crank's ``a(theta) = -r w^2 (cos theta + lambda cos 2 theta + ...)``,
-``lambda = r/l``. Resampled by crank angle with the tacho over whole revolutions
-(`recipdyn.analysis.vibration.angle_resample`), the record's 1st and 2nd orders give
+``lambda = r/l``. Fitted on the crank angle the tacho gives, over whole revolutions
+(`harmonics`), the record's 1st and 2nd orders give
 
 * **r/l** from the ratio of the 2nd to the 1st order's amplitude, which the
-  accelerometer's gain leaves unchanged (`estimate`);
-* **r** (times the gain) from the 1st order's amplitude over ``w^2``; the gain's declared
-  range (`recipdyn.chain.DEFAULT_RANGES`, +-5 %) widens its tolerance.
+  accelerometer's gain leaves unchanged;
+* **r** (times the gain) from the 1st order's amplitude over ``w^2``.
 
 Both are compared with the same orders of the diagnoser's own machine, computed numerically
 from its exact kinematics (`recipdyn.model.kinematics.ideal_mechanism`, the offset ``d``
-included), not from the truncated series.
+included), not from the truncated series (`estimate`, `check`).
 
 **The AC coupling.** An accelerometer input is AC-coupled: a Butterworth high-pass of
 order 1 or 2 with its corner at 0.1-2 Hz (`recipdyn.chain.DEFAULT_RANGES`), on a crank that
-turns at 2.5-4 Hz. It lowers the 1st order by up to 20 % and the 2nd by up to 3 %, and leads
-both in phase (up to 70 and 40 degrees), so the raw ratio overstates r/l by up to ~20 % for
-the chain's corner at its top. The phase leads tell the corner: the combination
-``D = 2 psi_1 - psi_2`` of the two orders' phases, less that of the kinematic orders, is
-independent of the crank angle's zero (a tacho mark off dead centre, a channel's delay
-cancel in it) and equals ``2 arg H(f) - arg H(2 f)`` of the high-pass ``H`` alone. For each
-order of the coupling (1 or 2) the corner that gives ``D`` is solved and the two orders'
-amplitudes are divided by ``|H|``; the two candidate orders' results are averaged, their
-difference is part of the uncertainty.
+turns at 2.5-4 Hz. At the top of that range it lowers the 1st order by up to 22 % and the
+2nd by up to 7 %, and leads both in phase, so the raw ratio overstates r/l by up to ~20 %.
+The phase leads tell the corner: the combination ``D = 2 psi_1 - psi_2`` of the two
+orders' phases, less that of the kinematic orders, is independent of the crank angle's zero
+(a tacho mark off dead centre and a channel's delay cancel in it) and equals ``2 arg H(f) -
+arg H(2 f)`` of the high-pass ``H`` alone. For each order of the coupling (1 or 2) the
+corner that gives ``D`` is solved (at most the declared range's top) and both orders'
+amplitudes are divided by ``|H|``; the two candidates are averaged.
 
 **What else moves these orders** (measured by ``benchmarks/bench_fingerprint.py`` on the
-shipped diagnoser's data set, every class and drawn chain): the gas force and the joints'
-impacts (the pins' clearance adds short impulses whose low-order content is the small
-velocity change they make), the sensor's drift (0.02-0.5 Hz, leaking into the 1st order
-on a 2-revolution record) and noise. The estimator's spread over those records sets the
-tolerances (`recipdyn.diagnosis.tolerances.FINGERPRINT`).
+shipped diagnoser's data set, every class and drawn chain): the joints' impacts and the
+chain's noise, drift and settling put content into every low order, which the kinematics
+leave nearly empty from the 3rd on (below 1 % of the 1st for r/l <= 0.3). Their RMS over
+the orders 3-6 is each record's own measure of how far its 1st and 2nd orders may be off:
+r/l is refused beyond a measured multiple of it; r, whose errors are the coupling's
+(corrected only in part) rather than the record's noise, beyond a fixed share
+(`recipdyn.diagnosis.tolerances.FINGERPRINT`, with the measurement).
 
-A record without a tacho, or with less than two whole revolutions, cannot be fingerprinted
-this way; the check then says so in the evidence and the other checks decide.
+A record without a tacho, or with less than two whole revolutions, is not fingerprinted;
+the check says so in the evidence and the other checks decide.
 """
 
 from __future__ import annotations
@@ -102,13 +102,13 @@ def harmonics(x, revs, orders=(1, 2)) -> tuple[np.ndarray, int]:
     theta})``, ``theta`` the crank angle after the tacho's mark), over the most whole
     revolutions ``revs`` covers from its first angle, and the number of those revolutions.
 
-    ``c_k = (1 / (n pi)) int x e^{-i k theta} d theta`` over the ``n`` revolutions, by the
-    trapezoidal rule on the samples' own crank angles (the window's two ends interpolated).
-    Not resampled by angle first: a few hundred angle samples per revolution would fold the
-    impacts' kilohertz ringing onto the low orders (measured: ~20 % of the 1st order). A
-    straight line through ``x`` in ``theta`` is removed first: a drift or the AC coupling's
-    settling would otherwise leak into the lowest orders (a line holds ``1/(pi k)`` of its
-    rise in order ``k``)."""
+    A least-squares fit, on the samples' own crank angles, of the orders 1 to
+    ``max(orders)`` together with a straight line in ``theta``: a drift or the AC
+    coupling's settling over the record would otherwise leak into the lowest orders (a line
+    holds ``1/(pi k)`` of its rise in order ``k``), and a line removed apart would take the
+    orders' sine parts' share of it along. Not resampled by angle first: a few hundred
+    angle samples per revolution would fold the impacts' kilohertz ringing onto the low
+    orders (measured on the data set: ~20 % of the 1st order)."""
     revs = np.asarray(revs, float)
     ok = np.isfinite(revs)
     r, y = revs[ok], np.asarray(x, float)[ok]
@@ -118,17 +118,15 @@ def harmonics(x, revs, orders=(1, 2)) -> tuple[np.ndarray, int]:
     n = int(np.floor((r[-1] - r[0]) + np.median(np.diff(r)) * (1 + 1e-9)))
     if n < 1:
         raise ValueError("less than one whole revolution covered")
-    end = min(r[0] + n, r[-1])
-    inside = r < end
-    th = 2.0 * np.pi * np.append(r[inside], end)
-    ya = np.append(y[inside], np.interp(end, r, y))
-    if end < r[0] + n:  # the last sample's interval: the record's first value continues it
-        th = np.append(th, 2.0 * np.pi * (r[0] + n))
-        ya = np.append(ya, ya[-1])
-    ya = ya - np.polyval(np.polyfit(th, ya, 1), th)
-    ks = np.asarray(orders)
-    c = np.trapezoid(ya[None, :] * np.exp(-1j * ks[:, None] * th[None, :]), th, axis=1)
-    return c / (n * np.pi), n
+    inside = r < r[0] + n
+    th, y = 2.0 * np.pi * r[inside], y[inside]
+    ks = np.arange(1, int(max(orders)) + 1)
+    cols = [np.ones_like(th), th - th.mean()]
+    for k in ks:
+        cols += [np.cos(k * th), np.sin(k * th)]
+    coef = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)[0]
+    c = coef[2::2] - 1j * coef[3::2]
+    return np.array([c[k - 1] for k in orders]), n
 
 
 def _values(machine=None) -> dict[str, float]:
@@ -173,22 +171,6 @@ def _corner(n: int, d: float, f: float) -> float:
         return 0.0
     hi = 10.0 * f
     if g(hi) < 0.0:  # beyond any AC coupling below the crank's speed
-        return hi
-    return float(brentq(g, 0.0, hi, xtol=1e-6 * f))
-
-
-def _corner_from_lead(n: int, lead: float, f: float) -> float:
-    """The corner (Hz) of the order-``n`` Butterworth high-pass that leads by ``lead`` (rad)
-    at ``f``; 0 for ``lead <= 0``, the largest tried (``10 f``) beyond its reach."""
-    from scipy.optimize import brentq
-
-    def g(fc):
-        return float(np.angle(_highpass(n, fc, [f])[0])) - lead
-
-    if lead <= 0.0:
-        return 0.0
-    hi = 10.0 * f
-    if g(hi) < 0.0:
         return hi
     return float(brentq(g, 0.0, hi, xtol=1e-6 * f))
 
@@ -249,16 +231,6 @@ def estimate(x, fs: float, revs, machine=None) -> dict[str, float]:
             return math.nan
         return float(brentq(g, lo, hi, xtol=1e-7))
 
-    # the 1st order's own lead over the kinematics: the coupling's, with the crank angle's
-    # zero known (the tacho's mark, or the pressures' phase)
-    lead = _wrap(np.angle(c[0]) - np.angle(k[0]))
-    r_lead, lam_lead, corners_lead = [], [], []
-    for order in (1, 2):
-        fc = _corner_from_lead(order, lead, f)
-        h = _highpass(order, fc, [f, 2 * f])
-        r_lead.append(abs(c[0]) / abs(h[0]) / abs(k[0]) * v["r"])
-        lam_lead.append((abs(c[1]) / abs(h[1])) / (abs(c[0]) / abs(h[0])))
-        corners_lead.append(fc)
     # what the kinematics do not explain in the orders 3-6: the impacts' and the noise's
     # share of the low orders, the scale of the 1st and 2nd orders' own errors
     # (the kinematics' own orders 3-6 are below 1 % of the 1st for r/l <= 0.3: not removed)
@@ -276,11 +248,6 @@ def estimate(x, fs: float, revs, machine=None) -> dict[str, float]:
         "r_spread": abs(rs[1] - rs[0]) / 2 / r if r > 0 else math.nan,
         "corner_hz": float(np.mean(corners)),
         "phase_d_deg": math.degrees(d),
-        "lead_deg": math.degrees(lead),
-        "r_lead": float(np.mean(r_lead)),
-        "r_lead_spread": abs(r_lead[1] - r_lead[0]) / 2 / float(np.mean(r_lead)),
-        "lam_lead": float(np.mean([lam_of(x_) for x_ in lam_lead])),
-        "corner_lead_hz": float(np.mean(corners_lead)),
         "resid_12": resid / abs(c[0]),
         "resid_2": resid / abs(c[1]),
         "revolutions": n,
@@ -301,11 +268,6 @@ def check(x, fs: float, revs, machine=None, *, tacho: bool = True) -> Fingerprin
     if not tacho:
         return Fingerprint("not checked", "no tacho: the crank orders need the crank angle")
     revs = np.asarray(revs, float)
-    span = np.nanmax(revs) - np.nanmin(revs) if np.isfinite(revs).any() else 0.0
-    if span < MIN_REVOLUTIONS:
-        return Fingerprint(
-            "not checked", f"{span:.1f} revolutions; at least {MIN_REVOLUTIONS} whole needed"
-        )
     try:
         e = estimate(x, fs, revs, machine)
     except ValueError as exc:
@@ -313,7 +275,7 @@ def check(x, fs: float, revs, machine=None, *, tacho: bool = True) -> Fingerprin
     if e["revolutions"] < MIN_REVOLUTIONS or not math.isfinite(e["lam"]):
         return Fingerprint(
             "not checked",
-            f"{e['revolutions']} whole revolution(s)"
+            f"{e['revolutions']} whole revolution(s); at least {MIN_REVOLUTIONS} needed"
             if e["revolutions"] < MIN_REVOLUTIONS
             else "the orders' ratio lies beyond any slider-crank's (r/l 0.02-0.6)",
         )

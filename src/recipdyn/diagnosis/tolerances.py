@@ -66,12 +66,14 @@ RESONANCE_CHECK_REL = 0.05
 #: ``benchmarks/bench_fingerprint.py --min-revs`` on the shipped diagnoser's data set: its
 #: 798 records (of 1440) whose two tacho edges span 2 whole revolutions (the diagnoser's
 #: own machine, 9 classes, chains drawn from `recipdyn.chain.DEFAULT_RANGES`; 211 of
-#: held-out conditions). ``|r/r0 - 1|``: median 0.039, 95 % 0.123, 99 % 0.166, largest
-#: 0.206 (held-out: 95 % 0.119, 99 % 0.163); ``r_tol`` lies above the largest. ``|lam/lam0
-#: - 1| / u``: median 0.32, 95 % 1.11, 99 % 1.45, largest 2.81; ``lam_z_limit`` lies above
-#: the largest (``|lam/lam0 - 1|`` itself: median 0.020, 95 % 0.119, 99 % 0.223). None of
-#: the 798 is refused. ``r_u95`` and ``lam_z95`` (the 95 % quantiles) give the reported 95 %
-#: half-widths. The 1st order's error grows with the coupling's corner (its 95 % quantile
-#: 0.065 below 0.3 Hz, 0.166 at 1.2-2 Hz): the corner read from the phases corrects part.
-FINGERPRINT = {"r_tol": 0.21, "r_u95": 0.123, "lam_z_limit": 3.0, "lam_z95": 1.11,
+#: held-out conditions). ``|r/r0 - 1|``: median 0.035, 95 % 0.108, 99 % 0.147, largest
+#: 0.202 (held-out: 95 % 0.104, 99 % 0.148); ``r_tol`` lies above the largest. ``|lam/lam0
+#: - 1| / u``: median 0.22, 95 % 0.84, 99 % 1.29, largest 1.90 (held-out: 0.75, 1.05,
+#: 1.28); ``lam_z_limit`` lies above the largest (``|lam/lam0 - 1|`` itself: median 0.019,
+#: 95 % 0.110, 99 % 0.228, largest 0.745: a worn crank pin's impacts, whose ``u`` is as
+#: large). None of the 798 is refused. ``r_u95`` and ``lam_z95`` (the 95 % quantiles) give
+#: the reported 95 % half-widths. The 1st order's error grows with the coupling's corner
+#: (95 % quantile 0.06-0.07 below 0.3 Hz, 0.12-0.15 at 1.2-2 Hz); the corner read from the
+#: phases corrects part of it (uncorrected: 99 % 0.182, largest 0.219).
+FINGERPRINT = {"r_tol": 0.21, "r_u95": 0.108, "lam_z_limit": 2.0, "lam_z95": 0.84,
                "records": 798}  # fmt: skip
