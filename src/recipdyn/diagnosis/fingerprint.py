@@ -53,6 +53,10 @@ __all__ = ["Fingerprint", "harmonics", "kinematic_orders", "estimate", "check", 
 PER_REV = 360
 #: The fewest whole revolutions the fingerprint is read from.
 MIN_REVOLUTIONS = 2
+#: A window of whole revolutions may lack this share of one (a tacho's jitter of up to 1
+#: degree on its last pulse): the least-squares fit of the orders stays orthogonal to
+#: ~1e-3 of a revolution's missing content.
+SPAN_SLACK = 0.005
 
 
 @dataclass(frozen=True)
@@ -114,8 +118,10 @@ def harmonics(x, revs, orders=(1, 2)) -> tuple[np.ndarray, int]:
     r, y = revs[ok], np.asarray(x, float)[ok]
     if r.size < 2 or np.any(np.diff(r) <= 0):
         raise ValueError("crank angle must increase (a tacho or a positive speed)")
-    # the last sample ends its interval: a record of exactly N revolutions covers N
-    n = int(np.floor((r[-1] - r[0]) + np.median(np.diff(r)) * (1 + 1e-9)))
+    # the last sample ends its interval, and the tacho's jitter moves the last pulse: a
+    # record whose pulses span N revolutions to within `SPAN_SLACK` covers N (the fit
+    # below does not need the window filled to the sample)
+    n = int(np.floor((r[-1] - r[0]) + np.median(np.diff(r)) + SPAN_SLACK))
     if n < 1:
         raise ValueError("less than one whole revolution covered")
     inside = r < r[0] + n
