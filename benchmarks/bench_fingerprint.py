@@ -88,8 +88,8 @@ def main(argv=None):
     r["lam_raw_err"] = r.lam_raw / r.lam_ref - 1
     r["r_err"] = r.r / r.r_ref - 1
     r["r_raw_err"] = r.r_raw / r.r_ref - 1
-    # r/l's error in units of the record's own uncertainty (the orders 3-6)
-    r["lam_z"] = r.lam_err / np.hypot(r.resid_12, r.resid_2)
+    # r/l's error in units of the record's own uncertainty (the orders 3-6, the coupling)
+    r["lam_z"] = r.lam_err / np.sqrt(r.resid_12**2 + r.resid_2**2 + r.lam_spread**2)
     r["r_err_gain"] = r.r / (r.r_ref * r.gain) - 1  # with the drawn gain known
     if a.min_revs:
         r = r[r.revolutions >= 2].copy()

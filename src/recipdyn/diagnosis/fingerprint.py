@@ -287,9 +287,10 @@ def check(x, fs: float, revs, machine=None, *, tacho: bool = True) -> Fingerprin
         )
     f = FINGERPRINT
     # r/l: this record's standard uncertainty, the crank orders 3-6 the kinematics leave
-    # empty in units of the orders read, times the measured limit; r: a fixed tolerance (its
+    # empty in units of the orders read and the AC coupling's two candidate orders'
+    # disagreement, times the measured limit; r: a fixed tolerance (its
     # errors are the AC coupling's, not the record's noise)
-    u_l = math.hypot(e["resid_12"], e["resid_2"])
+    u_l = math.sqrt(e["resid_12"] ** 2 + e["resid_2"] ** 2 + e["lam_spread"] ** 2)
     dl = e["lam"] / e["lam_ref"] - 1.0
     dr = e["r"] / e["r_ref"] - 1.0
     tol_l = f["lam_z_limit"] * u_l
