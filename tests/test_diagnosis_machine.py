@@ -198,7 +198,8 @@ def test_diagnose_refuses_a_record_of_another_machine_and_says_how_to_build_one(
     """A simulated record carries its parameters: a 90 mm crank (the diagnoser's: 120 mm) is
     refused without a machine file, naming the parameter and giving the commands that build a
     diagnoser for that machine from the record itself; the CLI exits 2 in one line. The same
-    machine is answered; a user's machine file names the machine whatever the record says."""
+    machine is answered; a user's machine file names the machine whatever the record's
+    attributes say (its own acceleration is still fingerprinted: test_diagnosis_fingerprint)."""
     from recipdyn.cli import main
     from recipdyn.diagnosis.diagnose import diagnose
 
@@ -218,5 +219,9 @@ def test_diagnose_refuses_a_record_of_another_machine_and_says_how_to_build_one(
     res = diagnose(same, machine=theirs, **kw)
     assert res.refused and "bore = 0.3 (the diagnoser's: 0.5" in res.reason
     assert f"--machine {theirs}" in res.reason
+    # the user's file is read instead of the record's attributes (their check passes), but
+    # the record's own crosshead acceleration still shows a 90 mm crank (fingerprint.py)
     mine = _dump(tmp_path, "mine.toml")
-    assert not diagnose(other, machine=mine, **kw).reason.startswith("another machine")
+    res = diagnose(other, machine=mine, **kw)
+    assert res.reason.startswith("another machine (its crosshead acceleration's crank orders)")
+    assert "r = 0.09" not in res.reason

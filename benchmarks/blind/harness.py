@@ -144,7 +144,8 @@ def diagnose_channels(ch: dict, channels: str, model) -> dict:
         return {"refused": False, "error": f"{type(exc).__name__}: {exc}", "reason": "",
                 "seconds": time.perf_counter() - t0}  # fmt: skip
     ans = {"refused": bool(res.refused), "reason": res.reason, "error": None,
-           "seconds": time.perf_counter() - t0}  # fmt: skip
+           "seconds": time.perf_counter() - t0,
+           "fingerprint": res.evidence.get("fingerprint")}  # fmt: skip
     if not res.refused:
         ans.update(
             label=res.label,
@@ -240,6 +241,8 @@ def _reason_kind(reason: str) -> str:
     if r.startswith("on the held-out conditions,"):  # the channel gate (names the channels)
         # below the class's confidence threshold (channels.selective_threshold), or not at all
         return "confidence threshold" if "below that threshold" in r else "channel gate"
+    if r.startswith("another machine (its crosshead acceleration's crank orders)"):
+        return "machine fingerprint"
     for key, kind in (("crank speed", "speed range"), ("sampling rate", "sampling rate"),
                       ("noise floor", "noise floor"), ("impacts ring", "sensor band"),
                       ("sensor band", "sensor band"), ("transducer offset", "offset range"),

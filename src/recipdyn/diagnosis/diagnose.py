@@ -92,6 +92,10 @@ class Diagnosis:
                     f"{ch['recall']:.0%}; all classes {ch['accuracy']:.0%} of {ch['n']} records)"
                 )
             lines.append(line)
+        if ev.get("fingerprint"):
+            from .fingerprint import Fingerprint
+
+            lines.append(Fingerprint(**ev["fingerprint"]).text())
         for name, e in ev.get("chain", {}).items():
             lines.append(f"chain: {name.replace('_', ' ')} {_estimate_text(e)}")
         lines.append(
@@ -382,6 +386,14 @@ def _diagnose_arrays(
         low = {} if declared is None else {"min_hz": RESONANCE_CHECK_MIN_HZ}  # (tolerances)
         chain.update(resonance(x, fs, revs if tacho is not None else None, form, **low))
         res.evidence["chain"] = _chain_summary(chain)
+    # the record's own machine, from its acceleration's crank orders (fingerprint.py)
+    from .fingerprint import check as fingerprint
+    from .fingerprint import refusal as other_machine
+
+    fp = fingerprint(x, fs, revs, machine_pairs, tacho=tacho is not None)
+    res.evidence["fingerprint"] = fp.to_dict()
+    if why := other_machine(fp, diag):
+        return _refuse(res, why, t0)
     row = record_features(
         x, fs, revs, angle=tacho is not None, p_head=ph, p_crank=pc, machine=machine_pairs
     )

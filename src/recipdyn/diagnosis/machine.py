@@ -575,6 +575,18 @@ def record_machine(path: str | Path) -> Machine | None:
     return replace(machine_from_file(path), nominal=False)
 
 
+def how_to_build(source: str | None, spec: Mapping[str, Any]) -> str:
+    """The commands that build a diagnoser for the machine of ``source`` (its machine file,
+    or a record of it), or how to describe it first when there is no file."""
+    if source and Path(source).suffix in (".toml", ".nc"):
+        return build_commands(source, spec)
+    return (
+        "describe it in a machine file (recipdyn simulate --set NAME=VALUE ... --dump-config "
+        "machine.toml) and build one: recipdyn dataset --machine machine.toml -o DS && "
+        "recipdyn train DS -o machine.skops"
+    )
+
+
 def refusal(diag, machine: Machine | None) -> str | None:
     """Why ``diag`` must not diagnose a record of ``machine`` (None: it may, or no machine
     is known): the parameters beyond the tolerances and the commands that build a diagnoser
@@ -586,11 +598,7 @@ def refusal(diag, machine: Machine | None) -> str | None:
     if not diffs:
         return None
     src = machine.source
-    how = build_commands(src, diag.card["spec"]) if Path(src).suffix in (".toml", ".nc") else (
-        "describe it in a machine file (recipdyn simulate --set NAME=VALUE ... --dump-config "
-        "machine.toml) and build one: recipdyn dataset --machine machine.toml -o DS && "
-        "recipdyn train DS -o machine.skops"
-    )  # fmt: skip
+    how = how_to_build(src, diag.card["spec"])
     return (
         f"another machine ({src}): {'; '.join(diffs)}: this diagnoser was built for "
         f"{mine.text() if not mine.is_default else 'the default machine'} and would answer "

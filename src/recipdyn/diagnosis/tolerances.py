@@ -5,7 +5,7 @@ module of the package, so that each reads them without importing another's code.
 
 __all__ = ["RANGE_SLACK", "RING_SLACK", "FLOOR_SLACK", "OPERATING", "BASELINE_SPREAD_FLOOR",
            "SNR_CALIBRATION", "RING_AGREEMENT", "RESONANCE_CHECK_MIN_HZ",
-           "RESONANCE_CHECK_REL"]  # fmt: skip
+           "RESONANCE_CHECK_REL", "FINGERPRINT"]  # fmt: skip
 
 #: Slack on the training range of the crank speed and the sampling rate (relative).
 RANGE_SLACK = 0.02
@@ -55,3 +55,28 @@ RESONANCE_CHECK_MIN_HZ = 600.0
 #: checked: its reported interval covered 87 % of 369 read resonances below 0.45 fs (4 and 10
 #: revolutions; the relative errors' 97.5 % quantile: 0.043); with 5 % added, 98.9 %.
 RESONANCE_CHECK_REL = 0.05
+
+#: The machine fingerprint's tolerances (`recipdyn.diagnosis.fingerprint`): a record of 2 or
+#: more whole revolutions is another machine when its r times the gain (the acceleration's
+#: 1st crank order over omega**2, corrected for the AC coupling) departs from the
+#: diagnoser's machine by more than ``r_tol`` (relative), or its r/l (the 2nd over the 1st
+#: order, corrected) by more than ``lam_z_limit`` times its own standard uncertainty
+#: ``u = sqrt(e_12**2 + e_2**2 + s**2)``: ``e_12``, ``e_2`` the RMS of the crank orders 3-6
+#: (which the kinematics leave below 1 % of the 1st) over the 1st and over the 2nd order's
+#: amplitude, ``s`` half the disagreement of the AC coupling's two candidate orders (median
+#: 0.005, 99 % 0.061). Measured by
+#: ``benchmarks/bench_fingerprint.py --min-revs`` on the shipped diagnoser's data set: its
+#: 1379 records (of 1440) whose two tacho edges span 2 whole revolutions (the diagnoser's
+#: own machine, 9 classes, chains drawn from `recipdyn.chain.DEFAULT_RANGES`; 347 of
+#: held-out conditions). ``|r/r0 - 1|``: median 0.034, 95 % 0.106, 99 % 0.147, largest
+#: 0.202 (held-out: 95 % 0.103, 99 % 0.154); ``r_tol`` lies above the largest. ``|lam/lam0
+#: - 1| / u``: median 0.21, 95 % 0.85, 99 % 1.31, then 1.84, 1.88, 1.90, 2.33, 2.59, 3.18
+#: (held-out: 95 % 0.72, 99 % 1.06, largest 1.27); ``lam_z_limit`` is the 99 % quantile
+#: times a margin of 1.5, beyond which 3 of the 1379 lie (SNR 10.7-12.6 dB, the range's
+#: noisiest). ``|lam/lam0 - 1|`` itself: median 0.018, 95 % 0.109, 99 % 0.223, largest
+#: 0.745 (a worn crank pin's impacts, whose ``u`` is as large). ``r_u95`` and ``lam_z95``
+#: (the 95 % quantiles) give the reported 95 % half-widths. The 1st order's error grows with
+#: the coupling's corner (95 % quantile 0.06 below 0.3 Hz, 0.12-0.15 at 1.2-2 Hz); the
+#: corner read from the phases corrects part of it (uncorrected: 99 % 0.183, largest 0.246).
+FINGERPRINT = {"r_tol": 0.21, "r_u95": 0.106, "lam_z_limit": 2.0, "lam_z95": 0.85,
+               "records": 1379}  # fmt: skip
