@@ -353,6 +353,8 @@ def _diagnose_arrays(
     # the channels' own samples: a clipped pressure, or an accelerometer clipped outside the
     # converter ranges the diagnoser's data set drew, is refused (chainrange.py)
     signals = read_channels(x, fs, revs, ph, pc, edges.size if tacho is not None else 0)
+    # the tacho pulses of the data set's records: a mark at each end of their revolutions
+    signals["train_pulses"] = int(round(float(diag.card["spec"].get("revolutions", 0)))) + 1
     why, clip = clipping_refusal(signals, declared_ranges(diag))
     res.evidence.update(clip)
     if why:
