@@ -88,6 +88,25 @@ def _inertia_range(local) -> tuple[float, float]:
     return float(inertia.min()), float(inertia.max())
 
 
+def _ring(model, kicked: str, fs: float = 2000.0, duration: float = 2.5):
+    """``model`` at its defaults with the state ``kicked`` 0.01 rad ahead, integrated for
+    ``duration`` s at rtol 1e-10 and sampled at ``fs``: ``(solution, state layout, the
+    coupling twist's dominant frequency, half a bin)`` (the largest bin of its Hann-windowed
+    FFT, 0 Hz left out)."""
+    from recipdyn.integrate import integrate
+
+    v = model.parameters()
+    st = model.configuration(v).layout.state
+    y0 = model.initial_state(v)
+    y0[st[kicked]] += 0.01
+    t = np.arange(int(duration * fs)) / fs
+    sol = integrate(model.system(v), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-12)
+    twist = sol.y[:, st["theta1"]] - sol.y[:, st["shaft.theta_flywheel"]]
+    spectrum = np.abs(np.fft.rfft((twist - twist.mean()) * np.hanning(t.size)))
+    freqs = np.fft.rfftfreq(t.size, 1.0 / fs)
+    return sol, st, freqs[1 + np.argmax(spectrum[1:])], 0.5 * fs / t.size
+
+
 def test_a_free_oscillation_turns_at_the_linear_trains_lowest_natural_frequency():
     """The rotor started 0.01 rad ahead of its static twist, no damping, a weak gas load (1 %
     of the paper's): the coupling's twist oscillates at the train's lowest natural frequency
@@ -97,22 +116,12 @@ def test_a_free_oscillation_turns_at_the_linear_trains_lowest_natural_frequency(
     revolution: more inertia lowers every eigenvalue (Courant-Fischer), so the train with each
     throw at its smallest and at its largest inertia brackets the frequency (a width of ~1e-4
     of it here: the throws hold 0.03 % of the train's inertia)."""
-    from recipdyn.integrate import integrate
     from recipdyn.model.shaft import TorsionalTrain, train_of
 
     kc, ks = 5.5e6, 2.5e6
     model = _model(_machine(kc, ks, extra=(("load_amplitude", 2000.0),)))
     v = model.parameters()
-    st = model.configuration(v).layout.state
-    y0 = model.initial_state(v)
-    y0[st["theta1"]] += 0.01
-    fs, T = 2000.0, 2.5
-    t = np.arange(int(T * fs)) / fs
-    sol = integrate(model.system(v), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-12)
-    twist = sol.y[:, st["theta1"]] - sol.y[:, st["shaft.theta_flywheel"]]
-    spectrum = np.abs(np.fft.rfft((twist - twist.mean()) * np.hanning(t.size)))
-    freqs = np.fft.rfftfreq(t.size, 1.0 / fs)
-    f_sim = freqs[1 + np.argmax(spectrum[1:])]
+    _, _, f_sim, half_bin = _ring(model, "theta1")
 
     f_lin = train_of(model.machine, v, (kc, ks, ks), J_motor=J_MOTOR).natural_frequencies()[0]
     lo, hi = _inertia_range(model.throws(v)[0])  # (the two throws are alike)
@@ -124,7 +133,6 @@ def test_a_free_oscillation_turns_at_the_linear_trains_lowest_natural_frequency(
 
     band = (f_at(hi), f_at(lo))
     assert band[0] <= f_lin <= band[1]
-    half_bin = 0.5 * fs / t.size
     assert band[0] - half_bin <= f_sim <= band[1] + half_bin, (f_sim, f_lin, band, half_bin)
     assert abs(f_sim - f_lin) < 0.02 * f_lin  # (and it is the ~20 Hz mode, not another)
 
@@ -401,23 +409,13 @@ def test_a_held_rotors_shaft_twists_at_the_grounded_trains_frequency_and_balance
     damped sections and the full load, half a revolution: ``E(t) - E(0) = W_motor + sum W_gas
     - W_shaft_damping`` to 1e-7 of the motor's work (the integration's tolerance), the motor's
     work being the coupling's torque times ``omega``."""
-    from recipdyn.integrate import integrate
     from recipdyn.model.shaft import TorsionalTrain, train_of
 
     kc, ks = 5.5e6, 2.5e6
     model = _model(_machine(kc, ks, extra=(("load_amplitude", 2000.0),), motor="held"))
     v = model.parameters()
-    st = model.configuration(v).layout.state
-    y0 = model.initial_state(v)
-    y0[st["shaft.theta_flywheel"]] += 0.01
-    fs, T = 2000.0, 2.5
-    t = np.arange(int(T * fs)) / fs
-    sol = integrate(model.system(v), y0, (0.0, t[-1]), t_eval=t, rtol=1e-10, atol=1e-12)
+    sol, st, f_sim, half_bin = _ring(model, "shaft.theta_flywheel")
     assert np.all(sol.y[:, st["omega1"]] == OMEGA)
-    twist = sol.y[:, st["theta1"]] - sol.y[:, st["shaft.theta_flywheel"]]
-    spectrum = np.abs(np.fft.rfft((twist - twist.mean()) * np.hanning(t.size)))
-    freqs = np.fft.rfftfreq(t.size, 1.0 / fs)
-    f_sim = freqs[1 + np.argmax(spectrum[1:])]
     f_held = train_of(model.machine, v, (kc, ks, ks), J_motor=J_MOTOR,
                       held=True).natural_frequencies()[0]  # fmt: skip
     f_free = train_of(model.machine, v, (kc, ks, ks), J_motor=J_MOTOR).natural_frequencies()[0]
@@ -429,7 +427,6 @@ def test_a_held_rotors_shaft_twists_at_the_grounded_trains_frequency_and_balance
                               grounded=True).natural_frequencies()[0]  # fmt: skip
 
     band = (f_at(hi), f_at(lo))
-    half_bin = 0.5 * fs / t.size
     assert band[0] - half_bin <= f_sim <= band[1] + half_bin, (f_sim, f_held, band)
     assert abs(f_free - f_held) > 10 * half_bin  # (the grounded mode, not the free one)
 
