@@ -86,7 +86,14 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--revolutions", type=float, default=4.0)
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="2 conditions x 2 chains: checks that it runs, measures little",
+    )
     args = ap.parse_args(argv)
+    if args.quick:
+        args.conditions, args.chains = min(args.conditions, 2), min(args.chains, 2)
     import bench_chain_ranges as b
     from recipdyn.diagnosis.dataset import design
 
