@@ -295,7 +295,7 @@ def test_the_tacho_is_refused_on_the_crank_angle_error_its_jitter_leaves_not_the
 
     def run(jitter, pulses):
         est = {"tacho_jitter": Estimate(jitter, math.nan, "deg", "corrected")}
-        return check_chain(declared, est, None, signals={"n_pulses": pulses, "train_pulses": 3})
+        return check_chain(declared, est, None, signals={"n_pulses": pulses}, train_pulses=3)
 
     checks, why = run(0.5, 40)
     st = {c.name: c for c in checks}

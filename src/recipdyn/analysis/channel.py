@@ -44,8 +44,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Clipping", "clipping", "level_spacing", "Hum", "mains_hum", "CLIP_MIN_RUNS",
-           "CLIP_STEP_CODES"]  # fmt: skip
+__all__ = ["Clipping", "clipping", "level_spacing", "Hum", "mains_hum", "mains_hums",
+           "CLIP_MIN_RUNS", "CLIP_STEP_CODES"]  # fmt: skip
 
 #: Excursions onto one extreme value that make a channel clipped (`clipping`): an unclipped
 #: signal with noise reaches its extreme once.
@@ -210,7 +210,7 @@ def mains_hum(
     synchronous average (``bins`` per revolution; default about one per sample) is removed
     first (see the module's notes). ``about_mean``: the level is against the RMS of the
     signal less its mean (an AC signal's); False: against its RMS with the mean (an absolute
-    pressure's).
+    pressure's). `mains_hums` reads several frequencies of one signal at once.
 
     Examples
     --------
@@ -221,11 +221,17 @@ def mains_hum(
     >>> bool(h.lo < 0.1 < h.hi)
     True
     """
+    return mains_hums(x, fs, (freq_hz,), revs, bins, about_mean)[0]
+
+
+def mains_hums(
+    x, fs: float, freqs, revs=None, bins: int | None = None, about_mean: bool = True
+) -> tuple[Hum, ...]:
+    """`mains_hum` at each of ``freqs``, the signal's synchronous average removed once."""
     x = np.asarray(x, float)
     n = x.size
-    nan = Hum(freq_hz, math.nan, math.nan, math.nan, math.nan)
-    if not (0 < freq_hz < 0.5 * fs) or n < 16:
-        return Hum(**{**nan.__dict__, "note": "above the Nyquist frequency"})
+    if n < 16:
+        return tuple(_no_hum(f, "above the Nyquist frequency") for f in freqs)
     mean = float(np.mean(x))
     x = x - mean
     t = np.arange(n) / fs
@@ -241,18 +247,32 @@ def mains_hum(
         def remove(y):
             return y - np.mean(y)
 
-    def fit(f, y):
+    y = remove(x)
+    return tuple(_hum(x, y, t, fs, f, remove, mean, about_mean) for f in freqs)
+
+
+def _no_hum(freq_hz: float, note: str) -> Hum:
+    return Hum(freq_hz, math.nan, math.nan, math.nan, math.nan, note)
+
+
+def _hum(x, y, t, fs: float, freq_hz: float, remove, mean: float, about_mean: bool) -> Hum:
+    """One frequency of `mains_hums`: ``x`` the signal less its mean, ``y`` that less its
+    synchronous average (``remove``), ``t`` the samples' times."""
+    n = x.size
+    if not 0 < freq_hz < 0.5 * fs:
+        return _no_hum(freq_hz, "above the Nyquist frequency")
+
+    def fit(f):
         c, s = np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t)
         a = np.column_stack([remove(c), remove(s)])
         kept = float(np.sum(a**2)) / float(np.sum(c**2) + np.sum(s**2))
         coef, *_ = np.linalg.lstsq(a, y, rcond=None)
-        return coef, kept, a
+        return coef, kept
 
-    y = remove(x)
-    coef, kept, _ = fit(freq_hz, y)
+    coef, kept = fit(freq_hz)
     if kept < HUM_MIN_KEPT:
-        return Hum(**{**nan.__dict__, "note": f"{freq_hz:g} Hz lies on an order of the speed "
-                      "(the synchronous average holds it)"})  # fmt: skip
+        return _no_hum(freq_hz, f"{freq_hz:g} Hz lies on an order of the speed (the "
+                       "synchronous average holds it)")  # fmt: skip
     amp = float(math.hypot(*coef))
     # the noise's share: the same fit at neighbouring frequencies, away from any hum line
     df = fs / n
@@ -260,11 +280,11 @@ def mains_hum(
     for j in HUM_NEIGHBOURS:
         for f in (freq_hz - j * df, freq_hz + j * df):
             if 0 < f < 0.5 * fs:
-                c2, k2, _ = fit(f, y)
+                c2, k2 = fit(f)
                 if k2 >= HUM_MIN_KEPT:
                     noise.append(float(np.sum(c2**2)))
     if len(noise) < 5:
-        return Hum(**{**nan.__dict__, "note": "too few neighbouring frequencies"})
+        return _no_hum(freq_hz, "too few neighbouring frequencies")
     sd = math.sqrt(0.5 * float(np.mean(noise)))  # one coefficient's standard deviation
     w = 2 * np.pi * freq_hz * t
     rest = x - coef[0] * np.cos(w) - coef[1] * np.sin(w) + (0.0 if about_mean else mean)

@@ -204,6 +204,7 @@ def check_chain(
     floor: tuple[float, str] | None,
     ring_hz: float = math.nan,
     signals: dict[str, Any] | None = None,
+    train_pulses: int = 0,
 ) -> tuple[list[ChainCheck], str | None]:
     """The record's chain against ``declared`` (`declared_ranges`): ``estimates`` the
     record's chain estimates (`recipdyn.diagnosis.correction.Estimate` by name: the
@@ -211,8 +212,9 @@ def check_chain(
     frequency its impacts ring at (`recipdyn.diagnosis.evidence.ringing_hz`: the resonance is
     read only where the two agree within `RING_AGREEMENT`; its damping with it),
     ``signals`` what `read_channels` read of the channels' own samples (hum, converter
-    step, the tacho's pulses). Returns every check and the refusal (None if every estimated
-    parameter is inside its range)."""
+    step, the tacho's pulses), ``train_pulses`` the tacho pulses of the data set's records
+    (the crank-angle error their jitter could leave; 0: not checked). Returns every check
+    and the refusal (None if every estimated parameter is inside its range)."""
     checks = []
     r = estimates.get("resonance_hz")
     if r is not None:
@@ -242,7 +244,7 @@ def check_chain(
         checks.append(_check("damping", d.value if ok else math.nan, d.value - d.uncertainty,
                              d.value + d.uncertainty, declared,
                              "" if ok else "the resonance is not read"))  # fmt: skip
-    checks += _tacho_checks(declared, estimates, signals or {})
+    checks += _tacho_checks(declared, estimates, signals or {}, train_pulses)
     g = estimates.get("gain_ratio")
     if g is not None and "pressure.gain" in declared:
         a, b, _ = declared["pressure.gain"]
@@ -266,7 +268,7 @@ def read_channels(x, fs: float, revs, p_head=None, p_crank=None, n_pulses: int =
     against the crank-synchronous signal
     (``revs``: the crank angle in revolutions, finite), the record's speed and the tacho's
     pulse count (``n_pulses``)."""
-    from ..analysis.channel import clipping, level_spacing, mains_hum
+    from ..analysis.channel import clipping, level_spacing, mains_hums
 
     revs = np.asarray(revs, float)
     out: dict[str, Any] = {
@@ -281,11 +283,10 @@ def read_channels(x, fs: float, revs, p_head=None, p_crank=None, n_pulses: int =
         out[f"clip_{ch}"] = clipping(y)
         out[f"step_{ch}"] = level_spacing(y)
         out[f"peak_{ch}"] = float(np.max(np.abs(y)))
-        for f in MAINS:
-            for k in range(1, (HUM_HARMONICS if ch == "accelerometer" else 1) + 1):
-                out[f"hum_{ch}_{k * f:g}"] = mains_hum(
-                    y, fs, k * f, revs=revs, about_mean=ch == "accelerometer"
-                )
+        orders = HUM_HARMONICS if ch == "accelerometer" else 1
+        lines = [k * f for f in MAINS for k in range(1, orders + 1)]
+        hums = mains_hums(y, fs, lines, revs=revs, about_mean=ch == "accelerometer")
+        out.update({f"hum_{ch}_{f:g}": h for f, h in zip(lines, hums, strict=True)})
     return out
 
 
@@ -342,7 +343,7 @@ def clipping_refusal(
             "accelerometer.full_scale_g=LO,HI)"), evidence  # fmt: skip
 
 
-def _tacho_checks(declared, estimates, signals) -> list[ChainCheck | None]:
+def _tacho_checks(declared, estimates, signals, n_train: int) -> list[ChainCheck | None]:
     out = []
     j = estimates.get("tacho_jitter")
     dof = signals.get("n_pulses", 0) - 3  # (the fit's parabola: `correction._degree`)
@@ -360,7 +361,7 @@ def _tacho_checks(declared, estimates, signals) -> list[ChainCheck | None]:
                           "" if ok else j.note or j.status))  # fmt: skip
         # the crank angle's error the jitter leaves (correction.axis_sd) against the largest
         # the data set's records could hold: its widest jitter over their pulses
-        n, n_train = signals.get("n_pulses", 0), signals.get("train_pulses", 0)
+        n = signals.get("n_pulses", 0)
         if ok and n_train >= 2:
             a, b, unit = declared["tacho.jitter_deg"]
             f, f_train = (

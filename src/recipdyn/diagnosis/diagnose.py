@@ -353,8 +353,6 @@ def _diagnose_arrays(
     # the channels' own samples: a clipped pressure, or an accelerometer clipped outside the
     # converter ranges the diagnoser's data set drew, is refused (chainrange.py)
     signals = read_channels(x, fs, revs, ph, pc, edges.size if tacho is not None else 0)
-    # the tacho pulses of the data set's records: a mark at each end of their revolutions
-    signals["train_pulses"] = int(round(float(diag.card["spec"].get("revolutions", 0)))) + 1
     why, clip = clipping_refusal(signals, declared_ranges(diag))
     res.evidence.update(clip)
     if why:
@@ -434,7 +432,9 @@ def _diagnose_arrays(
         if read is not None:  # the floor's share, and the SNR it gives
             res.evidence["noise_floor"] = {"share": floor[0], "training_range": list(floor[1:]),
                                            "snr_db": list(snr_estimate(*read)[:3])}  # fmt: skip
-        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"], signals)
+        # the tacho pulses of the data set's records: a mark at each end of their revolutions
+        pulses = int(round(float(diag.card["spec"].get("revolutions", 0)))) + 1
+        checks, why = check_chain(declared, chain, read, row["acc_ring_hz"], signals, pulses)
         res.evidence["chain_ranges"] = as_evidence(checks)
         if why:
             return _refuse(res, why, t0)

@@ -5,7 +5,7 @@ without its machine's description must still not be answered for another one. Th
 crosshead's axial acceleration carries the mechanism's geometry in its lowest crank orders:
 the slider-crank's ``a(theta) = -r w^2 (cos theta + lambda cos 2 theta + ...)``,
 ``lambda = r/l``. Fitted on the crank angle the tacho gives, over whole revolutions
-(`harmonics`), the record's 1st and 2nd orders give
+(`recipdyn.analysis.vibration.crank_orders`), the record's 1st and 2nd orders give
 
 * **r/l** from the ratio of the 2nd to the 1st order's amplitude, which the
   accelerometer's gain leaves unchanged;
@@ -47,16 +47,14 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.vibration import crank_orders as harmonics
+
 __all__ = ["Fingerprint", "harmonics", "kinematic_orders", "estimate", "check", "refusal"]
 
 #: Crank-angle samples per revolution for the orders (the 2nd order has 180 per period).
 PER_REV = 360
 #: The fewest whole revolutions the fingerprint is read from.
 MIN_REVOLUTIONS = 2
-#: A window of whole revolutions may lack this share of one (a tacho's jitter of up to 1
-#: degree on its last pulse): the least-squares fit of the orders stays orthogonal to
-#: ~1e-3 of a revolution's missing content.
-SPAN_SLACK = 0.005
 
 
 @dataclass(frozen=True)
@@ -99,40 +97,6 @@ class Fingerprint:
             f" mm (the diagnoser's {1e3 * self.r_ref:.1f} mm, tolerance +-"
             f"{100 * self.r_tol:.0f} %): {self.status}"
         )
-
-
-def harmonics(x, revs, orders=(1, 2)) -> tuple[np.ndarray, int]:
-    """The complex amplitudes of the crank ``orders`` of ``x`` (``x ~ Re(c_k e^{i k
-    theta})``, ``theta`` the crank angle after the tacho's mark), over the most whole
-    revolutions ``revs`` covers from its first angle, and the number of those revolutions.
-
-    A least-squares fit, on the samples' own crank angles, of the orders 1 to
-    ``max(orders)`` together with a straight line in ``theta``: a drift or the AC
-    coupling's settling over the record would otherwise leak into the lowest orders (a line
-    holds ``1/(pi k)`` of its rise in order ``k``), and a line removed apart would take the
-    orders' sine parts' share of it along. Not resampled by angle first: a few hundred
-    angle samples per revolution would fold the impacts' kilohertz ringing onto the low
-    orders (measured on the data set: ~20 % of the 1st order)."""
-    revs = np.asarray(revs, float)
-    ok = np.isfinite(revs)
-    r, y = revs[ok], np.asarray(x, float)[ok]
-    if r.size < 2 or np.any(np.diff(r) <= 0):
-        raise ValueError("crank angle must increase (a tacho or a positive speed)")
-    # the last sample ends its interval, and the tacho's jitter moves the last pulse: a
-    # record whose pulses span N revolutions to within `SPAN_SLACK` covers N (the fit
-    # below does not need the window filled to the sample)
-    n = int(np.floor((r[-1] - r[0]) + np.median(np.diff(r)) + SPAN_SLACK))
-    if n < 1:
-        raise ValueError("less than one whole revolution covered")
-    inside = r < r[0] + n
-    th, y = 2.0 * np.pi * r[inside], y[inside]
-    ks = np.arange(1, int(max(orders)) + 1)
-    cols = [np.ones_like(th), th - th.mean()]
-    for k in ks:
-        cols += [np.cos(k * th), np.sin(k * th)]
-    coef = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)[0]
-    c = coef[2::2] - 1j * coef[3::2]
-    return np.array([c[k - 1] for k in orders]), n
 
 
 def _values(machine=None) -> dict[str, float]:

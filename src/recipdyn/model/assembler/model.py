@@ -885,11 +885,10 @@ class ContactMachine(MachineModel):
             pre = c.machine.prefix(th.name)
             out.update({pre + k: s for k, s in own.items()})
         if shared(c.machine):
-            for k, sig in _shared_crank(c, values, t, y, out).items():
-                if sig is None:
-                    out.pop(k, None)
-                else:
-                    out[k] = sig
+            out.update(_shared_crank(c, values, t, y, out))
+            for q in (c.machine.prefix(th.name) for th in c.machine.throws):
+                for k in ("alpha1", "motor_torque", "W_motor", "omega1"):  # (the shaft's now)
+                    out.pop(q + k, None)
         elif not c.machine.flat and c.machine.shaft.drive == "motor":  # (one throw, named)
             pre, phase = c.machine.prefix(c.machine.throws[0].name), self.throws(values)[0]["phase"]
             out["theta1"] = Signal(out[pre + "theta1"].values - float(phase), "rad",
@@ -953,8 +952,9 @@ def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndar
     """The signals of a motor's crank that several contact throws share: the shaft's angle,
     speed and acceleration, the motor's torque and work, the machine's energy (each throw's,
     its own crank's included, and the drive's) and per throw the shaft's torque on its crank
-    (``crank_torque``) and work (``W_crank``), in place of its one-throw model's crank
-    signals (its own ``alpha1``, ``motor_torque``, ``W_motor``, ``omega1``)."""
+    (``crank_torque``) and work (``W_crank``); they replace each throw's one-throw model's
+    crank signals (its own ``alpha1``, ``motor_torque``, ``W_motor``, ``omega1``), which the
+    caller drops."""
     from ..base import Signal, rhs_series
 
     st = c.layout.state
@@ -964,8 +964,6 @@ def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndar
     w = y[:, st[pre[0] + "omega1"]]
     sig: dict[str, Signal] = {}
     for q in pre:
-        for k in ("alpha1", "motor_torque", "W_motor", "omega1"):
-            sig[q + k] = None  # (dropped below)
         sig[q + "crank_torque"] = Signal(dy[:, st[q + "W_crank"]] / w, "N*m",
                                          "torque of the shaft on the throw's crank")  # fmt: skip
         sig[q + "W_crank"] = Signal(y[:, st[q + "W_crank"]], "J", "work of the shaft on the "
