@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import pickle
 import time
 from pathlib import Path
 
@@ -65,7 +66,7 @@ def _case(rng, kind: str, cond_task: dict, machine_defaults: dict) -> dict:
 
 def main(argv: list[str] | None = None) -> None:
     from recipdyn.diagnosis import default_model_path, load
-    from recipdyn.diagnosis.baseline import build_baseline
+    from recipdyn.diagnosis.baseline import build_baseline, load_baseline
     from recipdyn.diagnosis.classes import CLASSES
     from recipdyn.diagnosis.dataset import DatasetSpec, design
     from recipdyn.diagnosis.diagnose import diagnose_arrays
@@ -82,6 +83,24 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="out/baseline_bench.json")
+    ap.add_argument(
+        "--cache",
+        default=None,
+        help="folder keeping each case's records and baseline (re-diagnosed, not "
+        "rebuilt, when the run is repeated with another --out)",
+    )
+    ap.add_argument(
+        "--task-offset",
+        type=int,
+        default=0,
+        help="case c takes the (c + this)-th held-out healthy record's condition "
+        "and chain (evaluate on conditions not developed on)",
+    )
+    ap.add_argument(
+        "--variants",
+        default="without,with,with records referral,with sim referral",
+        help="which diagnoses to run (comma-separated)",
+    )
     ap.add_argument("--quick", action="store_true", help="1 perturbed and 1 nominal case")
     args = ap.parse_args(argv)
     if args.quick:
@@ -104,7 +123,7 @@ def main(argv: list[str] | None = None) -> None:
             if c < len(done["cases"]):
                 continue
             rng = np.random.default_rng([args.seed, c])
-            cond = tasks[c % len(tasks)]
+            cond = tasks[(c + args.task_offset) % len(tasks)]
             case = _case(rng, kind, cond, defaults)
             t0 = time.perf_counter()
             base_kw = {"fs": cond["fs"], "revolutions": args.revolutions,
@@ -127,11 +146,26 @@ def main(argv: list[str] | None = None) -> None:
                     test.append((fc.name, s))
                     kw = {**base_kw, "revolutions": 4.0, "seed": 1000 * c + 100 + len(test)}
                     jobs.append(((fc.name, k), p, kw))
-            recs = dict(pool.map(record_job, jobs))
+            stem = None if args.cache is None else Path(args.cache) / f"seed{args.seed}-case{c}"
+            if stem is not None and stem.with_suffix(".pkl").exists():
+                recs = pickle.loads(stem.with_suffix(".pkl").read_bytes())
+            else:
+                recs = dict(pool.map(record_job, jobs))
+                if stem is not None:
+                    stem.parent.mkdir(parents=True, exist_ok=True)
+                    stem.with_suffix(".pkl").write_bytes(pickle.dumps(recs))
             t_sim = time.perf_counter() - t0
             healthy = [recs[("baseline", i)] for i in range(args.records)]
             t0 = time.perf_counter()
-            b = build_baseline(healthy, diag, workers=args.workers)
+            if stem is not None and stem.with_suffix(".json").exists():
+                b = load_baseline(stem.with_suffix(".json"))
+                if not b.delta_sim:  # a baseline of an older build: its fit re-referred
+                    b = build_baseline(healthy, diag, workers=args.workers, fit=b.fit)
+                    b.save(stem.with_suffix(".json"))
+            else:
+                b = build_baseline(healthy, diag, workers=args.workers)
+                if stem is not None:
+                    b.save(stem.with_suffix(".json"))
             t_fit = time.perf_counter() - t0
             f = b.fit
             cover = {}
@@ -163,13 +197,19 @@ def main(argv: list[str] | None = None) -> None:
                 kw = {"tacho": r.tacho, "p_head": r.p_head, "p_crank": r.p_crank, "model": diag}
                 row = {"truth": name, "severity": s}
                 rec_b = dataclasses.replace(b, delta=b.delta_records, referral="records")
+                sim_b = dataclasses.replace(b, delta=b.delta_sim, referral="sim")
                 for tag, extra in (("without", {}), ("with", {"baseline": b}),
-                                   ("with records referral", {"baseline": rec_b})):  # fmt: skip
+                                   ("with records referral", {"baseline": rec_b}),
+                                   ("with sim referral", {"baseline": sim_b})):  # fmt: skip
+                    if tag not in args.variants.split(","):
+                        continue
                     try:
                         a = diagnose_arrays(r.accel, r.fs, **kw, **extra)
                         row[tag] = "refused" if a.refused else a.label
-                    except ParameterError:  # the command's one-line refusal (exit 2)
+                        row[f"{tag}: why"] = _why(a)
+                    except ParameterError as exc:  # the command's one-line refusal (exit 2)
                         row[tag] = "refused"
+                        row[f"{tag}: why"] = {"gate": "input", "reason": str(exc)}
                 answers.append(row)
             done["cases"].append({
                 "kind": kind, "condition": cond["condition"], "truth": case["truth"],
@@ -190,6 +230,39 @@ def main(argv: list[str] | None = None) -> None:
     report(done)
 
 
+#: The gate a refusal came from, by the words of its reason (`diagnose_arrays`).
+GATES = (
+    ("another machine", "fingerprint"),
+    ("r/l", "fingerprint"),
+    ("noise floor", "noise floor"),
+    ("novelty p-value", "ood"),
+    ("no simulated", "consistency"),
+    ("channels", "channel gate"),
+    ("held-out", "channel gate"),
+    ("offset", "chain range"),
+    ("resonance", "chain range"),
+    ("tacho", "chain range"),
+    ("clipp", "clipping"),
+)
+
+
+def _why(a) -> dict:
+    """Which gate answered the record and the numbers behind it: the refusal's gate (by its
+    reason's words) or ``classifier``, the top probabilities, the novelty p-value and the
+    consistency check's p-value and worst residual, the features farthest from the healthy
+    training records."""
+    gate = "classifier"
+    if a.refused:
+        gate = next((g for w, g in GATES if w in a.reason), "other")
+    top = sorted(a.probabilities.items(), key=lambda kv: -kv[1])[:3]
+    c = a.evidence.get("consistency") or {}
+    w = c.get("worst") or {}
+    return {"gate": gate, "reason": a.reason[:300], "top": [[k, round(v, 3)] for k, v in top],
+            "ood_p": a.ood.get("p_value"), "cons_p": c.get("p_value"),
+            "cons_worst": [w.get("curve"), w.get("angle_deg"), w.get("z")] if w else None,
+            "deciding": a.evidence.get("deciding")}  # fmt: skip
+
+
 def report(done: dict) -> None:
     for kind in ("perturbed", "nominal"):
         cases = [c for c in done["cases"] if c["kind"] == kind]
@@ -205,8 +278,10 @@ def report(done: dict) -> None:
             ratio = [abs(r["value"] - r["truth"]) / max((r["hi"] - r["lo"]) / 2, 1e-300)
                      for r in rows]  # fmt: skip
             print(f"| {n} | {ins}/{len(rows)} | {np.median(ratio):.2f} |")
-        for tag in ("without", "with", "with records referral"):
+        for tag in ("without", "with", "with records referral", "with sim referral"):
             ans = [a for c in cases for a in c["answers"] if tag in a]
+            if not ans:
+                continue
             h = [a for a in ans if a["truth"] == "healthy"]
             f = [a for a in ans if a["truth"] != "healthy"]
             hr = sum(a[tag] == "healthy" for a in h) / len(h)

@@ -769,6 +769,8 @@ def diagnoser_id(diag) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+#: How a baseline refers later records (`Baseline`, `build_baseline`).
+REFERRALS = ("model", "records", "sim")
 #: The accelerometer SNR (dB) of the referral's simulated records: the feature difference of
 #: two records sensed with the same noise is the machine's, at any SNR inside the training
 #: range.
@@ -813,6 +815,7 @@ class Baseline:
     referral: str = "model"
     delta_model: dict[str, float] = field(default_factory=dict)
     delta_records: dict[str, float] = field(default_factory=dict)
+    delta_sim: dict[str, float] = field(default_factory=dict)
 
     @property
     def chain(self) -> dict[str, float]:
@@ -900,6 +903,7 @@ def build_baseline(
     max_nfev: int = 25,
     progress: Callable[[str], None] | None = None,
     referral: str = "model",
+    fit: MachineFit | None = None,
 ) -> Baseline:
     """The machine's own healthy baseline for diagnoser ``diag`` from healthy ``records``
     (module docstring): the fit (`fit_machine`), then the healthy machine with the fitted
@@ -912,11 +916,12 @@ def build_baseline(
     from ..parallel import process_pool, stop_pool
     from .machine import feature_shift, healthy_parameters, healthy_spreads
 
-    if referral not in ("records", "model"):
-        raise ParameterError(f"referral = {referral!r}; allowed: records, model")
+    if referral not in REFERRALS:
+        raise ParameterError(f"referral = {referral!r}; allowed: {', '.join(REFERRALS)}")
     machine = machine or diag.machine
-    fit = fit_machine(records, machine, uncertain=uncertain, estimator=estimator,
-                      workers=workers, max_nfev=max_nfev, progress=progress)  # fmt: skip
+    if fit is None:
+        fit = fit_machine(records, machine, uncertain=uncertain, estimator=estimator,
+                          workers=workers, max_nfev=max_nfev, progress=progress)  # fmt: skip
     changes = diag.card["spec"].get("machine") or None
     nominal = {**machine.as_dict, **healthy_parameters(None if machine.is_default else machine)}
     fitted = {**nominal, **fit.machine}
@@ -941,7 +946,7 @@ def build_baseline(
     groups = feature_groups(diag.names)
     measured = [record_features_of(rec, fit.chain, changes) for rec in records]
     expected = [_expected(diag, m, feats[2 * i + 1]) for i, m in enumerate(measured)]
-    delta_model, delta_records, spread = {}, {}, {}
+    delta_model, delta_records, delta_sim, spread = {}, {}, {}, {}
     for n in groups["pressure"] + groups["cycle"]:
         d = [feats[2 * i][n] - feats[2 * i + 1][n] for i in range(len(records))]
         d = [v for v in d if math.isfinite(v)]
@@ -952,6 +957,10 @@ def build_baseline(
         e = [v for v in e if math.isfinite(v)]
         if e:
             delta_records[n] = float(np.mean(e))
+        e = [m[n] - feats[2 * i + 1][n] for i, m in enumerate(measured)]
+        e = [v for v in e if math.isfinite(v)]
+        if e:
+            delta_sim[n] = float(np.mean(e))
     spreads = healthy_spreads(diag)
     worst, which = 0.0, ""
     for i, got in enumerate(measured):
@@ -961,10 +970,10 @@ def build_baseline(
     check = {"shift": worst, "feature": which}
     if progress is not None:
         progress(f"baseline: referral simulated ({len(tasks)} records)")
-    delta = delta_records if referral == "records" else delta_model
+    delta = {"records": delta_records, "model": delta_model, "sim": delta_sim}[referral]
     return Baseline(fit, delta, spread, check, diagnoser_id(diag),
                     [r.name for r in records], __version__, referral, delta_model,
-                    delta_records)  # fmt: skip
+                    delta_records, delta_sim)  # fmt: skip
 
 
 def _expected(diag, row: Mapping[str, float], nominal: Mapping[str, float]) -> dict:
