@@ -20,16 +20,18 @@ with the simulator:
    The uncertainty is the Laplace approximation at the optimum, the residuals' scale and
    lag-1 autocorrelation taken into the covariance, so the intervals widen where the
    pressures cannot tell a parameter (the masses, which the pressures barely see).
-3. **The referral** (`build_baseline`, `Baseline.refer`): the healthy machine with the fitted
-   parameters and the diagnoser's nominal one are simulated and sensed at each record's
-   operating point with the same noise; the difference of their pressure and cycle features
-   (the features the fitted parameters act on, and those the diagnoser's own healthy
-   baseline, `recipdyn.diagnosis.train.fit_baseline`, refers to the operating point) is the
-   machine's own healthy offset from the diagnoser's machine, taken off every later record's
-   features after its chain is corrected (offsets removed, crank angle re-phased): the
-   diagnoser then reads deviations from the machine's own healthy state. The acceleration's
-   features are not referred: the masses that act on them are not fitted, and two simulated
-   records' impacts differ by more than the fitted parameters move them.
+3. **The referral** (`build_baseline`, `Baseline.refer`): every later record's features,
+   after its chain is corrected (offsets removed, crank angle re-phased), are referred to
+   the machine's own healthy records: the healthy records' pressure and cycle features less
+   what the diagnoser's healthy machine shows at their operating points (its own healthy
+   baseline, `recipdyn.diagnosis.train.fit_baseline`, which carries the operating point's
+   effect) is the machine's healthy offset, taken off; the diagnoser then reads deviations
+   from the machine's own healthy state. The healthy machine with the fitted parameters and
+   the diagnoser's nominal one are also simulated and sensed at each record's operating
+   point (the model's referral, kept for comparison, and the check of the records against
+   the fit). The acceleration's features are not referred: the masses that act on them are
+   not fitted, and two simulated records' impacts differ by more than the fitted parameters
+   move them.
 
 The baseline is a small JSON file tied to one diagnoser (its data set's spec).
 """
@@ -792,16 +794,27 @@ class Baseline:
 
     ``fit``: the fitted parameters and chain (`MachineFit`); ``delta``: each pressure and
     cycle feature's healthy offset of this machine from the diagnoser's, the one `refer`
-    takes off, by ``referral``: ``"model"`` (the default; ``delta_model``: the fitted
-    machine's simulated features less the nominal one's, averaged over the records'
-    operating points; ``delta_spread`` its spread over them) or ``"records"``
-    (``delta_records``: the healthy records' own features, chain corrected, less what the
-    diagnoser's healthy machine shows at their operating points, averaged: on one nominal
-    machine it moved the crank end's pressure-shape bins by ~2 healthy spreads, the
-    diagnoser's affine healthy baseline being that far off there, and its 4 healthy records
-    were called a sticking plate, where the model's referral left them healthy); ``check``:
-    the largest departure of the (chain-corrected) healthy records' features from the fitted
-    machine's, in the healthy machine's own spreads
+    takes off, by ``referral``:
+
+    * ``"records"`` (the default; ``delta_records``): the healthy records' own features,
+      chain corrected, less what the diagnoser's healthy machine shows at their operating
+      points (its affine healthy baseline, `recipdyn.diagnosis.train.fit_baseline`, for the
+      features it models; the nominal machine's simulated record for the rest), averaged: a
+      later record is then read as its departure from the machine's own healthy records,
+      the operating point's effect carried by the diagnoser's baseline, as condition
+      monitoring refers a reading to the machine's own healthy state at the same load. It
+      holds what the fit does not: the valve springs' and lifts' effect, which the model's
+      referral leaves in (docs/diagnosis.md: the perturbed machines' healthy records called
+      a sticking plate, their weak springs healthy, with the model's referral);
+    * ``"model"`` (``delta_model``): the fitted machine's simulated features less the
+      nominal one's, averaged over the records' operating points (``delta_spread`` its
+      spread over them): only the fitted parameters' effect;
+    * ``"sim"`` (``delta_sim``): the healthy records' features less the nominal machine's
+      simulated record at the same operating point (a two-revolution simulation's own
+      cycle-to-cycle noise enters the offset; measured worse than ``"records"``).
+
+    ``check``: the largest departure of the (chain-corrected) healthy records' features
+    from the fitted machine's, in the healthy machine's own spreads
     (`recipdyn.diagnosis.machine.healthy_spreads`), and the feature; ``diagnoser``:
     `diagnoser_id`."""
 
@@ -812,7 +825,7 @@ class Baseline:
     diagnoser: str
     records: list[str] = field(default_factory=list)
     recipdyn_version: str = ""
-    referral: str = "model"
+    referral: str = "records"
     delta_model: dict[str, float] = field(default_factory=dict)
     delta_records: dict[str, float] = field(default_factory=dict)
     delta_sim: dict[str, float] = field(default_factory=dict)
@@ -902,7 +915,7 @@ def build_baseline(
     workers: int = 2,
     max_nfev: int = 25,
     progress: Callable[[str], None] | None = None,
-    referral: str = "model",
+    referral: str = "records",
     fit: MachineFit | None = None,
 ) -> Baseline:
     """The machine's own healthy baseline for diagnoser ``diag`` from healthy ``records``
@@ -910,8 +923,10 @@ def build_baseline(
     parameters and the diagnoser's nominal one simulated and sensed at each record's
     operating point, with the same noise, and their features' difference
     (`Baseline.delta_model`); the healthy records' own departure from the diagnoser's healthy
-    machine (`Baseline.delta_records`); ``referral`` chooses which `Baseline.refer` takes
-    off."""
+    machine (`Baseline.delta_records`), and against the nominal machine's simulated records
+    (`Baseline.delta_sim`); ``referral`` chooses which `Baseline.refer` takes off (`REFERRALS`;
+    default ``"records"``). ``fit``: a `MachineFit` already made from these records (the fit
+    is then not run again: the referral alone is rebuilt)."""
     from .. import __version__
     from ..parallel import process_pool, stop_pool
     from .machine import feature_shift, healthy_parameters, healthy_spreads
@@ -944,10 +959,13 @@ def build_baseline(
     from .evidence import feature_groups
 
     groups = feature_groups(diag.names)
+    fixed = constant_in_health(diag)
     measured = [record_features_of(rec, fit.chain, changes) for rec in records]
     expected = [_expected(diag, m, feats[2 * i + 1]) for i, m in enumerate(measured)]
     delta_model, delta_records, delta_sim, spread = {}, {}, {}, {}
     for n in groups["pressure"] + groups["cycle"]:
+        if n in fixed:
+            continue
         d = [feats[2 * i][n] - feats[2 * i + 1][n] for i in range(len(records))]
         d = [v for v in d if math.isfinite(v)]
         if d:
@@ -974,6 +992,22 @@ def build_baseline(
     return Baseline(fit, delta, spread, check, diagnoser_id(diag),
                     [r.name for r in records], __version__, referral, delta_model,
                     delta_records, delta_sim)  # fmt: skip
+
+
+def constant_in_health(diag) -> set[str]:
+    """The features the diagnoser's healthy training records hold at one value (their
+    interquartile range zero): a pressure-shape bin at the cycle's peak is 1 by construction
+    (``pc_100`` of the shipped diagnoser: 1 from its healthy records' 25th percentile up).
+    They have no healthy offset to take off: referred, a healthy record's 1 became 0.984 on
+    a perturbed machine (the diagnoser's affine baseline, a mean, predicts below the bound),
+    below every healthy simulated record, and the consistency check refused all 4 of its
+    healthy records at 11 standard deviations there. `build_baseline` leaves them as
+    measured."""
+    st = diag.state
+    healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
+    Z = st["Z_train"].astype(float)[healthy]
+    iqr = np.nanpercentile(Z, 75, axis=0) - np.nanpercentile(Z, 25, axis=0)
+    return {n for n, q in zip(diag.names, iqr, strict=True) if q == 0}
 
 
 def _expected(diag, row: Mapping[str, float], nominal: Mapping[str, float]) -> dict:
@@ -1030,7 +1064,12 @@ def simulated_record(
                       summary=False, **params)  # fmt: skip
     rec = sensors.record(
         ds,
-        accelerometer=sensors.Accelerometer(snr_db=snr_db, resonance_hz=resonance_hz),
+        # the mount's exact (analog) response, as a real mount's and the drawn chains' of the
+        # data set: the bilinear one of `recipdyn.sensors`' fixed chain moves the resonance
+        # `estimate_chain` reads (an analog fit) by up to 5 % near 0.4 fs
+        accelerometer=sensors.Accelerometer(
+            snr_db=snr_db, resonance_hz=resonance_hz, response="exact"
+        ),  # fmt: skip
         pressure=sensors.PressureTransducer(),
         tacho=sensors.Tacho(angle=math.radians(chain.get("phase_deg", 0.0))),
         seed=seed,
