@@ -964,8 +964,6 @@ def build_baseline(
     expected = [_expected(diag, m, feats[2 * i + 1]) for i, m in enumerate(measured)]
     delta_model, delta_records, delta_sim, spread = {}, {}, {}, {}
     for n in groups["pressure"] + groups["cycle"]:
-        if n in fixed:
-            continue
         d = [feats[2 * i][n] - feats[2 * i + 1][n] for i in range(len(records))]
         d = [v for v in d if math.isfinite(v)]
         if d:
@@ -979,6 +977,8 @@ def build_baseline(
         e = [v for v in e if math.isfinite(v)]
         if e:
             delta_sim[n] = float(np.mean(e))
+            if n in fixed:  # at its bound: the nominal machine's own value, not a mean's
+                delta_records[n] = delta_sim[n]
     spreads = healthy_spreads(diag)
     worst, which = 0.0, ""
     for i, got in enumerate(measured):
@@ -998,11 +998,14 @@ def constant_in_health(diag) -> set[str]:
     """The features the diagnoser's healthy training records hold at one value (their
     interquartile range zero): a pressure-shape bin at the cycle's peak is 1 by construction
     (``pc_100`` of the shipped diagnoser: 1 from its healthy records' 25th percentile up).
-    They have no healthy offset to take off: referred, a healthy record's 1 became 0.984 on
-    a perturbed machine (the diagnoser's affine baseline, a mean, predicts below the bound),
-    below every healthy simulated record, and the consistency check refused all 4 of its
-    healthy records at 11 standard deviations there. `build_baseline` leaves them as
-    measured."""
+    Their healthy value at an operating point is that bound, which the diagnoser's affine
+    healthy baseline (a mean over records some of which peak in the next bin) misses: referred
+    to it, a perturbed machine's healthy 1 became 0.984, below every healthy simulated record,
+    and the consistency check refused all 4 of its healthy records at 11 standard deviations
+    there; left unreferred, another perturbed machine's own peak in the next bin (0.98) was
+    refused the same way. `build_baseline` refers them to the nominal machine's simulated
+    records at the healthy records' operating points (``delta_sim``), which hold the bound
+    exactly."""
     st = diag.state
     healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
     Z = st["Z_train"].astype(float)[healthy]
