@@ -960,7 +960,6 @@ def build_baseline(
 
     groups = feature_groups(diag.names)
     fixed = constant_in_health(diag)
-    bound = healthy_bound(diag, fixed)
     measured = [record_features_of(rec, fit.chain, changes) for rec in records]
     expected = [_expected(diag, m, feats[2 * i + 1]) for i, m in enumerate(measured)]
     delta_model, delta_records, delta_sim, spread = {}, {}, {}, {}
@@ -978,11 +977,8 @@ def build_baseline(
         e = [v for v in e if math.isfinite(v)]
         if e:
             delta_sim[n] = float(np.mean(e))
-        if n in fixed and n in delta_records:  # held at a bound by healthy machines
-            at_bound = [m[n] == bound[n] for m in measured]
-            # the machine's own healthy records at the bound: its healthy value is the
-            # bound, nothing to take off; off it, their offset as any feature's
-            delta_records[n] = 0.0 if all(at_bound) else delta_records[n]
+            if n in fixed:  # at its bound: the nominal machine's own value, not a mean's
+                delta_records[n] = delta_sim[n]
     spreads = healthy_spreads(diag)
     worst, which = 0.0, ""
     for i, got in enumerate(measured):
@@ -1002,32 +998,19 @@ def constant_in_health(diag) -> set[str]:
     """The features the diagnoser's healthy training records hold at one value (their
     interquartile range zero): a pressure-shape bin at the cycle's peak is 1 by construction
     (``pc_100`` of the shipped diagnoser: 1 from its healthy records' 25th percentile up).
-    Additive referral is wrong at a bound. Referred to the diagnoser's affine healthy
-    baseline (a mean, below the bound), a perturbed machine's healthy 1 became 0.984, below
-    every healthy simulated record: the consistency check refused all 4 of its healthy
-    records at 11 standard deviations; referred to the nominal machine's simulated records,
-    another machine's healthy 1 became 0.98 and its 4 healthy records were named a sticking
-    plate; left unreferred, a third machine's own peak in the next bin (0.98) was refused
-    like the first. `build_baseline` refers such a feature only where the machine's own
-    healthy records leave the bound, and then as any other feature."""
+    Their healthy value at an operating point is that bound, which the diagnoser's affine
+    healthy baseline (a mean over records some of which peak in the next bin) misses: referred
+    to it, a perturbed machine's healthy 1 became 0.984, below every healthy simulated record,
+    and the consistency check refused all 4 of its healthy records at 11 standard deviations
+    there; left unreferred, another perturbed machine's own peak in the next bin (0.98) was
+    refused the same way. `build_baseline` refers them to the nominal machine's simulated
+    records at the healthy records' operating points (``delta_sim``), which hold the bound
+    exactly."""
     st = diag.state
     healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
     Z = st["Z_train"].astype(float)[healthy]
     iqr = np.nanpercentile(Z, 75, axis=0) - np.nanpercentile(Z, 25, axis=0)
     return {n for n, q in zip(diag.names, iqr, strict=True) if q == 0}
-
-
-def healthy_bound(diag, names) -> dict[str, float]:
-    """The value at which the diagnoser's healthy training records hold each of ``names``
-    (`constant_in_health`): their median."""
-    st = diag.state
-    healthy = np.array([lab == "healthy" for lab in st["train_labels"]])
-    out = {}
-    for n in names:
-        j = diag.names.index(n)
-        z = float(np.nanmedian(st["Z_train"].astype(float)[healthy, j]))
-        out[n] = float(np.float16(z * st["scale"][j] + st["center"][j]))
-    return out
 
 
 def _expected(diag, row: Mapping[str, float], nominal: Mapping[str, float]) -> dict:
