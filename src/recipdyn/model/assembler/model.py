@@ -843,13 +843,12 @@ class ContactMachine(MachineModel):
         pre = [c.machine.prefix(t.name) for t in c.machine.throws]
         mixed = any(not is_contact(t) for t in c.machine.throws)
         if shared(c.machine) or mixed:  # every throw's recorded values by index
-            aux = tuple(sorted({*counters, *(st[q + n] for q, v, t in
-                                             zip(pre, c.locals, c.machine.throws, strict=True)
-                                             if is_contact(t)
-                                             for i, n in ((8, "v_impact"),
-                                                          (9, "v_impact_crosshead"))
-                                             if i not in RIGID[v["clearance_joints"]])}))
-            aux_states = 0  # fmt: skip
+            recorded = set(counters)
+            for q, v, t in zip(pre, c.locals, c.machine.throws, strict=True):
+                if is_contact(t):  # its approach velocities (the damping law's)
+                    recorded |= {st[q + n] for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
+                                 if i not in RIGID[v["clearance_joints"]]}  # fmt: skip
+            aux, aux_states = tuple(sorted(recorded)), 0
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
             aux_states = 1
