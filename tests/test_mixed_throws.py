@@ -1,0 +1,142 @@
+"""Throws of different kinds on one crankshaft: ideal (link family) throws beside contact ones
+(issue 43; template ``contact_throws``, each ideal throw its one-throw module of the massless
+link with rc = 0, called on its slice: docs/architecture.md, "A throw of another kind").
+
+* the crank prescribed: the throws do not interact, so the ideal throw is the one-throw
+  ideal compressor (`--model compressor`, rc = 0) from its own crank angle, to the bit (its
+  motion is its crank's, and the module and the arithmetic are that model's), and the contact
+  throw is the one-throw contact model to the integration's error (module docstring of
+  tests/test_contact_throws.py: the bound is 10 times the one-throw run's error estimate);
+* on a motor they share the crank: the machine's energy balance closes, the ideal throw's own
+  balance (its energy against the shaft's and the gas's work on it) closes, and the shaft's
+  equation holds at every sample;
+* a worn crank pin shows in its own throw's channels: its crosshead's acceleration carries
+  the impacts' kHz band, the ideal throw's only what the crank's acceleration brings it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.signal import butter, sosfiltfilt
+from test_contact_throws import (
+    LOAD,
+    OMEGA,
+    RTOL,
+    _bound,
+    _machine,
+    _motor_machine,
+    _one,
+    _simulate,
+    _throw,
+)
+
+from recipdyn.errors import ParameterError
+from recipdyn.model.machine import Throw
+from recipdyn.model.registry import get_model
+
+
+def _ideal(name, phase=0.0, **kw):
+    return Throw(name, crank_joint="ideal", params=(("load_amplitude", LOAD), ("phase", phase)),
+                 **kw)  # fmt: skip
+
+
+def test_an_ideal_throw_beside_a_contact_throw_is_each_its_one_throw_run():
+    """Crank prescribed, a contact throw at 0 deg and an ideal one at 180 deg, a quarter
+    revolution (impacts at the contact pin): the ideal throw's every signal is the one-throw
+    ideal compressor's from theta1_0 = pi, to the bit; the contact throw's pin and crosshead
+    are the one-throw contact model's within 10 times its error estimate."""
+    m = _machine(_throw("throw1"), _ideal("throw2", math.pi))
+    assert type(m).__name__ == "ContactMachine"
+    kw = dict(revolutions=0.25, fs=20000.0)
+    a = _simulate(model=m, rtol=RTOL, **kw)
+    assert a.sizes["impact_event"] >= 2
+    link = get_model("compressor")
+    lv = link.parameters({"omega": OMEGA, "load_amplitude": LOAD, "theta1_0": math.pi, "rc": 0.0})
+    b = _simulate(model=link, params=lv, rtol=RTOL, **kw)
+    for k in b.data_vars:
+        if k in ("W_gas",) or str(k).startswith("impact"):
+            continue
+        np.testing.assert_array_equal(a[f"throw2.{k}"].values, b[k].values, err_msg=str(k))
+    _, _, run, ref = _one(0.0, **kw)
+    for k in ("ex", "ey", "x"):
+        err = np.abs(a[f"throw1.{k}"].values - ref[k].values).max()
+        assert err <= _bound(run, ref, k), (k, err, _bound(run, ref, k))
+    summary = m.run_summary(m.parameters(), a)
+    assert summary["throw1.impacts"] >= 1
+    own = {k[len("throw2.") :]: val for k, val in summary.items() if k.startswith("throw2.")}
+    assert own == link.run_summary(lv, b)
+
+
+def test_a_mixed_machine_on_a_motor_balances_its_energy():
+    """Invariant (as tests/test_contact_throws.py's): ``W_motor = dE + sum_k (-W_gas,k) +
+    W_loss`` over half a revolution on a light drive (30 kg m^2: the speed swings ~3 %), the
+    residual under ``n_steps rtol max(|E|, |W|)``; the ideal throw's own energy against the
+    shaft's work on its crank and the gas's (``W_crank``, ``W_gas``: its share of the crank
+    turned into work at the shaft's acceleration) under the same bound; the shaft's equation
+    ``sum_k crank_torque_k = T_m - J_drive alpha1`` to 1e-9 of the motor's torque (rounding of
+    a sum of a few terms of that size: ~1e-15)."""
+    m = _motor_machine(_ideal("throw1", math.pi), _throw("throw2"))
+    v = m.parameters({"shaft.J_drive": 30.0})
+    ds = _simulate(model=m, params=v, revolutions=0.5, fs=5000.0, rtol=RTOL)
+    assert ds.sizes["impact_event"] >= 2
+    w = ds["omega1"].values
+    assert w.max() - w.min() > 0.01 * OMEGA  # (the throws do swing the crank)
+    E, Wm = ds["energy"].values, ds["W_motor"].values
+    Wg = ds["throw1.W_gas"].values + ds["throw2.W_gas"].values
+    Wl = ds["throw2.W_loss"].values
+    scale = max(np.abs(E).max(), np.abs(Wm).max(), np.abs(Wg).max())
+    bound = float(ds.attrs["solver_nsteps"]) * RTOL * scale
+    residual = np.abs((Wm - Wm[0]) - (E - E[0]) + (Wg - Wg[0]) - (Wl - Wl[0])).max()
+    assert residual < bound, (residual, bound)
+    E1, Wc1 = ds["throw1.energy"].values, ds["throw1.W_crank"].values
+    Wg1 = ds["throw1.W_gas"].values
+    own = np.abs((E1 - E1[0]) - (Wc1 - Wc1[0]) - (Wg1 - Wg1[0])).max()
+    assert own < bound and np.abs(Wc1).max() > 1e2, (own, bound)
+    shaft = ds["motor_torque"].values - 30.0 * ds["alpha1"].values
+    cranks = ds["throw1.crank_torque"].values + ds["throw2.crank_torque"].values
+    assert np.abs(cranks - shaft).max() <= 1e-9 * np.abs(ds["motor_torque"].values).max()
+    summary = m.run_summary(v, ds)
+    assert summary["energy_balance_residual"] < bound / scale
+
+
+def _band(x, fs):
+    """Mean square of ``x`` in the 1-5 kHz band (the impacts' ringing; the crank's harmonics
+    at 24 Hz x n lie far below it), zero-phase 4th-order Butterworth."""
+    sos = butter(4, [1000.0, 5000.0], btype="band", fs=fs, output="sos")
+    return float(np.mean(sosfiltfilt(sos, x) ** 2))
+
+
+def test_a_worn_crank_pin_shows_in_its_own_throws_channels():
+    """Throw 2's worn crank pin beside an ideal throw 1, one revolution on a light drive (30 kg
+    m^2): throw 2's crosshead acceleration carries the impacts' 1-5 kHz band, more than 1000
+    times throw 1's (measured 1.3e4); throw 1's band holds no more than the crank's
+    acceleration brings it: an ideal throw's crosshead accelerates at ``-r w^2 f(theta) -
+    r alpha1 g(theta)``, ``|g| <= 1 + lambda``, the first term as smooth as the speed (its
+    band ~1e-6 of the second's: w is alpha1's integral, /(2 pi 1 kHz / 150 rad/s)^2), so its
+    band is at most ``(r (1 + lambda))^2`` times alpha1's (measured 0.27 of it), beside the
+    healthy machine's (both throws ideal: 3e-4 (m/s^2)^2, a million times below)."""
+    fs = 20000.0
+    m = _motor_machine(_ideal("throw1", math.pi), _throw("throw2"))
+    v = m.parameters({"shaft.J_drive": 30.0})
+    ds = _simulate(model=m, params=v, revolutions=1.0, fs=fs, rtol=1e-9)
+    healthy = _motor_machine(_ideal("throw1", math.pi), _ideal("throw2"))
+    hv = healthy.parameters({"shaft.J_drive": 30.0})
+    dh = _simulate(model=healthy, params=hv, revolutions=1.0, fs=fs, rtol=1e-9)
+    e1, e2 = _band(ds["throw1.a"].values, fs), _band(ds["throw2.a"].values, fs)
+    assert e2 > 1e3 * e1, (e1, e2)
+    r, lam = v["throw1.r"], v["throw1.r"] / v["throw1.l"]
+    carried = (r * (1.0 + lam)) ** 2 * _band(ds["alpha1"].values, fs)
+    assert e1 <= carried + _band(dh["throw1.a"].values, fs), (e1, carried)
+    assert e2 > 1e6 * _band(dh["throw2.a"].values, fs)
+
+
+def test_the_massless_link_beside_a_contact_throw_is_refused_in_one_line():
+    """An ideal pin joins contact throws; the massless link (rc > 0, its validity bound of a
+    link that can only push) does not yet."""
+    with pytest.raises(ParameterError) as exc:
+        _machine(_throw("throw1"), Throw("throw2", params=(("load_amplitude", LOAD),)))
+    msg = str(exc.value)
+    assert "throw2.crank_joint = 'link'" in msg and "'ideal'" in msg and "\n" not in msg
