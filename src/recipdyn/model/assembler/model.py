@@ -956,8 +956,9 @@ class ContactMachine(MachineModel):
             for k in map(str, ds.data_vars):
                 if k.startswith(pre):
                     rename[k] = k[len(pre) :]
-                elif k.startswith(ev):
-                    rename[k] = "impact_" + k[len(ev) :]
+                elif k.startswith(ev):  # (its crank's work under its one-throw name)
+                    own = k[len(ev) :]
+                    rename[k] = "impact_" + _ONE_THROW_NAMES.get(own, own)
             view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
             if not is_contact(th):  # an ideal throw: its cylinder's figures and its rod load
                 own = MachineModel._throw_summary({**v, "load": th.load}, view)
@@ -970,6 +971,7 @@ class ContactMachine(MachineModel):
             if "impact_time" in view:  # its own events: where its reset moved its states
                 part = c.layout.state.parts[f"{th.name}.mechanism"]
                 names = [n[len(pre) :] for n in c.layout.state.names[part]]
+                names = [_ONE_THROW_NAMES.get(n, n) for n in names]
                 moved = np.column_stack(
                     [view[f"impact_{n}"].values != view[f"impact_{n}_after"].values for n in names]
                 )
@@ -979,6 +981,11 @@ class ContactMachine(MachineModel):
         if "W_motor" in ds.data_vars and "shaft.work" in c.layout.state.parts:
             out["energy_balance_residual"] = _energy_residual(c, ds)
         return out
+
+
+#: A throw's state in a machine whose crank several throws share, by its name in the
+#: one-throw model (`.contact_throws`: the shaft's work on its crank, there the motor's).
+_ONE_THROW_NAMES = {"W_crank": "W_motor", "W_crank_after": "W_motor_after"}
 
 
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
