@@ -21,6 +21,10 @@ import math
 import numpy as np
 import pytest
 from scipy.signal import butter, sosfiltfilt
+
+from recipdyn.errors import ParameterError
+from recipdyn.model.machine import Throw
+from recipdyn.model.registry import get_model
 from test_contact_throws import (
     LOAD,
     OMEGA,
@@ -32,10 +36,6 @@ from test_contact_throws import (
     _simulate,
     _throw,
 )
-
-from recipdyn.errors import ParameterError
-from recipdyn.model.machine import Throw
-from recipdyn.model.registry import get_model
 
 
 def _ideal(name, phase=0.0, **kw):
