@@ -29,6 +29,7 @@ from test_contact_throws import (
     LOAD,
     OMEGA,
     RTOL,
+    RTOL_REF,
     _bound,
     _machine,
     _motor_machine,
@@ -131,6 +132,36 @@ def test_a_worn_crank_pin_shows_in_its_own_throws_channels():
     carried = (r * (1.0 + lam)) ** 2 * _band(ds["alpha1"].values, fs)
     assert e1 <= carried + _band(dh["throw1.a"].values, fs), (e1, carried)
     assert e2 > 1e6 * _band(dh["throw2.a"].values, fs)
+
+
+@pytest.mark.parametrize("kinds", ["ideal+contact", "contact+contact"])
+def test_a_held_rotor_turns_contact_throws_as_the_prescribed_speed_does(kinds):
+    """A held rotor on a rigid shaft (``motor = held``): the crank's acceleration is 0 by
+    construction, so its speed stays ``omega`` exactly (to the bit) and every throw moves as
+    on the prescribed crank: the pins, the crossheads within 10 times the prescribed
+    machine's own error estimate (at ``rtol`` 1e-10 against 1e-12), a quarter revolution
+    with impacts; the motor's torque is the throws' (``sum_k crank_torque_k = T_m``, the
+    shaft's equation at alpha 0) to 1e-9 of its peak (rounding ~1e-16)."""
+    second = (_throw("throw2") if kinds == "ideal+contact"
+              else _throw("throw2", math.pi, rc=0.5e-3))  # fmt: skip
+    first = _ideal("throw1", math.pi) if kinds == "ideal+contact" else _throw("throw1")
+    m = _motor_machine(first, second, motor="held")
+    kw = dict(revolutions=0.25, fs=20000.0)
+    ds = _simulate(model=m, params=m.parameters(), rtol=RTOL, **kw)
+    assert ds.sizes["impact_event"] >= 2
+    assert np.all(ds["omega1"].values == OMEGA) and np.all(ds["alpha1"].values == 0.0)
+    p = _machine(first, second)
+    run, ref = _simulate(model=p, rtol=RTOL, **kw), _simulate(model=p, rtol=RTOL_REF, atol=1e-14,
+                                                               **kw)  # fmt: skip
+    names = ["throw1.x", "throw2.x", "throw2.ex", "throw2.ey"]
+    if kinds == "contact+contact":
+        names += ["throw1.ex", "throw1.ey"]
+    for k in names:
+        err = np.abs(ds[k].values - ref[k].values).max()
+        assert err <= _bound(run, ref, k), (k, err, _bound(run, ref, k))
+    tm = ds["motor_torque"].values
+    cranks = ds["throw1.crank_torque"].values + ds["throw2.crank_torque"].values
+    assert np.abs(cranks - tm).max() <= 1e-9 * np.abs(tm).max()
 
 
 def test_the_massless_link_beside_a_contact_throw_is_refused_in_one_line():

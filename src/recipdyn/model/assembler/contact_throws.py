@@ -151,11 +151,6 @@ def refusal(machine: Machine) -> str | None:
         return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
                 "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
-    if machine.shaft.drive == "motor" and machine.shaft.motor == "held":
-        return (f"{where}: motor = 'held' with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: 'induction' or 'constant', or drive = 'prescribed' "
-                "(a held rotor on a rigid shaft turns the crank as a prescribed speed "
-                "does)")  # fmt: skip
     if machine.frame is not None:
         return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
@@ -226,10 +221,8 @@ class ContactConfiguration:
         absent = ("recipdyn.model.assembler.generate", "absent")
         roles["torque"] = absent
         motor = self.machine.shaft.drive == "motor"
-        if motor:
-            from .assemble import motor_of
-
-            law = motor_of(self.machine)
+        if motor:  # (a held rotor: its throws' modules turn on a torque of 0, `throw_law`)
+            law = throw_law(self.machine)
             roles["torque"] = (law.module, law.kernel("torque"))
         link = self.link_module
         for r in ("rhs", "jac", "event", "reset", "share"):
@@ -246,6 +239,7 @@ class ContactConfiguration:
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
             "HAS_GUIDE": self.locals[first].get("guide", "ideal") == "clearance",
             "HAS_LINK": link is not None,
+            "HELD": held(self.machine),
             "LINK_EVENTS": self.link_events,
             "MOTOR": motor,
             "N_THROWS": len(throws),
@@ -308,6 +302,8 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         v["motor"] = machine.shaft.motor
         if shared(machine):  # its own crank; the drive's inertia is the machine's
             v["J_drive"] = 0.0
+        if held(machine):
+            v.update(motor=throw_law(machine).name, motor_torque=0.0)
     if "load" in names:
         v["load"] = throw.load
     try:
@@ -326,8 +322,25 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
 
 
 def shared(machine: Machine) -> bool:
-    """Whether the throws share a free crank's acceleration (a motor, several throws)."""
-    return machine.shaft.drive == "motor" and len(machine.throws) > 1
+    """Whether the throws share a free crank's acceleration (a motor and several throws, or
+    a held rotor: the template turns the crank, each throw's module its own crank alone)."""
+    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine))
+
+
+def held(machine: Machine) -> bool:
+    """Whether the motor is a held rotor (on a rigid shaft: its torque holds the speed)."""
+    return machine.shaft.drive == "motor" and machine.shaft.motor == "held"
+
+
+def throw_law(machine: Machine):
+    """The torque law of each throw's module on a motor: the motor's, or under a held rotor
+    (which has no torque law: its torque is the one that holds the speed) the constant
+    torque's, at 0 (`throw_contact_values`): each module then gives its crank's acceleration
+    under its own joint's and load's torque alone, which is what the template needs."""
+    from ..components.drive import CONSTANT_TORQUE
+    from .assemble import motor_of
+
+    return CONSTANT_TORQUE if held(machine) else motor_of(machine)
 
 
 #: A free crank's state names in a throw's one-throw state, then in its slice of a machine's
@@ -400,6 +413,8 @@ def throw_link_values(machine: Machine, throw: Throw, local: Mapping[str, Any], 
         v["load"] = throw.load
     if shared(machine):
         v["J_drive"] = 0.0
+    if held(machine):
+        v.update(motor=throw_law(machine).name, motor_torque=0.0)
     try:
         return model.parameters(v)
     except ParameterError as exc:

@@ -80,6 +80,7 @@ from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 CFG = 0
 HAS_GUIDE = False
 HAS_LINK = False
+HELD = False
 LINK_EVENTS = False
 MOTOR = False
 N_THROWS = np.int64(1)
@@ -162,7 +163,7 @@ def _shaft(y, p, out):
     their cranks, and each throw's derivatives at it (module docstring); ``out`` holds each
     throw's own derivatives at its own crank acceleration on entry."""
     w = y[THROW_STATE[0] + THROW_CRANK[0] + 1]
-    tm = torque(w, p, SHAFT + 1)
+    tm = 0.0 if HELD else torque(w, p, SHAFT + 1)
     num = tm
     den = p[SHAFT]
     for k in range(N_THROWS):
@@ -170,7 +171,11 @@ def _shaft(y, p, out):
         ic = _inertia(y, p, k)[0]
         num += ic * out[s + THROW_CRANK[k] + 1] - torque(w, p, o + THROW_TORQUE[k])
         den += ic
-    alpha = num / den
+    if HELD:  # the rotor's torque is the one that holds its speed: the throws' sum's opposite
+        tm = -num
+        alpha = 0.0
+    else:
+        alpha = num / den
     for k in range(N_THROWS):
         s, o, c = THROW_STATE[k], THROW_PARAMS[k], THROW_CRANK[k]
         share = _inertia(y, p, k)
