@@ -17,6 +17,7 @@ link with rc = 0, called on its slice: docs/architecture.md, "A throw of another
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -162,6 +163,43 @@ def test_a_held_rotor_turns_contact_throws_as_the_prescribed_speed_does(kinds):
     tm = ds["motor_torque"].values
     cranks = ds["throw1.crank_torque"].values + ds["throw2.crank_torque"].values
     assert np.abs(cranks - tm).max() <= 1e-9 * np.abs(tm).max()
+
+
+def _placed(name, joint, phase, cylinder, g=None):
+    params = (("load_amplitude", LOAD), ("phase", phase), *((("g", g),) if g is not None else ()))
+    return Throw(name, crank_joint=joint, cylinder_angle=cylinder, params=params)
+
+
+def test_a_throw_on_the_other_side_of_the_shaft_runs_in_its_own_axes():
+    """``cylinder_angle = 180 deg`` with contact and ideal throws: a throw's equations run in
+    its own axes (its crank angle there the shaft's plus phase minus 180 deg), its weight along
+    its own +y (``g`` negated, as the link family's: tests/test_shaking.py checks the mirror).
+    Without weight a contact throw at phase 180 deg turned 180 deg is the unturned one at
+    phase 0, to the bit (the same values in its own axes); with weight its packed ``g`` is
+    negated; an ideal throw turned beside a contact throw is the link family's turned throw
+    (both throws ideal, `MachineModel`) to the bit, its joint forces (where the weight acts)
+    included. A quarter revolution, crank prescribed."""
+    from recipdyn.model.assembler.model import MachineModel
+
+    kw = dict(revolutions=0.25, fs=20000.0, rtol=RTOL)
+    first = _placed("throw1", "contact", 0.0, 0.0, g=0.0)
+    a = _simulate(model=_machine(first, _placed("throw2", "contact", math.pi, math.pi, g=0.0)),
+                  **kw)  # fmt: skip
+    b = _simulate(model=_machine(first, _placed("throw2", "contact", 0.0, 0.0, g=0.0)), **kw)
+    for k in ("ex", "ey", "x", "joint_force_x", "joint_force_y"):
+        np.testing.assert_array_equal(a[f"throw2.{k}"].values, b[f"throw2.{k}"].values, k)
+    m = _machine(_placed("throw1", "contact", 0.0, 0.0),
+                 _placed("throw2", "contact", math.pi, math.pi))  # fmt: skip
+    assert [v["g"] for v in m.contact(m.parameters()).locals] == [9.81, -9.81]
+    turned = _placed("throw2", "ideal", math.pi, math.pi)
+    m = _machine(_placed("throw1", "contact", 0.0, 0.0), turned)
+    link = MachineModel(replace(m.machine, name="link",
+                                throws=(_placed("throw1", "ideal", 0.0, 0.0), turned)))  # fmt: skip
+    assert type(link).__name__ == "MachineModel"
+    c, d = _simulate(model=m, **kw), _simulate(model=link, **kw)
+    assert np.abs(d["throw2.joint_force_y"].values).max() > 1e3
+    for k in ("theta1", "x", "a", "joint_force_x", "joint_force_y", "crank_torque"):
+        np.testing.assert_array_equal(c[f"throw2.{k}"].values, d[f"throw2.{k}"].values, k)
 
 
 def test_the_massless_link_beside_a_contact_throw_is_refused_in_one_line():

@@ -169,9 +169,6 @@ def refusal(machine: Machine) -> str | None:
                     f"{t.crank_joint!r} is not modelled yet on a machine; allowed: "
                     f"{', '.join(map(repr, LOADS))} (one throw: --model compressor-contact "
                     "or compressor-contact-valves)")  # fmt: skip
-        if t.cylinder_angle:
-            return (f"{where}: {t.name}.cylinder_angle = 180 deg with crank_joint = "
-                    f"{t.crank_joint!r} is not modelled yet; allowed: 0")  # fmt: skip
     return None
 
 
@@ -306,11 +303,7 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
             v.update(motor=throw_law(machine).name, motor_torque=0.0)
     if "load" in names:
         v["load"] = throw.load
-    try:
-        out = model.parameters(v)
-    except ParameterError as exc:  # with the throw's namespace: ``throw2.rc = ...``
-        part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
-        raise ParameterError(f"{machine.prefix(part)}{exc}") from None
+    out = _validated(machine, throw, model, v)
     worn = throw.crank_joint != "ideal"  # (an ideal crank pin's rod turns with its crank)
     if shared(machine) and worn and not out["J1"] + out["m1"] * out["rs"] ** 2 > 0.0:
         raise ParameterError(
@@ -415,11 +408,23 @@ def throw_link_values(machine: Machine, throw: Throw, local: Mapping[str, Any], 
         v["J_drive"] = 0.0
     if held(machine):
         v.update(motor=throw_law(machine).name, motor_torque=0.0)
+    return _validated(machine, throw, model, v)
+
+
+def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict[str, Any]:
+    """``v`` validated by the throw's one-throw ``model``, refused with the throw's namespace
+    (``throw2.rc = ...``). A throw on the other side of the shaft (``cylinder_angle`` 180
+    deg) has its weight along its own +y: its ``g`` negated (`.assemble.throw_values`),
+    checked as the user gave it and kept negated."""
+    g = float(v.get("g", 0.0))
     try:
-        return model.parameters(v)
+        out = model.parameters({**v, "g": -g} if g < 0.0 else v)
     except ParameterError as exc:
         part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
         raise ParameterError(f"{machine.prefix(part)}{exc}") from None
+    if g < 0.0:
+        out["g"] = g
+    return out
 
 
 def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None
