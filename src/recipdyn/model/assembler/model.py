@@ -926,10 +926,11 @@ class ContactMachine(MachineModel):
             pre = c.machine.prefix(th.name)
             out.update({pre + k: s for k, s in own.items()})
         if shared(c.machine):
-            out.update(_shared_crank(c, values, t, y, out))
+            crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
                 for k in ("alpha1", "motor_torque", "W_motor", "omega1"):  # (the shaft's now)
                     out.pop(q + k, None)
+            out.update(crank)
         elif not c.machine.flat and c.machine.shaft.drive == "motor":  # (one throw, named)
             pre, phase = c.machine.prefix(c.machine.throws[0].name), self.throws(values)[0]["phase"]
             out["theta1"] = Signal(out[pre + "theta1"].values - float(phase), "rad",
