@@ -167,10 +167,14 @@ def _shaft(y, p, out):
     num = tm
     den = p[SHAFT]
     for k in range(N_THROWS):
-        s, o = THROW_STATE[k], THROW_PARAMS[k]
-        ic = _inertia(y, p, k)[0]
-        num += ic * out[s + THROW_CRANK[k] + 1] - torque(w, p, o + THROW_TORQUE[k])
+        s, o, c = THROW_STATE[k], THROW_PARAMS[k], THROW_CRANK[k]
+        share = _inertia(y, p, k)
+        ic = share[0]
+        num += ic * out[s + c + 1] - torque(w, p, o + THROW_TORQUE[k])
         den += ic
+        if _is_link(k):  # its share held in its crank's rate and work slots until below
+            out[s + c] = ic
+            out[s + c + 2] = share[1]
     if HELD:  # the rotor's torque is the one that holds its speed: the throws' sum's opposite
         tm = -num
         alpha = 0.0
@@ -178,7 +182,11 @@ def _shaft(y, p, out):
         alpha = num / den
     for k in range(N_THROWS):
         s, o, c = THROW_STATE[k], THROW_PARAMS[k], THROW_CRANK[k]
-        share = _inertia(y, p, k)
+        if _is_link(k):  # (its share, held above; its crank's rate back: the speed)
+            share = (out[s + c], out[s + c + 2], 0.0, 0.0)
+            out[s + c] = y[s + c + 1]
+        else:
+            share = _inertia(y, p, k)
         ic = share[0]
         da = alpha - out[s + c + 1]
         _correct(y, p, out, k, share, da)
