@@ -37,12 +37,21 @@ turns with the crank: the Schur complement of its mass matrix,
 
 A throw's ``crosshead_joint`` and ``guide`` (structure keys of the machine's description)
 choose the rest of its joints: a worn crosshead pin, the guide's clearance (the family's
-whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. Not yet (refused in
-one line): the held motor, a flexible shaft, a load
-of a user's file or a table, a frame, an interstage volume, a throw on the other side of the
-shaft (``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and
-throws of different families in one machine
-(`recipdyn.model.assembler.assemble.family_of`).
+whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. A held rotor
+(``motor = held``, a rigid shaft) turns the crank at alpha = 0, each throw's module on a
+constant torque of 0 (`throw_law`). A throw on the other side of the shaft (``cylinder_angle``
+180 deg) runs in its own axes with its ``g`` negated (`_validated`).
+
+Throws with ideal pins (``crank_joint = ideal``, the massless link's family) join such a
+machine as a throw of another kind (`is_contact` false): each one is its one-throw model of the
+massless link at rc = 0 (given by the caller, ``link(throw)``: ``--model compressor`` or
+``compressor-valves``), its values `throw_link_values`, its slices that model's vector and
+state, its kernels that model's generated module, which the template calls on the throw's
+views by its kind (``THROW_KIND``; docs/architecture.md, "A throw of another kind").
+
+Not yet (refused in one line, `refusal`): a flexible shaft, a load of a user's file or a
+table, a frame, an interstage volume, contact throws whose joints' configurations differ
+(`same_joints`), and the massless link (rc > 0) beside contact throws.
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is

@@ -54,6 +54,19 @@ other accelerations fall by ``k = M_rr^-1 m_r0`` per unit of the crank's
 torque on its crank, ``T_k = T + I_k (alpha - alpha_k)``; the motor's work is the last state,
 ``W_MOTOR``. The Jacobian: fourth-order central differences of the whole right-hand side, the
 steps ``1e-5 max(|y_i|, s_i)``, the scales ``s_i`` in the parameter vector at ``SCALE``.
+A held rotor (``HELD``): the crank's acceleration 0, the motor's torque ``-sum_k tau_k``.
+
+Throws of another kind (``HAS_LINK``; ``THROW_KIND[k]`` 1): an ideal throw is its one-throw
+module of the massless link (template `prescribed` or `motor`, rc = 0), whose ``rhs``,
+``jac``, ``event`` and ``reset`` are bound as ``link_rhs``, ... and called on the throw's
+views as a contact throw's are (its events: its load's, ``LINK_EVENTS``, or none). Its crank
+angle's offset in its slice and its torque law's are ``THROW_CRANK[k]`` and
+``THROW_TORQUE[k]`` (a contact throw's: its module's ``M``, ``MO``). With a motor its module
+turns its own crank at ``alpha_k = (T + Q) / I`` (its drive's inertia 0), ``link_share`` (the
+motor template's ``share``) gives its ``(I, k)``, and the crank's composition treats it as a
+contact throw: ``tau_k = I alpha_k - T``, its clearance angle's acceleration moved by ``-k
+(alpha - alpha_k)``. Without ideal throws the ``link_*`` roles are bound to ``absent`` in
+branches on ``HAS_LINK`` that numba removes.
 """
 
 import math
