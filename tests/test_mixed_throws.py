@@ -165,6 +165,22 @@ def test_a_held_rotor_turns_contact_throws_as_the_prescribed_speed_does(kinds):
     assert np.abs(cranks - tm).max() <= 1e-9 * np.abs(tm).max()
 
 
+def test_one_contact_throw_on_a_held_rotor_is_the_prescribed_throw():
+    """A machine of one contact throw on a held rotor (flat names, as ``--model
+    compressor-contact``'s): the speed constant to the bit, the pin and the crosshead the
+    prescribed throw's within 10 times its error estimate, a quarter revolution; the motor's
+    torque is the throw's crank torque (the shaft's equation at alpha 0, one term)."""
+    m = _motor_machine(_throw("throw1"), motor="held")
+    kw = dict(revolutions=0.25, fs=20000.0)
+    ds = _simulate(model=m, params=m.parameters(), rtol=RTOL, **kw)
+    assert np.all(ds["omega1"].values == OMEGA) and ds.sizes["impact_event"] >= 2
+    _, _, run, ref = _one(0.0, **kw)
+    for k in ("ex", "ey", "x"):
+        err = np.abs(ds[k].values - ref[k].values).max()
+        assert err <= _bound(run, ref, k), (k, err, _bound(run, ref, k))
+    np.testing.assert_array_equal(ds["motor_torque"].values, ds["crank_torque"].values)
+
+
 def _placed(name, joint, phase, cylinder, g=None):
     params = (("load_amplitude", LOAD), ("phase", phase), *((("g", g),) if g is not None else ()))
     return Throw(name, crank_joint=joint, cylinder_angle=cylinder, params=params)
