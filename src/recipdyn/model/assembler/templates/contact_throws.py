@@ -30,13 +30,13 @@ the other throws' onsets in a minimum.
 
 With a motor (``MOTOR``) each throw's module is its joints' configuration with the crank free
 (template `contact`, the crank's angle, speed and work the last three states of its slice at
-``THROW_M``: its own angle, the shaft's plus its phase, and the shaft's speed). A machine of
+``THROW_CRANK[k]``: its own angle, the shaft's plus its phase, and the shaft's speed). A machine of
 one throw is then the one-throw module itself. With several (``SHARED``) each throw's slice
 holds its own crank's inertia (``J1 + m1 rs^2``, at ``THROW_CO``, the drive's left out) and
 the throws share the crank's acceleration: with a worn crank pin the crank and the rod are
 bodies apart, joined by the pin's force, which depends on the states only, so the throw's
 crank equation ``I_k alpha_k = T + tau_k`` (its module's, at the torque ``T`` of its torque
-law's slice ``THROW_MO``) gives the torque ``tau_k = I_k alpha_k - T`` the rod, the joint and
+law's slice ``THROW_TORQUE[k]``) gives the torque ``tau_k = I_k alpha_k - T`` the rod, the joint and
 the crank's weight put on its crank, and the crank turns as
 
     alpha = (T_m + sum_k tau_k) / (J_drive + sum_k I_k)
