@@ -10,21 +10,22 @@ and two healthy blind records of 4 revolutions were named ``sticking_valve`` at 
 0.99, above that class's threshold 0.957. The threshold did not transfer because the record
 was not of the length it was measured on.
 
-So a record holding at least two whole windows of the data set's length is scored **on its
-windows**: consecutive, non-overlapping stretches of that many whole revolutions (from the
-first whole revolution), each read and classified as a record of the data set. The answer
-is the class of the windows' mean probabilities (`scores`), and the class is named only
-where **every** window's probability of it reaches the class's threshold: the gate reads
+So a record holding at least two windows of the data set's length is scored **on its
+windows**: stretches of that many whole revolutions, one revolution apart (a record of W
+whole revolutions holds W - L + 1 windows of L), each read and classified as a record of
+the data set. The answer is the class of the windows' mean probabilities (`scores`), and
+the class is named only where **every** window's probability of it reaches the class's threshold: the gate reads
 the lowest of them (`WindowScores.gate_p`). Why the lowest: each window is a record of
 the length the threshold was measured on, so the probability that a wrong class clears it
 in every window is at most the probability that it clears it in one, which is what the
-held-out table measured (the windows of one record are not independent, so no more than
-that is claimed). Averaging the windows alone would not bound it: a class whose wrong
-answers have a mean probability above the threshold would clear it more often on average.
+held-out table measured (the windows of one record are not independent, and they
+overlap, so no more than that is claimed). Averaging the windows alone would not bound it:
+a class whose wrong answers have a mean probability above the threshold would clear it
+more often on average.
 
-A record of fewer than two windows is scored whole (it is of the data set's length or
-barely longer). Everything else the diagnosis reads (the chain, the domain, the physics
-consistency, the severity) is read on the whole record.
+A record of fewer than two windows (fewer than L + 1 whole revolutions) is scored whole:
+it is of the data set's length. Everything else the diagnosis reads (the chain, the
+domain, the physics consistency, the severity) is read on the whole record.
 """
 
 from __future__ import annotations
@@ -36,19 +37,23 @@ import numpy as np
 
 __all__ = ["window_slices", "WindowScores", "scores", "WINDOWS_MIN"]
 
-#: The fewest whole windows of the data set's length a record must hold to be scored by
-#: windows (one window is the record itself).
+#: The fewest windows of the data set's length a record must hold to be scored by windows
+#: (one window is the record itself).
 WINDOWS_MIN = 2
 
 
 def window_slices(revs, revolutions: float) -> list[slice]:
-    """Consecutive, non-overlapping sample ranges of ``revolutions`` whole revolutions each.
+    """Sample ranges of ``revolutions`` whole revolutions each, one revolution apart.
 
-    ``revs``: the crank angle in revolutions at each sample (finite, increasing). The first
-    window starts at the first whole revolution; each runs from the sample nearest its first
-    revolution's start to the sample nearest its last one's end (that sample is the next
-    window's first), so that the features count its revolutions whole. Empty if fewer than
-    `WINDOWS_MIN` windows fit, or ``revolutions`` is not a positive whole number.
+    ``revs``: the crank angle in revolutions at each sample (finite, increasing). The whole
+    revolutions are those the features count (`recipdyn.diagnosis.evidence._whole_revs`:
+    from the first whole revolution, a sample or two short still covering one); a record of
+    W of them holds W - ``revolutions`` + 1 windows, the i-th starting at the i-th whole
+    revolution (so a record that the crank-angle correction moved by a degree, and that
+    holds one whole revolution fewer than its tacho pulses, keeps its windows). Each runs
+    from the sample nearest its first revolution's start to the sample nearest its last
+    one's end. Empty if fewer than `WINDOWS_MIN` windows fit, or ``revolutions`` is not a
+    positive whole number.
     """
     r = np.asarray(revs, float)
     L = float(revolutions)
@@ -58,12 +63,12 @@ def window_slices(revs, revolutions: float) -> list[slice]:
     tol = 2.0 * step  # a sample or two short still covers a revolution (as the features)
     start = math.ceil(r[0] - tol)
     whole = math.floor(r[-1] + tol) - start
-    k = int(whole // L)
+    k = int(whole - L) + 1
     if k < WINDOWS_MIN:
         return []
     out = []
     for i in range(k):
-        a, b = start + i * L, start + (i + 1) * L
+        a, b = start + i, start + i + L
         # from the sample nearest the window's first revolution to the one nearest its end
         i0 = int(np.searchsorted(r, a - step / 2))
         i1 = min(int(np.searchsorted(r, b - step / 2)) + 1, r.size)
