@@ -313,6 +313,11 @@ def test_a_long_record_is_named_only_where_each_window_of_the_data_sets_length_w
     win = res.evidence["windows"]
     assert win["revolutions"] == 2 and win["n"] >= 2
     assert res.probabilities["healthy"] == pytest.approx(np.mean(win["p"]))
+    from recipdyn.app.diagnosis import evidence_rows  # the answer and the page say so
+
+    assert f"scored on {win['n']} windows of 2 revolutions" in res.text()
+    shown = dict((r[0], r[1]) for r in evidence_rows(res.evidence))
+    assert shown["windows of the data set's length"].startswith(f"{win['n']} windows of 2 ")
     edges = tacho_times(s["tacho"], s["fs"])
     cut_p = []
     for i in range(edges.size - 2):  # a little before the first pulse to after the third
