@@ -6,9 +6,8 @@ class's answers at ``p >= t`` holds for records of that length. A longer record 
 classifier surer of its answer, wrong answers included: its features are averaged over more
 revolutions, so they lie further inside whichever class's region they fall in. A held-out
 healthy record answered ``sticking_valve`` at p 0.60 over 2 revolutions gave 0.96 over 4,
-and two healthy blind records of 4 revolutions were named ``sticking_valve`` at p 0.98 and
-0.99, above that class's threshold 0.957. The threshold did not transfer because the record
-was not of the length it was measured on.
+above that class's threshold 0.957: the threshold does not transfer to a record that is not
+of the length it was measured on (a user's record of 10 revolutions, say).
 
 So a record holding at least two windows of the data set's length is scored **on its
 windows**: stretches of that many whole revolutions, one revolution apart (a record of W
