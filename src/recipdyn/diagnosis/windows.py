@@ -13,14 +13,14 @@ So a record holding at least two windows of the data set's length is scored **on
 windows**: stretches of that many whole revolutions, one revolution apart (a record of W
 whole revolutions holds W - L + 1 windows of L), each read and classified as a record of
 the data set. The answer is the class of the windows' mean probabilities (`scores`), and
-the class is named only where **every** window's probability of it reaches the class's threshold: the gate reads
-the lowest of them (`WindowScores.gate_p`). Why the lowest: each window is a record of
-the length the threshold was measured on, so the probability that a wrong class clears it
-in every window is at most the probability that it clears it in one, which is what the
-held-out table measured (the windows of one record are not independent, and they
-overlap, so no more than that is claimed). Averaging the windows alone would not bound it:
-a class whose wrong answers have a mean probability above the threshold would clear it
-more often on average.
+the class is named only where **every** window's probability of it reaches the class's
+threshold: the gate reads the lowest of them (`WindowScores.gate_p`). Why the lowest: each
+window is a record of the length the threshold was measured on, so the probability that a
+wrong class clears it in every window is at most the probability that it clears it in one,
+which is what the held-out table measured (the windows of one record are not independent,
+and they overlap, so no more than that is claimed). Averaging the windows alone would not
+bound it: a class whose wrong answers have a mean probability above the threshold would
+clear it more often on average.
 
 A record of fewer than two windows (fewer than L + 1 whole revolutions) is scored whole:
 it is of the data set's length. Everything else the diagnosis reads (the chain, the
