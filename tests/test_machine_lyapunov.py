@@ -94,8 +94,13 @@ def test_the_spectrum_of_uncoupled_throws_is_the_union_of_theirs():
                                   k=k, rtol=1e-9, atol=1e-12)  # fmt: skip
         return r.exponents, np.abs(r.exponents - r.history[len(r.history) // 2])
 
-    both, e_both = run(_machine(_throw("throw1", 0.0, 1e-3, "lubricated"),
-                                _throw("throw2", math.pi / 2, 0.5e-3, "lubricated")), k=K)
+    both, e_both = run(
+        _machine(
+            _throw("throw1", 0.0, 1e-3, "lubricated"),
+            _throw("throw2", math.pi / 2, 0.5e-3, "lubricated"),
+        ),
+        k=K,
+    )
     ones = [run(_machine(_throw("throw1", t_phase, rc, "lubricated")))
             for t_phase, rc in ((0.0, 1e-3), (math.pi / 2, 0.5e-3))]  # fmt: skip
     union = np.concatenate([o[0] for o in ones])
