@@ -758,11 +758,17 @@ class ContactMachine(MachineModel):
                 if t.load == "paper"
             },
         }
-        if len(machine.throws) > 1:
+        # (the reason, said when `lyapunov_supported` is False)
+        self.lyapunov_refusal = next(
+            (m.lyapunov_refusal for m in map(_one_model, machine.throws) if m.lyapunov_refusal),
+            "",
+        )
+        if len(machine.throws) > 1 and machine.shaft.drive == "motor":
             self.lyapunov_refusal = (
-                "the recorded approach velocities of all but the last throw sit among the "
-                "degrees of freedom of a machine of several contact throws (Benettin's method "
-                "would count them); one throw: --model compressor-contact"
+                "each throw of a machine of several contact throws on a motor carries its own "
+                "copy of the crank's angle and speed (one degree of freedom, counted once per "
+                "throw: Benettin's method would add a spurious exponent for each); offered "
+                "with drive = 'prescribed' or one throw"
             )
 
     def contact(self, values: Mapping[str, Any]) -> ContactConfiguration:
@@ -796,10 +802,14 @@ class ContactMachine(MachineModel):
         return False
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        """Where every throw's joints have it (`system`: each throw's recorded approach
+        velocities are auxiliary components, its work integrals passive), with a prescribed
+        crank or one throw."""
         machine = self.structure(values)
-        if len(machine.throws) > 1:
+        if len(machine.throws) > 1 and machine.shaft.drive == "motor":
             return False
-        return _one_model(machine.throws[0]).lyapunov_supported(self.contact_values(values)[0])
+        return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
+            machine.throws, self.contact_values(values), strict=True))  # fmt: skip
 
     def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
         return self.contact(values).layout.state.named()
@@ -841,17 +851,19 @@ class ContactMachine(MachineModel):
         if len(c.locals) == 1 and c.machine.shaft.drive == "motor":  # the model's own
             passive, aux = list(own.passive), own.aux
         pre = [c.machine.prefix(t.name) for t in c.machine.throws]
-        mixed = any(not is_contact(t) for t in c.machine.throws)
-        if shared(c.machine) or mixed:  # every throw's recorded values by index
-            recorded = set(counters)
-            for q, v, t in zip(pre, c.locals, c.machine.throws, strict=True):
-                if is_contact(t):  # its approach velocities (the damping law's)
-                    recorded |= {st[q + n] for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
-                                 if i not in RIGID[v["clearance_joints"]]}  # fmt: skip
-            aux, aux_states = tuple(sorted(recorded)), 0
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
             aux_states = 1
+        if len(c.locals) > 1:  # every throw's recorded values by index (Lyapunov's aux)
+            recorded = set(counters)
+            for t, v in zip(c.machine.throws, c.locals, strict=True):
+                if is_contact(t):  # its one-throw model's: approach velocities, counters
+                    s = st.start(f"{t.name}.mechanism")
+                    one = own if v is c.locals[first] else _one_model(t).system(v)
+                    recorded |= {s + i for i in (*range(one.dim - one.aux_states, one.dim),
+                                                 *one.aux)}  # fmt: skip
+            aux = tuple(sorted(recorded - set(passive)))
+            aux_states = 1 if shared(c.machine) else 0
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
