@@ -55,13 +55,17 @@ def _simulate(**kw):
 
 @pytest.mark.parametrize("selectors,route,own", ROUTES, ids=[r[1] for r in ROUTES])
 def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
-    """The model delegates: the same compiled kernels on the same parameter vector, so every
-    recorded variable and the number of right-hand-side calls equal the implementation's
-    exactly (no tolerance: the arithmetic is the same)."""
+    """The model delegates to the machine of one throw the assembler builds, and a contact
+    route's machine (`OneContact`: the assembled layout and parameter vector) runs what its
+    joints' configuration (the model class the old name reached, now its part) runs: the same
+    compiled kernels on the same parameter vector, so every recorded variable and the number
+    of right-hand-side calls equal exactly (no tolerance: the arithmetic is the same)."""
     m = get_model("compressor")
     values = m.parameters(selectors)
     assert m.route(values)[0] == route
-    impl = family.implementation(route)
+    impl = family.machine(route)
+    assert m.route(values)[1] is impl
+    impl = getattr(impl, "part", impl)  # (the contact routes: the old class, a part now)
     assert np.array_equal(m.system(values).params, impl.system(impl.parameters(own)).params)
     kw = dict(revolutions=0.25, fs=2000.0)
     a = _simulate(model=m, params=selectors, **kw)
@@ -91,6 +95,7 @@ def test_presets_keep_the_values_and_sweep_digests_of_the_old_names(name):
 
     preset = get_model(name)
     impl = preset.route(family.PRESETS[name])[1]
+    impl = getattr(impl, "part", impl)  # (a contact route: its joints' configuration)
     assert preset.parameters() == impl.parameters()
     assert preset.schema is impl.schema and preset.state_names == impl.state_names
     axis = parse_axis("omega=19:21:2", name)

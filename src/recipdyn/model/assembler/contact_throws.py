@@ -69,8 +69,8 @@ if TYPE_CHECKING:
     from ..protocol import Param
 
 __all__ = ["ContactConfiguration", "assemble_contact", "contact_configuration",
-           "contact_throw_params", "one_model", "refusal", "throw_contact_values", "joints_key",
-           "same_joints", "LOADS"]  # fmt: skip
+           "contact_throw_params", "one_model", "joints_part", "one_throw_configuration",
+           "refusal", "throw_contact_values", "joints_key", "same_joints", "LOADS"]  # fmt: skip
 
 #: The loads a contact throw of a machine takes today.
 LOADS = ("paper", "cycle", "valves")
@@ -85,6 +85,12 @@ def one_model(throw: Throw):
     """The one-throw model of a contact throw: ``compressor-contact``'s, or with the dynamic
     valves ``compressor-contact-valves``'s."""
     return _models()[throw.load == "valves"]
+
+
+def joints_part(valves: bool = False):
+    """The joints' configuration part of a contact throw (its schema, checks, packing,
+    states, kernels module, signals and summary): with the dynamic valves or without."""
+    return _models()[bool(valves)]
 
 
 @lru_cache(maxsize=1)
@@ -404,3 +410,19 @@ def contact_configuration(machine: Machine, items: tuple) -> ContactConfiguratio
     locals_ = [throw_contact_values(machine, t, v)
                for t, v in zip(machine.throws, own, strict=True)]  # fmt: skip
     return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)))
+
+
+def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:
+    """A machine of one contact throw at its validated one-throw values ``local`` (the
+    compressor's names: the family's routes ``contact`` and ``contact-valves``), assembled
+    without validating them again (remembered per values)."""
+    items = tuple(sorted(local.items()))
+    try:
+        return _one_throw_configuration(machine, items)
+    except TypeError:  # an unhashable value (a table as lists): assembled each time
+        return assemble_contact(machine, [dict(local)])
+
+
+@lru_cache(maxsize=32)
+def _one_throw_configuration(machine: Machine, items: tuple) -> ContactConfiguration:
+    return assemble_contact(machine, [dict(items)])
