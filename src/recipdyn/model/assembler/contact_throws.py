@@ -367,7 +367,8 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
     from ..components.contact_model import pack
 
     models = [one_model(t) for t in machine.throws]
-    same_joints(machine, locals_)
+    if len(locals_) > 1:  # (one throw: nothing to compare)
+        same_joints(machine, locals_)
     modules = [m.kernels(v) for m, v in zip(models, locals_, strict=True)]
     assert all(m is modules[0] for m in modules), "joints_key misses a choice of the module"
     pv, sv = SlicesBuilder(), SlicesBuilder()
