@@ -78,6 +78,34 @@ def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
     assert a.attrs["vibration_signal"] == impl.vibration()[0]
 
 
+@pytest.mark.parametrize("selectors,route", [(r[0], r[1]) for r in ROUTES],
+                         ids=[f"{r[1]}-{i}" for i, r in enumerate(ROUTES)])  # fmt: skip
+def test_every_route_is_a_machine_of_the_one_assembler(selectors, route):
+    """Every configuration is a machine of one throw built by the assembler (issue 43: one
+    path): ``family`` holds no table of implementations, only `family.ASSEMBLER`, and a
+    contact route's system is its assembled configuration's (the throw's slice of the state
+    and of the parameter vector from `contact_throws.one_throw_configuration`), the same
+    module as a machine file's throw (its kernels the throw's module). Nothing integrates."""
+    from recipdyn.model.assembler.model import ContactMachine, MachineModel
+
+    assert not hasattr(family, "ROUTES") and not hasattr(family, "implementation")
+    m = get_model("compressor")
+    values = m.parameters(selectors)
+    name, machine, _ = m.route(values)
+    assert name == route and isinstance(machine, MachineModel)
+    assert set(family.ROUTE_NAMES) == {"link", "link-valves", "contact", "contact-valves"}
+    if not route.startswith("contact"):
+        return
+    assert isinstance(machine, ContactMachine)
+    own = {k: v for k, v in values.items() if k in machine.schema.names}
+    c = machine.contact(own)
+    s = machine.system(own)
+    assert len(c.machine.throws) == 1 and c.machine.flat
+    assert s.params is c.params and s.state_names == c.layout.state.names
+    assert s.rhs is c.throw_module.rhs and s.jac is c.throw_module.jac
+    assert c.layout.params.parts["throw1"] == slice(0, c.params.size)
+
+
 #: The presets whose implementation is the one their old name reached (compressor-guide's was
 #: a kernel of its own, now the reference model compressor-guide-reference: the preset runs
 #: the contact joints' kernels with the guide's clearance, `test_compressor_guide_is_the_..`).
