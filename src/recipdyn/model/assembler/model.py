@@ -548,14 +548,16 @@ class MachineModel(Model):
         return out
 
     # -- outputs -------------------------------------------------------------------------
-    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
-                ) -> dict[str, Signal]:  # fmt: skip
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray,
+                dy: np.ndarray | None = None) -> dict[str, Signal]:  # fmt: skip
         """Per throw: its crosshead's motion, rod angle, clearance state, gas force, joint and
         guide forces, and its cylinder's signals (the cycle's pressures and volumes; the
         valves' pressures, volumes, temperatures and mass flows), under its name; with a motor
         the crank's speed and acceleration, the motor's torque and work, each throw's gas work
         and the machine's energy. The crank angle, speed and gas forces come from the
-        compiled observer: the functions that were integrated."""
+        compiled observer: the functions that were integrated. ``dy``: the derivatives at
+        ``y`` when they are not this model's own (a throw's slice of a machine whose crank
+        other throws share, `ContactMachine`); by default its right-hand side's."""
         from .. import valves as va
         from ..base import Signal, rhs_series
         from ..components.load import cycle_outputs
@@ -565,7 +567,8 @@ class MachineModel(Model):
         st, ov = c.layout.state, c.layout.outputs
         t = np.ascontiguousarray(t, dtype=np.float64)
         y = np.ascontiguousarray(y, dtype=np.float64)
-        dy = rhs_series(c.kernels.rhs, c.params, t, y)
+        if dy is None:
+            dy = rhs_series(c.kernels.rhs, c.params, t, y)
         obs = c.kernels.observe(t, y, c.params)
         w1 = obs[:, ov["omega1"]]
         motor = c.motor is not None
@@ -736,14 +739,22 @@ class ContactMachine(MachineModel):
             f"{len(machine.throws)} throws on one crankshaft ({machine.shaft.drive} drive), "
             "contact-impact pins"
         )
+        from .contact_throws import is_contact
+
         pre = [machine.prefix(t.name) for t in machine.throws]
-        self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
-            ("ex", "m"), ("ey", "m"), ("x", "m"), ("v", "m/s"), ("a", "m/s**2")))  # fmt: skip
+        worn = [q for q, t in zip(pre, machine.throws, strict=True) if is_contact(t)]
+        self.section_signals = tuple((f"{q}{s}", u) for q, t in zip(pre, machine.throws,
+                                                                     strict=True)
+                                     for s, u in (*((("ex", "m"), ("ey", "m")) if is_contact(t)
+                                                    else (("theta_c", "rad"),
+                                                          ("thetadot_c", "rad/s"))),
+                                                  ("x", "m"), ("v", "m/s"),
+                                                  ("a", "m/s**2")))  # fmt: skip
         self.validity_bounds = ()
         self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
-        self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in pre)
+        self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in worn)
         self.max_signals = tuple((f"{q}eccentricity_ratio", f"{q}max_eccentricity_ratio", "1")
-                                 for q in pre)  # fmt: skip
+                                 for q in worn)  # fmt: skip
         self.event_example = {
             "shaft.omega" if not machine.flat else "omega": 150.0,
             **{
@@ -764,7 +775,8 @@ class ContactMachine(MachineModel):
         `.contact_throws.contact_configuration`)."""
         from .contact_throws import contact_configuration
 
-        return contact_configuration(self.structure(values), tuple(sorted(values.items())))
+        return contact_configuration(self.structure(values), tuple(sorted(values.items())),
+                                     _one_model)  # fmt: skip
 
     def contact_values(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
         """Each throw's values as the one-throw contact model takes them."""
@@ -773,10 +785,12 @@ class ContactMachine(MachineModel):
     # -- what MachineModel does for the massless link ----------------------------------
     def check(self, values: Mapping[str, Any]) -> None:
         """Each throw's checks (its one-throw model's), refused with its namespace."""
-        from .contact_throws import same_joints, throw_contact_values
+        from .contact_throws import is_contact, same_joints, throw_contact_values
+        from .contact_throws import throw_link_values as link
 
         machine = self.structure(values)
-        locals_ = [throw_contact_values(machine, t, v)
+        locals_ = [throw_contact_values(machine, t, v) if is_contact(t)
+                   else link(machine, t, v, _one_model(t))
                    for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
         same_joints(machine, locals_)
 
@@ -811,24 +825,38 @@ class ContactMachine(MachineModel):
 
     def system(self, values: Mapping[str, Any]) -> AssembledSystem:
         from ..joints.pins import I_WIN, I_WLOSS, RIGID
-        from .contact_throws import shared
+        from .contact_throws import is_contact, shared
         from .system import AssembledSystem, Frozen
 
         c = self.contact(values)
         st = c.layout.state
-        passive, aux = [], ()
+        passive, aux, counters = [], (), []
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             s = st.start(f"{t.name}.mechanism")
+            if not is_contact(t):  # an ideal throw: its one-throw configuration's
+                own_c = _one_model(t).configuration(v)
+                passive += [s + i for i in own_c.passive([v])]
+                n = st.parts[f"{t.name}.mechanism"].stop - s
+                counters += range(s + n - own_c.aux_states, s + n)
+                continue
             passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
-        own = _one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
+        first = next(k for k, t in enumerate(c.machine.throws) if is_contact(t))
+        own = _one_model(c.machine.throws[first]).system(c.locals[first])  # (its aux states)
+        aux_states = own.aux_states
         if len(c.locals) == 1 and c.machine.shaft.drive == "motor":  # the model's own
             passive, aux = list(own.passive), own.aux
+        pre = [c.machine.prefix(t.name) for t in c.machine.throws]
+        mixed = any(not is_contact(t) for t in c.machine.throws)
+        if shared(c.machine) or mixed:  # every throw's recorded values by index
+            recorded = set(counters)
+            for q, v, t in zip(pre, c.locals, c.machine.throws, strict=True):
+                if is_contact(t):  # its approach velocities (the damping law's)
+                    recorded |= {st[q + n] for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
+                                 if i not in RIGID[v["clearance_joints"]]}  # fmt: skip
+            aux, aux_states = tuple(sorted(recorded)), 0
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
-            pre = [c.machine.prefix(t.name) for t in c.machine.throws]
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
-            aux = tuple(sorted(st[q + n] for q, v in zip(pre, c.locals, strict=True)
-                               for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
-                               if i not in RIGID[v["clearance_joints"]]))  # fmt: skip
+            aux_states = 1
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -841,7 +869,7 @@ class ContactMachine(MachineModel):
             name=self.system_name(values),
             attrs=self.system_attrs(values),
             events=self.events(values),
-            aux_states=1 if shared(c.machine) else own.aux_states,
+            aux_states=aux_states,
             aux=aux,
             passive=tuple(sorted(passive)),
             model=self,
@@ -852,12 +880,14 @@ class ContactMachine(MachineModel):
         """Each throw's one-throw initial state (the pin along its rod load at its own crank
         angle, `CompressorContact.initial_state`); with several throws each recorded approach
         velocity carries its pin's phase (+ in contact, - in free flight)."""
+        from .contact_throws import is_contact
+
         c = self.contact(values)
         parts = []
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             model = _one_model(t)
             y = model.initial_state(v)
-            if len(c.locals) > 1 and not model.tracks_separations(v):
+            if is_contact(t) and len(c.locals) > 1 and not model.tracks_separations(v):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
@@ -878,22 +908,34 @@ class ContactMachine(MachineModel):
                 ) -> dict[str, Signal]:  # fmt: skip
         """Each throw's signals, the one-throw contact model's of its states (its crank angle
         its own: the shaft's plus its phase), under its name; the shaft's crank angle."""
-        from ..base import Signal
-        from .contact_throws import shared
+        from ..base import Signal, rhs_series
+        from .contact_throws import is_contact, shared
 
         c = self.contact(values)
         y = np.asarray(y, dtype=np.float64)
         out: dict[str, Signal] = {}
+        dy = None
+        if shared(c.machine) and c.link_module is not None:  # (the shaft's acceleration)
+            dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
-            own = _one_model(th).outputs(v, t, np.ascontiguousarray(y[:, part]))
+            yk = np.ascontiguousarray(y[:, part])
+            if is_contact(th):
+                own = _one_model(th).outputs(v, t, yk)
+            else:  # an ideal throw: its one-throw model's, at the shaft's acceleration
+                own = _one_model(th).outputs(v, t, yk, None if dy is None else dy[:, part])
+                own.setdefault("theta1", Signal(
+                    yk[:, 2] if "theta1" in dict(_one_model(th).states(v)) else
+                    float(v["theta1_0"]) + float(v["omega"]) * np.asarray(t, dtype=float),
+                    "rad", "crank angle of this throw (the shaft's + phase)"))  # fmt: skip
             pre = c.machine.prefix(th.name)
             out.update({pre + k: s for k, s in own.items()})
         if shared(c.machine):
-            out.update(_shared_crank(c, values, t, y, out))
+            crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
                 for k in ("alpha1", "motor_torque", "W_motor", "omega1"):  # (the shaft's now)
                     out.pop(q + k, None)
+            out.update(crank)
         elif not c.machine.flat and c.machine.shaft.drive == "motor":  # (one throw, named)
             pre, phase = c.machine.prefix(c.machine.throws[0].name), self.throws(values)[0]["phase"]
             out["theta1"] = Signal(out[pre + "theta1"].values - float(phase), "rad",
@@ -907,6 +949,8 @@ class ContactMachine(MachineModel):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """Each throw's figures (`CompressorContact.run_summary` of its signals and of the
         events at which its own pin changed phase), under its name."""
+        from .contact_throws import is_contact
+
         c = self.contact(values)
         if c.machine.flat:
             return _one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
@@ -918,12 +962,22 @@ class ContactMachine(MachineModel):
             for k in map(str, ds.data_vars):
                 if k.startswith(pre):
                     rename[k] = k[len(pre) :]
-                elif k.startswith(ev):
-                    rename[k] = "impact_" + k[len(ev) :]
+                elif k.startswith(ev):  # (its crank's work under its one-throw name)
+                    own = k[len(ev) :]
+                    rename[k] = "impact_" + _ONE_THROW_NAMES.get(own, own)
             view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
+            if not is_contact(th):  # an ideal throw: its cylinder's figures and its rod load
+                own = MachineModel._throw_summary({**v, "load": th.load}, view)
+                if "api618_pin_reversal" not in own and {"theta1", "a", "gas_force"} <= set(view):
+                    from ..cycle import pin_reversal_summary
+
+                    own.update(pin_reversal_summary(v, view))
+                out.update({pre + k: val for k, val in own.items()})
+                continue
             if "impact_time" in view:  # its own events: where its reset moved its states
                 part = c.layout.state.parts[f"{th.name}.mechanism"]
                 names = [n[len(pre) :] for n in c.layout.state.names[part]]
+                names = [_ONE_THROW_NAMES.get(n, n) for n in names]
                 moved = np.column_stack(
                     [view[f"impact_{n}"].values != view[f"impact_{n}_after"].values for n in names]
                 )
@@ -935,21 +989,36 @@ class ContactMachine(MachineModel):
         return out
 
 
+#: A throw's state in a machine whose crank several throws share, by its name in the
+#: one-throw model (`.contact_throws`: the shaft's work on its crank, there the motor's).
+_ONE_THROW_NAMES = {"W_crank": "W_motor", "W_crank_after": "W_motor_after"}
+
+
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
     """The machine's energy balance over the record, ``W_motor + sum_k W_gas,k = dE + sum_k
     W_loss,k``: its largest residual over the largest of the energy and the motor's work."""
     pre = [c.machine.prefix(th.name) for th in c.machine.throws]
     E, Wm = ds["energy"].values, ds["W_motor"].values
     Wg = sum(ds[q + "W_gas"].values for q in pre)
-    Wl = sum(ds[q + "W_loss"].values for q in pre)
+    Wl = sum(ds[q + "W_loss"].values for q in pre if q + "W_loss" in ds)  # (ideal: none)
     bal = (Wm - Wm[0]) + (Wg - Wg[0]) - (E - E[0]) - (Wl - Wl[0])
     return float(np.abs(bal).max() / max(np.abs(E).max(), np.abs(Wm).max(), 1e-300))
 
 
 def _one_model(throw: Throw):
-    from .contact_throws import one_model
+    """A throw's one-throw model: the contact joints' (`.contact_throws.one_model`), or for
+    an ideal throw beside them the massless link's (``--model compressor``, with the dynamic
+    valves ``compressor-valves``)."""
+    from .contact_throws import is_contact, one_model
 
-    return one_model(throw)
+    if is_contact(throw):
+        return one_model(throw)
+    return _link_valves_model() if throw.load == "valves" else LINK
+
+
+@lru_cache(maxsize=1)
+def _link_valves_model() -> OneThrow:
+    return _link_valves()
 
 
 def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndarray,
