@@ -78,8 +78,8 @@ if TYPE_CHECKING:
     from ..protocol import Param
 
 __all__ = ["ContactConfiguration", "assemble_contact", "contact_configuration",
-           "contact_throw_params", "one_model", "refusal", "throw_contact_values", "joints_key",
-           "same_joints", "LOADS"]  # fmt: skip
+           "contact_throw_params", "one_model", "joints_part", "one_throw_configuration",
+           "refusal", "throw_contact_values", "joints_key", "same_joints", "LOADS"]  # fmt: skip
 
 #: The loads a contact throw of a machine takes today.
 LOADS = ("paper", "cycle", "valves")
@@ -94,6 +94,12 @@ def one_model(throw: Throw):
     """The one-throw model of a contact throw: ``compressor-contact``'s, or with the dynamic
     valves ``compressor-contact-valves``'s."""
     return _models()[throw.load == "valves"]
+
+
+def joints_part(valves: bool = False):
+    """The joints' configuration part of a contact throw (its schema, checks, packing,
+    states, kernels module, signals and summary): with the dynamic valves or without."""
+    return _models()[bool(valves)]
 
 
 @lru_cache(maxsize=1)
@@ -445,7 +451,8 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
     values ``locals_``' entry, `throw_link_values`)."""
     from ..components.contact_model import pack
 
-    same_joints(machine, locals_)
+    if len(locals_) > 1:  # (one throw: nothing to compare)
+        same_joints(machine, locals_)
     pv, sv = SlicesBuilder(), SlicesBuilder()
     chunks, scales, modules, links = [], [], [], []
     crank = _CRANK_STATES if shared(machine) else {}
@@ -502,3 +509,19 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
                else throw_link_values(machine, t, v, link(t))
                for t, v in zip(machine.throws, own, strict=True)]  # fmt: skip
     return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link)
+
+
+def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:
+    """A machine of one contact throw at its validated one-throw values ``local`` (the
+    compressor's names: the family's routes ``contact`` and ``contact-valves``), assembled
+    without validating them again (remembered per values)."""
+    items = tuple(sorted(local.items()))
+    try:
+        return _one_throw_configuration(machine, items)
+    except TypeError:  # an unhashable value (a table as lists): assembled each time
+        return assemble_contact(machine, [dict(local)])
+
+
+@lru_cache(maxsize=32)
+def _one_throw_configuration(machine: Machine, items: tuple) -> ContactConfiguration:
+    return assemble_contact(machine, [dict(items)])

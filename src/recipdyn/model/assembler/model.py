@@ -68,7 +68,12 @@ __all__ = [
     "ContactMachine",
     "OneThrow",
     "LINK",
+    "OneContact",
+    "ONE_THROW",
+    "one_throw",
     "LINK_VALVES",  # noqa: F822 (built on first use, __getattr__)
+    "CONTACT",  # noqa: F822
+    "CONTACT_VALVES",  # noqa: F822
     "VALVES_SCHEMA",  # noqa: F822
     "machine_schema",
     "compressor_model",
@@ -1434,11 +1439,180 @@ def _link_valves() -> OneThrow:
     )
 
 
+class OneContact(ContactMachine):
+    """The compressor of one throw with contact-impact or lubricated pins or the guide's
+    clearance, as ``--model compressor`` takes it (routes ``contact`` and ``contact-valves``
+    of `recipdyn.model.family`; the presets ``compressor-contact``,
+    ``compressor-contact-valves``, ``compressor-guide``): the machine of one contact throw
+    its selectors choose (``crank_joint``, ``crosshead_joint``, ``guide``, ``load``,
+    ``drive``, ``motor``), under the compressor's names, so every record, config and sweep
+    store made before still runs with the same values.
+
+    Its system is the assembler's (`.contact_throws.one_throw_configuration`: the throw's
+    slice of the parameter vector and of the state, the kernels of its joints'
+    configuration, template ``contact``); with one throw the template ``contact_throws``
+    calls those kernels on the whole vector and adds nothing, so the machine's kernels are
+    the throw's module itself (no second module to compile: tests/test_contact_throws.py
+    checks a machine file of one throw through ``contact_throws`` against this, to the bit).
+    What a throw's values mean (schema, checks, packing, states, signals, summary, events)
+    is its joints' configuration part (`.contact_throws.joints_part`), as for every throw of
+    a `ContactMachine`."""
+
+    def __init__(self, valves: bool = False) -> None:
+        from .contact_throws import joints_part
+
+        part = joints_part(valves)
+        self.part = part
+        self.valves = valves
+        self.machine = Machine(name=part.name, description=part.description)
+        self.name, self.description, self.schema = part.name, part.description, part.schema
+        for k in ("state_names", "state_units", "section_signals", "vibration_signal",
+                  "section_pair", "summary_verdicts", "event_example", "mean_signals",
+                  "max_signals", "lyapunov_refusal", "validity_bounds"):  # fmt: skip
+            setattr(self, k, getattr(part, k))
+
+    # the declarations are the part's (class values of the contact joints: no assembly)
+    state_names = ()  # type: ignore[assignment]
+    state_units = ()  # type: ignore[assignment]
+
+    def structure(self, values: Mapping[str, Any]) -> Machine:
+        """The machine of one throw at ``values`` (its pins, guide, load and drive)."""
+        from ..components.contact_model import joint_types
+
+        crank, cross = joint_types(values)
+        load = "valves" if self.valves else values.get("load", "paper")
+        throw = Throw(crank_joint=crank, crosshead_joint=cross,
+                      guide=values.get("guide", "ideal"),
+                      load=load if isinstance(load, str) else "paper")  # fmt: skip
+        shaft = Shaft(drive=values.get("drive", "prescribed"),
+                      motor=values.get("motor", "induction"))  # fmt: skip
+        return _one_throw(self.name, self.description, throw, shaft)
+
+    def contact(self, values: Mapping[str, Any]) -> ContactConfiguration:
+        """The machine of one throw assembled at validated ``values``."""
+        from .contact_throws import one_throw_configuration
+
+        return one_throw_configuration(self.structure(values), values)
+
+    def throws(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
+        return [{**values, "phase": 0.0}]
+
+    # -- the system: the assembler's ---------------------------------------------------
+    def system(self, values: Mapping[str, Any]) -> AssembledSystem:
+        """The assembled machine's parameter vector, state layout and kernels; the tangent
+        space's declarations (auxiliary and passive states) the joints' configuration's."""
+        from .system import AssembledSystem, Frozen
+
+        c = self.contact(values)
+        k = c.throw_module  # (one throw: the machine's kernels, class docstring)
+        own = self.part.tangent(values)
+        names, units = zip(*c.layout.state.named(), strict=True)
+        return AssembledSystem(
+            rhs=k.rhs,
+            jac=k.jac,
+            rhs_jac=own["rhs_jac"] and k.rhs_jac,
+            params=c.params,
+            state_names=names,
+            state_units=units,
+            period=own["period"],
+            name=self.name,
+            events=self.events(values),
+            aux_states=own["aux_states"],
+            aux=own["aux"],
+            passive=own["passive"],
+            model=self,
+            values=Frozen(values),
+        )
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        return self.part.events(values)
+
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        return self.part.states(values)
+
+    # -- what a throw's values mean: its joints' configuration part ---------------------
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        return self.part.schema_for(values)
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        return self.part.parameters(values, **kw)
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        self.part.check(values)
+
+    def period(self, values: Mapping[str, Any]) -> float:
+        return self.part.period(values)
+
+    def section_angle(self, values: Mapping[str, Any]) -> str | None:
+        return self.part.section_angle(values)
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        return self.part.has_dynamics(values)
+
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        return self.part.validity_applies(values)
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        return self.part.lyapunov_supported(values)
+
+    def identity_values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return self.part.identity_values(values)
+
+    def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
+        return self.part.law_range(values, ds)
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        return self.part.initial_state(values)
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        return self.part.state_scale(values)
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        return self.part.outputs(values, t, y)
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        return self.part.run_summary(values, ds)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        return self.part.record_attrs(values, y0)
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        return self.part.values_from_record(attrs)
+
+    # -- what the joints' kernels offer beyond the protocol ---------------------------
+    def kernels(self, values: Mapping[str, Any]):
+        """The compiled kernels at validated ``values`` (the throw's module)."""
+        return self.contact(values).throw_module
+
+    def load_part(self, values: Mapping[str, Any]):
+        return self.part.load_part(values)
+
+    def tracks_separations(self, values: Mapping[str, Any]) -> bool:
+        return self.part.tracks_separations(values)
+
+
+#: The compressor of one throw by route (`recipdyn.model.family.route`: which machine the
+#: selectors describe): every configuration of ``--model compressor`` is one of these.
+ONE_THROW = {"link": "LINK", "link-valves": "LINK_VALVES", "contact": "CONTACT",
+             "contact-valves": "CONTACT_VALVES"}  # fmt: skip
+
+
+def one_throw(route: str) -> MachineModel:
+    """The machine of one throw of route ``route`` (`ONE_THROW`; built when first asked
+    for)."""
+    name = ONE_THROW[route]
+    return globals()[name] if name in globals() else __getattr__(name)
+
+
 def __getattr__(name: str):
     if name == "VALVES_SCHEMA":
         return _valves_schema()
-    if name == "LINK_VALVES":
-        globals()[name] = _link_valves()
+    if name in ("LINK_VALVES", "CONTACT", "CONTACT_VALVES"):
+        globals()[name] = (_link_valves() if name == "LINK_VALVES"
+                           else OneContact(valves=name == "CONTACT_VALVES"))  # fmt: skip
         return globals()[name]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
