@@ -97,15 +97,16 @@ _SELECTORS = ("load", "drive", "motor", "equations")
 _CYCLE_GROUP = "cycle"
 
 
-def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
+def _throw_params(throw: Throw, shaft: Shaft, frame: bool = False) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
     adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
-    throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
+    throw with contact joints, theirs (`.contact_throws.contact_throw_params`; on a
+    ``frame`` its crank's ``rs``, ``m1`` too)."""
     if throw_family(throw) == "contact":
         from .contact_throws import contact_throw_params
 
-        return contact_throw_params(throw, shaft)
+        return contact_throw_params(throw, shaft, frame)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -180,7 +181,7 @@ def machine_schema(machine: Machine) -> Schema:
                        for p in INTERSTAGE_PARAMS]  # fmt: skip
     for t in machine.throws:
         given = t.values
-        own = _throw_params(t, machine.shaft)
+        own = _throw_params(t, machine.shaft, machine.frame is not None)
         known = {p.name for p in own} | {"load_table"}
         for k in given:
             if k not in known:
@@ -618,8 +619,11 @@ class MachineModel(Model):
                                        "phase - cylinder_angle)")  # fmt: skip
                 own.update(_shaking(p, kin, fg, wk, ak, th, shake))
             if frame is not None:
+                from ..mechanism.shaking import throw_shaking
+
                 own.update(frame.at_guide(th, own["a"].values))
-                frame.throws.append((p, own["frame_a"].values, kin, wk, ak))
+                frame.throws.append((p.m1 + p.m2 + p.m3, own["frame_a"].values,
+                                     throw_shaking(p, kin, wk, ak)[0]))  # fmt: skip
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -745,7 +749,9 @@ class ContactMachine(MachineModel):
                                                           ("thetadot_c", "rad/s"))),
                                                   ("x", "m"), ("v", "m/s"),
                                                   ("a", "m/s**2")))  # fmt: skip
-        self.validity_bounds = ()
+        # on a frame its one-way coupling's bound (MachineModel's), no link's
+        self.validity_bounds = tuple(b for b in self.validity_bounds
+                                     if b[0] == "frame_coupling_margin")  # fmt: skip
         self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
         self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in worn)
         self.max_signals = tuple((f"{q}eccentricity_ratio", f"{q}max_eccentricity_ratio", "1")
@@ -793,11 +799,12 @@ class ContactMachine(MachineModel):
         return True
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        return False
+        """The frame's one-way coupling (a machine with a frame); nothing else."""
+        return self.structure(values).frame is not None
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         machine = self.structure(values)
-        if len(machine.throws) > 1:
+        if len(machine.throws) > 1 or machine.frame is not None:
             return False
         return _one_model(machine.throws[0]).lyapunov_supported(self.contact_values(values)[0])
 
@@ -852,6 +859,9 @@ class ContactMachine(MachineModel):
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
             aux_states = 1
+        if c.machine.frame is not None:  # its states and work integrals (one-way: passive)
+            for part in ("frame", "frame.work"):
+                passive += range(*st.parts[part].indices(st.size))
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -888,6 +898,8 @@ class ContactMachine(MachineModel):
             parts.append(y)
         if "shaft.work" in c.layout.state.parts:  # the motor's work, the machine's last state
             parts.append(np.zeros(1))
+        if c.machine.frame is not None:  # the frame at rest on its mounts, its works 0
+            parts.append(np.zeros(8))
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -897,6 +909,8 @@ class ContactMachine(MachineModel):
                for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
         if "shaft.work" in c.layout.state.parts:
             own.append(np.ones(1))
+        if c.machine.frame is not None:  # (its displacements at their own size: microns)
+            own.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
         return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
@@ -910,8 +924,11 @@ class ContactMachine(MachineModel):
         y = np.asarray(y, dtype=np.float64)
         out: dict[str, Signal] = {}
         dy = None
-        if shared(c.machine) and c.link_module is not None:  # (the shaft's acceleration)
+        frame = None
+        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None:
             dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
+        if c.machine.frame is not None:
+            frame = _FrameRecord(c, values, y, dy)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
             yk = np.ascontiguousarray(y[:, part])
@@ -924,7 +941,19 @@ class ContactMachine(MachineModel):
                     float(v["theta1_0"]) + float(v["omega"]) * np.asarray(t, dtype=float),
                     "rad", "crank angle of this throw (the shaft's + phase)"))  # fmt: skip
             pre = c.machine.prefix(th.name)
+            if frame is not None:  # its accelerometer: its crosshead's + the frame's
+                own.update(frame.at_guide(th, own["a"].values))
+                own.update(_contact_shaking(c, th, v, t, y, dy))
+                frame.throws.append((float(v["m1"]) + float(v["m2"]) + float(v["m3"]),
+                                     own["frame_a"].values, own["_fx"].values))  # fmt: skip
+                del own["_fx"]
             out.update({pre + k: s for k, s in own.items()})
+        if frame is not None:
+            names = [c.machine.prefix(th.name) for th in c.machine.throws]
+            out["shake_x"] = Signal(sum(out[q + "shake_x"].values for q in names), "N",
+                                    "shaking force on the frame along x: the sum over the "
+                                    "throws of -(m1 a1 + m2 a2 + m3 a3)")  # fmt: skip
+            out.update(frame.signals())
         if shared(c.machine):
             crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
@@ -947,9 +976,11 @@ class ContactMachine(MachineModel):
         from .contact_throws import is_contact
 
         c = self.contact(values)
-        if c.machine.flat:
-            return _one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
         out: dict[str, Any] = {}
+        if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
+            out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
+        if c.machine.flat:
+            return {**_one_model(c.machine.throws[0]).run_summary(c.locals[0], ds), **out}
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             pre = f"{th.name}."
             ev = f"impact_{pre}"
@@ -982,6 +1013,41 @@ class ContactMachine(MachineModel):
         if "W_motor" in ds.data_vars and "shaft.work" in c.layout.state.parts:
             out["energy_balance_residual"] = _energy_residual(c, ds)
         return out
+
+
+def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, Any],
+                     t: np.ndarray, y: np.ndarray, dy: np.ndarray) -> dict[str, Signal]:  # fmt: skip
+    """A contact throw's shaking force on the frame (the compiled
+    `recipdyn.model.joints.pins.contact_shaking` the frame's equations read, at each sample)
+    in the frame's axes (``shake_x``) and in its own along its stroke (``_fx``, for the
+    frame's feedback)."""
+    from ..base import Signal
+    from ..frame.body import _cos_sin
+    from ..joints.pins import contact_shaking
+
+    st = c.layout.state
+    part = st.parts[f"{throw.name}.mechanism"]
+    o = c.layout.params.parts[throw.name]
+    pk = c.params[o]
+    m1rs = float(local["m1"]) * float(local["rs"])
+    t = np.asarray(t, dtype=np.float64)
+    w0 = float(local["omega"])
+    fx = np.empty(t.shape[0])
+    fy = np.empty(t.shape[0])
+    motor = c.machine.shaft.drive == "motor"
+    crank = int(c.throw_module.M)
+    for i in range(t.shape[0]):
+        yk, dk = y[i, part], dy[i, part]
+        if motor:
+            th, w, a = yk[crank], yk[crank + 1], dk[crank + 1]
+        else:
+            th, w, a = float(local["theta1_0"]) + w0 * t[i], w0, 0.0
+        fx[i], fy[i] = contact_shaking(th, w, a, yk, dk, pk, m1rs)
+    cs, sn = _cos_sin(throw.cylinder_angle)
+    gx = cs * fx - sn * fy
+    return {"shake_x": Signal(gx, "N", "this throw's shaking force on the frame along the "
+                              "frame's x: -(m1 a1 + m2 a2 + m3 a3)"),
+            "_fx": Signal(fx, "N", "")}  # fmt: skip
 
 
 #: A throw's state in a machine whose crank several throws share, by its name in the
@@ -1144,15 +1210,13 @@ class _FrameRecord:
         ``(m1 + m2 + m3) |a_f|`` over the throw's largest shaking force along its stroke)."""
         from ..base import Signal
         from ..frame.body import FEEDBACK_LIMIT, energy
-        from ..mechanism.shaking import throw_shaking
 
         mounts = -(self.q @ self.K.T + self.qd @ self.C.T)
         feedback = np.zeros(self.q.shape[0])
-        for p, fa, kin, w1, a1 in self.throws:
-            fx, _ = throw_shaking(p, kin, w1, a1)
+        for mass, fa, fx in self.throws:  # (each throw's moving mass, frame_a, shaking F_x)
             top = float(np.max(np.abs(fx)))
             if top > 0.0:
-                feedback = np.maximum(feedback, (p.m1 + p.m2 + p.m3) * np.abs(fa) / top)
+                feedback = np.maximum(feedback, mass * np.abs(fa) / top)
         return {
             "frame_energy": Signal(energy(self.M, self.K, self.q, self.qd), "J", "the frame's "
                                    "kinetic energy + its mounts' strain energy"),
