@@ -1016,7 +1016,8 @@ class ContactMachine(MachineModel):
 
 
 def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, Any],
-                     t: np.ndarray, y: np.ndarray, dy: np.ndarray) -> dict[str, Signal]:  # fmt: skip
+                     t: np.ndarray, y: np.ndarray, dy: np.ndarray
+                     ) -> dict[str, Signal]:  # fmt: skip
     """A contact throw's shaking force on the frame (the compiled
     `recipdyn.model.joints.pins.contact_shaking` the frame's equations read, at each sample)
     in the frame's axes (``shake_x``) and in its own along its stroke (``_fx``, for the
