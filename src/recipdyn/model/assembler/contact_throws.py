@@ -161,12 +161,9 @@ def refusal(machine: Machine) -> str | None:
                 "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
     if machine.frame is not None:
         for t in machine.throws:
-            if not is_contact(t) or t.guide == "clearance":
-                what = (f"{t.name}.guide = 'clearance'" if is_contact(t)
-                        else f"{t.name}.crank_joint = {t.crank_joint!r}")  # fmt: skip
-                return (f"{where}: a [frame] with {what} beside contact pins is not modelled "
-                        "yet; allowed on a frame: throws with contact or lubricated pins and "
-                        "ideal guides, or throws of the massless link's family alone")  # fmt: skip
+            if t.guide == "clearance":
+                return (f"{where}: a [frame] with {t.name}.guide = 'clearance' is not modelled "
+                        "yet; allowed on a frame: ideal guides (guide = 'ideal')")  # fmt: skip
     if machine.interstages:
         return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
                 "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
@@ -234,8 +231,11 @@ class ContactConfiguration:
             law = throw_law(self.machine)
             roles["torque"] = (law.module, law.kernel("torque"))
         link = self.link_module
-        for r in ("rhs", "jac", "event", "reset", "share"):
+        frame = self.machine.frame is not None
+        for r in ("rhs", "jac", "event", "reset", "share", "crank"):
             on = link is not None and (r != "share" or shared(self.machine))
+            if r == "crank":  # (an ideal throw's crank angle on a frame, the crank prescribed)
+                on = link is not None and frame and not motor
             roles[f"link_{r}"] = (link.__name__, r) if on else absent
         kinds = [0 if is_contact(t) else 1 for t in throws]
         first = kinds.index(0)  # (a contact throw: the machine's family)
@@ -244,7 +244,6 @@ class ContactConfiguration:
         crank = {0: int(m.M), 1: int(getattr(link, "CRANK", 0))}
         torque_at = {0: int(m.MO), 1: int(getattr(link, "MOTOR", 0))}
         end = slices[-1].stop
-        frame = self.machine.frame is not None
         constants = {
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
             "FRAME": frame,
@@ -256,6 +255,9 @@ class ContactConfiguration:
             "HAS_LINK": link is not None,
             "HELD": held(self.machine),
             "LINK_EVENTS": self.link_events,
+            "LINK_MECH": int(link.THROW_MECH[0]) if link is not None else 0,
+            "LINK_PHASE": int(link.THROW_PHASE[0]) if link is not None else 0,
+            "LINK_SHAFT": int(getattr(link, "SHAFT", 0)),
             "MOTOR": motor,
             "N_THROWS": len(throws),
             "OWN_EVENT": len(throws) == 1 or phased,

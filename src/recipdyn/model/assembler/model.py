@@ -1018,13 +1018,15 @@ class ContactMachine(MachineModel):
 def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, Any],
                      t: np.ndarray, y: np.ndarray, dy: np.ndarray
                      ) -> dict[str, Signal]:  # fmt: skip
-    """A contact throw's shaking force on the frame (the compiled
-    `recipdyn.model.joints.pins.contact_shaking` the frame's equations read, at each sample)
-    in the frame's axes (``shake_x``) and in its own along its stroke (``_fx``, for the
-    frame's feedback)."""
+    """A throw's shaking force on the frame (the compiled function the frame's equations read,
+    at each sample: a contact throw's `recipdyn.model.joints.pins.contact_shaking`, an ideal
+    throw's `recipdyn.model.mechanism.link_kernels.shaking`) in the frame's axes
+    (``shake_x``) and in its own along its stroke (``_fx``, for the frame's feedback)."""
     from ..base import Signal
     from ..frame.body import _cos_sin
     from ..joints.pins import contact_shaking
+    from ..mechanism.link_kernels import shaking
+    from .contact_throws import is_contact
 
     st = c.layout.state
     part = st.parts[f"{throw.name}.mechanism"]
@@ -1036,14 +1038,19 @@ def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, 
     fx = np.empty(t.shape[0])
     fy = np.empty(t.shape[0])
     motor = c.machine.shaft.drive == "motor"
-    crank = int(c.throw_module.M)
+    link = None if is_contact(throw) else c.link_module
+    crank = int(c.throw_module.M if link is None else getattr(link, "CRANK", 0))
     for i in range(t.shape[0]):
         yk, dk = y[i, part], dy[i, part]
         if motor:
             th, w, a = yk[crank], yk[crank + 1], dk[crank + 1]
         else:
             th, w, a = float(local["theta1_0"]) + w0 * t[i], w0, 0.0
-        fx[i], fy[i] = contact_shaking(th, w, a, yk, dk, pk, m1rs)
+        if link is None:
+            fx[i], fy[i] = contact_shaking(th, w, a, yk, dk, pk, m1rs)
+        else:
+            fx[i], fy[i] = shaking(th + pk[int(link.THROW_PHASE[0])], yk[0], w, yk[1], a,
+                                   dk[1], pk, int(link.THROW_MECH[0]))  # fmt: skip
     cs, sn = _cos_sin(throw.cylinder_angle)
     gx = cs * fx - sn * fy
     return {"shake_x": Signal(gx, "N", "this throw's shaking force on the frame along the "

@@ -97,9 +97,11 @@ from recipdyn.model.joints.pins import (
     contact_shaking,
     ideal_share,
 )
+from recipdyn.model.mechanism.link_kernels import shaking as link_shaking
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as link_crank
 from recipdyn.model.assembler.generate import absent as link_event
 from recipdyn.model.assembler.generate import absent as link_jac
 from recipdyn.model.assembler.generate import absent as link_reset
@@ -121,6 +123,9 @@ HAS_GUIDE = False
 HAS_LINK = False
 HELD = False
 LINK_EVENTS = False
+LINK_MECH = np.int64(0)
+LINK_PHASE = np.int64(0)
+LINK_SHAFT = np.int64(0)
 MOTOR = False
 N_THROWS = np.int64(1)
 OWN_EVENT = True
@@ -263,17 +268,36 @@ def _frame(t, y, p, out):
     for k in range(N_THROWS):
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
         pk = p[o : o + m]
-        if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
-            c = THROW_CRANK[k]
-            th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
+        if _is_link(k):
+            fx, fy = _link_shaking(t, y[s : s + n], pk, out[s : s + n], THROW_CRANK[k])
         else:
-            w = pk[P_OMEGA]
-            th, a = pk[P_TH10] + w * t, 0.0
-        fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk, p[FRAME_CRANKS + k])
+            if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
+                c = THROW_CRANK[k]
+                th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
+            else:
+                w = pk[P_OMEGA]
+                th, a = pk[P_TH10] + w * t, 0.0
+            fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                     p[FRAME_CRANKS + k])  # fmt: skip
         gx, gpsi = throw_load(k, fx, fy, p, FRAME_PARAMS)
         qx += gx
         qpsi += gpsi
     frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
+
+
+@nb.njit(cache=True)
+def _link_shaking(t, y, p, out, c):
+    """An ideal throw's shaking force in its own axes (`recipdyn.model.mechanism.link_kernels`
+    ``shaking``) on its views: its crank's angle its module's (``link_crank`` at its drive's
+    slice ``LINK_SHAFT``, or with a motor its slice's at ``c``) plus its module's phase (at
+    ``LINK_PHASE``), its clearance angle's states and acceleration (``out[1]``, at the
+    shaft's acceleration), its mechanism's slice at ``LINK_MECH``."""
+    if MOTOR:
+        th, w, a = y[c], y[c + 1], out[c + 1]
+    else:
+        th, w = link_crank(t, y, p, LINK_SHAFT)
+        a = 0.0
+    return link_shaking(th + p[LINK_PHASE], y[0], w, y[1], a, out[1], p, LINK_MECH)
 
 
 @compiled(RHS_SIGNATURE)
