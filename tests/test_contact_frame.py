@@ -169,6 +169,8 @@ def test_the_frames_load_is_the_bearing_and_guide_reactions_of_the_contact_force
     assert np.max(ds["frame.W_damping"].values) > 0.0
     np.testing.assert_allclose(e - e[0], w, atol=1e-6 * top)
     assert 0.0 < model.run_summary(v, ds)["frame_feedback_ratio"] < 0.05
+    assert [b[0] for b in model.validity_bounds] == ["frame_coupling_margin"]
+    assert ds.attrs["validity"] == "ok"
 
 
 def test_two_identical_contact_throws_balanced_opposed_leave_the_frame_still_in_translation():

@@ -268,15 +268,19 @@ def _frame(t, y, p, out):
     for k in range(N_THROWS):
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
         pk = p[o : o + m]
-        if _is_link(k):
-            fx, fy = _link_shaking(t, y[s : s + n], pk, out[s : s + n], THROW_CRANK[k])
+        if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
+            c = THROW_CRANK[k]
+            th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
         else:
-            if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
-                c = THROW_CRANK[k]
-                th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
+            w = pk[P_OMEGA]
+            th, a = pk[P_TH10] + w * t, 0.0
+        if HAS_LINK:  # (pruned without ideal throws: their roles are absent then)
+            if THROW_KIND[k] == 1:
+                fx, fy = _link_shaking(t, y[s : s + n], pk, out[s : s + n], THROW_CRANK[k])
             else:
-                w = pk[P_OMEGA]
-                th, a = pk[P_TH10] + w * t, 0.0
+                fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                         p[FRAME_CRANKS + k])  # fmt: skip
+        else:
             fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
                                      p[FRAME_CRANKS + k])  # fmt: skip
         gx, gpsi = throw_load(k, fx, fy, p, FRAME_PARAMS)
