@@ -116,23 +116,22 @@ def _models():
 _CRANK = ("rs", "m1", "J1")
 
 
-def contact_throw_params(throw: Throw, shaft: Shaft | None = None) -> tuple[Param, ...]:
+def contact_throw_params(throw: Throw, shaft: Shaft | None = None, frame: bool = False
+                         ) -> tuple[Param, ...]:  # fmt: skip
     """A contact throw's parameters under their local names (its one-throw model's,
     without the shaft's, the stage's and the structure's; the cycle's with ``load = cycle``
     or ``valves`` only, the paper load's with ``load = paper`` only; with a motor its
-    crank's ``rs``, ``m1``, ``J1``), with its ``phase``."""
+    crank's ``rs``, ``m1``, ``J1``; on a ``frame`` its crank's ``rs``, ``m1``: its rotating
+    unbalance shakes the frame), with its ``phase``."""
     from ..components.guide import GUIDE_PARAMS
 
     motor = shaft is not None and shaft.drive == "motor"
-    skip = {*SHAFT_NAMES, *STAGE_NAMES, *(n for n in _STRUCTURE if not (motor and n in _CRANK))}
+    crank = _CRANK if motor else (("rs", "m1") if frame else ())
+    skip = {*SHAFT_NAMES, *STAGE_NAMES, *(n for n in _STRUCTURE if n not in crank)}
     if throw.guide != "clearance":
         skip |= {p.name for p in GUIDE_PARAMS}
     schema = one_model(throw).schema
-    out = [
-        p
-        for p in schema
-        if p.name not in skip and (p.group != "drive" or (motor and p.name in _CRANK))
-    ]
+    out = [p for p in schema if p.name not in skip and (p.group != "drive" or p.name in crank)]
     if throw.crank_joint == "ideal":
         out = [p for p in out if p.name not in ("rc", "K", "journal_radius", "e0_angle")]
     if throw.crosshead_joint == "ideal":
@@ -167,9 +166,10 @@ def refusal(machine: Machine) -> str | None:
                 "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
                 "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
     if machine.frame is not None:
-        return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
-                "and guides")  # fmt: skip
+        for t in machine.throws:
+            if t.guide == "clearance":
+                return (f"{where}: a [frame] with {t.name}.guide = 'clearance' is not modelled "
+                        "yet; allowed on a frame: ideal guides (guide = 'ideal')")  # fmt: skip
     if machine.interstages:
         return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
                 "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
@@ -237,8 +237,11 @@ class ContactConfiguration:
             law = throw_law(self.machine)
             roles["torque"] = (law.module, law.kernel("torque"))
         link = self.link_module
-        for r in ("rhs", "jac", "event", "reset", "share"):
+        frame = self.machine.frame is not None
+        for r in ("rhs", "jac", "event", "reset", "share", "crank"):
             on = link is not None and (r != "share" or shared(self.machine))
+            if r == "crank":  # (an ideal throw's crank angle on a frame, the crank prescribed)
+                on = link is not None and frame and not motor
             roles[f"link_{r}"] = (link.__name__, r) if on else absent
         kinds = [0 if is_contact(t) else 1 for t in throws]
         first = kinds.index(0)  # (a contact throw: the machine's family)
@@ -249,10 +252,18 @@ class ContactConfiguration:
         end = slices[-1].stop
         constants = {
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
+            "FRAME": frame,
+            "FRAME_CRANKS": pv.start("frame.cranks") if frame else 0,
+            "FRAME_PARAMS": pv.start("frame") if frame else 0,
+            "FRAME_STATE": st.start("frame") if frame else 0,
+            "FRAME_WORK": st.start("frame.work") if frame else 0,
             "HAS_GUIDE": self.locals[first].get("guide", "ideal") == "clearance",
             "HAS_LINK": link is not None,
             "HELD": held(self.machine),
             "LINK_EVENTS": self.link_events,
+            "LINK_MECH": int(link.THROW_MECH[0]) if link is not None else 0,
+            "LINK_PHASE": int(link.THROW_PHASE[0]) if link is not None else 0,
+            "LINK_SHAFT": int(getattr(link, "SHAFT", 0)),
             "MOTOR": motor,
             "N_THROWS": len(throws),
             "OWN_EVENT": len(throws) == 1 or phased,
@@ -274,6 +285,8 @@ class ContactConfiguration:
             stem += f"_ideal{kinds.count(1)}"
         if motor:
             stem += f"_motor_{self.machine.shaft.motor}".replace("-", "_")
+        if frame:
+            stem += "_frame"
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -442,13 +455,16 @@ def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict
     return out
 
 
-def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None
-                     ) -> ContactConfiguration:  # fmt: skip
+def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None,
+                     frame: Mapping[str, Any] | None = None) -> ContactConfiguration:  # fmt: skip
     """Resolve a machine of contact throws (and ideal ones): each throw's one-throw vector and
     state, one after another (module docstring); with a motor and several throws then the
     drive's slice (its inertia ``J_drive`` and the torque law's) and the machine's work of
     the motor. ``link(throw)``: an ideal throw's one-throw model of the massless link (its
-    values ``locals_``' entry, `throw_link_values`)."""
+    values ``locals_``' entry, `throw_link_values`). On a ``[frame]`` (its values ``frame``,
+    names inside ``frame.``) then the frame's slice (`recipdyn.model.frame.body.pack`), each
+    throw's crank's static moment ``m1 rs`` (part ``frame.cranks``) and the difference steps'
+    scales, and the frame's states and work integrals last."""
     from ..components.contact_model import pack
 
     if len(locals_) > 1:  # (one throw: nothing to compare)
@@ -489,6 +505,20 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
         pv.reserve("shaft", drive.size)
         sv.add("shaft.work", (("W_motor", "J"),))
         scales.append(np.ones(1))
+    if machine.frame is not None:  # (one-way: nothing before it reads it)
+        from ..frame.body import STATES as FRAME_STATES
+        from ..frame.body import WORK as FRAME_WORK
+        from ..frame.body import pack as frame_pack
+
+        chunks.append(frame_pack(machine, frame or {}))
+        pv.reserve("frame", chunks[-1].size)
+        chunks.append(np.array([float(v["m1"]) * float(v["rs"]) for v in locals_]))
+        pv.reserve("frame.cranks", chunks[-1].size)
+        sv.add("frame", ((f"frame.{s}", u) for s, u in FRAME_STATES))
+        sv.add("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK))
+        # the frame's displacements, rates and work integrals: linear in them, any step
+        scales.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
+    if shared(machine) or machine.frame is not None:
         chunks.append(np.concatenate(scales))
         pv.reserve("jacobian", chunks[-1].size)
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
@@ -508,7 +538,12 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
     locals_ = [throw_contact_values(machine, t, v) if is_contact(t)
                else throw_link_values(machine, t, v, link(t))
                for t, v in zip(machine.throws, own, strict=True)]  # fmt: skip
-    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link)
+    frame = None
+    if machine.frame is not None:
+        from .assemble import frame_values
+
+        frame = frame_values(values)
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame)
 
 
 def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:

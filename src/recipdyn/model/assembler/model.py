@@ -102,15 +102,16 @@ _SELECTORS = ("load", "drive", "motor", "equations")
 _CYCLE_GROUP = "cycle"
 
 
-def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
+def _throw_params(throw: Throw, shaft: Shaft, frame: bool = False) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
     adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
-    throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
+    throw with contact joints, theirs (`.contact_throws.contact_throw_params`; on a
+    ``frame`` its crank's ``rs``, ``m1`` too)."""
     if throw_family(throw) == "contact":
         from .contact_throws import contact_throw_params
 
-        return contact_throw_params(throw, shaft)
+        return contact_throw_params(throw, shaft, frame)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -185,7 +186,7 @@ def machine_schema(machine: Machine) -> Schema:
                        for p in INTERSTAGE_PARAMS]  # fmt: skip
     for t in machine.throws:
         given = t.values
-        own = _throw_params(t, machine.shaft)
+        own = _throw_params(t, machine.shaft, machine.frame is not None)
         known = {p.name for p in own} | {"load_table"}
         for k in given:
             if k not in known:
@@ -623,8 +624,11 @@ class MachineModel(Model):
                                        "phase - cylinder_angle)")  # fmt: skip
                 own.update(_shaking(p, kin, fg, wk, ak, th, shake))
             if frame is not None:
+                from ..mechanism.shaking import throw_shaking
+
                 own.update(frame.at_guide(th, own["a"].values))
-                frame.throws.append((p, own["frame_a"].values, kin, wk, ak))
+                frame.throws.append((p.m1 + p.m2 + p.m3, own["frame_a"].values,
+                                     throw_shaking(p, kin, wk, ak)[0]))  # fmt: skip
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -750,7 +754,9 @@ class ContactMachine(MachineModel):
                                                           ("thetadot_c", "rad/s"))),
                                                   ("x", "m"), ("v", "m/s"),
                                                   ("a", "m/s**2")))  # fmt: skip
-        self.validity_bounds = ()
+        # on a frame its one-way coupling's bound (MachineModel's), no link's
+        self.validity_bounds = tuple(b for b in self.validity_bounds
+                                     if b[0] == "frame_coupling_margin")  # fmt: skip
         self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
         self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in worn)
         self.max_signals = tuple((f"{q}eccentricity_ratio", f"{q}max_eccentricity_ratio", "1")
@@ -768,7 +774,13 @@ class ContactMachine(MachineModel):
             (m.lyapunov_refusal for m in map(_one_model, machine.throws) if m.lyapunov_refusal),
             "",
         )
-        if len(machine.throws) > 1 and machine.shaft.drive == "motor":
+        if machine.frame is not None:
+            self.lyapunov_refusal = (
+                "Lyapunov exponents of contact throws on a [frame] are not offered yet (the "
+                "frame's states as passive components are checked for ideal throws only); "
+                "offered without the [frame], or with ideal throws"
+            )
+        elif len(machine.throws) > 1 and machine.shaft.drive == "motor":
             self.lyapunov_refusal = (
                 "each throw of a machine of several contact throws on a motor carries its own "
                 "copy of the crank's angle and speed (one degree of freedom, counted once per "
@@ -804,14 +816,15 @@ class ContactMachine(MachineModel):
         return True
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        return False
+        """The frame's one-way coupling (a machine with a frame); nothing else."""
+        return self.structure(values).frame is not None
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         """Where every throw's joints have it (`system`: each throw's recorded approach
         velocities are auxiliary components, its work integrals passive), with a prescribed
-        crank or one throw."""
+        crank or one throw, and no frame (`lyapunov_refusal`)."""
         machine = self.structure(values)
-        if len(machine.throws) > 1 and machine.shaft.drive == "motor":
+        if machine.frame is not None or (len(machine.throws) > 1 and machine.shaft.drive == "motor"):
             return False
         return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
             machine.throws, self.contact_values(values), strict=True))  # fmt: skip
@@ -859,7 +872,11 @@ class ContactMachine(MachineModel):
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
             aux_states = 1
-        if len(c.locals) > 1:  # every throw's recorded values by index (Lyapunov's aux)
+        if c.machine.frame is not None:  # its states and work integrals (one-way: passive)
+            for part in ("frame", "frame.work"):
+                passive += range(*st.parts[part].indices(st.size))
+        if len(c.locals) > 1 or c.machine.frame is not None:  # every throw's recorded values
+            # by index (Lyapunov's aux); the frame's states, after the throws', passive
             recorded = set(counters)
             for t, v in zip(c.machine.throws, c.locals, strict=True):
                 if is_contact(t):  # its one-throw model's: approach velocities, counters
@@ -868,7 +885,7 @@ class ContactMachine(MachineModel):
                     recorded |= {s + i for i in (*range(one.dim - one.aux_states, one.dim),
                                                  *one.aux)}  # fmt: skip
             aux = tuple(sorted(recorded - set(passive)))
-            aux_states = 1 if shared(c.machine) else 0
+            aux_states = 1 if shared(c.machine) and c.machine.frame is None else 0
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -905,6 +922,8 @@ class ContactMachine(MachineModel):
             parts.append(y)
         if "shaft.work" in c.layout.state.parts:  # the motor's work, the machine's last state
             parts.append(np.zeros(1))
+        if c.machine.frame is not None:  # the frame at rest on its mounts, its works 0
+            parts.append(np.zeros(8))
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -914,6 +933,8 @@ class ContactMachine(MachineModel):
                for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
         if "shaft.work" in c.layout.state.parts:
             own.append(np.ones(1))
+        if c.machine.frame is not None:  # (its displacements at their own size: microns)
+            own.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
         return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
@@ -927,8 +948,11 @@ class ContactMachine(MachineModel):
         y = np.asarray(y, dtype=np.float64)
         out: dict[str, Signal] = {}
         dy = None
-        if shared(c.machine) and c.link_module is not None:  # (the shaft's acceleration)
+        frame = None
+        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None:
             dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
+        if c.machine.frame is not None:
+            frame = _FrameRecord(c, values, y, dy)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
             yk = np.ascontiguousarray(y[:, part])
@@ -941,7 +965,19 @@ class ContactMachine(MachineModel):
                     float(v["theta1_0"]) + float(v["omega"]) * np.asarray(t, dtype=float),
                     "rad", "crank angle of this throw (the shaft's + phase)"))  # fmt: skip
             pre = c.machine.prefix(th.name)
+            if frame is not None:  # its accelerometer: its crosshead's + the frame's
+                own.update(frame.at_guide(th, own["a"].values))
+                own.update(_contact_shaking(c, th, v, t, y, dy))
+                frame.throws.append((float(v["m1"]) + float(v["m2"]) + float(v["m3"]),
+                                     own["frame_a"].values, own["_fx"].values))  # fmt: skip
+                del own["_fx"]
             out.update({pre + k: s for k, s in own.items()})
+        if frame is not None:
+            names = [c.machine.prefix(th.name) for th in c.machine.throws]
+            out["shake_x"] = Signal(sum(out[q + "shake_x"].values for q in names), "N",
+                                    "shaking force on the frame along x: the sum over the "
+                                    "throws of -(m1 a1 + m2 a2 + m3 a3)")  # fmt: skip
+            out.update(frame.signals())
         if shared(c.machine):
             crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
@@ -964,9 +1000,11 @@ class ContactMachine(MachineModel):
         from .contact_throws import is_contact
 
         c = self.contact(values)
-        if c.machine.flat:
-            return _one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
         out: dict[str, Any] = {}
+        if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
+            out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
+        if c.machine.flat:
+            return {**_one_model(c.machine.throws[0]).run_summary(c.locals[0], ds), **out}
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             pre = f"{th.name}."
             ev = f"impact_{pre}"
@@ -999,6 +1037,49 @@ class ContactMachine(MachineModel):
         if "W_motor" in ds.data_vars and "shaft.work" in c.layout.state.parts:
             out["energy_balance_residual"] = _energy_residual(c, ds)
         return out
+
+
+def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, Any],
+                     t: np.ndarray, y: np.ndarray, dy: np.ndarray
+                     ) -> dict[str, Signal]:  # fmt: skip
+    """A throw's shaking force on the frame (the compiled function the frame's equations read,
+    at each sample: a contact throw's `recipdyn.model.joints.pins.contact_shaking`, an ideal
+    throw's `recipdyn.model.mechanism.link_kernels.shaking`) in the frame's axes
+    (``shake_x``) and in its own along its stroke (``_fx``, for the frame's feedback)."""
+    from ..base import Signal
+    from ..frame.body import _cos_sin
+    from ..joints.pins import contact_shaking
+    from ..mechanism.link_kernels import shaking
+    from .contact_throws import is_contact
+
+    st = c.layout.state
+    part = st.parts[f"{throw.name}.mechanism"]
+    o = c.layout.params.parts[throw.name]
+    pk = c.params[o]
+    m1rs = float(local["m1"]) * float(local["rs"])
+    t = np.asarray(t, dtype=np.float64)
+    w0 = float(local["omega"])
+    fx = np.empty(t.shape[0])
+    fy = np.empty(t.shape[0])
+    motor = c.machine.shaft.drive == "motor"
+    link = None if is_contact(throw) else c.link_module
+    crank = int(c.throw_module.M if link is None else getattr(link, "CRANK", 0))
+    for i in range(t.shape[0]):
+        yk, dk = y[i, part], dy[i, part]
+        if motor:
+            th, w, a = yk[crank], yk[crank + 1], dk[crank + 1]
+        else:
+            th, w, a = float(local["theta1_0"]) + w0 * t[i], w0, 0.0
+        if link is None:
+            fx[i], fy[i] = contact_shaking(th, w, a, yk, dk, pk, m1rs)
+        else:
+            fx[i], fy[i] = shaking(th + pk[int(link.THROW_PHASE[0])], yk[0], w, yk[1], a,
+                                   dk[1], pk, int(link.THROW_MECH[0]))  # fmt: skip
+    cs, sn = _cos_sin(throw.cylinder_angle)
+    gx = cs * fx - sn * fy
+    return {"shake_x": Signal(gx, "N", "this throw's shaking force on the frame along the "
+                              "frame's x: -(m1 a1 + m2 a2 + m3 a3)"),
+            "_fx": Signal(fx, "N", "")}  # fmt: skip
 
 
 #: A throw's state in a machine whose crank several throws share, by its name in the
@@ -1161,15 +1242,13 @@ class _FrameRecord:
         ``(m1 + m2 + m3) |a_f|`` over the throw's largest shaking force along its stroke)."""
         from ..base import Signal
         from ..frame.body import FEEDBACK_LIMIT, energy
-        from ..mechanism.shaking import throw_shaking
 
         mounts = -(self.q @ self.K.T + self.qd @ self.C.T)
         feedback = np.zeros(self.q.shape[0])
-        for p, fa, kin, w1, a1 in self.throws:
-            fx, _ = throw_shaking(p, kin, w1, a1)
+        for mass, fa, fx in self.throws:  # (each throw's moving mass, frame_a, shaking F_x)
             top = float(np.max(np.abs(fx)))
             if top > 0.0:
-                feedback = np.maximum(feedback, (p.m1 + p.m2 + p.m3) * np.abs(fa) / top)
+                feedback = np.maximum(feedback, mass * np.abs(fa) / top)
         return {
             "frame_energy": Signal(energy(self.M, self.K, self.q, self.qd), "J", "the frame's "
                                    "kinetic energy + its mounts' strain energy"),

@@ -67,6 +67,16 @@ motor template's ``share``) gives its ``(I, k)``, and the crank's composition tr
 contact throw: ``tau_k = I alpha_k - T``, its clearance angle's acceleration moved by ``-k
 (alpha - alpha_k)``. Without ideal throws the ``link_*`` roles are bound to ``absent`` in
 branches on ``HAS_LINK`` that numba removes.
+
+A frame on its mounts (``FRAME``; `recipdyn.model.frame`): after the throws' derivatives (and
+the shaft's), each contact throw's shaking force from its states and its pins' accelerations
+(`recipdyn.model.joints.pins.contact_shaking`; its crank's angle, speed and acceleration the
+prescribed ones or its slice's; its crank's static moment ``m1 rs`` at ``FRAME_CRANKS + k``)
+is taken by the frame (`recipdyn.model.frame.kernels`: ``throw_load``, ``frame_rhs``; its slice
+``FRAME_PARAMS``, its states ``FRAME_STATE``, its work integrals ``FRAME_WORK``). One-way: no
+throw reads the frame's states, so the throws' Jacobian is unchanged and the frame's rows are
+central differences of the whole right-hand side (`_frame_rows`). Without a frame the
+branches on ``FRAME`` are removed.
 """
 
 import math
@@ -75,10 +85,23 @@ import numba as nb
 import numpy as np
 
 from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, compiled
-from recipdyn.model.joints.pins import G_GUIDE, I_WIN, P_R, _flip, contact_factor, ideal_share
+from recipdyn.model.frame.kernels import frame_rhs, throw_load
+from recipdyn.model.joints.pins import (
+    G_GUIDE,
+    I_WIN,
+    P_OMEGA,
+    P_R,
+    P_TH10,
+    _flip,
+    contact_factor,
+    contact_shaking,
+    ideal_share,
+)
+from recipdyn.model.mechanism.link_kernels import shaking as link_shaking
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as link_crank
 from recipdyn.model.assembler.generate import absent as link_event
 from recipdyn.model.assembler.generate import absent as link_jac
 from recipdyn.model.assembler.generate import absent as link_reset
@@ -91,10 +114,18 @@ from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
+FRAME = False
+FRAME_CRANKS = np.int64(0)
+FRAME_PARAMS = np.int64(0)
+FRAME_STATE = np.int64(0)
+FRAME_WORK = np.int64(0)
 HAS_GUIDE = False
 HAS_LINK = False
 HELD = False
 LINK_EVENTS = False
+LINK_MECH = np.int64(0)
+LINK_PHASE = np.int64(0)
+LINK_SHAFT = np.int64(0)
 MOTOR = False
 N_THROWS = np.int64(1)
 OWN_EVENT = True
@@ -222,6 +253,55 @@ def _rhs(t, y, p, out):
         throw_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
     if SHARED:
         _shaft(y, p, out)
+    if FRAME:
+        _frame(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def _frame(t, y, p, out):
+    """The frame's derivatives: every throw's shaking force (`contact_shaking`, from its
+    states and its pins' accelerations already in ``out``; its crank's static moment at
+    ``FRAME_CRANKS + k``) as generalised forces on the frame (one-way: no throw reads the
+    frame's states)."""
+    qx = 0.0
+    qpsi = 0.0
+    for k in range(N_THROWS):
+        s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        pk = p[o : o + m]
+        if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
+            c = THROW_CRANK[k]
+            th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
+        else:
+            w = pk[P_OMEGA]
+            th, a = pk[P_TH10] + w * t, 0.0
+        if HAS_LINK:  # (pruned without ideal throws: their roles are absent then)
+            if THROW_KIND[k] == 1:
+                fx, fy = _link_shaking(t, y[s : s + n], pk, out[s : s + n], THROW_CRANK[k])
+            else:
+                fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                         p[FRAME_CRANKS + k])  # fmt: skip
+        else:
+            fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                     p[FRAME_CRANKS + k])  # fmt: skip
+        gx, gpsi = throw_load(k, fx, fy, p, FRAME_PARAMS)
+        qx += gx
+        qpsi += gpsi
+    frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
+
+
+@nb.njit(cache=True)
+def _link_shaking(t, y, p, out, c):
+    """An ideal throw's shaking force in its own axes (`recipdyn.model.mechanism.link_kernels`
+    ``shaking``) on its views: its crank's angle its module's (``link_crank`` at its drive's
+    slice ``LINK_SHAFT``, or with a motor its slice's at ``c``) plus its module's phase (at
+    ``LINK_PHASE``), its clearance angle's states and acceleration (``out[1]``, at the
+    shaft's acceleration), its mechanism's slice at ``LINK_MECH``."""
+    if MOTOR:
+        th, w, a = y[c], y[c + 1], out[c + 1]
+    else:
+        th, w = link_crank(t, y, p, LINK_SHAFT)
+        a = 0.0
+    return link_shaking(th + p[LINK_PHASE], y[0], w, y[1], a, out[1], p, LINK_MECH)
 
 
 @compiled(RHS_SIGNATURE)
@@ -269,6 +349,27 @@ def jac(t, y, p, J):
         for i in range(n):
             for j in range(n):
                 J[s + i, s + j] = block[i, j]
+    if FRAME:  # its rows over every column (the throws' rows do not read the frame's states)
+        _frame_rows(t, y, p, J)
+
+
+@nb.njit(cache=True)
+def _frame_rows(t, y, p, J):
+    """The frame's rows (its states and work integrals) by the fourth-order central
+    differences of `_fd_jac` (its steps), the rest of ``J`` left as it is."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    rows = np.concatenate((np.arange(FRAME_STATE, FRAME_STATE + 6),
+                           np.arange(FRAME_WORK, FRAME_WORK + 2)))  # fmt: skip
+    for k in range(n):
+        h = 1e-5 * max(abs(y[k]), p[SCALE + k])
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in rows:
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
 
 
 @nb.njit(cache=True)
