@@ -824,7 +824,8 @@ class ContactMachine(MachineModel):
         velocities are auxiliary components, its work integrals passive), with a prescribed
         crank or one throw, and no frame (`lyapunov_refusal`)."""
         machine = self.structure(values)
-        if machine.frame is not None or (len(machine.throws) > 1 and machine.shaft.drive == "motor"):
+        several_on_motor = len(machine.throws) > 1 and machine.shaft.drive == "motor"
+        if machine.frame is not None or several_on_motor:
             return False
         return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
             machine.throws, self.contact_values(values), strict=True))  # fmt: skip
