@@ -48,6 +48,10 @@ CASES = {
     # machine's own module is new
     "two contact throws, motor (file)": (
         str(ROOT / "examples" / "machines" / "two_throw_contact_motor.toml"), {}),
+    # after motor and contact-motor, whose modules its ideal and its contact throw are: only
+    # the machine's own module is new
+    "ideal + contact throw, motor (file)": (
+        str(ROOT / "tests" / "machines" / "mixed_throws_motor.toml"), {}),
 }  # fmt: skip
 
 _RUN = """

@@ -20,8 +20,17 @@ inertia and the motor's torque, so that in phase each throw moves as the one thr
 (``compressor-contact --set drive=motor``) does. Measured (5 rounds, two runs): 1326, 1302,
 1315 steps a revolution for 1, 2, 4 throws, ratios 0.94-0.95 and 0.79-0.84.
 
+With ``--joint mixed`` the machine has throws of two kinds: a contact throw (as above) and an
+ideal one (rc = 0, the massless link's family) in phase, against each throw alone (``compressor-
+contact`` and ``compressor`` with rc = 0 at the same values), on the prescribed crank or the
+motor (there the mixed machine gets twice the drive). The ideal throw alone has no impacts and
+takes far fewer steps, so the cost is also given per step: the machine's against the sum of
+the two throws' costs per step (target 1.1: one right-hand side of the machine against one of
+each throw).
+
     python benchmarks/bench_throws.py [--throws 1 2 4] [--rounds 5] [--revolutions 1]
-                                      [--joint link|contact] [--drive prescribed|motor|both]
+                                      [--joint link|contact|mixed]
+                                      [--drive prescribed|motor|both]
 """
 
 from __future__ import annotations
@@ -67,7 +76,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument(
         "--joint",
-        choices=("link", "contact"),
+        choices=("link", "contact", "mixed"),
         default="link",
         help="the crank pins: the massless link, or contact-impact joints",
     )
@@ -84,6 +93,9 @@ def main(argv: list[str] | None = None) -> None:
 
     from recipdyn.integrate import integrate
 
+    if args.joint == "mixed":
+        _mixed(args)
+        return
     drive_arg = args.drive or ("prescribed" if args.joint == "contact" else "both")
     drives = ("prescribed", "motor") if drive_arg == "both" else (drive_arg,)
     for drive in drives:
@@ -123,6 +135,56 @@ def main(argv: list[str] | None = None) -> None:
             print(f"  {n} throw(s): {best[n]:.4f} s ({steps[n]:.0f} steps)  ratio per step "
                   f"{best[n] / steps[n] / (n * one / steps[min(cases)]):.2f}  ratio "
                   f"{best[n] / (n * one):.2f}")  # fmt: skip
+
+
+def _mixed(args) -> None:
+    """``--joint mixed``: a contact throw and an ideal one against each alone (docstring)."""
+    from recipdyn.integrate import integrate
+    from recipdyn.model.assembler.model import MachineModel
+    from recipdyn.model.machine import Machine, Shaft, Throw
+    from recipdyn.model.registry import get_model
+
+    for drive in ("prescribed", "motor") if args.drive in (None, "both") else (args.drive,):
+        motor = {"drive": "motor", **CONTACT_MOTOR} if drive == "motor" else {}
+        cases = {}
+        for name, model_name, extra in (("contact alone", "compressor-contact", {}),
+                                        ("ideal alone", "compressor", {"rc": 0.0})):  # fmt: skip
+            m = get_model(model_name)
+            cases[name] = (m, m.parameters({**CONTACT, **motor, **extra}))
+        shaft = {"omega": CONTACT["omega"]}
+        if drive == "motor":
+            shaft.update({k: (2 * v if k != "motor_sync_speed" else v)
+                          for k, v in CONTACT_MOTOR.items()})  # fmt: skip
+        load = (("load_amplitude", CONTACT["load_amplitude"]),)
+        throws = (Throw("throw1", crank_joint="contact", params=load),
+                  Throw("throw2", crank_joint="ideal", params=load))  # fmt: skip
+        shaft_ = Shaft(drive, params=tuple(shaft.items()))
+        m = MachineModel(Machine("bench-mixed", shaft=shaft_, throws=throws))
+        cases["mixed machine"] = (m, m.parameters())
+        runs = {}
+        for name, (m, v) in cases.items():
+            s, y0 = m.system(v), m.initial_state(v)
+            integrate(s, y0, (0.0, 0.01 * m.period(v)))  # compiled before the timing
+            runs[name] = (s, y0, m.period(v))
+        best = dict.fromkeys(runs, math.inf)
+        steps = {}
+        for r in range(args.rounds):
+            for name in list(runs) if r % 2 == 0 else list(runs)[::-1]:
+                s, y0, period = runs[name]
+                t0 = time.process_time()
+                run = integrate(s, y0, (0.0, args.revolutions * period))
+                best[name] = min(best[name], (time.process_time() - t0) / args.revolutions)
+                steps[name] = run.nsteps / args.revolutions
+        per = {n: best[n] / steps[n] for n in runs}
+        print(f"{drive}: CPU s per revolution (steps per revolution), per step")
+        for n in runs:
+            print(f"  {n}: {best[n]:.4f} s ({steps[n]:.0f} steps)  {1e6 * per[n]:.2f} us/step")
+        print(
+            f"  ratio per step, machine / (contact + ideal): "
+            f"{per['mixed machine'] / (per['contact alone'] + per['ideal alone']):.2f}; "
+            f"per revolution, machine / (contact + ideal): "
+            f"{best['mixed machine'] / (best['contact alone'] + best['ideal alone']):.2f}"
+        )
 
 
 if __name__ == "__main__":

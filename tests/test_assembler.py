@@ -370,7 +370,7 @@ def test_simulate_a_machine_file_from_the_command_line(tmp_path, capsys):
     bad.write_text('[[throw]]\ncrank_joint = "contact"\n[[throw]]\n')
     assert main(["simulate", "--machine", str(bad), "-o", str(tmp_path / "b.nc")]) == 2
     err = capsys.readouterr().err.strip()
-    assert "crank_joint = 'contact'" in err and len(err.splitlines()) == 1
+    assert "throw2.crank_joint = 'link'" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "b.nc").exists()
 
 

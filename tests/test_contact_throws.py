@@ -165,22 +165,21 @@ def test_the_contact_throws_template_binds_its_reference_configuration():
 
 
 def test_throws_of_two_families_and_what_a_motor_does_not_take_are_refused_in_one_line():
-    """Throws of two families (the link beside a contact pin, or beside an ideal crank pin
-    with a worn crosshead pin), the link with a worn crosshead pin, and contact throws whose
-    pins differ (a worn crosshead pin on one only); the held motor and a flexible shaft with
-    contact pins, and on a motor a worn crank pin's crank without an inertia of its own."""
+    """The massless link beside a contact pin, or beside an ideal crank pin with a worn
+    crosshead pin (an ideal pin may stand there: tests/test_mixed_throws.py), the link with a
+    worn crosshead pin, and contact throws whose
+    pins differ (a worn crosshead pin on one only); a flexible shaft with contact pins (the
+    held motor runs them: tests/test_mixed_throws.py), and on a motor a worn crank pin's
+    crank without an inertia of its own."""
     worn = Throw("throw2", crank_joint="ideal", crosshead_joint="contact")
     for throws, drive, words in (
         ((_throw("throw1"), Throw("throw2")), "prescribed", "throw2.crank_joint = 'link'"),
-        ((Throw("throw1"), worn), "prescribed", "crosshead_joint = 'contact'"),
+        ((Throw("throw1"), worn), "prescribed", "throw1.crank_joint = 'link'"),
         ((Throw("throw1", crosshead_joint="contact"),), "prescribed", "beside crank_joint"),
-        ((_throw("throw1"), _throw("throw2")), "held", "motor = 'held'"),
         ((_throw("throw1"),), "torsion", "[shaft.torsion]"),
     ):
         with pytest.raises(ParameterError) as exc:
-            if drive == "held":
-                _motor_machine(*throws, motor="held")
-            elif drive == "torsion":
+            if drive == "torsion":
                 _motor_machine(*throws, torsion=True)
             else:
                 _machine(*throws, drive=drive)

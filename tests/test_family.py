@@ -55,13 +55,17 @@ def _simulate(**kw):
 
 @pytest.mark.parametrize("selectors,route,own", ROUTES, ids=[r[1] for r in ROUTES])
 def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
-    """The model delegates: the same compiled kernels on the same parameter vector, so every
-    recorded variable and the number of right-hand-side calls equal the implementation's
-    exactly (no tolerance: the arithmetic is the same)."""
+    """The model delegates to the machine of one throw the assembler builds, and a contact
+    route's machine (`OneContact`: the assembled layout and parameter vector) runs what its
+    joints' configuration (the model class the old name reached, now its part) runs: the same
+    compiled kernels on the same parameter vector, so every recorded variable and the number
+    of right-hand-side calls equal exactly (no tolerance: the arithmetic is the same)."""
     m = get_model("compressor")
     values = m.parameters(selectors)
     assert m.route(values)[0] == route
-    impl = family.implementation(route)
+    impl = family.machine(route)
+    assert m.route(values)[1] is impl
+    impl = getattr(impl, "part", impl)  # (the contact routes: the old class, a part now)
     assert np.array_equal(m.system(values).params, impl.system(impl.parameters(own)).params)
     kw = dict(revolutions=0.25, fs=2000.0)
     a = _simulate(model=m, params=selectors, **kw)
@@ -72,6 +76,34 @@ def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
     assert a.attrs["solver_nfev"] == b.attrs["solver_nfev"]
     assert a.attrs["model"] == "compressor"
     assert a.attrs["vibration_signal"] == impl.vibration()[0]
+
+
+@pytest.mark.parametrize("selectors,route", [(r[0], r[1]) for r in ROUTES],
+                         ids=[f"{r[1]}-{i}" for i, r in enumerate(ROUTES)])  # fmt: skip
+def test_every_route_is_a_machine_of_the_one_assembler(selectors, route):
+    """Every configuration is a machine of one throw built by the assembler (issue 43: one
+    path): ``family`` holds no table of implementations, only `family.ASSEMBLER`, and a
+    contact route's system is its assembled configuration's (the throw's slice of the state
+    and of the parameter vector from `contact_throws.one_throw_configuration`), the same
+    module as a machine file's throw (its kernels the throw's module). Nothing integrates."""
+    from recipdyn.model.assembler.model import ContactMachine, MachineModel
+
+    assert not hasattr(family, "ROUTES") and not hasattr(family, "implementation")
+    m = get_model("compressor")
+    values = m.parameters(selectors)
+    name, machine, _ = m.route(values)
+    assert name == route and isinstance(machine, MachineModel)
+    assert set(family.ROUTE_NAMES) == {"link", "link-valves", "contact", "contact-valves"}
+    if not route.startswith("contact"):
+        return
+    assert isinstance(machine, ContactMachine)
+    own = {k: v for k, v in values.items() if k in machine.schema.names}
+    c = machine.contact(own)
+    s = machine.system(own)
+    assert len(c.machine.throws) == 1 and c.machine.flat
+    assert s.params is c.params and s.state_names == c.layout.state.names
+    assert s.rhs is c.throw_module.rhs and s.jac is c.throw_module.jac
+    assert c.layout.params.parts["throw1"] == slice(0, c.params.size)
 
 
 #: The presets whose implementation is the one their old name reached (compressor-guide's was
@@ -91,6 +123,7 @@ def test_presets_keep_the_values_and_sweep_digests_of_the_old_names(name):
 
     preset = get_model(name)
     impl = preset.route(family.PRESETS[name])[1]
+    impl = getattr(impl, "part", impl)  # (a contact route: its joints' configuration)
     assert preset.parameters() == impl.parameters()
     assert preset.schema is impl.schema and preset.state_names == impl.state_names
     axis = parse_axis("omega=19:21:2", name)

@@ -16,12 +16,15 @@ import pytest
 
 import recipdyn
 from recipdyn.errors import ParameterError
+from recipdyn.model.assembler.model import one_throw
 from recipdyn.model.components.contact_model import pack
 from recipdyn.model.components.load import PAPER
-from recipdyn.model.compressor_contact import COMPRESSOR_CONTACT as CC
 from recipdyn.model.joints.contact import FRICTION_LAWS, FRICTION_ROLES
 from recipdyn.model.joints.pins import N_PACKED
 from recipdyn.model.reference.compressor_guide import KERNELS, ideal_crosshead
+
+#: The contact joints' machine of one throw (``compressor-contact``'s, the one assembler's).
+CC = one_throw("contact")
 
 #: Both pins ideal, the guide worn: the configuration `compressor-guide` integrates.
 IDEAL_PINS = {"guide": "clearance", "crank_joint": "ideal", "crosshead_joint": "ideal"}

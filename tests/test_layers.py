@@ -153,10 +153,11 @@ def _routes(path: Path) -> set[str]:
 
 def _model_modules() -> set[str]:
     """The modules that are models (a registered `Model` each): the ones the registry's
-    built-in table names, and the implementations ``compressor`` routes to."""
+    built-in table names, and the one assembler's machines of one throw that ``compressor``
+    delegates to (``family.ASSEMBLER``)."""
     from recipdyn.model import family, registry
 
-    tables = [*registry._BUILTIN.values(), registry.MACHINE_MODEL, *family.ROUTES.values()]
+    tables = [*registry._BUILTIN.values(), registry.MACHINE_MODEL, family.ASSEMBLER]
     return {t.partition(":")[0].removeprefix("recipdyn.model.") for t in tables}
 
 
@@ -179,8 +180,7 @@ def _model_edges(graph: dict[str, set[str]], models: set[str]) -> set[tuple[str,
 
 
 #: The model modules of the compressor (the registry's and family's tables must name them).
-MODEL_MODULES = {"family", "assembler.model", "compressor_contact", "compressor_contact_valves",
-                 "reference.compressor_guide"}  # fmt: skip
+MODEL_MODULES = {"family", "assembler.model", "reference.compressor_guide"}
 
 
 def test_no_model_module_imports_another():
@@ -189,8 +189,8 @@ def test_no_model_module_imports_another():
     model is assembled from shared parts (`model/components/`, `model/joints/`, ...).
 
     ``family`` (the model ``compressor``) is a model module like the others: its imports are
-    checked the same way (it imports none). It reaches its implementations only through
-    its routing table, ``family.ROUTES`` (import strings ``recipdyn.model.X:OBJ``, imported
+    checked the same way (it imports none). It reaches the machines of one throw only
+    through ``family.ASSEMBLER`` (an import string ``recipdyn.model.X:OBJ``, imported
     when a configuration first asks for one): `test_only_the_routing_tables_name_models`
     checks that those strings are the table's and nothing else's, and since family is a
     model module, an implementation that imported it back would fail here."""
@@ -203,15 +203,16 @@ def test_no_model_module_imports_another():
 
 def test_only_the_routing_tables_name_models():
     """Import strings of models appear in the two routing tables only: the registry's
-    (model name -> model, and machine file -> the machines' model) and family's ``ROUTES``
-    (selectors -> implementation), each naming exactly its table's modules; no other module
+    (model name -> model, and machine file -> the machines' model) and family's
+    ``ASSEMBLER`` (route -> machine of one throw), each naming exactly its table's modules;
+    no other module
     of the model package holds one."""
     from recipdyn.model import family, registry
 
     found = {_node(p.relative_to(MODEL).with_suffix("").parts): _routes(p)
              for p in MODEL.rglob("*.py")}  # fmt: skip
     tables = {"registry": {**registry._BUILTIN, "machine files": registry.MACHINE_MODEL},
-              "family": family.ROUTES}  # fmt: skip
+              "family": {"assembler": family.ASSEMBLER}}  # fmt: skip
     for name, table in tables.items():
         want = {t.partition(":")[0].removeprefix("recipdyn.model.") for t in table.values()}
         assert found.pop(name) == want, name

@@ -63,6 +63,7 @@ MACHINES = [
     str(Path(__file__).parents[1] / "examples" / "machines" / "two_throw_torsion.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_contact.toml"),
     str(Path(__file__).parent / "machines" / "two_throw_contact_motor.toml"),
+    str(Path(__file__).parent / "machines" / "mixed_throws.toml"),
 ]
 MODELS = [*model_names(), EXAMPLE, *PRESETS, *MACHINES]
 

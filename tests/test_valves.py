@@ -325,7 +325,7 @@ def test_a_valve_impact_and_a_contact_onset_closer_than_a_step_are_both_located(
     chamber whose volume differs by the journal's 1 mm (measured offset 1.3e-11 s; the onset
     1.5e-14 s)."""
     from recipdyn.integrate import integrate
-    from recipdyn.model import compressor_contact_valves as ccv
+    from recipdyn.model.components import contact_valves_model as ccv
     from recipdyn.model.joints import pins
 
     s, y0, kw, t_valve = _close_pair_state(gap)

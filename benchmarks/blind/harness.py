@@ -145,7 +145,11 @@ def diagnose_channels(ch: dict, channels: str, model) -> dict:
                 "seconds": time.perf_counter() - t0}  # fmt: skip
     ans = {"refused": bool(res.refused), "reason": res.reason, "error": None,
            "seconds": time.perf_counter() - t0,
-           "fingerprint": res.evidence.get("fingerprint")}  # fmt: skip
+           "fingerprint": res.evidence.get("fingerprint"),
+           "windows": res.evidence.get("windows")}  # fmt: skip
+    if res.probabilities:  # the classifier's answer, named or refused
+        top = max(res.probabilities, key=res.probabilities.get)
+        ans.update(top=top, top_p=float(res.probabilities[top]))
     if not res.refused:
         ans.update(
             label=res.label,

@@ -78,6 +78,19 @@ EVIDENCE: dict[str, tuple[str, str, Any]] = {
             f"{_db(v['training_range'][1])} to {_db(v['training_range'][0])})"
         ),
     ),
+    "windows": (
+        "windows of the data set's length",
+        "a record longer than the data set's is classified on its windows of that length, "
+        "one revolution apart: the answer is their mean probability, and a class that needs "
+        "a confidence threshold is named only where every window reaches it",
+        lambda v: (
+            f"{v['n']} windows of {float(v['revolutions']):g} revolutions: p "
+            + ", ".join(f"{float(x):.2f}" for x in v["p"])
+            + " (each window's answer: "
+            + ", ".join(v["labels"])
+            + ")"
+        ),
+    ),
     "pressure_deviation": (
         "head-end pressure shape",
         "the largest difference between the record's head-end pressure over a revolution "

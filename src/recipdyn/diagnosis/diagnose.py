@@ -92,6 +92,15 @@ class Diagnosis:
                     f"{ch['recall']:.0%}; all classes {ch['accuracy']:.0%} of {ch['n']} records)"
                 )
             lines.append(line)
+        if ev.get("windows"):
+            w = ev["windows"]
+            lines.append(
+                f"scored on {w['n']} windows of {w['revolutions']:g} revolutions (the data "
+                f"set's records): p of '{self.label}' "
+                + ", ".join(f"{v:.2f}" for v in w["p"])
+                + "; each window's answer "
+                + ", ".join(w["labels"])
+            )
         if ev.get("fingerprint"):
             from .fingerprint import Fingerprint
 
@@ -470,12 +479,29 @@ def _diagnose_arrays(
         )
     proba = diag.predict_proba(X)[0]
     classes = diag.classes
+    # a record longer than the data set's: scored on its windows of the data set's length,
+    # the length the confidence thresholds were measured at (windows.py)
+    from .windows import scores as window_scores
+
+    win = window_scores(diag, x, fs, revs, p_head=ph, p_crank=pc, angle=tacho is not None,
+                        machine=machine_pairs, baseline=baseline)  # fmt: skip
+    if win is not None:
+        proba = win.mean
     k = int(np.argmax(proba))
     res.probabilities = {c: float(p) for c, p in zip(classes, proba, strict=True)}
+    if win is not None:
+        res.evidence["windows"] = win.evidence(k)
     # a class is named only with channels whose held-out answers of it were right
     subset = available(X[0], diag.names)
-    named, why, facts = gate(naming_of(diag), subset, classes[k], proba[k])
+    p_gate = proba[k] if win is None else win.gate_p(k)
+    named, why, facts = gate(naming_of(diag), subset, classes[k], p_gate)
     res.evidence["channels"] = facts
+    if not named and win is not None and "confidence" in facts:
+        w = res.evidence["windows"]
+        why += (
+            f" (p: the lowest of its {w['n']} windows of {w['revolutions']:g} revolutions, the "
+            f"length the threshold was measured at: {', '.join(f'{v:.3f}' for v in w['p'])})"
+        )
     if not named:
         return _refuse(res, why, t0)
     # out of the domain (domain.py), then not explained by the physics (consistency.py)

@@ -59,12 +59,13 @@ saltation matrices (tests/test_contact.py checks the
 tangent flow against differences of the flow across impacts).
 
 Where the code is: this module holds the derivations (`lagrangian`, `generate`; with a motor
-`free_crank_lagrangian`, `generate_drive`) and the registered instance; the model
-(`CompressorContact`: schema, packing, outputs, summaries) is
-`recipdyn.model.components.contact_model`, shared with `compressor-contact-valves`; the
-compiled parts (layout, joints' forces, accelerations, events) are
-`recipdyn.model.joints.pins`, and the glue that joins them with a load
-`recipdyn.model.components.contact`.
+`free_crank_lagrangian`, `generate_drive`); the model of ``--model compressor-contact`` is the
+one assembler's machine of one contact throw (`recipdyn.model.assembler.model.OneContact`,
+the family's route ``contact``), whose joints' configuration part (schema, packing, outputs,
+summaries; shared with the dynamic valves' part) is
+`recipdyn.model.components.contact_model`; the compiled parts (layout, joints' forces,
+accelerations, events) are `recipdyn.model.joints.pins`, and the glue that joins them with a
+load `recipdyn.model.components.contact`.
 """
 
 from __future__ import annotations
@@ -72,10 +73,9 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
-from .components.contact_model import CompressorContact
 from .joints.pins import GUIDE_INPUTS, GUIDE_JOINTS, INPUTS, JOINTS, MECH
 
-__all__ = ["CompressorContact", "COMPRESSOR_CONTACT", "lagrangian", "generate"]
+__all__ = ["lagrangian", "generate"]
 
 
 @lru_cache(maxsize=8)
@@ -307,8 +307,6 @@ def generate_share() -> str:
 def _share_target() -> Path:
     return Path(__file__).with_name("_compressor_contact_share.py")
 
-
-COMPRESSOR_CONTACT = CompressorContact()
 
 if __name__ == "__main__":  # pragma: no cover - developer tool
     _target().write_text(generate())

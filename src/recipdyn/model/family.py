@@ -1,4 +1,4 @@
-r"""The compressor: one model whose parameters choose the implementation.
+r"""The compressor: one model whose parameters describe the machine the assembler builds.
 
 ``--model compressor`` takes five *selectors*, each a parameter:
 
@@ -14,12 +14,13 @@ r"""The compressor: one model whose parameters choose the implementation.
                           crosshead moves and tilts between the guide's shoes)
 ========================  ==================================================================
 
-The selectors choose one of the implementations (`ROUTES`) and the model delegates every call
-to it: the same compiled kernels run on the same parameter vector, so a configuration gives
-the numbers its implementation gives, to the bit, at the same cost. A combination that no
-implementation covers is refused in one line that says why (`route`), and a parameter that
-belongs to another configuration is refused in one line naming the selector value that
-enables it (`owner`).
+The selectors describe a machine of one throw (`route`: the massless link or ideal pins,
+``link`` and ``link-valves``; contact-impact or lubricated pins or the guide's clearance,
+``contact`` and ``contact-valves``), which the one assembler builds
+(`recipdyn.model.assembler.model.one_throw`: `OneThrow`, `OneContact`), and the model
+delegates every call to it. A combination that no machine covers is refused in one line
+that says why (`route`), and a parameter that belongs to another configuration is refused in
+one line naming the selector value that enables it (`owner`).
 
 The old model names are *presets*: ``compressor-contact`` is this model with
 ``crank_joint = contact`` as its default, ``compressor-valves`` with ``load = valves``,
@@ -55,7 +56,7 @@ from .protocol import Model, Param, Schema, UnknownParameterError
 from .registry import is_spec
 
 __all__ = [
-    "Compressor", "SELECTORS", "ROUTES", "PRESETS", "route", "owner", "implementation",
+    "Compressor", "SELECTORS", "ROUTE_NAMES", "PRESETS", "route", "owner", "machine",
     "COMPRESSOR",
     "COMPRESSOR_CONTACT", "COMPRESSOR_VALVES",  # noqa: F822 (built on first use, __getattr__)
     "COMPRESSOR_CONTACT_VALVES", "COMPRESSOR_GUIDE",  # noqa: F822
@@ -63,27 +64,24 @@ __all__ = [
 
 _DEFAULTS = SELECTORS.defaults()
 
-#: The implementations, by route: where each lives (imported when first asked for).
-ROUTES = {
-    "link": "recipdyn.model.assembler.model:LINK",
-    "link-valves": "recipdyn.model.assembler.model:LINK_VALVES",
-    "contact": "recipdyn.model.compressor_contact:COMPRESSOR_CONTACT",
-    "contact-valves": "recipdyn.model.compressor_contact_valves:COMPRESSOR_CONTACT_VALVES",
-}
-_LOADED: dict[str, Model] = {}
+#: The one assembler's compressor of one throw (`recipdyn.model.assembler.model.one_throw`):
+#: the machine each route is, imported when a configuration first asks for one (this model
+#: module imports no other model module, tests/test_layers.py).
+ASSEMBLER = "recipdyn.model.assembler.model:one_throw"
+#: The routes: which machine of one throw the selectors describe (`route`).
+ROUTE_NAMES = ("link", "link-valves", "contact", "contact-valves")
 
 
-def implementation(name: str) -> Model:
-    """The implementation of route ``name`` (`ROUTES`)."""
-    if name not in _LOADED:
-        module, _, attr = ROUTES[name].partition(":")
-        _LOADED[name] = getattr(importlib.import_module(module), attr)
-    return _LOADED[name]
+def machine(name: str) -> Model:
+    """The machine of one throw of route ``name`` (`ROUTE_NAMES`), built by the one
+    assembler."""
+    module, _, attr = ASSEMBLER.partition(":")
+    return getattr(importlib.import_module(module), attr)(name)
 
 
 def route(s: Mapping[str, Any], table: bool = False) -> str:
-    """The implementation (a key of `ROUTES`) for the selector values ``s`` (``table``: a
-    load or pressure table is given); a combination that none covers raises
+    """The route (one of `ROUTE_NAMES`: the machine of one throw) for the selector values
+    ``s`` (``table``: a load or pressure table is given); a combination that none covers raises
     [`ParameterError`][recipdyn.errors.ParameterError] in one line that says why and what is
     allowed."""
     crank, cross, load, drive, guide = (s[k] for k in SELECTORS.names)
@@ -175,8 +173,8 @@ def _not_own(impl: Model) -> frozenset[str]:
 
 def _holds_valves(attrs: Mapping[str, Any]) -> bool:
     """Whether record attributes hold the dynamic valves' parameters."""
-    link = implementation("link").schema.names
-    return any(f"param_{k}" in attrs for k in implementation("link-valves").schema.names
+    link = machine("link").schema.names
+    return any(f"param_{k}" in attrs for k in machine("link-valves").schema.names
                if k not in link)  # fmt: skip
 
 
@@ -185,8 +183,8 @@ def owner(name: str, s: Mapping[str, Any]) -> str:
     (``"crosshead_joint = 'contact' | 'lubricated'"``), or ``""`` if none does; ``s``: the
     current selector values (one selector is changed at a time; a crosshead-pin parameter is
     the crosshead joint's)."""
-    contact = implementation("contact").schema
-    if name in contact and name not in implementation("link").schema:
+    contact = machine("contact").schema
+    if name in contact and name not in machine("link").schema:
         if contact[name].group == "guide":
             return "guide = 'clearance'"
         if name.endswith("_crosshead") or name.startswith("crosshead_pin"):
@@ -206,7 +204,7 @@ def owner(name: str, s: Mapping[str, Any]) -> str:
             if sel.name == "guide":  # the guide's clearance runs with ideal pins
                 trial.update(crank_joint="ideal", crosshead_joint="ideal")
             try:
-                impl = implementation(route(trial))
+                impl = machine(route(trial))
             except ParameterError:
                 continue
             if name in impl.schema or name in impl.schema.aliases:
@@ -229,7 +227,7 @@ class Compressor(Model):
         self.choosable = choosable
         self._selectors = _chosen(self.defaults, _DEFAULTS)
         self._routes: dict[tuple, tuple[str, dict[str, Any]]] = {}
-        impl = implementation(route(self._selectors))
+        impl = machine(route(self._selectors))
         self.description = description or impl.description
         self._adopt(impl)
         others = {k: v for k, v in self.defaults.items() if k not in SELECTORS.names}
@@ -275,7 +273,7 @@ class Compressor(Model):
         # the default configuration's
         if name.startswith("_"):
             raise AttributeError(name)
-        return getattr(implementation(self._route0()), name)
+        return getattr(machine(self._route0()), name)
 
     def _route0(self, s: Mapping[str, Any] | None = None) -> str:
         """The route at the selector values ``s`` (default: this preset's)."""
@@ -308,7 +306,7 @@ class Compressor(Model):
         except TypeError:  # an unhashable value
             s = self.selectors(values)
             name = route(s, table)
-        return name, implementation(name), dict(s)
+        return name, machine(name), dict(s)
 
     def _split(self, values: Mapping[str, Any]) -> tuple[Model, dict[str, Any]]:
         """The implementation at validated ``values`` and its own values."""
@@ -579,8 +577,8 @@ class Compressor(Model):
             if p.name not in seen:
                 rows.append((replace(p, default=self._selectors[p.name]), "selector"))
                 seen.add(p.name)
-        for name in ROUTES:
-            for p in implementation(name).schema:
+        for name in ROUTE_NAMES:
+            for p in machine(name).schema:
                 if p.name not in seen:
                     rows.append((p, owner(p.name, self._selectors)))
                     seen.add(p.name)

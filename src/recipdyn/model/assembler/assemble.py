@@ -74,25 +74,12 @@ def throw_family(t) -> str:
 
 
 def family_of(machine: Machine) -> str:
-    """The mechanism family of the machine's throws; refused in one line when they differ
-    (the templates bind one family's roles for every throw)."""
-    kinds = {throw_family(t) for t in machine.throws}
-    if len(kinds) > 1:
-        first = machine.throws[0]
-        other = next(t for t in machine.throws if throw_family(t) != throw_family(first))
-
-        def pins(t) -> str:
-            out = f"{t.name}.crank_joint = {t.crank_joint!r}"
-            if (t.crosshead_joint, t.guide) != ("ideal", "ideal"):
-                out += f" (crosshead_joint = {t.crosshead_joint!r}, guide = {t.guide!r})"
-            return out
-
-        raise ParameterError(
-            f"machine {machine.name!r}: {pins(other)} beside {pins(first)}: the throws of a "
-            "machine carry one family of pins today (the massless link or ideal pins, or "
-            "contact | lubricated pins and the guide's clearance)"
-        )
-    return kinds.pop()
+    """The family that builds the machine: the massless link's (template ``prescribed`` or
+    ``motor``) when every throw is of the link family, else the contact joints'
+    (`recipdyn.model.assembler.contact_throws`), which hosts ideal throws beside its own as a
+    throw of another kind (each one a one-throw module of the massless link called on its
+    slice)."""
+    return "contact" if any(throw_family(t) == "contact" for t in machine.throws) else "link"
 
 
 def frame_values(values: Mapping[str, Any]) -> dict[str, Any]:

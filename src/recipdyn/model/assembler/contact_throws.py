@@ -37,12 +37,21 @@ turns with the crank: the Schur complement of its mass matrix,
 
 A throw's ``crosshead_joint`` and ``guide`` (structure keys of the machine's description)
 choose the rest of its joints: a worn crosshead pin, the guide's clearance (the family's
-whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. Not yet (refused in
-one line): the held motor, a flexible shaft, a load
-of a user's file or a table, a frame, an interstage volume, a throw on the other side of the
-shaft (``cylinder_angle``), throws whose joints' configurations differ (`same_joints`), and
-throws of different families in one machine
-(`recipdyn.model.assembler.assemble.family_of`).
+whatever the crank pin); the loads ``paper``, ``cycle`` and ``valves``. A held rotor
+(``motor = held``, a rigid shaft) turns the crank at alpha = 0, each throw's module on a
+constant torque of 0 (`throw_law`). A throw on the other side of the shaft (``cylinder_angle``
+180 deg) runs in its own axes with its ``g`` negated (`_validated`).
+
+Throws with ideal pins (``crank_joint = ideal``, the massless link's family) join such a
+machine as a throw of another kind (`is_contact` false): each one is its one-throw model of the
+massless link at rc = 0 (given by the caller, ``link(throw)``: ``--model compressor`` or
+``compressor-valves``), its values `throw_link_values`, its slices that model's vector and
+state, its kernels that model's generated module, which the template calls on the throw's
+views by its kind (``THROW_KIND``; docs/architecture.md, "A throw of another kind").
+
+Not yet (refused in one line, `refusal`): a flexible shaft, a load of a user's file or a
+table, a frame, an interstage volume, contact throws whose joints' configurations differ
+(`same_joints`), and the massless link (rc > 0) beside contact throws.
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
@@ -69,8 +78,8 @@ if TYPE_CHECKING:
     from ..protocol import Param
 
 __all__ = ["ContactConfiguration", "assemble_contact", "contact_configuration",
-           "contact_throw_params", "one_model", "refusal", "throw_contact_values", "joints_key",
-           "same_joints", "LOADS"]  # fmt: skip
+           "contact_throw_params", "one_model", "joints_part", "one_throw_configuration",
+           "refusal", "throw_contact_values", "joints_key", "same_joints", "LOADS"]  # fmt: skip
 
 #: The loads a contact throw of a machine takes today.
 LOADS = ("paper", "cycle", "valves")
@@ -87,6 +96,12 @@ def one_model(throw: Throw):
     return _models()[throw.load == "valves"]
 
 
+def joints_part(valves: bool = False):
+    """The joints' configuration part of a contact throw (its schema, checks, packing,
+    states, kernels module, signals and summary): with the dynamic valves or without."""
+    return _models()[bool(valves)]
+
+
 @lru_cache(maxsize=1)
 def _models():
     """The contact model and the contact model with the dynamic valves (the parts' classes,
@@ -101,23 +116,22 @@ def _models():
 _CRANK = ("rs", "m1", "J1")
 
 
-def contact_throw_params(throw: Throw, shaft: Shaft | None = None) -> tuple[Param, ...]:
+def contact_throw_params(throw: Throw, shaft: Shaft | None = None, frame: bool = False
+                         ) -> tuple[Param, ...]:  # fmt: skip
     """A contact throw's parameters under their local names (its one-throw model's,
     without the shaft's, the stage's and the structure's; the cycle's with ``load = cycle``
     or ``valves`` only, the paper load's with ``load = paper`` only; with a motor its
-    crank's ``rs``, ``m1``, ``J1``), with its ``phase``."""
+    crank's ``rs``, ``m1``, ``J1``; on a ``frame`` its crank's ``rs``, ``m1``: its rotating
+    unbalance shakes the frame), with its ``phase``."""
     from ..components.guide import GUIDE_PARAMS
 
     motor = shaft is not None and shaft.drive == "motor"
-    skip = {*SHAFT_NAMES, *STAGE_NAMES, *(n for n in _STRUCTURE if not (motor and n in _CRANK))}
+    crank = _CRANK if motor else (("rs", "m1") if frame else ())
+    skip = {*SHAFT_NAMES, *STAGE_NAMES, *(n for n in _STRUCTURE if n not in crank)}
     if throw.guide != "clearance":
         skip |= {p.name for p in GUIDE_PARAMS}
     schema = one_model(throw).schema
-    out = [
-        p
-        for p in schema
-        if p.name not in skip and (p.group != "drive" or (motor and p.name in _CRANK))
-    ]
+    out = [p for p in schema if p.name not in skip and (p.group != "drive" or p.name in crank)]
     if throw.crank_joint == "ideal":
         out = [p for p in out if p.name not in ("rc", "K", "journal_radius", "e0_angle")]
     if throw.crosshead_joint == "ideal":
@@ -136,6 +150,14 @@ def contact_throw_params(throw: Throw, shaft: Shaft | None = None) -> tuple[Para
     return (*out, PHASE)
 
 
+def is_contact(throw: Throw) -> bool:
+    """Whether a throw is one of the contact joints' (a worn pin or the guide's clearance),
+    not an ideal throw of the massless link's family (`.assemble.throw_family`)."""
+    from .assemble import throw_family
+
+    return throw_family(throw) == "contact"
+
+
 def refusal(machine: Machine) -> str | None:
     """Why a machine of contact throws cannot be assembled yet (one line), or None."""
     where = f"machine {machine.name!r}"
@@ -143,28 +165,25 @@ def refusal(machine: Machine) -> str | None:
         return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
                 "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
                 "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
-    if machine.shaft.drive == "motor" and machine.shaft.motor == "held":
-        return (f"{where}: motor = 'held' with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: 'induction' or 'constant', or drive = 'prescribed' "
-                "(a held rotor on a rigid shaft turns the crank as a prescribed speed "
-                "does)")  # fmt: skip
     if machine.frame is not None:
-        return (f"{where}: a [frame] with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead pins "
-                "and guides")  # fmt: skip
+        for t in machine.throws:
+            if t.guide == "clearance":
+                return (f"{where}: a [frame] with {t.name}.guide = 'clearance' is not modelled "
+                        "yet; allowed on a frame: ideal guides (guide = 'ideal')")  # fmt: skip
     if machine.interstages:
         return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
                 "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
                 "pins and guides")  # fmt: skip
     for t in machine.throws:
+        if not is_contact(t) and t.crank_joint != "ideal":
+            return (f"{where}: {t.name}.crank_joint = {t.crank_joint!r} (the massless link) "
+                    "beside throws with contact pins or the guide's clearance is not modelled "
+                    "yet; allowed there: 'ideal', 'contact', 'lubricated'")  # fmt: skip
         if t.load not in LOADS:
             return (f"{where}: {t.name}.load = {t.load!r} with crank_joint = "
                     f"{t.crank_joint!r} is not modelled yet on a machine; allowed: "
                     f"{', '.join(map(repr, LOADS))} (one throw: --model compressor-contact "
                     "or compressor-contact-valves)")  # fmt: skip
-        if t.cylinder_angle:
-            return (f"{where}: {t.name}.cylinder_angle = 180 deg with crank_joint = "
-                    f"{t.crank_joint!r} is not modelled yet; allowed: 0")  # fmt: skip
     return None
 
 
@@ -183,7 +202,10 @@ class ContactConfiguration:
         vector (part ``throwK``).
     params : ndarray
     throw_module : module
-        The throws' kernels (the one-throw module, template ``contact``).
+        The contact throws' kernels (the one-throw module, template ``contact``).
+    link_module : module or None
+        The ideal throws' kernels (the one-throw module of the massless link with rc = 0,
+        template ``prescribed`` or ``motor``), None without ideal throws.
     """
 
     machine: Machine
@@ -191,6 +213,8 @@ class ContactConfiguration:
     layout: Layout
     params: np.ndarray
     throw_module: ModuleType
+    link_module: ModuleType | None = None
+    link_events: bool = False
 
     def bindings(self) -> tuple[str, dict, dict, str, str]:
         """The machine module's template, roles, constants, stem and note."""
@@ -206,19 +230,40 @@ class ContactConfiguration:
         slices = [pv.parts[t.name] for t in throws]
         mod = self.throw_module.__name__
         roles = {f"throw_{r}": (mod, r) for r in ("rhs", "jac", "event", "reset")}
-        roles["torque"] = ("recipdyn.model.assembler.generate", "absent")
+        absent = ("recipdyn.model.assembler.generate", "absent")
+        roles["torque"] = absent
         motor = self.machine.shaft.drive == "motor"
-        if motor:
-            from .assemble import motor_of
-
-            law = motor_of(self.machine)
+        if motor:  # (a held rotor: its throws' modules turn on a torque of 0, `throw_law`)
+            law = throw_law(self.machine)
             roles["torque"] = (law.module, law.kernel("torque"))
-        phased = one_model(throws[0]).tracks_separations(self.locals[0])
+        link = self.link_module
+        frame = self.machine.frame is not None
+        for r in ("rhs", "jac", "event", "reset", "share", "crank"):
+            on = link is not None and (r != "share" or shared(self.machine))
+            if r == "crank":  # (an ideal throw's crank angle on a frame, the crank prescribed)
+                on = link is not None and frame and not motor
+            roles[f"link_{r}"] = (link.__name__, r) if on else absent
+        kinds = [0 if is_contact(t) else 1 for t in throws]
+        first = kinds.index(0)  # (a contact throw: the machine's family)
+        phased = one_model(throws[first]).tracks_separations(self.locals[first])
         m = self.throw_module
+        crank = {0: int(m.M), 1: int(getattr(link, "CRANK", 0))}
+        torque_at = {0: int(m.MO), 1: int(getattr(link, "MOTOR", 0))}
         end = slices[-1].stop
         constants = {
-            "CFG": _literal(CFG[self.locals[0]["clearance_joints"]]),
-            "HAS_GUIDE": self.locals[0].get("guide", "ideal") == "clearance",
+            "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
+            "FRAME": frame,
+            "FRAME_CRANKS": pv.start("frame.cranks") if frame else 0,
+            "FRAME_PARAMS": pv.start("frame") if frame else 0,
+            "FRAME_STATE": st.start("frame") if frame else 0,
+            "FRAME_WORK": st.start("frame.work") if frame else 0,
+            "HAS_GUIDE": self.locals[first].get("guide", "ideal") == "clearance",
+            "HAS_LINK": link is not None,
+            "HELD": held(self.machine),
+            "LINK_EVENTS": self.link_events,
+            "LINK_MECH": int(link.THROW_MECH[0]) if link is not None else 0,
+            "LINK_PHASE": int(link.THROW_PHASE[0]) if link is not None else 0,
+            "LINK_SHAFT": int(getattr(link, "SHAFT", 0)),
             "MOTOR": motor,
             "N_THROWS": len(throws),
             "OWN_EVENT": len(throws) == 1 or phased,
@@ -226,17 +271,22 @@ class ContactConfiguration:
             "SHAFT": end,
             "SHARED": shared(self.machine),
             "THROW_CO": int(m.CO),
-            "THROW_M": int(m.M),
-            "THROW_MO": int(m.MO),
+            "THROW_CRANK": arr(crank[k] for k in kinds),
+            "THROW_KIND": arr(kinds),
             "THROW_N": arr(s.stop - s.start for s in parts),
             "THROW_NP": arr(s.stop - s.start for s in slices),
             "THROW_PARAMS": arr(s.start for s in slices),
             "THROW_STATE": arr(s.start for s in parts),
+            "THROW_TORQUE": arr(torque_at[k] for k in kinds),
             "W_MOTOR": st.start("shaft.work") if "shaft.work" in st.parts else parts[-1].stop,
         }
-        stem = f"{self.locals[0]['clearance_joints']}_{len(throws)}"
+        stem = f"{self.locals[first]['clearance_joints']}_{len(throws)}"
+        if link is not None:
+            stem += f"_ideal{kinds.count(1)}"
         if motor:
             stem += f"_motor_{self.machine.shaft.motor}".replace("-", "_")
+        if frame:
+            stem += "_frame"
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -277,13 +327,11 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         v["motor"] = machine.shaft.motor
         if shared(machine):  # its own crank; the drive's inertia is the machine's
             v["J_drive"] = 0.0
+        if held(machine):
+            v.update(motor=throw_law(machine).name, motor_torque=0.0)
     if "load" in names:
         v["load"] = throw.load
-    try:
-        out = model.parameters(v)
-    except ParameterError as exc:  # with the throw's namespace: ``throw2.rc = ...``
-        part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
-        raise ParameterError(f"{machine.prefix(part)}{exc}") from None
+    out = _validated(machine, throw, model, v)
     worn = throw.crank_joint != "ideal"  # (an ideal crank pin's rod turns with its crank)
     if shared(machine) and worn and not out["J1"] + out["m1"] * out["rs"] ** 2 > 0.0:
         raise ParameterError(
@@ -295,8 +343,25 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
 
 
 def shared(machine: Machine) -> bool:
-    """Whether the throws share a free crank's acceleration (a motor, several throws)."""
-    return machine.shaft.drive == "motor" and len(machine.throws) > 1
+    """Whether the throws share a free crank's acceleration (a motor and several throws, or
+    a held rotor: the template turns the crank, each throw's module its own crank alone)."""
+    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine))
+
+
+def held(machine: Machine) -> bool:
+    """Whether the motor is a held rotor (on a rigid shaft: its torque holds the speed)."""
+    return machine.shaft.drive == "motor" and machine.shaft.motor == "held"
+
+
+def throw_law(machine: Machine):
+    """The torque law of each throw's module on a motor: the motor's, or under a held rotor
+    (which has no torque law: its torque is the one that holds the speed) the constant
+    torque's, at 0 (`throw_contact_values`): each module then gives its crank's acceleration
+    under its own joint's and load's torque alone, which is what the template needs."""
+    from ..components.drive import CONSTANT_TORQUE
+    from .assemble import motor_of
+
+    return CONSTANT_TORQUE if held(machine) else motor_of(machine)
 
 
 #: A free crank's state names in a throw's one-throw state, then in its slice of a machine's
@@ -341,40 +406,94 @@ def joints_key(throw: Throw, local: Mapping[str, Any]) -> tuple:
 
 
 def same_joints(machine: Machine, locals_: list[dict]) -> None:
-    """Refuse, in one line, throws whose joints' configurations differ (`joints_key`)."""
-    first = joints_key(machine.throws[0], locals_[0])
-    for t, v in zip(machine.throws[1:], locals_[1:], strict=True):
+    """Refuse, in one line, contact throws whose joints' configurations differ
+    (`joints_key`); the ideal throws beside them are of one configuration by construction
+    (their load, `refusal`)."""
+    pairs = [(t, v) for t, v in zip(machine.throws, locals_, strict=True) if is_contact(t)]
+    first = joints_key(*pairs[0])
+    for t, v in pairs[1:]:
         if joints_key(t, v) != first:
             raise ParameterError(
                 f"{t.name}: its pins, guide, laws or load differ from "
-                f"{machine.throws[0].name}'s (which pins are worn, the guide's clearance, "
-                "friction_law, a contact law of a file, load): the throws of a machine share "
-                "one configuration of the joints today (their values differ freely)"
+                f"{pairs[0][0].name}'s (which pins are worn, the guide's clearance, "
+                "friction_law, a contact law of a file, load): the contact throws of a machine "
+                "share one configuration of the joints today (their values differ freely)"
             )
 
 
-def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
-                     ) -> ContactConfiguration:  # fmt: skip
-    """Resolve a machine of contact throws: each throw's one-throw vector and state, one
-    after another (module docstring); with a motor and several throws then the drive's slice
-    (its inertia ``J_drive`` and the torque law's) and the machine's work of the motor."""
+def throw_link_values(machine: Machine, throw: Throw, local: Mapping[str, Any], model
+                      ) -> dict[str, Any]:  # fmt: skip
+    """An ideal throw's values as its one-throw model of the massless link (``model``:
+    ``--model compressor``, or ``compressor-valves``) takes them, rc = 0 (validated there,
+    refused with the throw's namespace): its crank angle at ``t = 0`` the shaft's plus its
+    phase, and with a motor and several throws the drive's inertia 0 (the machine's)."""
+    names = set(model.schema.names)
+    v = {k: val for k, val in local.items() if k in names}
+    v.update(rc=0.0, theta1_0=float(local["theta1_0"]) + float(local["phase"]))
+    if "load" in names:
+        v["load"] = throw.load
+    if shared(machine):
+        v["J_drive"] = 0.0
+    if held(machine):
+        v.update(motor=throw_law(machine).name, motor_torque=0.0)
+    return _validated(machine, throw, model, v)
+
+
+def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict[str, Any]:
+    """``v`` validated by the throw's one-throw ``model``, refused with the throw's namespace
+    (``throw2.rc = ...``). A throw on the other side of the shaft (``cylinder_angle`` 180
+    deg) has its weight along its own +y: its ``g`` negated (`.assemble.throw_values`),
+    checked as the user gave it and kept negated."""
+    g = float(v.get("g", 0.0))
+    try:
+        out = model.parameters({**v, "g": -g} if g < 0.0 else v)
+    except ParameterError as exc:
+        part = "shaft" if str(exc).split(" ")[0] in SHAFT_NAMES else throw.name
+        raise ParameterError(f"{machine.prefix(part)}{exc}") from None
+    if g < 0.0:
+        out["g"] = g
+    return out
+
+
+def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None,
+                     frame: Mapping[str, Any] | None = None) -> ContactConfiguration:  # fmt: skip
+    """Resolve a machine of contact throws (and ideal ones): each throw's one-throw vector and
+    state, one after another (module docstring); with a motor and several throws then the
+    drive's slice (its inertia ``J_drive`` and the torque law's) and the machine's work of
+    the motor. ``link(throw)``: an ideal throw's one-throw model of the massless link (its
+    values ``locals_``' entry, `throw_link_values`). On a ``[frame]`` (its values ``frame``,
+    names inside ``frame.``) then the frame's slice (`recipdyn.model.frame.body.pack`), each
+    throw's crank's static moment ``m1 rs`` (part ``frame.cranks``) and the difference steps'
+    scales, and the frame's states and work integrals last."""
     from ..components.contact_model import pack
 
-    models = [one_model(t) for t in machine.throws]
-    same_joints(machine, locals_)
-    modules = [m.kernels(v) for m, v in zip(models, locals_, strict=True)]
-    assert all(m is modules[0] for m in modules), "joints_key misses a choice of the module"
+    if len(locals_) > 1:  # (one throw: nothing to compare)
+        same_joints(machine, locals_)
     pv, sv = SlicesBuilder(), SlicesBuilder()
-    chunks, scales = [], []
+    chunks, scales, modules, links = [], [], [], []
     crank = _CRANK_STATES if shared(machine) else {}
-    for t, v, model in zip(machine.throws, locals_, models, strict=True):
-        vec = pack(v, model.load_part(v))
+    link_events = False
+    for t, v in zip(machine.throws, locals_, strict=True):
+        pre = machine.prefix(t.name)
+        if is_contact(t):
+            model = one_model(t)
+            modules.append(model.kernels(v))
+            vec = pack(v, model.load_part(v))
+            names = model.states(v)
+            scales.append(fd_scales(v, len(names)))
+        else:  # an ideal throw: its one-throw configuration of the massless link
+            cfg = link(t).configuration(v)
+            links.append(cfg.kernels)
+            link_events = cfg.has_states
+            vec = cfg.params
+            names = cfg.layout.state.named()
+            assert cfg.layout.state.start("throw1.mechanism") == 0  # (theta_c, thetadot_c first)
+            scales.append(np.full(len(names), 1e-3))  # (as a contact module's other states)
         chunks.append(vec)
         pv.reserve(t.name, vec.size)
-        pre = machine.prefix(t.name)
-        names = model.states(v)
         sv.add(f"{t.name}.mechanism", ((pre + crank.get(n, n), u) for n, u in names))
-        scales.append(fd_scales(v, len(names)))
+    assert all(m is modules[0] for m in modules), "joints_key misses a choice of the module"
+    assert all(m is links[0] for m in links), "the ideal throws' modules differ"
     if shared(machine):  # the drive's inertia and torque law; the difference steps' scales
         from ..components.drive import MOTOR
         from .assemble import _torque_values, motor_of
@@ -386,21 +505,58 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
         pv.reserve("shaft", drive.size)
         sv.add("shaft.work", (("W_motor", "J"),))
         scales.append(np.ones(1))
+    if machine.frame is not None:  # (one-way: nothing before it reads it)
+        from ..frame.body import STATES as FRAME_STATES
+        from ..frame.body import WORK as FRAME_WORK
+        from ..frame.body import pack as frame_pack
+
+        chunks.append(frame_pack(machine, frame or {}))
+        pv.reserve("frame", chunks[-1].size)
+        chunks.append(np.array([float(v["m1"]) * float(v["rs"]) for v in locals_]))
+        pv.reserve("frame.cranks", chunks[-1].size)
+        sv.add("frame", ((f"frame.{s}", u) for s, u in FRAME_STATES))
+        sv.add("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK))
+        # the frame's displacements, rates and work integrals: linear in them, any step
+        scales.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
+    if shared(machine) or machine.frame is not None:
         chunks.append(np.concatenate(scales))
         pv.reserve("jacobian", chunks[-1].size)
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
     return ContactConfiguration(machine, tuple(locals_), layout,
-                                np.concatenate(chunks).astype(np.float64),
-                                modules[0])  # fmt: skip
+                                np.concatenate(chunks).astype(np.float64), modules[0],
+                                links[0] if links else None, link_events)  # fmt: skip
 
 
 @lru_cache(maxsize=32)
-def contact_configuration(machine: Machine, items: tuple) -> ContactConfiguration:
-    """The machine assembled at the validated values ``items`` (sorted pairs; remembered)."""
+def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactConfiguration:
+    """The machine assembled at the validated values ``items`` (sorted pairs; remembered);
+    ``link``: as `assemble_contact`'s."""
     from .assemble import throw_values
 
     values = dict(items)
     own = [throw_values(machine, values, k) for k in range(len(machine.throws))]
-    locals_ = [throw_contact_values(machine, t, v)
+    locals_ = [throw_contact_values(machine, t, v) if is_contact(t)
+               else throw_link_values(machine, t, v, link(t))
                for t, v in zip(machine.throws, own, strict=True)]  # fmt: skip
-    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)))
+    frame = None
+    if machine.frame is not None:
+        from .assemble import frame_values
+
+        frame = frame_values(values)
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame)
+
+
+def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:
+    """A machine of one contact throw at its validated one-throw values ``local`` (the
+    compressor's names: the family's routes ``contact`` and ``contact-valves``), assembled
+    without validating them again (remembered per values)."""
+    items = tuple(sorted(local.items()))
+    try:
+        return _one_throw_configuration(machine, items)
+    except TypeError:  # an unhashable value (a table as lists): assembled each time
+        return assemble_contact(machine, [dict(local)])
+
+
+@lru_cache(maxsize=32)
+def _one_throw_configuration(machine: Machine, items: tuple) -> ContactConfiguration:
+    return assemble_contact(machine, [dict(items)])

@@ -68,7 +68,12 @@ __all__ = [
     "ContactMachine",
     "OneThrow",
     "LINK",
+    "OneContact",
+    "ONE_THROW",
+    "one_throw",
     "LINK_VALVES",  # noqa: F822 (built on first use, __getattr__)
+    "CONTACT",  # noqa: F822
+    "CONTACT_VALVES",  # noqa: F822
     "VALVES_SCHEMA",  # noqa: F822
     "machine_schema",
     "compressor_model",
@@ -97,15 +102,16 @@ _SELECTORS = ("load", "drive", "motor", "equations")
 _CYCLE_GROUP = "cycle"
 
 
-def _throw_params(throw: Throw, shaft: Shaft) -> tuple[Param, ...]:
+def _throw_params(throw: Throw, shaft: Shaft, frame: bool = False) -> tuple[Param, ...]:
     """A throw's parameters under their local names: its configuration's (the compressor's
     schema for its load, `VALVES_SCHEMA` for the dynamic valves; a load of a user's file
     adds its own) without the shaft's, the stages' and the selectors, with its ``phase``; a
-    throw with contact joints, theirs (`.contact_throws.contact_throw_params`)."""
+    throw with contact joints, theirs (`.contact_throws.contact_throw_params`; on a
+    ``frame`` its crank's ``rs``, ``m1`` too)."""
     if throw_family(throw) == "contact":
         from .contact_throws import contact_throw_params
 
-        return contact_throw_params(throw, shaft)
+        return contact_throw_params(throw, shaft, frame)
     if throw.load == "valves":
         base = list(_valves_schema())
     else:
@@ -180,7 +186,7 @@ def machine_schema(machine: Machine) -> Schema:
                        for p in INTERSTAGE_PARAMS]  # fmt: skip
     for t in machine.throws:
         given = t.values
-        own = _throw_params(t, machine.shaft)
+        own = _throw_params(t, machine.shaft, machine.frame is not None)
         known = {p.name for p in own} | {"load_table"}
         for k in given:
             if k not in known:
@@ -543,14 +549,16 @@ class MachineModel(Model):
         return out
 
     # -- outputs -------------------------------------------------------------------------
-    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
-                ) -> dict[str, Signal]:  # fmt: skip
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray,
+                dy: np.ndarray | None = None) -> dict[str, Signal]:  # fmt: skip
         """Per throw: its crosshead's motion, rod angle, clearance state, gas force, joint and
         guide forces, and its cylinder's signals (the cycle's pressures and volumes; the
         valves' pressures, volumes, temperatures and mass flows), under its name; with a motor
         the crank's speed and acceleration, the motor's torque and work, each throw's gas work
         and the machine's energy. The crank angle, speed and gas forces come from the
-        compiled observer: the functions that were integrated."""
+        compiled observer: the functions that were integrated. ``dy``: the derivatives at
+        ``y`` when they are not this model's own (a throw's slice of a machine whose crank
+        other throws share, `ContactMachine`); by default its right-hand side's."""
         from .. import valves as va
         from ..base import Signal, rhs_series
         from ..components.load import cycle_outputs
@@ -560,7 +568,8 @@ class MachineModel(Model):
         st, ov = c.layout.state, c.layout.outputs
         t = np.ascontiguousarray(t, dtype=np.float64)
         y = np.ascontiguousarray(y, dtype=np.float64)
-        dy = rhs_series(c.kernels.rhs, c.params, t, y)
+        if dy is None:
+            dy = rhs_series(c.kernels.rhs, c.params, t, y)
         obs = c.kernels.observe(t, y, c.params)
         w1 = obs[:, ov["omega1"]]
         motor = c.motor is not None
@@ -615,8 +624,11 @@ class MachineModel(Model):
                                        "phase - cylinder_angle)")  # fmt: skip
                 own.update(_shaking(p, kin, fg, wk, ak, th, shake))
             if frame is not None:
+                from ..mechanism.shaking import throw_shaking
+
                 own.update(frame.at_guide(th, own["a"].values))
-                frame.throws.append((p, own["frame_a"].values, kin, wk, ak))
+                frame.throws.append((p.m1 + p.m2 + p.m3, own["frame_a"].values,
+                                     throw_shaking(p, kin, wk, ak)[0]))  # fmt: skip
             out.update({pre + name: sig for name, sig in own.items()})
         if motor:
             out.update({
@@ -731,14 +743,24 @@ class ContactMachine(MachineModel):
             f"{len(machine.throws)} throws on one crankshaft ({machine.shaft.drive} drive), "
             "contact-impact pins"
         )
+        from .contact_throws import is_contact
+
         pre = [machine.prefix(t.name) for t in machine.throws]
-        self.section_signals = tuple((f"{q}{s}", u) for q in pre for s, u in (
-            ("ex", "m"), ("ey", "m"), ("x", "m"), ("v", "m/s"), ("a", "m/s**2")))  # fmt: skip
-        self.validity_bounds = ()
+        worn = [q for q, t in zip(pre, machine.throws, strict=True) if is_contact(t)]
+        self.section_signals = tuple((f"{q}{s}", u) for q, t in zip(pre, machine.throws,
+                                                                     strict=True)
+                                     for s, u in (*((("ex", "m"), ("ey", "m")) if is_contact(t)
+                                                    else (("theta_c", "rad"),
+                                                          ("thetadot_c", "rad/s"))),
+                                                  ("x", "m"), ("v", "m/s"),
+                                                  ("a", "m/s**2")))  # fmt: skip
+        # on a frame its one-way coupling's bound (MachineModel's), no link's
+        self.validity_bounds = tuple(b for b in self.validity_bounds
+                                     if b[0] == "frame_coupling_margin")  # fmt: skip
         self.summary_verdicts = tuple(f"{q}api618_pin_reversal" for q in pre)
-        self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in pre)
+        self.mean_signals = tuple((f"{q}contact", f"{q}contact_fraction", "1") for q in worn)
         self.max_signals = tuple((f"{q}eccentricity_ratio", f"{q}max_eccentricity_ratio", "1")
-                                 for q in pre)  # fmt: skip
+                                 for q in worn)  # fmt: skip
         self.event_example = {
             "shaft.omega" if not machine.flat else "omega": 150.0,
             **{
@@ -747,11 +769,23 @@ class ContactMachine(MachineModel):
                 if t.load == "paper"
             },
         }
-        if len(machine.throws) > 1:
+        # (the reason, said when `lyapunov_supported` is False)
+        self.lyapunov_refusal = next(
+            (m.lyapunov_refusal for m in map(_one_model, machine.throws) if m.lyapunov_refusal),
+            "",
+        )
+        if machine.frame is not None:
             self.lyapunov_refusal = (
-                "the recorded approach velocities of all but the last throw sit among the "
-                "degrees of freedom of a machine of several contact throws (Benettin's method "
-                "would count them); one throw: --model compressor-contact"
+                "Lyapunov exponents of contact throws on a [frame] are not offered yet (the "
+                "frame's states as passive components are checked for ideal throws only); "
+                "offered without the [frame], or with ideal throws"
+            )
+        elif len(machine.throws) > 1 and machine.shaft.drive == "motor":
+            self.lyapunov_refusal = (
+                "each throw of a machine of several contact throws on a motor carries its own "
+                "copy of the crank's angle and speed (one degree of freedom, counted once per "
+                "throw: Benettin's method would add a spurious exponent for each); offered "
+                "with drive = 'prescribed' or one throw"
             )
 
     def contact(self, values: Mapping[str, Any]) -> ContactConfiguration:
@@ -759,7 +793,8 @@ class ContactMachine(MachineModel):
         `.contact_throws.contact_configuration`)."""
         from .contact_throws import contact_configuration
 
-        return contact_configuration(self.structure(values), tuple(sorted(values.items())))
+        return contact_configuration(self.structure(values), tuple(sorted(values.items())),
+                                     _one_model)  # fmt: skip
 
     def contact_values(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
         """Each throw's values as the one-throw contact model takes them."""
@@ -768,10 +803,12 @@ class ContactMachine(MachineModel):
     # -- what MachineModel does for the massless link ----------------------------------
     def check(self, values: Mapping[str, Any]) -> None:
         """Each throw's checks (its one-throw model's), refused with its namespace."""
-        from .contact_throws import same_joints, throw_contact_values
+        from .contact_throws import is_contact, same_joints, throw_contact_values
+        from .contact_throws import throw_link_values as link
 
         machine = self.structure(values)
-        locals_ = [throw_contact_values(machine, t, v)
+        locals_ = [throw_contact_values(machine, t, v) if is_contact(t)
+                   else link(machine, t, v, _one_model(t))
                    for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
         same_joints(machine, locals_)
 
@@ -779,13 +816,19 @@ class ContactMachine(MachineModel):
         return True
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        return False
+        """The frame's one-way coupling (a machine with a frame); nothing else."""
+        return self.structure(values).frame is not None
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        """Where every throw's joints have it (`system`: each throw's recorded approach
+        velocities are auxiliary components, its work integrals passive), with a prescribed
+        crank or one throw, and no frame (`lyapunov_refusal`)."""
         machine = self.structure(values)
-        if len(machine.throws) > 1:
+        several_on_motor = len(machine.throws) > 1 and machine.shaft.drive == "motor"
+        if machine.frame is not None or several_on_motor:
             return False
-        return _one_model(machine.throws[0]).lyapunov_supported(self.contact_values(values)[0])
+        return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
+            machine.throws, self.contact_values(values), strict=True))  # fmt: skip
 
     def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
         return self.contact(values).layout.state.named()
@@ -806,24 +849,44 @@ class ContactMachine(MachineModel):
 
     def system(self, values: Mapping[str, Any]) -> AssembledSystem:
         from ..joints.pins import I_WIN, I_WLOSS, RIGID
-        from .contact_throws import shared
+        from .contact_throws import is_contact, shared
         from .system import AssembledSystem, Frozen
 
         c = self.contact(values)
         st = c.layout.state
-        passive, aux = [], ()
+        passive, aux, counters = [], (), []
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             s = st.start(f"{t.name}.mechanism")
+            if not is_contact(t):  # an ideal throw: its one-throw configuration's
+                own_c = _one_model(t).configuration(v)
+                passive += [s + i for i in own_c.passive([v])]
+                n = st.parts[f"{t.name}.mechanism"].stop - s
+                counters += range(s + n - own_c.aux_states, s + n)
+                continue
             passive += [s + i for i in (*RIGID[v["clearance_joints"]], I_WIN, I_WLOSS)]
-        own = _one_model(c.machine.throws[0]).system(c.locals[0])  # (its auxiliary states)
+        first = next(k for k, t in enumerate(c.machine.throws) if is_contact(t))
+        own = _one_model(c.machine.throws[first]).system(c.locals[first])  # (its aux states)
+        aux_states = own.aux_states
         if len(c.locals) == 1 and c.machine.shaft.drive == "motor":  # the model's own
             passive, aux = list(own.passive), own.aux
+        pre = [c.machine.prefix(t.name) for t in c.machine.throws]
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
-            pre = [c.machine.prefix(t.name) for t in c.machine.throws]
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
-            aux = tuple(sorted(st[q + n] for q, v in zip(pre, c.locals, strict=True)
-                               for i, n in ((8, "v_impact"), (9, "v_impact_crosshead"))
-                               if i not in RIGID[v["clearance_joints"]]))  # fmt: skip
+            aux_states = 1
+        if c.machine.frame is not None:  # its states and work integrals (one-way: passive)
+            for part in ("frame", "frame.work"):
+                passive += range(*st.parts[part].indices(st.size))
+        if len(c.locals) > 1 or c.machine.frame is not None:  # every throw's recorded values
+            # by index (Lyapunov's aux); the frame's states, after the throws', passive
+            recorded = set(counters)
+            for t, v in zip(c.machine.throws, c.locals, strict=True):
+                if is_contact(t):  # its one-throw model's: approach velocities, counters
+                    s = st.start(f"{t.name}.mechanism")
+                    one = own if v is c.locals[first] else _one_model(t).system(v)
+                    recorded |= {s + i for i in (*range(one.dim - one.aux_states, one.dim),
+                                                 *one.aux)}  # fmt: skip
+            aux = tuple(sorted(recorded - set(passive)))
+            aux_states = 1 if shared(c.machine) and c.machine.frame is None else 0
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -836,7 +899,7 @@ class ContactMachine(MachineModel):
             name=self.system_name(values),
             attrs=self.system_attrs(values),
             events=self.events(values),
-            aux_states=1 if shared(c.machine) else own.aux_states,
+            aux_states=aux_states,
             aux=aux,
             passive=tuple(sorted(passive)),
             model=self,
@@ -847,17 +910,21 @@ class ContactMachine(MachineModel):
         """Each throw's one-throw initial state (the pin along its rod load at its own crank
         angle, `CompressorContact.initial_state`); with several throws each recorded approach
         velocity carries its pin's phase (+ in contact, - in free flight)."""
+        from .contact_throws import is_contact
+
         c = self.contact(values)
         parts = []
         for t, v in zip(c.machine.throws, c.locals, strict=True):
             model = _one_model(t)
             y = model.initial_state(v)
-            if len(c.locals) > 1 and not model.tracks_separations(v):
+            if is_contact(t) and len(c.locals) > 1 and not model.tracks_separations(v):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
         if "shaft.work" in c.layout.state.parts:  # the motor's work, the machine's last state
             parts.append(np.zeros(1))
+        if c.machine.frame is not None:  # the frame at rest on its mounts, its works 0
+            parts.append(np.zeros(8))
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -867,28 +934,57 @@ class ContactMachine(MachineModel):
                for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
         if "shaft.work" in c.layout.state.parts:
             own.append(np.ones(1))
+        if c.machine.frame is not None:  # (its displacements at their own size: microns)
+            own.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
         return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
                 ) -> dict[str, Signal]:  # fmt: skip
         """Each throw's signals, the one-throw contact model's of its states (its crank angle
         its own: the shaft's plus its phase), under its name; the shaft's crank angle."""
-        from ..base import Signal
-        from .contact_throws import shared
+        from ..base import Signal, rhs_series
+        from .contact_throws import is_contact, shared
 
         c = self.contact(values)
         y = np.asarray(y, dtype=np.float64)
         out: dict[str, Signal] = {}
+        dy = None
+        frame = None
+        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None:
+            dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
+        if c.machine.frame is not None:
+            frame = _FrameRecord(c, values, y, dy)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
-            own = _one_model(th).outputs(v, t, np.ascontiguousarray(y[:, part]))
+            yk = np.ascontiguousarray(y[:, part])
+            if is_contact(th):
+                own = _one_model(th).outputs(v, t, yk)
+            else:  # an ideal throw: its one-throw model's, at the shaft's acceleration
+                own = _one_model(th).outputs(v, t, yk, None if dy is None else dy[:, part])
+                own.setdefault("theta1", Signal(
+                    yk[:, 2] if "theta1" in dict(_one_model(th).states(v)) else
+                    float(v["theta1_0"]) + float(v["omega"]) * np.asarray(t, dtype=float),
+                    "rad", "crank angle of this throw (the shaft's + phase)"))  # fmt: skip
             pre = c.machine.prefix(th.name)
+            if frame is not None:  # its accelerometer: its crosshead's + the frame's
+                own.update(frame.at_guide(th, own["a"].values))
+                own.update(_contact_shaking(c, th, v, t, y, dy))
+                frame.throws.append((float(v["m1"]) + float(v["m2"]) + float(v["m3"]),
+                                     own["frame_a"].values, own["_fx"].values))  # fmt: skip
+                del own["_fx"]
             out.update({pre + k: s for k, s in own.items()})
+        if frame is not None:
+            names = [c.machine.prefix(th.name) for th in c.machine.throws]
+            out["shake_x"] = Signal(sum(out[q + "shake_x"].values for q in names), "N",
+                                    "shaking force on the frame along x: the sum over the "
+                                    "throws of -(m1 a1 + m2 a2 + m3 a3)")  # fmt: skip
+            out.update(frame.signals())
         if shared(c.machine):
-            out.update(_shared_crank(c, values, t, y, out))
+            crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
                 for k in ("alpha1", "motor_torque", "W_motor", "omega1"):  # (the shaft's now)
                     out.pop(q + k, None)
+            out.update(crank)
         elif not c.machine.flat and c.machine.shaft.drive == "motor":  # (one throw, named)
             pre, phase = c.machine.prefix(c.machine.throws[0].name), self.throws(values)[0]["phase"]
             out["theta1"] = Signal(out[pre + "theta1"].values - float(phase), "rad",
@@ -902,10 +998,14 @@ class ContactMachine(MachineModel):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         """Each throw's figures (`CompressorContact.run_summary` of its signals and of the
         events at which its own pin changed phase), under its name."""
+        from .contact_throws import is_contact
+
         c = self.contact(values)
-        if c.machine.flat:
-            return _one_model(c.machine.throws[0]).run_summary(c.locals[0], ds)
         out: dict[str, Any] = {}
+        if "frame_feedback" in ds.variables:  # the frame on its mounts: one-way coupling
+            out["frame_feedback_ratio"] = float(np.max(ds["frame_feedback"].values))
+        if c.machine.flat:
+            return {**_one_model(c.machine.throws[0]).run_summary(c.locals[0], ds), **out}
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             pre = f"{th.name}."
             ev = f"impact_{pre}"
@@ -913,12 +1013,22 @@ class ContactMachine(MachineModel):
             for k in map(str, ds.data_vars):
                 if k.startswith(pre):
                     rename[k] = k[len(pre) :]
-                elif k.startswith(ev):
-                    rename[k] = "impact_" + k[len(ev) :]
+                elif k.startswith(ev):  # (its crank's work under its one-throw name)
+                    own = k[len(ev) :]
+                    rename[k] = "impact_" + _ONE_THROW_NAMES.get(own, own)
             view = ds[list(rename)].rename(rename).assign_attrs(ds.attrs)
+            if not is_contact(th):  # an ideal throw: its cylinder's figures and its rod load
+                own = MachineModel._throw_summary({**v, "load": th.load}, view)
+                if "api618_pin_reversal" not in own and {"theta1", "a", "gas_force"} <= set(view):
+                    from ..cycle import pin_reversal_summary
+
+                    own.update(pin_reversal_summary(v, view))
+                out.update({pre + k: val for k, val in own.items()})
+                continue
             if "impact_time" in view:  # its own events: where its reset moved its states
                 part = c.layout.state.parts[f"{th.name}.mechanism"]
                 names = [n[len(pre) :] for n in c.layout.state.names[part]]
+                names = [_ONE_THROW_NAMES.get(n, n) for n in names]
                 moved = np.column_stack(
                     [view[f"impact_{n}"].values != view[f"impact_{n}_after"].values for n in names]
                 )
@@ -930,21 +1040,79 @@ class ContactMachine(MachineModel):
         return out
 
 
+def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, Any],
+                     t: np.ndarray, y: np.ndarray, dy: np.ndarray
+                     ) -> dict[str, Signal]:  # fmt: skip
+    """A throw's shaking force on the frame (the compiled function the frame's equations read,
+    at each sample: a contact throw's `recipdyn.model.joints.pins.contact_shaking`, an ideal
+    throw's `recipdyn.model.mechanism.link_kernels.shaking`) in the frame's axes
+    (``shake_x``) and in its own along its stroke (``_fx``, for the frame's feedback)."""
+    from ..base import Signal
+    from ..frame.body import _cos_sin
+    from ..joints.pins import contact_shaking
+    from ..mechanism.link_kernels import shaking
+    from .contact_throws import is_contact
+
+    st = c.layout.state
+    part = st.parts[f"{throw.name}.mechanism"]
+    o = c.layout.params.parts[throw.name]
+    pk = c.params[o]
+    m1rs = float(local["m1"]) * float(local["rs"])
+    t = np.asarray(t, dtype=np.float64)
+    w0 = float(local["omega"])
+    fx = np.empty(t.shape[0])
+    fy = np.empty(t.shape[0])
+    motor = c.machine.shaft.drive == "motor"
+    link = None if is_contact(throw) else c.link_module
+    crank = int(c.throw_module.M if link is None else getattr(link, "CRANK", 0))
+    for i in range(t.shape[0]):
+        yk, dk = y[i, part], dy[i, part]
+        if motor:
+            th, w, a = yk[crank], yk[crank + 1], dk[crank + 1]
+        else:
+            th, w, a = float(local["theta1_0"]) + w0 * t[i], w0, 0.0
+        if link is None:
+            fx[i], fy[i] = contact_shaking(th, w, a, yk, dk, pk, m1rs)
+        else:
+            fx[i], fy[i] = shaking(th + pk[int(link.THROW_PHASE[0])], yk[0], w, yk[1], a,
+                                   dk[1], pk, int(link.THROW_MECH[0]))  # fmt: skip
+    cs, sn = _cos_sin(throw.cylinder_angle)
+    gx = cs * fx - sn * fy
+    return {"shake_x": Signal(gx, "N", "this throw's shaking force on the frame along the "
+                              "frame's x: -(m1 a1 + m2 a2 + m3 a3)"),
+            "_fx": Signal(fx, "N", "")}  # fmt: skip
+
+
+#: A throw's state in a machine whose crank several throws share, by its name in the
+#: one-throw model (`.contact_throws`: the shaft's work on its crank, there the motor's).
+_ONE_THROW_NAMES = {"W_crank": "W_motor", "W_crank_after": "W_motor_after"}
+
+
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
     """The machine's energy balance over the record, ``W_motor + sum_k W_gas,k = dE + sum_k
     W_loss,k``: its largest residual over the largest of the energy and the motor's work."""
     pre = [c.machine.prefix(th.name) for th in c.machine.throws]
     E, Wm = ds["energy"].values, ds["W_motor"].values
     Wg = sum(ds[q + "W_gas"].values for q in pre)
-    Wl = sum(ds[q + "W_loss"].values for q in pre)
+    Wl = sum(ds[q + "W_loss"].values for q in pre if q + "W_loss" in ds)  # (ideal: none)
     bal = (Wm - Wm[0]) + (Wg - Wg[0]) - (E - E[0]) - (Wl - Wl[0])
     return float(np.abs(bal).max() / max(np.abs(E).max(), np.abs(Wm).max(), 1e-300))
 
 
 def _one_model(throw: Throw):
-    from .contact_throws import one_model
+    """A throw's one-throw model: the contact joints' (`.contact_throws.one_model`), or for
+    an ideal throw beside them the massless link's (``--model compressor``, with the dynamic
+    valves ``compressor-valves``)."""
+    from .contact_throws import is_contact, one_model
 
-    return one_model(throw)
+    if is_contact(throw):
+        return one_model(throw)
+    return _link_valves_model() if throw.load == "valves" else LINK
+
+
+@lru_cache(maxsize=1)
+def _link_valves_model() -> OneThrow:
+    return _link_valves()
 
 
 def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndarray,
@@ -1075,15 +1243,13 @@ class _FrameRecord:
         ``(m1 + m2 + m3) |a_f|`` over the throw's largest shaking force along its stroke)."""
         from ..base import Signal
         from ..frame.body import FEEDBACK_LIMIT, energy
-        from ..mechanism.shaking import throw_shaking
 
         mounts = -(self.q @ self.K.T + self.qd @ self.C.T)
         feedback = np.zeros(self.q.shape[0])
-        for p, fa, kin, w1, a1 in self.throws:
-            fx, _ = throw_shaking(p, kin, w1, a1)
+        for mass, fa, fx in self.throws:  # (each throw's moving mass, frame_a, shaking F_x)
             top = float(np.max(np.abs(fx)))
             if top > 0.0:
-                feedback = np.maximum(feedback, (p.m1 + p.m2 + p.m3) * np.abs(fa) / top)
+                feedback = np.maximum(feedback, mass * np.abs(fa) / top)
         return {
             "frame_energy": Signal(energy(self.M, self.K, self.q, self.qd), "J", "the frame's "
                                    "kinetic energy + its mounts' strain energy"),
@@ -1353,11 +1519,180 @@ def _link_valves() -> OneThrow:
     )
 
 
+class OneContact(ContactMachine):
+    """The compressor of one throw with contact-impact or lubricated pins or the guide's
+    clearance, as ``--model compressor`` takes it (routes ``contact`` and ``contact-valves``
+    of `recipdyn.model.family`; the presets ``compressor-contact``,
+    ``compressor-contact-valves``, ``compressor-guide``): the machine of one contact throw
+    its selectors choose (``crank_joint``, ``crosshead_joint``, ``guide``, ``load``,
+    ``drive``, ``motor``), under the compressor's names, so every record, config and sweep
+    store made before still runs with the same values.
+
+    Its system is the assembler's (`.contact_throws.one_throw_configuration`: the throw's
+    slice of the parameter vector and of the state, the kernels of its joints'
+    configuration, template ``contact``); with one throw the template ``contact_throws``
+    calls those kernels on the whole vector and adds nothing, so the machine's kernels are
+    the throw's module itself (no second module to compile: tests/test_contact_throws.py
+    checks a machine file of one throw through ``contact_throws`` against this, to the bit).
+    What a throw's values mean (schema, checks, packing, states, signals, summary, events)
+    is its joints' configuration part (`.contact_throws.joints_part`), as for every throw of
+    a `ContactMachine`."""
+
+    def __init__(self, valves: bool = False) -> None:
+        from .contact_throws import joints_part
+
+        part = joints_part(valves)
+        self.part = part
+        self.valves = valves
+        self.machine = Machine(name=part.name, description=part.description)
+        self.name, self.description, self.schema = part.name, part.description, part.schema
+        for k in ("state_names", "state_units", "section_signals", "vibration_signal",
+                  "section_pair", "summary_verdicts", "event_example", "mean_signals",
+                  "max_signals", "lyapunov_refusal", "validity_bounds"):  # fmt: skip
+            setattr(self, k, getattr(part, k))
+
+    # the declarations are the part's (class values of the contact joints: no assembly)
+    state_names = ()  # type: ignore[assignment]
+    state_units = ()  # type: ignore[assignment]
+
+    def structure(self, values: Mapping[str, Any]) -> Machine:
+        """The machine of one throw at ``values`` (its pins, guide, load and drive)."""
+        from ..components.contact_model import joint_types
+
+        crank, cross = joint_types(values)
+        load = "valves" if self.valves else values.get("load", "paper")
+        throw = Throw(crank_joint=crank, crosshead_joint=cross,
+                      guide=values.get("guide", "ideal"),
+                      load=load if isinstance(load, str) else "paper")  # fmt: skip
+        shaft = Shaft(drive=values.get("drive", "prescribed"),
+                      motor=values.get("motor", "induction"))  # fmt: skip
+        return _one_throw(self.name, self.description, throw, shaft)
+
+    def contact(self, values: Mapping[str, Any]) -> ContactConfiguration:
+        """The machine of one throw assembled at validated ``values``."""
+        from .contact_throws import one_throw_configuration
+
+        return one_throw_configuration(self.structure(values), values)
+
+    def throws(self, values: Mapping[str, Any]) -> list[dict[str, Any]]:
+        return [{**values, "phase": 0.0}]
+
+    # -- the system: the assembler's ---------------------------------------------------
+    def system(self, values: Mapping[str, Any]) -> AssembledSystem:
+        """The assembled machine's parameter vector, state layout and kernels; the tangent
+        space's declarations (auxiliary and passive states) the joints' configuration's."""
+        from .system import AssembledSystem, Frozen
+
+        c = self.contact(values)
+        k = c.throw_module  # (one throw: the machine's kernels, class docstring)
+        own = self.part.tangent(values)
+        names, units = zip(*c.layout.state.named(), strict=True)
+        return AssembledSystem(
+            rhs=k.rhs,
+            jac=k.jac,
+            rhs_jac=own["rhs_jac"] and k.rhs_jac,
+            params=c.params,
+            state_names=names,
+            state_units=units,
+            period=own["period"],
+            name=self.name,
+            events=self.events(values),
+            aux_states=own["aux_states"],
+            aux=own["aux"],
+            passive=own["passive"],
+            model=self,
+            values=Frozen(values),
+        )
+
+    def events(self, values: Mapping[str, Any]) -> tuple[Event, ...]:
+        return self.part.events(values)
+
+    def states(self, values: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+        return self.part.states(values)
+
+    # -- what a throw's values mean: its joints' configuration part ---------------------
+    def schema_for(self, values: Mapping[str, Any]) -> Schema:
+        return self.part.schema_for(values)
+
+    def parameters(self, values: Mapping[str, Any] | Any | None = None, **kw: Any
+                   ) -> dict[str, Any]:  # fmt: skip
+        return self.part.parameters(values, **kw)
+
+    def check(self, values: Mapping[str, Any]) -> None:
+        self.part.check(values)
+
+    def period(self, values: Mapping[str, Any]) -> float:
+        return self.part.period(values)
+
+    def section_angle(self, values: Mapping[str, Any]) -> str | None:
+        return self.part.section_angle(values)
+
+    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
+        return self.part.has_dynamics(values)
+
+    def validity_applies(self, values: Mapping[str, Any]) -> bool:
+        return self.part.validity_applies(values)
+
+    def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
+        return self.part.lyapunov_supported(values)
+
+    def identity_values(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        return self.part.identity_values(values)
+
+    def law_range(self, values: Mapping[str, Any], ds: Any) -> str:
+        return self.part.law_range(values, ds)
+
+    def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
+        return self.part.initial_state(values)
+
+    def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
+        return self.part.state_scale(values)
+
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
+                ) -> dict[str, Signal]:  # fmt: skip
+        return self.part.outputs(values, t, y)
+
+    def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
+        return self.part.run_summary(values, ds)
+
+    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
+                     ) -> dict[str, Any]:  # fmt: skip
+        return self.part.record_attrs(values, y0)
+
+    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
+        return self.part.values_from_record(attrs)
+
+    # -- what the joints' kernels offer beyond the protocol ---------------------------
+    def kernels(self, values: Mapping[str, Any]):
+        """The compiled kernels at validated ``values`` (the throw's module)."""
+        return self.contact(values).throw_module
+
+    def load_part(self, values: Mapping[str, Any]):
+        return self.part.load_part(values)
+
+    def tracks_separations(self, values: Mapping[str, Any]) -> bool:
+        return self.part.tracks_separations(values)
+
+
+#: The compressor of one throw by route (`recipdyn.model.family.route`: which machine the
+#: selectors describe): every configuration of ``--model compressor`` is one of these.
+ONE_THROW = {"link": "LINK", "link-valves": "LINK_VALVES", "contact": "CONTACT",
+             "contact-valves": "CONTACT_VALVES"}  # fmt: skip
+
+
+def one_throw(route: str) -> MachineModel:
+    """The machine of one throw of route ``route`` (`ONE_THROW`; built when first asked
+    for)."""
+    name = ONE_THROW[route]
+    return globals()[name] if name in globals() else __getattr__(name)
+
+
 def __getattr__(name: str):
     if name == "VALVES_SCHEMA":
         return _valves_schema()
-    if name == "LINK_VALVES":
-        globals()[name] = _link_valves()
+    if name in ("LINK_VALVES", "CONTACT", "CONTACT_VALVES"):
+        globals()[name] = (_link_valves() if name == "LINK_VALVES"
+                           else OneContact(valves=name == "CONTACT_VALVES"))  # fmt: skip
         return globals()[name]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

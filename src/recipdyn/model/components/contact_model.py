@@ -1,10 +1,13 @@
-r"""The contact-impact joints at the pins as a model: what its models share.
+r"""The contact-impact joints at the pins: the joints' configuration part of a throw.
 
-`compressor-contact` (`recipdyn.model.compressor_contact`: a load without states) and
-`compressor-contact-valves` (`recipdyn.model.compressor_contact_valves`: the cylinder gas
-with dynamic valves as states) are the same joints with the same parameters, packing,
-generated glue, outputs and summaries: `CompressorContact` holds them (the second model
-overrides what its load's states change). The compiled parts are
+A throw with a contact or lubricated pin, or the guide's clearance, is one configuration of
+these joints: `CompressorContact` holds what its values mean (schema, checks, packing,
+states, the generated glue's bindings, outputs, summaries) and `.contact_valves_model`
+overrides what the dynamic valves' states change. The one assembler builds the machines from
+them: the family's one-throw machine (``compressor-contact``, ``compressor-contact-valves``,
+``compressor-guide``: `recipdyn.model.assembler.model.OneContact`) and a machine's contact
+throws (`recipdyn.model.assembler.contact_throws`); neither class is a registered model. The
+derivations are `recipdyn.model.compressor_contact`, the compiled parts
 `recipdyn.model.joints.pins`, the kernels' templates `recipdyn.model.assembler.templates.joints`
 (the joints' forces, one module per contact law) and `.contact` (one per configuration).
 """
@@ -918,57 +921,49 @@ class CompressorContact(Model):
         return (self.lyapunov_refusal == GUIDE_REFUSAL and not has_guide(values)
                 and stateful_user_load(values) is None)  # fmt: skip
 
-    def _motor_system(self, values: Mapping[str, Any]) -> ODESystem:
-        """The joints with the crank free: autonomous, the crank's states last. The approach
-        velocities (8, 9) are auxiliary, not passive: the damping law reads them, so their
-        tangent components must follow the flow through each onset's saltation matrix (held
-        at 0, the tangent flow missed that dependence: off by several times its size after
-        twelve impacts, tests/test_motor_lyapunov.py). The work integrals, the motor's
-        included, are passive: nothing depends on them, and a component that acts on nothing
-        but is rescaled with the vectors each interval grows without bound along a
-        contracting one (the motor's work overflowed Benettin's vectors within a
-        revolution)."""
-        k = self.kernels(values)
-        names, units = zip(*self.states(values), strict=True)
+    def tangent(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """What the system says of its states beyond their names (`system`; the family's
+        assembled one-throw machine takes it from here too): ``rhs_jac`` (whether the
+        kernels' fused right-hand side and Jacobian is used), ``period`` (None with a motor:
+        autonomous), ``aux_states`` (the last auxiliary states), ``aux`` and ``passive``.
+
+        With a motor the approach velocities (8, 9) are auxiliary, not passive: the damping
+        law reads them, so their tangent components must follow the flow through each
+        onset's saltation matrix (held at 0, the tangent flow missed that dependence: off by
+        several times its size after twelve impacts, tests/test_motor_lyapunov.py). The work
+        integrals, the motor's included, are passive: nothing depends on them, and a
+        component that acts on nothing but is rescaled with the vectors each interval grows
+        without bound along a contracting one (the motor's work overflowed Benettin's vectors
+        within a revolution)."""
         rigid = RIGID[values["clearance_joints"]]
-        # the guide's corners' phases (not its lateral position and tilt), a load's states
-        corners = range(G_GUIDE + 4, G_GUIDE + N_GUIDE_STATES) if has_guide(values) else ()
-        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
-                         params=pack(values, self.load_part(values)), state_names=names,
-                         state_units=units, period=None, name=self.name,
-                         events=self.events(values), aux_states=1,
-                         aux=tuple(i for i in (8, 9) if i not in rigid),
-                         passive=(*rigid, I_WIN, I_WLOSS, *corners,
-                                  *range(first_load_state(values), len(names) - 3),
-                                  len(names) - 1))  # fmt: skip
+        if has_motor(values):  # the crank's states last; the guide's corners' phases (not
+            # its lateral position and tilt) and a load's states passive
+            n = len(self.states(values))
+            corners = range(G_GUIDE + 4, G_GUIDE + N_GUIDE_STATES) if has_guide(values) else ()
+            return {"rhs_jac": True, "period": None, "aux_states": 1,
+                    "aux": tuple(i for i in (8, 9) if i not in rigid),
+                    "passive": (*rigid, I_WIN, I_WLOSS, *corners,
+                                *range(first_load_state(values), n - 3), n - 1)}  # fmt: skip
+        load = stateful_user_load(values)
+        if load is not None or has_guide(values):  # a load's states after the joints' (and
+            # the guide's)
+            return {"rhs_jac": True, "period": self.period(values),
+                    "aux_states": 4 if load is None else len(load.aux_states), "aux": (),
+                    "passive": (*rigid, 8, 9, I_WIN, I_WLOSS)}  # fmt: skip
+        return {"rhs_jac": True, "period": self.period(values), "aux_states": 4, "aux": (),
+                "passive": (*rigid, I_WIN, I_WLOSS)}  # fmt: skip
 
     def system(self, values: Mapping[str, Any]) -> ODESystem:
-        if has_motor(values):
-            return self._motor_system(values)
+        """The joints' kernels on their packed values (`tangent`: what the system says of
+        its states)."""
         k = self.kernels(values)
-        load = stateful_user_load(values)
-        if load is not None:  # its states after the joints' (and the guide's)
-            names, units = zip(*self.states(values), strict=True)
-            return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
-                             params=pack(values, self.load_part(values)), state_names=names,
-                             state_units=units, period=self.period(values), name=self.name,
-                             events=self.events(values), aux_states=len(load.aux_states),
-                             passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN,
-                                      I_WLOSS))  # fmt: skip
-        if has_guide(values):
-            names, units = zip(*self.states(values), strict=True)
-            return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
-                             params=pack(values, self.load_part(values)), state_names=names,
-                             state_units=units, period=self.period(values), name=self.name,
-                             events=self.events(values), aux_states=4,
-                             passive=(*RIGID[values["clearance_joints"]], 8, 9, I_WIN,
-                                      I_WLOSS))  # fmt: skip
-        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac,
-                         params=pack(values, self.load_part(values)),
-                         state_names=self.state_names,
-                         state_units=self.state_units, period=self.period(values),
-                         name=self.name, events=self.events(values), aux_states=4,
-                         passive=(*RIGID[values["clearance_joints"]], I_WIN, I_WLOSS))  # fmt: skip
+        own = self.tangent(values)
+        names, units = zip(*self.states(values), strict=True)
+        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac if own["rhs_jac"] else None,
+                         params=pack(values, self.load_part(values)), state_names=names,
+                         state_units=units, period=own["period"], name=self.name,
+                         events=self.events(values), aux_states=own["aux_states"],
+                         aux=own["aux"], passive=own["passive"])  # fmt: skip
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         """Both eccentricities along the rod load as the massless link's equilibrium (rod in

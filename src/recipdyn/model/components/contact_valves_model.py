@@ -1,7 +1,33 @@
-r"""The model of the contact joints with the dynamic valves, shared by the model modules that
-use it: ``compressor-contact-valves`` (`recipdyn.model.compressor_contact_valves`, whose
-docstring describes it) and a machine's throws with contact crank pins and the dynamic valves
-(`recipdyn.model.assembler.contact_throws`).
+r"""The contact joints driven by the cylinder gas with dynamic valves: the joints'
+configuration part of a throw with ``crank_joint`` (or ``crosshead_joint``, ``guide``) worn
+and ``load = valves`` (``compressor-contact-valves``, the family's route ``contact-valves``:
+`recipdyn.model.assembler.model.OneContact`; a machine's throws,
+`recipdyn.model.assembler.contact_throws`).
+
+The contact joints (`recipdyn.model.compressor_contact`: journal free in its bearing, flight,
+impacts, friction, oil film) with the gas load of `valves`: the chamber pressures and masses
+and the valve plates are states integrated with the eccentricities, the chamber volumes follow
+the crosshead of the joint's own state, and the gas force follows the pressures (the load
+component `recipdyn.model.components.load.VALVES`, a load with states, joined to the joints by
+the generated glue of `recipdyn.model.components.contact`). This is the pairing the double-
+acting cycle needs: its rod load reverses twice a revolution, where the massless link of
+``compressor-valves`` leaves its validity and the journal really crosses its clearance.
+
+State: the contact model's twelve (``ex ... W_loss``), then the twelve gas states and the four
+mass counters of `valves` (with a motor, then the crank's ``theta1, omega1, W_motor``).
+
+Events: the integrator locates one event function, so the contact onsets and separations and
+the valve impacts share one: the minimum of the joints' phased contact factors
+(`phased_factor`) and the valves' normalised distances to the stop
+each moving plate moves toward. Every factor is positive between its events and falls through
+0 at one, and its reset makes it positive again (a joint changes phase, an onset recording the
+approach velocity; a plate rebounds or rests), so the minimum falls through 0 at each event and
+two events however close are both located (a product of signed factors would lose both
+events of a pair closer than a quarter step).
+
+The Jacobian is a fourth-order central difference over the whole state (the valve laws are
+not written for the contact model's complex-step Jacobian); Benettin's method is refused as
+for the massless link with dynamic valves.
 """
 
 from __future__ import annotations
@@ -101,18 +127,23 @@ class CompressorContactValves(cm.CompressorContact):
         joints', the guide's with its clearance; with a motor the crank's follow)."""
         return _GAS
 
-    def system(self, values: Mapping[str, Any]) -> ODESystem:
+    def tangent(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """With a motor the contact model's; else the valves' mass counters the last
+        auxiliary states, no fused Jacobian."""
         if cm.has_motor(values):
-            return self._motor_system(values)
+            return super().tangent(values)
+        return {"rhs_jac": False, "period": self.period(values), "aux_states": va.N_AUX,
+                "aux": (), "passive": ()}  # fmt: skip
+
+    def system(self, values: Mapping[str, Any]) -> ODESystem:
         k = self.kernels(values)
-        if cm.has_guide(values):
-            names, units = zip(*self.states(values), strict=True)
-            return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=names,
-                             state_units=units, period=self.period(values), name=self.name,
-                             events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
-        return ODESystem(rhs=k.rhs, jac=k.jac, params=pack(values), state_names=STATE_NAMES,
-                         state_units=STATE_UNITS, period=self.period(values), name=self.name,
-                         events=self.events(values), aux_states=va.N_AUX)  # fmt: skip
+        own = self.tangent(values)
+        names, units = zip(*self.states(values), strict=True)
+        return ODESystem(rhs=k.rhs, jac=k.jac, rhs_jac=k.rhs_jac if own["rhs_jac"] else None,
+                         params=pack(values), state_names=names, state_units=units,
+                         period=own["period"], name=self.name, events=self.events(values),
+                         aux_states=own["aux_states"], aux=own["aux"],
+                         passive=own["passive"])  # fmt: skip
 
     def check(self, values: Mapping[str, Any]) -> None:
         super().check(self._values(values))

@@ -124,6 +124,35 @@ def _kinematics_at(th1, w, p, e1x, e1y, u1, v1, e2x, e2y, u2, v2):
     return s2, c2, th2d, v3, s1, c1
 
 
+@nb.njit(cache=True)
+def contact_shaking(th1, w, a1, y, yd, p, m1rs):
+    """A contact throw's shaking force on the frame in its own axes, ``(F_x, F_y)`` in N:
+    ``-(m1 a1 + m2 a2 + m3 a3)`` (`recipdyn.model.mechanism.shaking`), from the crank's angle
+    ``th1``, speed ``w`` and acceleration ``a1``, the throw's states ``y`` (its slice) and
+    their derivatives ``yd`` (the pins' eccentricities' accelerations ``yd[4:8]``), its
+    parameters ``p`` and its crank's static moment ``m1rs`` (``m1 rs``). An ideal guide (the
+    crosshead moves along the stroke only).
+
+    The big end is the crank pin's centre moved by the crank pin's eccentricity, ``B = r
+    e(theta1) + e1``; the rod's small end is ``(x3 + e2x, e2y - d)`` (``x3`` the crosshead
+    pin's place along the stroke), so ``l sin theta2 = e2y - d - B_y`` differentiated twice
+    gives ``theta2''`` (`_kinematics_at` the first derivative); a point ``lam`` along the rod
+    from its big end accelerates by ``B'' + lam (e(theta2))''`` and the crosshead by the small
+    end's x less ``e2x''``."""
+    r, l, ls, m2, m3 = p[P_R], p[P_L], p[P_LS], p[P_M2], p[P_M3]
+    s2, c2, th2d, _, s1, c1 = _kinematics_at(th1, w, p, y[0], y[1], y[4], y[5], y[2], y[3],
+                                             y[6], y[7])  # fmt: skip
+    bx = -r * (c1 * w * w + s1 * a1) + yd[4]
+    by = r * (c1 * a1 - s1 * w * w) + yd[5]
+    th2dd = ((yd[7] - by) / l + s2 * th2d * th2d) / c2
+    rod_x = -(s2 * th2dd + c2 * th2d * th2d)  # e(theta2)'' per unit length
+    rod_y = c2 * th2dd - s2 * th2d * th2d
+    a3 = bx + l * rod_x - yd[6]
+    fx = -(m1rs * (-c1 * w * w - s1 * a1) + m2 * (bx + ls * rod_x) + m3 * a3)
+    fy = -(m1rs * (-s1 * w * w + c1 * a1) + m2 * (by + ls * rod_y))
+    return fx, fy
+
+
 #: The first gas state and the first mass counter of a load with states (the dynamic valves),
 #: after the joints' twelve.
 G_GAS = len(STATE_NAMES)

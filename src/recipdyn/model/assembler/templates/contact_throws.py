@@ -30,13 +30,13 @@ the other throws' onsets in a minimum.
 
 With a motor (``MOTOR``) each throw's module is its joints' configuration with the crank free
 (template `contact`, the crank's angle, speed and work the last three states of its slice at
-``THROW_M``: its own angle, the shaft's plus its phase, and the shaft's speed). A machine of
+``THROW_CRANK[k]``: its own angle, the shaft's plus its phase, and the shaft's speed). A machine of
 one throw is then the one-throw module itself. With several (``SHARED``) each throw's slice
 holds its own crank's inertia (``J1 + m1 rs^2``, at ``THROW_CO``, the drive's left out) and
 the throws share the crank's acceleration: with a worn crank pin the crank and the rod are
 bodies apart, joined by the pin's force, which depends on the states only, so the throw's
 crank equation ``I_k alpha_k = T + tau_k`` (its module's, at the torque ``T`` of its torque
-law's slice ``THROW_MO``) gives the torque ``tau_k = I_k alpha_k - T`` the rod, the joint and
+law's slice ``THROW_TORQUE[k]``) gives the torque ``tau_k = I_k alpha_k - T`` the rod, the joint and
 the crank's weight put on its crank, and the crank turns as
 
     alpha = (T_m + sum_k tau_k) / (J_drive + sum_k I_k)
@@ -54,6 +54,29 @@ other accelerations fall by ``k = M_rr^-1 m_r0`` per unit of the crank's
 torque on its crank, ``T_k = T + I_k (alpha - alpha_k)``; the motor's work is the last state,
 ``W_MOTOR``. The Jacobian: fourth-order central differences of the whole right-hand side, the
 steps ``1e-5 max(|y_i|, s_i)``, the scales ``s_i`` in the parameter vector at ``SCALE``.
+A held rotor (``HELD``): the crank's acceleration 0, the motor's torque ``-sum_k tau_k``.
+
+Throws of another kind (``HAS_LINK``; ``THROW_KIND[k]`` 1): an ideal throw is its one-throw
+module of the massless link (template `prescribed` or `motor`, rc = 0), whose ``rhs``,
+``jac``, ``event`` and ``reset`` are bound as ``link_rhs``, ... and called on the throw's
+views as a contact throw's are (its events: its load's, ``LINK_EVENTS``, or none). Its crank
+angle's offset in its slice and its torque law's are ``THROW_CRANK[k]`` and
+``THROW_TORQUE[k]`` (a contact throw's: its module's ``M``, ``MO``). With a motor its module
+turns its own crank at ``alpha_k = (T + Q) / I`` (its drive's inertia 0), ``link_share`` (the
+motor template's ``share``) gives its ``(I, k)``, and the crank's composition treats it as a
+contact throw: ``tau_k = I alpha_k - T``, its clearance angle's acceleration moved by ``-k
+(alpha - alpha_k)``. Without ideal throws the ``link_*`` roles are bound to ``absent`` in
+branches on ``HAS_LINK`` that numba removes.
+
+A frame on its mounts (``FRAME``; `recipdyn.model.frame`): after the throws' derivatives (and
+the shaft's), each contact throw's shaking force from its states and its pins' accelerations
+(`recipdyn.model.joints.pins.contact_shaking`; its crank's angle, speed and acceleration the
+prescribed ones or its slice's; its crank's static moment ``m1 rs`` at ``FRAME_CRANKS + k``)
+is taken by the frame (`recipdyn.model.frame.kernels`: ``throw_load``, ``frame_rhs``; its slice
+``FRAME_PARAMS``, its states ``FRAME_STATE``, its work integrals ``FRAME_WORK``). One-way: no
+throw reads the frame's states, so the throws' Jacobian is unchanged and the frame's rows are
+central differences of the whole right-hand side (`_frame_rows`). Without a frame the
+branches on ``FRAME`` are removed.
 """
 
 import math
@@ -62,10 +85,28 @@ import numba as nb
 import numpy as np
 
 from recipdyn.model.base import EVENT_SIGNATURE, JAC_SIGNATURE, RHS_SIGNATURE, compiled
-from recipdyn.model.joints.pins import G_GUIDE, I_WIN, P_R, _flip, contact_factor, ideal_share
+from recipdyn.model.frame.kernels import frame_rhs, throw_load
+from recipdyn.model.joints.pins import (
+    G_GUIDE,
+    I_WIN,
+    P_OMEGA,
+    P_R,
+    P_TH10,
+    _flip,
+    contact_factor,
+    contact_shaking,
+    ideal_share,
+)
+from recipdyn.model.mechanism.link_kernels import shaking as link_shaking
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as link_crank
+from recipdyn.model.assembler.generate import absent as link_event
+from recipdyn.model.assembler.generate import absent as link_jac
+from recipdyn.model.assembler.generate import absent as link_reset
+from recipdyn.model.assembler.generate import absent as link_rhs
+from recipdyn.model.assembler.generate import absent as link_share
 from recipdyn.model.assembler.generate import absent as torque
 from recipdyn.model.assembler.templates.contact import event as throw_event
 from recipdyn.model.assembler.templates.contact import jac as throw_jac
@@ -73,7 +114,18 @@ from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
+FRAME = False
+FRAME_CRANKS = np.int64(0)
+FRAME_PARAMS = np.int64(0)
+FRAME_STATE = np.int64(0)
+FRAME_WORK = np.int64(0)
 HAS_GUIDE = False
+HAS_LINK = False
+HELD = False
+LINK_EVENTS = False
+LINK_MECH = np.int64(0)
+LINK_PHASE = np.int64(0)
+LINK_SHAFT = np.int64(0)
 MOTOR = False
 N_THROWS = np.int64(1)
 OWN_EVENT = True
@@ -81,12 +133,13 @@ SCALE = np.int64(33)
 SHAFT = np.int64(33)
 SHARED = False
 THROW_CO = np.int64(31)
-THROW_M = np.int64(12)
-THROW_MO = np.int64(33)
+THROW_CRANK = np.array([12], dtype=np.int64)
+THROW_KIND = np.array([0], dtype=np.int64)
 THROW_N = np.array([12], dtype=np.int64)
 THROW_NP = np.array([33], dtype=np.int64)
 THROW_PARAMS = np.array([0], dtype=np.int64)
 THROW_STATE = np.array([0], dtype=np.int64)
+THROW_TORQUE = np.array([33], dtype=np.int64)
 W_MOTOR = np.int64(12)
 # </bindings>
 
@@ -97,13 +150,55 @@ IDEAL_CRANK = CFG == 1 or CFG == 3
 
 @nb.njit(cache=True)
 def _share(y, p, k):
-    """Throw ``k``'s share of the crank's inertia beyond its crank's own, and ``k`` of its
-    other accelerations (`recipdyn.model.joints.pins.ideal_share`); none with a worn crank
-    pin."""
+    """Contact throw ``k``'s share of the crank's inertia beyond its crank's own, and ``k`` of
+    its other accelerations (`recipdyn.model.joints.pins.ideal_share`); none with a worn
+    crank pin."""
     if IDEAL_CRANK:
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
-        return ideal_share(y[s : s + n], p[o : o + m], CFG, HAS_GUIDE, THROW_M, G_GUIDE)
+        return ideal_share(y[s : s + n], p[o : o + m], CFG, HAS_GUIDE, THROW_CRANK[k], G_GUIDE)
     return 0.0, 0.0, 0.0, 0.0
+
+
+@nb.njit(cache=True)
+def _is_link(k):
+    """Whether throw ``k`` is an ideal (link family) throw (``THROW_KIND`` 1)."""
+    return HAS_LINK and THROW_KIND[k] == 1
+
+
+@nb.njit(cache=True)
+def _inertia(y, p, k):
+    """Throw ``k``'s share of the crank's inertia and the coefficients of its accelerations
+    on the crank's: a contact throw's crank's own (at ``THROW_CO``) and its rod's with an
+    ideal crank pin (`_share`); an ideal throw's ``(I, k)`` of its equations (its module's
+    ``share``: the massless link's ``free_contribution``)."""
+    if HAS_LINK:
+        if THROW_KIND[k] == 1:
+            s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+            i_k, c_k = link_share(y[s : s + n], p[o : o + m], 0)
+            return i_k, c_k, 0.0, 0.0
+    share = _share(y, p, k)
+    return p[THROW_PARAMS[k] + THROW_CO] + share[0], share[1], share[2], share[3]
+
+
+@nb.njit(cache=True)
+def _correct(y, p, out, k, share, da):
+    """Throw ``k``'s own accelerations moved from its crank's acceleration at its own torque
+    alone to the shaft's, ``da`` more (module docstring)."""
+    s, o = THROW_STATE[k], THROW_PARAMS[k]
+    if _is_link(k):  # its clearance angle's: theta_c'' = c - k alpha
+        out[s + 1] -= share[1] * da
+    elif CFG == 3:  # the guide's lateral position alone
+        out[s + G_GUIDE + 2] -= share[1] * da
+    elif CFG == 1:  # the crosshead pin (and the guide's lateral position)
+        out[s + 6] -= share[1] * da
+        out[s + 7] -= share[2] * da
+        if HAS_GUIDE:
+            out[s + G_GUIDE + 2] -= share[3] * da
+    else:  # the crank pin's eccentricity: the rod's big end does not depend on alpha
+        th = y[s + THROW_CRANK[k]]
+        r = p[o + P_R]
+        out[s + 4] += r * math.sin(th) * da
+        out[s + 5] -= r * math.cos(th) * da
 
 
 @nb.njit(cache=True)
@@ -111,37 +206,39 @@ def _shaft(y, p, out):
     """With a motor and several throws: the crank's acceleration from the throws' torques on
     their cranks, and each throw's derivatives at it (module docstring); ``out`` holds each
     throw's own derivatives at its own crank acceleration on entry."""
-    w = y[THROW_STATE[0] + THROW_M + 1]
-    tm = torque(w, p, SHAFT + 1)
+    w = y[THROW_STATE[0] + THROW_CRANK[0] + 1]
+    tm = 0.0 if HELD else torque(w, p, SHAFT + 1)
     num = tm
     den = p[SHAFT]
     for k in range(N_THROWS):
-        s, o = THROW_STATE[k], THROW_PARAMS[k]
-        ic = p[o + THROW_CO] + _share(y, p, k)[0]
-        num += ic * out[s + THROW_M + 1] - torque(w, p, o + THROW_MO)
+        s, o, c = THROW_STATE[k], THROW_PARAMS[k], THROW_CRANK[k]
+        share = _inertia(y, p, k)
+        ic = share[0]
+        num += ic * out[s + c + 1] - torque(w, p, o + THROW_TORQUE[k])
         den += ic
-    alpha = num / den
+        if _is_link(k):  # its share held in its crank's rate and work slots until below
+            out[s + c] = ic
+            out[s + c + 2] = share[1]
+    if HELD:  # the rotor's torque is the one that holds its speed: the throws' sum's opposite
+        tm = -num
+        alpha = 0.0
+    else:
+        alpha = num / den
     for k in range(N_THROWS):
-        s, o = THROW_STATE[k], THROW_PARAMS[k]
-        share = _share(y, p, k)
-        ic = p[o + THROW_CO] + share[0]
-        da = alpha - out[s + THROW_M + 1]
-        if CFG == 3:  # the guide's lateral position alone
-            out[s + G_GUIDE + 2] -= share[1] * da
-        elif CFG == 1:  # the crosshead pin (and the guide's lateral position)
-            out[s + 6] -= share[1] * da
-            out[s + 7] -= share[2] * da
-            if HAS_GUIDE:
-                out[s + G_GUIDE + 2] -= share[3] * da
-        else:  # the crank pin's eccentricity: the rod's big end does not depend on alpha
-            th = y[s + THROW_M]
-            r = p[o + P_R]
-            out[s + 4] += r * math.sin(th) * da
-            out[s + 5] -= r * math.cos(th) * da
-        tk = torque(w, p, o + THROW_MO) + ic * da  # the shaft's torque on its crank
-        out[s + I_WIN] += ic * da * w
-        out[s + THROW_M + 1] = alpha
-        out[s + THROW_M + 2] = tk * w
+        s, o, c = THROW_STATE[k], THROW_PARAMS[k], THROW_CRANK[k]
+        if _is_link(k):  # (its share, held above; its crank's rate back: the speed)
+            share = (out[s + c], out[s + c + 2], 0.0, 0.0)
+            out[s + c] = y[s + c + 1]
+        else:
+            share = _inertia(y, p, k)
+        ic = share[0]
+        da = alpha - out[s + c + 1]
+        _correct(y, p, out, k, share, da)
+        tk = torque(w, p, o + THROW_TORQUE[k]) + ic * da  # the shaft's torque on its crank
+        if not _is_link(k):  # (the joint's work integral holds the shaft's work on it)
+            out[s + I_WIN] += ic * da * w
+        out[s + c + 1] = alpha
+        out[s + c + 2] = tk * w
     out[W_MOTOR] = tm * w
 
 
@@ -149,9 +246,62 @@ def _shaft(y, p, out):
 def _rhs(t, y, p, out):
     for k in range(N_THROWS):
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        if HAS_LINK:
+            if THROW_KIND[k] == 1:
+                link_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
+                continue
         throw_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
     if SHARED:
         _shaft(y, p, out)
+    if FRAME:
+        _frame(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def _frame(t, y, p, out):
+    """The frame's derivatives: every throw's shaking force (`contact_shaking`, from its
+    states and its pins' accelerations already in ``out``; its crank's static moment at
+    ``FRAME_CRANKS + k``) as generalised forces on the frame (one-way: no throw reads the
+    frame's states)."""
+    qx = 0.0
+    qpsi = 0.0
+    for k in range(N_THROWS):
+        s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        pk = p[o : o + m]
+        if MOTOR:  # its own crank's angle, the shaft's speed and acceleration
+            c = THROW_CRANK[k]
+            th, w, a = y[s + c], y[s + c + 1], out[s + c + 1]
+        else:
+            w = pk[P_OMEGA]
+            th, a = pk[P_TH10] + w * t, 0.0
+        if HAS_LINK:  # (pruned without ideal throws: their roles are absent then)
+            if THROW_KIND[k] == 1:
+                fx, fy = _link_shaking(t, y[s : s + n], pk, out[s : s + n], THROW_CRANK[k])
+            else:
+                fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                         p[FRAME_CRANKS + k])  # fmt: skip
+        else:
+            fx, fy = contact_shaking(th, w, a, y[s : s + n], out[s : s + n], pk,
+                                     p[FRAME_CRANKS + k])  # fmt: skip
+        gx, gpsi = throw_load(k, fx, fy, p, FRAME_PARAMS)
+        qx += gx
+        qpsi += gpsi
+    frame_rhs(qx, qpsi, y, FRAME_STATE, FRAME_WORK, p, FRAME_PARAMS, out)
+
+
+@nb.njit(cache=True)
+def _link_shaking(t, y, p, out, c):
+    """An ideal throw's shaking force in its own axes (`recipdyn.model.mechanism.link_kernels`
+    ``shaking``) on its views: its crank's angle its module's (``link_crank`` at its drive's
+    slice ``LINK_SHAFT``, or with a motor its slice's at ``c``) plus its module's phase (at
+    ``LINK_PHASE``), its clearance angle's states and acceleration (``out[1]``, at the
+    shaft's acceleration), its mechanism's slice at ``LINK_MECH``."""
+    if MOTOR:
+        th, w, a = y[c], y[c + 1], out[c + 1]
+    else:
+        th, w = link_crank(t, y, p, LINK_SHAFT)
+        a = 0.0
+    return link_shaking(th + p[LINK_PHASE], y[0], w, y[1], a, out[1], p, LINK_MECH)
 
 
 @compiled(RHS_SIGNATURE)
@@ -191,16 +341,46 @@ def jac(t, y, p, J):
     for k in range(N_THROWS):
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
         block = np.zeros((n, n))
-        throw_jac(t, y[s : s + n], p[o : o + m], block)
+        if _is_link(k):
+            if HAS_LINK:
+                link_jac(t, y[s : s + n], p[o : o + m], block)
+        else:
+            throw_jac(t, y[s : s + n], p[o : o + m], block)
         for i in range(n):
             for j in range(n):
                 J[s + i, s + j] = block[i, j]
+    if FRAME:  # its rows over every column (the throws' rows do not read the frame's states)
+        _frame_rows(t, y, p, J)
+
+
+@nb.njit(cache=True)
+def _frame_rows(t, y, p, J):
+    """The frame's rows (its states and work integrals) by the fourth-order central
+    differences of `_fd_jac` (its steps), the rest of ``J`` left as it is."""
+    n = y.shape[0]
+    yp = y.copy()
+    f = np.empty((4, n))
+    rows = np.concatenate((np.arange(FRAME_STATE, FRAME_STATE + 6),
+                           np.arange(FRAME_WORK, FRAME_WORK + 2)))  # fmt: skip
+    for k in range(n):
+        h = 1e-5 * max(abs(y[k]), p[SCALE + k])
+        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
+            yp[k] = y[k] + step
+            _rhs(t, yp, p, f[m])
+        yp[k] = y[k]
+        for i in rows:
+            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
 
 
 @nb.njit(cache=True)
 def _factor(t, y, p, k):
     """Throw ``k``'s event factor (positive between its events)."""
     s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+    if HAS_LINK:
+        if THROW_KIND[k] == 1:  # its load's events (the dynamic valves), or none
+            if LINK_EVENTS:
+                return link_event(t, y[s : s + n], p[o : o + m])
+            return np.inf
     if OWN_EVENT:
         return throw_event(t, y[s : s + n], p[o : o + m])
     return contact_factor(y[s : s + n], p[o : o + m], CFG)[0]
@@ -231,6 +411,11 @@ def reset(t, y, p, out):
         if _factor(t, y, p, k) > max(low, 0.0):
             continue
         s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        if HAS_LINK:
+            if THROW_KIND[k] == 1:
+                if LINK_EVENTS:
+                    link_reset(t, y[s : s + n], p[o : o + m], out[s : s + n])
+                continue
         if OWN_EVENT:
             throw_reset(t, y[s : s + n], p[o : o + m], out[s : s + n])
         else:

@@ -161,6 +161,18 @@ def _alpha(f, k):
 
 
 @nb.njit(cache=True)
+def share(y, p, k):
+    """Throw ``k``'s share of the crank's inertia ``I`` and the coefficient ``k`` of its
+    clearance angle's acceleration on the crank's (``theta_c'' = c - k theta1''``,
+    `free_contribution`): what a machine that hosts this module's throws beside others needs
+    to turn their common crank (template `contact_throws`)."""
+    s, m = THROW_STATE[k], THROW_MECH[k]
+    thk, wk = _crank(y[CRANK], y[CRANK + 1], y, p, k)
+    inertia, _, coef, _ = free_contribution(thk, y[s], wk, y[s + 1], _force(thk, y, p, k), p, m)
+    return inertia, coef
+
+
+@nb.njit(cache=True)
 def _rhs(t, y, p, out):
     th1 = y[CRANK]
     w1 = y[CRANK + 1]
