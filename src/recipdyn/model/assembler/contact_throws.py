@@ -49,9 +49,18 @@ massless link at rc = 0 (given by the caller, ``link(throw)``: ``--model compres
 state, its kernels that model's generated module, which the template calls on the throw's
 views by its kind (``THROW_KIND``; docs/architecture.md, "A throw of another kind").
 
+Interstage volumes (``[[interstage]]``, `recipdyn.model.components.interstage`): each volume's
+slice (its volume, cooler's temperature and gas constant) and its pressure (a state,
+``interstage1.p``) follow the throws' (and the drive's and the frame's); the template writes
+again the load's derivatives of each throw joined to one between the volume's line and its
+own slice's other line, and the volume's pressure rate from its stages' counters (template
+``contact_throws``). A fed stage's throws take the interstage's values as their suction
+line's (`.assemble.throw_values`), which their slices keep (unread by the template).
+
 Not yet (refused in one line, `refusal`): a flexible shaft, a load of a user's file or a
-table, a frame, an interstage volume, contact throws whose joints' configurations differ
-(`same_joints`), and the massless link (rc > 0) beside contact throws.
+table, the guide's clearance on a frame or with an interstage, contact throws whose joints'
+configurations differ (`same_joints`), and the massless link (rc > 0) beside contact
+throws.
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
@@ -171,9 +180,11 @@ def refusal(machine: Machine) -> str | None:
                 return (f"{where}: a [frame] with {t.name}.guide = 'clearance' is not modelled "
                         "yet; allowed on a frame: ideal guides (guide = 'ideal')")  # fmt: skip
     if machine.interstages:
-        return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
-                "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
-                "pins and guides")  # fmt: skip
+        for t in machine.throws:
+            if t.guide == "clearance":
+                return (f"{where}: an [[interstage]] with {t.name}.guide = 'clearance' is not "
+                        "modelled yet; allowed with an interstage: ideal guides (guide = "
+                        "'ideal')")  # fmt: skip
     for t in machine.throws:
         if not is_contact(t) and t.crank_joint != "ideal":
             return (f"{where}: {t.name}.crank_joint = {t.crank_joint!r} (the massless link) "
@@ -238,11 +249,14 @@ class ContactConfiguration:
             roles["torque"] = (law.module, law.kernel("torque"))
         link = self.link_module
         frame = self.machine.frame is not None
+        stages = bool(self.machine.interstages)
         for r in ("rhs", "jac", "event", "reset", "share", "crank"):
             on = link is not None and (r != "share" or shared(self.machine))
-            if r == "crank":  # (an ideal throw's crank angle on a frame, the crank prescribed)
-                on = link is not None and frame and not motor
+            if r == "crank":  # (an ideal throw's crank angle on a frame or an interstage's
+                # line, the crank prescribed)
+                on = link is not None and (frame or stages) and not motor
             roles[f"link_{r}"] = (link.__name__, r) if on else absent
+        roles.update(_interstage_roles(self.machine))
         kinds = [0 if is_contact(t) else 1 for t in throws]
         first = kinds.index(0)  # (a contact throw: the machine's family)
         phased = one_model(throws[first]).tracks_separations(self.locals[first])
@@ -250,8 +264,29 @@ class ContactConfiguration:
         crank = {0: int(m.M), 1: int(getattr(link, "CRANK", 0))}
         torque_at = {0: int(m.MO), 1: int(getattr(link, "MOTOR", 0))}
         end = slices[-1].stop
+        names = [i.name for i in self.machine.interstages]
+
+        def index(found) -> int:
+            return -1 if found is None else names.index(found.name)
+
+        def arr1(values) -> np.ndarray:  # (an empty array holds one unused -1)
+            return np.array(list(values) or [-1], dtype=np.int64)
+
+        def load_at(mod, g, a, o) -> np.ndarray:
+            return arr([int(g), int(a), int(o)]) if mod is not None else arr([0, 0, 0])
+
         constants = {
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
+            "CONTACT_LOAD": load_at(m, getattr(m, "G", 0), getattr(m, "A", 0),
+                                    getattr(m, "LO", 0)),
+            "INTERSTAGE": stages,
+            "IS_PARAM": arr1(pv.start(n) for n in names),
+            "IS_STATE": arr1(st[f"{n}.p"] for n in names),
+            "LINK_LOAD": load_at(link, *(getattr(link, k, [0])[0] for k in
+                                         ("LOAD_STATE", "LOAD_AUX", "THROW_LOAD"))),
+            "N_INTERSTAGES": len(names),
+            "THROW_IN": arr1(index(self.machine.interstage_into(t.stage)) for t in throws),
+            "THROW_OUT": arr1(index(self.machine.interstage_from(t.stage)) for t in throws),
             "FRAME": frame,
             "FRAME_CRANKS": pv.start("frame.cranks") if frame else 0,
             "FRAME_PARAMS": pv.start("frame") if frame else 0,
@@ -287,6 +322,8 @@ class ContactConfiguration:
             stem += f"_motor_{self.machine.shaft.motor}".replace("-", "_")
         if frame:
             stem += "_frame"
+        if stages:
+            stem += f"_is{len(names)}"
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -298,6 +335,22 @@ class ContactConfiguration:
             mod = generate.module(*self.bindings())
             object.__setattr__(self, "_kernels", mod)
         return mod
+
+
+def _interstage_roles(machine: Machine) -> dict[str, tuple[str, str]]:
+    """The roles of the interstage volumes and of the loads between their lines (the dynamic
+    valves': `.assemble.load_of`), absent without an interstage."""
+    from ..components.interstage import INTERSTAGE
+    from ..components.load import VALVES
+
+    names = ("load_rhs_lines", "load_lines", "load_flows", "interstage_line", "interstage_rate")
+    if not machine.interstages:
+        return dict.fromkeys(names, ("recipdyn.model.assembler.generate", "absent"))
+    return {"load_rhs_lines": (VALVES.module, VALVES.kernel("state_rhs_lines")),
+            "load_lines": (VALVES.module, VALVES.kernel("lines")),
+            "load_flows": (VALVES.module, VALVES.kernel("flows")),
+            "interstage_line": (INTERSTAGE.module, INTERSTAGE.kernel("line")),
+            "interstage_rate": (INTERSTAGE.module, INTERSTAGE.kernel("rate"))}  # fmt: skip
 
 
 def _literal(k: int):
@@ -456,7 +509,9 @@ def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict
 
 
 def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None,
-                     frame: Mapping[str, Any] | None = None) -> ContactConfiguration:  # fmt: skip
+                     frame: Mapping[str, Any] | None = None,
+                     stages: Mapping[str, Mapping[str, Any]] | None = None
+                     ) -> ContactConfiguration:  # fmt: skip
     """Resolve a machine of contact throws (and ideal ones): each throw's one-throw vector and
     state, one after another (module docstring); with a motor and several throws then the
     drive's slice (its inertia ``J_drive`` and the torque law's) and the machine's work of
@@ -464,7 +519,9 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
     values ``locals_``' entry, `throw_link_values`). On a ``[frame]`` (its values ``frame``,
     names inside ``frame.``) then the frame's slice (`recipdyn.model.frame.body.pack`), each
     throw's crank's static moment ``m1 rs`` (part ``frame.cranks``) and the difference steps'
-    scales, and the frame's states and work integrals last."""
+    scales, and the frame's states and work integrals; then per interstage volume its slice
+    (its values ``stages[name]``: ``volume``, ``cooler_temperature``; the gas constant its
+    upstream stage's) and its pressure (``interstage1.p``)."""
     from ..components.contact_model import pack
 
     if len(locals_) > 1:  # (one throw: nothing to compare)
@@ -518,7 +575,17 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
         sv.add("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK))
         # the frame's displacements, rates and work integrals: linear in them, any step
         scales.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
-    if shared(machine) or machine.frame is not None:
+    for i in machine.interstages:  # its volume, cooler's temperature, gas constant; its p
+        from ..components.interstage import INTERSTAGE
+
+        upstream = next(v for t, v in zip(machine.throws, locals_, strict=True)
+                        if t.stage == i.upstream)  # fmt: skip
+        own = dict(stages or {}).get(i.name, {})
+        chunks.append(INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}))
+        pv.reserve(i.name, chunks[-1].size)
+        sv.add(i.name, ((f"{i.name}.p", "Pa"),))
+        scales.append(np.array([1e3]))  # (a pressure: 1 kPa, at least, scales its step)
+    if shared(machine) or machine.frame is not None or machine.interstages:
         chunks.append(np.concatenate(scales))
         pv.reserve("jacobian", chunks[-1].size)
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
@@ -543,7 +610,10 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
         from .assemble import frame_values
 
         frame = frame_values(values)
-    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame)
+    stages = {i.name: {k[len(i.name) + 1 :]: v for k, v in values.items()
+                       if k.startswith(f"{i.name}.")} for i in machine.interstages}  # fmt: skip
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame,
+                            stages)
 
 
 def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:

@@ -780,6 +780,12 @@ class ContactMachine(MachineModel):
                 "frame's states as passive components are checked for ideal throws only); "
                 "offered without the [frame], or with ideal throws"
             )
+        elif machine.interstages:
+            self.lyapunov_refusal = (
+                "Lyapunov exponents of contact throws joined by an [[interstage]] are not "
+                "offered yet (checked for the massless link's throws only); offered without "
+                "the interstage, or with ideal throws"
+            )
         elif len(machine.throws) > 1 and machine.shaft.drive == "motor":
             self.lyapunov_refusal = (
                 "each throw of a machine of several contact throws on a motor carries its own "
@@ -811,6 +817,7 @@ class ContactMachine(MachineModel):
                    else link(machine, t, v, _one_model(t))
                    for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
         same_joints(machine, locals_)
+        self._check_interstages(machine, values)
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return True
@@ -825,7 +832,7 @@ class ContactMachine(MachineModel):
         crank or one throw, and no frame (`lyapunov_refusal`)."""
         machine = self.structure(values)
         several_on_motor = len(machine.throws) > 1 and machine.shaft.drive == "motor"
-        if machine.frame is not None or several_on_motor:
+        if machine.frame is not None or several_on_motor or machine.interstages:
             return False
         return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
             machine.throws, self.contact_values(values), strict=True))  # fmt: skip
@@ -925,6 +932,8 @@ class ContactMachine(MachineModel):
             parts.append(np.zeros(1))
         if c.machine.frame is not None:  # the frame at rest on its mounts, its works 0
             parts.append(np.zeros(8))
+        for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
+            parts.append(np.array([float(values[f"{i.upstream}.discharge_pressure"])]))
         return np.concatenate(parts)
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
@@ -936,6 +945,8 @@ class ContactMachine(MachineModel):
             own.append(np.ones(1))
         if c.machine.frame is not None:  # (its displacements at their own size: microns)
             own.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
+        for i in c.machine.interstages:  # (a pressure: its own size)
+            own.append(np.array([float(values[f"{i.upstream}.discharge_pressure"])]))
         return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
@@ -950,14 +961,18 @@ class ContactMachine(MachineModel):
         out: dict[str, Signal] = {}
         dy = None
         frame = None
-        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None:
+        stages = bool(c.machine.interstages)
+        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None \
+                or stages:  # fmt: skip
             dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
         if c.machine.frame is not None:
             frame = _FrameRecord(c, values, y, dy)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
             yk = np.ascontiguousarray(y[:, part])
-            if is_contact(th):
+            if is_contact(th) and stages and th.load == "valves":  # its lines: the machine's
+                own = _one_model(th).outputs(v, t, yk, np.ascontiguousarray(dy[:, part]))
+            elif is_contact(th):
                 own = _one_model(th).outputs(v, t, yk)
             else:  # an ideal throw: its one-throw model's, at the shaft's acceleration
                 own = _one_model(th).outputs(v, t, yk, None if dy is None else dy[:, part])
@@ -979,6 +994,8 @@ class ContactMachine(MachineModel):
                                     "shaking force on the frame along x: the sum over the "
                                     "throws of -(m1 a1 + m2 a2 + m3 a3)")  # fmt: skip
             out.update(frame.signals())
+        if stages:
+            out.update(_contact_interstage_outputs(c, y, dy))
         if shared(c.machine):
             crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
@@ -1086,6 +1103,38 @@ def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, 
 #: A throw's state in a machine whose crank several throws share, by its name in the
 #: one-throw model (`.contact_throws`: the shaft's work on its crank, there the motor's).
 _ONE_THROW_NAMES = {"W_crank": "W_motor", "W_crank_after": "W_motor_after"}
+
+
+def _contact_interstage_outputs(c: ContactConfiguration, y: np.ndarray, dy: np.ndarray
+                                ) -> dict[str, Signal]:  # fmt: skip
+    """`_interstage_outputs` of a machine of contact throws: each throw's mass counters at its
+    module's offset in its slice (a contact throw's ``A``, an ideal throw's ``LOAD_AUX``)."""
+    from ..base import Signal
+    from .contact_throws import is_contact
+
+    out: dict[str, Signal] = {}
+    st, pv = c.layout.state, c.layout.params
+    link = c.link_module
+    for i in c.machine.interstages:
+        pi = y[:, st[f"{i.name}.p"]]
+        vol, temp, gas_r = c.params[pv[i.name]]
+        flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
+        for t in c.machine.throws:
+            own = int(c.throw_module.A) if is_contact(t) else int(link.LOAD_AUX[0])
+            a = st.start(f"{t.name}.mechanism") + own
+            if t.stage == i.upstream:
+                flows["in"] += dy[:, a + 1] + dy[:, a + 3]
+            if t.stage == i.downstream:
+                flows["out"] += dy[:, a] + dy[:, a + 2]
+        out[f"{i.name}.p"] = Signal(pi, "Pa", f"interstage pressure: {i.upstream}'s discharge, "
+                                    f"{i.downstream}'s suction (absolute)")  # fmt: skip
+        out[f"{i.name}.mass"] = Signal(pi * vol / (gas_r * temp), "kg",
+                                       "gas mass in the interstage volume")  # fmt: skip
+        out[f"{i.name}.mdot_in"] = Signal(flows["in"], "kg/s", f"mass flow {i.upstream}'s "
+                                          "discharge valves deliver into the volume")  # fmt: skip
+        out[f"{i.name}.mdot_out"] = Signal(flows["out"], "kg/s", f"mass flow {i.downstream}'s "
+                                           "suction valves take from the volume")  # fmt: skip
+    return out
 
 
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
