@@ -15,7 +15,6 @@ into, or takes in from, the volume between two stages.
 from __future__ import annotations
 
 import dataclasses
-import math
 import warnings
 
 import numpy as np
@@ -24,7 +23,6 @@ import pytest
 from recipdyn.errors import ParameterError
 from recipdyn.model.assembler.model import ContactMachine, MachineModel
 from recipdyn.simulate import simulate
-
 from test_interstage import _machine
 
 #: The worn crank pin's radial clearance (m): small, so the machine stays near the ideal one.

@@ -277,13 +277,13 @@ class ContactConfiguration:
 
         constants = {
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
-            "CONTACT_LOAD": load_at(m, getattr(m, "G", 0), getattr(m, "A", 0),
-                                    getattr(m, "LO", 0)),
+            "CONTACT_LOAD": load_at(m, getattr(m, "G", 0), getattr(m, "A", 0), getattr(m, "LO", 0)),
             "INTERSTAGE": stages,
             "IS_PARAM": arr1(pv.start(n) for n in names),
             "IS_STATE": arr1(st[f"{n}.p"] for n in names),
-            "LINK_LOAD": load_at(link, *(getattr(link, k, [0])[0] for k in
-                                         ("LOAD_STATE", "LOAD_AUX", "THROW_LOAD"))),
+            "LINK_LOAD": load_at(
+                link, *(getattr(link, k, [0])[0] for k in ("LOAD_STATE", "LOAD_AUX", "THROW_LOAD"))
+            ),
             "N_INTERSTAGES": len(names),
             "THROW_IN": arr1(index(self.machine.interstage_into(t.stage)) for t in throws),
             "THROW_OUT": arr1(index(self.machine.interstage_from(t.stage)) for t in throws),
@@ -612,8 +612,9 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
         frame = frame_values(values)
     stages = {i.name: {k[len(i.name) + 1 :]: v for k, v in values.items()
                        if k.startswith(f"{i.name}.")} for i in machine.interstages}  # fmt: skip
-    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame,
-                            stages)
+    return assemble_contact(
+        machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame, stages
+    )
 
 
 def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:
