@@ -137,7 +137,7 @@ from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
-CONTACT_LOAD = np.array([0, 0, 0], dtype=np.int64)
+CONTACT_LOAD = np.array([12, 12, 31], dtype=np.int64)
 FRAME = False
 FRAME_CRANKS = np.int64(0)
 FRAME_PARAMS = np.int64(0)
