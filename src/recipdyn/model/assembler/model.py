@@ -893,7 +893,8 @@ class ContactMachine(MachineModel):
                     recorded |= {s + i for i in (*range(one.dim - one.aux_states, one.dim),
                                                  *one.aux)}  # fmt: skip
             aux = tuple(sorted(recorded - set(passive)))
-            aux_states = 1 if shared(c.machine) and c.machine.frame is None else 0
+            last = c.machine.frame is None and not c.machine.interstages  # (W_motor last)
+            aux_states = 1 if shared(c.machine) and last else 0
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
