@@ -156,6 +156,10 @@ def contact_throw_params(throw: Throw, shaft: Shaft | None = None, frame: bool =
         out = [p for p in out if p.group != "cycle" and p.name != "gas"]
     if throw.load != "paper":
         out = [p for p in out if p.name not in ("load_amplitude", "load_sign")]
+    if shaft is not None and shaft.torsion:  # the crankshaft section that ends at its crank
+        from ..shaft.flexible import THROW_PARAMS
+
+        out += THROW_PARAMS
     return (*out, PHASE)
 
 
@@ -170,10 +174,10 @@ def is_contact(throw: Throw) -> bool:
 def refusal(machine: Machine) -> str | None:
     """Why a machine of contact throws cannot be assembled yet (one line), or None."""
     where = f"machine {machine.name!r}"
-    if machine.shaft.torsion:
-        return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
-                "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
+    if machine.shaft.torsion and machine.shaft.motor == "held":
+        return (f"{where}: a [shaft.torsion] under a held rotor (motor = 'held') with contact "
+                "pins or the guide's clearance is not modelled yet; allowed: a motor with a "
+                "torque law ('induction', ...), or a rigid shaft")  # fmt: skip
     if machine.frame is not None:
         for t in machine.throws:
             if t.guide == "clearance":
@@ -257,6 +261,13 @@ class ContactConfiguration:
                 on = link is not None and (frame or stages) and not motor
             roles[f"link_{r}"] = (link.__name__, r) if on else absent
         roles.update(_interstage_roles(self.machine))
+        torsion = bool(self.machine.shaft.torsion)
+        roles["motor_torque"] = absent
+        if torsion:  # the rotor's torque law (each throw's module turns on a torque of 0)
+            from .assemble import motor_of
+
+            law = motor_of(self.machine)
+            roles["motor_torque"] = (law.module, law.kernel("torque"))
         kinds = [0 if is_contact(t) else 1 for t in throws]
         first = kinds.index(0)  # (a contact throw: the machine's family)
         phased = one_model(throws[first]).tracks_separations(self.locals[first])
@@ -285,6 +296,7 @@ class ContactConfiguration:
                 link, *(getattr(link, k, [0])[0] for k in ("LOAD_STATE", "LOAD_AUX", "THROW_LOAD"))
             ),
             "N_INTERSTAGES": len(names),
+            **_torsion_constants(self.machine, self.layout, crank, kinds),
             "THROW_IN": arr1(index(self.machine.interstage_into(t.stage)) for t in throws),
             "THROW_OUT": arr1(index(self.machine.interstage_from(t.stage)) for t in throws),
             "FRAME": frame,
@@ -324,6 +336,8 @@ class ContactConfiguration:
             stem += "_frame"
         if stages:
             stem += f"_is{len(names)}"
+        if torsion:
+            stem += "_torsion"
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -335,6 +349,31 @@ class ContactConfiguration:
             mod = generate.module(*self.bindings())
             object.__setattr__(self, "_kernels", mod)
         return mod
+
+
+def _torsion_constants(machine: Machine, layout: Layout, crank: Mapping[int, int],
+                       kinds: list[int]) -> dict[str, Any]:  # fmt: skip
+    """``TORSION``, the nodes' angles' states (the rotor's and flywheel's in the shaft's part,
+    then each throw's crank along the shaft, `recipdyn.model.shaft.flexible.order`), the
+    throw at each node, the slices of the sections and of the nodes' phases, the state of the
+    sections' dissipation (template ``contact_throws``)."""
+    st, pv = layout.state, layout.params
+    if not machine.shaft.torsion:
+        return {"TORSION": False, "N_NODES": 1, "NODE_ANGLE": np.zeros(1, dtype=np.int64),
+                "NODE_PHASES": 0, "NODE_THROW": np.full(1, -1, dtype=np.int64),
+                "SHAFT_DAMPING": 0, "TORSION_PARAMS": 0}  # fmt: skip
+    from ..shaft.flexible import order
+
+    along = order(machine)
+    nodes = st.start("shaft.nodes")
+    angles = [nodes, nodes + 2, *(st.start(f"{machine.throws[k].name}.mechanism")
+                                  + crank[kinds[k]] for k in along)]  # fmt: skip
+    return {"TORSION": True, "N_NODES": len(angles),
+            "NODE_ANGLE": np.array(angles, dtype=np.int64),
+            "NODE_PHASES": pv.start("shaft.phases"),
+            "NODE_THROW": np.array([-1, -1, *along], dtype=np.int64),
+            "SHAFT_DAMPING": st.start("shaft.work") + 1,
+            "TORSION_PARAMS": pv.start("shaft.torsion")}  # fmt: skip
 
 
 def _interstage_roles(machine: Machine) -> dict[str, tuple[str, str]]:
@@ -380,7 +419,7 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         v["motor"] = machine.shaft.motor
         if shared(machine):  # its own crank; the drive's inertia is the machine's
             v["J_drive"] = 0.0
-        if held(machine):
+        if held(machine) or machine.shaft.torsion:  # (its node's torques: the template's)
             v.update(motor=throw_law(machine).name, motor_torque=0.0)
     if "load" in names:
         v["load"] = throw.load
@@ -398,7 +437,8 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
 def shared(machine: Machine) -> bool:
     """Whether the throws share a free crank's acceleration (a motor and several throws, or
     a held rotor: the template turns the crank, each throw's module its own crank alone)."""
-    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine))
+    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine)
+                                               or bool(machine.shaft.torsion))  # fmt: skip
 
 
 def held(machine: Machine) -> bool:
@@ -414,7 +454,7 @@ def throw_law(machine: Machine):
     from ..components.drive import CONSTANT_TORQUE
     from .assemble import motor_of
 
-    return CONSTANT_TORQUE if held(machine) else motor_of(machine)
+    return CONSTANT_TORQUE if held(machine) or machine.shaft.torsion else motor_of(machine)
 
 
 #: A free crank's state names in a throw's one-throw state, then in its slice of a machine's
@@ -487,7 +527,7 @@ def throw_link_values(machine: Machine, throw: Throw, local: Mapping[str, Any], 
         v["load"] = throw.load
     if shared(machine):
         v["J_drive"] = 0.0
-    if held(machine):
+    if held(machine) or machine.shaft.torsion:
         v.update(motor=throw_law(machine).name, motor_torque=0.0)
     return _validated(machine, throw, model, v)
 
@@ -510,7 +550,8 @@ def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict
 
 def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None,
                      frame: Mapping[str, Any] | None = None,
-                     stages: Mapping[str, Mapping[str, Any]] | None = None
+                     stages: Mapping[str, Mapping[str, Any]] | None = None,
+                     torsion: Mapping[str, Any] | None = None
                      ) -> ContactConfiguration:  # fmt: skip
     """Resolve a machine of contact throws (and ideal ones): each throw's one-throw vector and
     state, one after another (module docstring); with a motor and several throws then the
@@ -521,7 +562,10 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
     throw's crank's static moment ``m1 rs`` (part ``frame.cranks``) and the difference steps'
     scales, and the frame's states and work integrals; then per interstage volume its slice
     (its values ``stages[name]``: ``volume``, ``cooler_temperature``; the gas constant its
-    upstream stage's) and its pressure (``interstage1.p``)."""
+    upstream stage's) and its pressure (``interstage1.p``). On a flexible shaft (its values
+    ``torsion``: the machine's namespaced ones, `recipdyn.model.shaft.flexible.pack`) the
+    rotor's and flywheel's angles and speeds (part ``shaft.nodes``) before the motor's work,
+    the sections' dissipation after it, the sections' slice and the nodes' phases."""
     from ..components.contact_model import pack
 
     if len(locals_) > 1:  # (one throw: nothing to compare)
@@ -560,8 +604,28 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
                                 law.pack(_torque_values(machine, locals_, law))])  # fmt: skip
         chunks.append(drive)
         pv.reserve("shaft", drive.size)
-        sv.add("shaft.work", (("W_motor", "J"),))
-        scales.append(np.ones(1))
+        if machine.shaft.torsion:  # the rotor's and flywheel's angles and speeds; the
+            # sections' slice and the nodes' phases (a throw's: its crank's angle less its
+            # node's); the sections' dissipation after the motor's work
+            from ..shaft.flexible import order
+            from ..shaft.flexible import pack as torsion_pack
+
+            pre = machine.prefix("shaft")
+            sv.add("shaft.nodes", (("theta1", "rad"), ("omega1", "rad/s"),
+                                   (pre + "theta_flywheel", "rad"),
+                                   (pre + "omega_flywheel", "rad/s")))  # fmt: skip
+            scales.append(np.ones(4))
+            chunks.append(torsion_pack(machine, torsion or {})[0])
+            pv.reserve("shaft.torsion", chunks[-1].size)
+            theta0 = float(torsion["theta1_0"]) if torsion else 0.0
+            chunks.append(np.array([0.0, 0.0, *(float(locals_[k]["theta1_0"]) - theta0
+                                                for k in order(machine))]))  # fmt: skip
+            pv.reserve("shaft.phases", chunks[-1].size)
+        work = (("W_motor", "J"),)
+        if machine.shaft.torsion:
+            work += ((machine.prefix("shaft") + "W_shaft_damping", "J"),)
+        sv.add("shaft.work", work)
+        scales.append(np.ones(len(work)))
     if machine.frame is not None:  # (one-way: nothing before it reads it)
         from ..frame.body import STATES as FRAME_STATES
         from ..frame.body import WORK as FRAME_WORK
@@ -612,9 +676,11 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
         frame = frame_values(values)
     stages = {i.name: {k[len(i.name) + 1 :]: v for k, v in values.items()
                        if k.startswith(f"{i.name}.")} for i in machine.interstages}  # fmt: skip
-    return assemble_contact(
-        machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame, stages
-    )
+    torsion = None
+    if machine.shaft.torsion:
+        torsion = {**values, "theta1_0": float(own[0]["theta1_0"])}
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame,
+                            stages, torsion)  # fmt: skip
 
 
 def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:

@@ -92,6 +92,21 @@ its slice at ``IS_PARAM[i]``. The gas force reads the chambers' states only, so 
 mechanisms are as before; the volumes couple the throws, so the Jacobian is then the central
 differences of the whole right-hand side (`_fd_jac`, an interstage's pressure's scale its
 slice's at ``SCALE``). Without one the branches on ``INTERSTAGE`` are removed.
+
+A torsionally flexible shaft (``TORSION``; `recipdyn.model.shaft.flexible`): the crank is a
+chain of ``N_NODES`` nodes, the motor's rotor and the flywheel (states ``NODE_ANGLE[0]``,
+``NODE_ANGLE[1]``, in the shaft's part) and each throw's crank in the order along the shaft
+(``NODE_THROW[j]``: its crank's angle and speed in its slice, at ``THROW_CRANK``). Each
+throw's module turns its own crank on a torque of 0 (as under a held rotor), so its crank
+equation ``I_k alpha_k = tau_k`` gives its own acceleration; its node's equation adds the
+sections' torques, ``I_k alpha = tau_k + T_(j-1) - T_j``, so its crank turns ``(T_(j-1) -
+T_j) / I_k`` faster and its other accelerations are corrected as on the rigid shaft
+(`_correct`). A section's twist is its nodes' angles less their phases (``NODE_PHASES + j``:
+a throw's slice holds its own angle, its node's plus its phase); its torque ``k twist + c
+twist'`` (slice ``TORSION_PARAMS``: ``J_motor``, the flywheel's inertia, then per section
+``(k, c)``); the rotor turns under the motor's torque law (``motor_torque`` at ``SHAFT + 1``),
+the sections' dissipation is the state ``SHAFT_DAMPING``. Without it the branches on
+``TORSION`` are removed.
 """
 
 import math
@@ -130,6 +145,7 @@ from recipdyn.model.assembler.generate import absent as link_share
 from recipdyn.model.assembler.generate import absent as load_flows
 from recipdyn.model.assembler.generate import absent as load_lines
 from recipdyn.model.assembler.generate import absent as load_rhs_lines
+from recipdyn.model.assembler.generate import absent as motor_torque
 from recipdyn.model.assembler.generate import absent as torque
 from recipdyn.model.assembler.templates.contact import event as throw_event
 from recipdyn.model.assembler.templates.contact import jac as throw_jac
@@ -156,10 +172,15 @@ LINK_PHASE = np.int64(0)
 LINK_SHAFT = np.int64(0)
 MOTOR = False
 N_INTERSTAGES = np.int64(0)
+N_NODES = np.int64(1)
+NODE_ANGLE = np.array([0], dtype=np.int64)
+NODE_PHASES = np.int64(0)
+NODE_THROW = np.array([-1], dtype=np.int64)
 N_THROWS = np.int64(1)
 OWN_EVENT = True
 SCALE = np.int64(33)
 SHAFT = np.int64(33)
+SHAFT_DAMPING = np.int64(0)
 SHARED = False
 THROW_CO = np.int64(31)
 THROW_CRANK = np.array([12], dtype=np.int64)
@@ -171,6 +192,8 @@ THROW_OUT = np.array([-1], dtype=np.int64)
 THROW_PARAMS = np.array([0], dtype=np.int64)
 THROW_STATE = np.array([0], dtype=np.int64)
 THROW_TORQUE = np.array([33], dtype=np.int64)
+TORSION = False
+TORSION_PARAMS = np.int64(0)
 W_MOTOR = np.int64(12)
 # </bindings>
 
@@ -285,9 +308,52 @@ def _rhs(t, y, p, out):
     if INTERSTAGE:
         _interstages(t, y, p, out)
     if SHARED:
-        _shaft(y, p, out)
+        if TORSION:
+            _torsion(y, p, out)
+        else:
+            _shaft(y, p, out)
     if FRAME:
         _frame(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def _torsion(y, p, out):
+    """On a flexible shaft: each node's acceleration from its torques (module docstring);
+    ``out`` holds each throw's own derivatives at its own crank's acceleration under a torque
+    of 0 on entry."""
+    o = TORSION_PARAMS
+    rotor = NODE_ANGLE[0]
+    tm = motor_torque(y[rotor + 1], p, SHAFT + 1)
+    loss = 0.0
+    upstream = 0.0  # the torque of the section before node j
+    for j in range(N_NODES):
+        a = NODE_ANGLE[j]
+        torque_j = 0.0
+        if j < N_NODES - 1:
+            b = NODE_ANGLE[j + 1]
+            twist = (y[a] - p[NODE_PHASES + j]) - (y[b] - p[NODE_PHASES + j + 1])
+            rate = y[a + 1] - y[b + 1]
+            kk, cc = p[o + 2 + 2 * j], p[o + 3 + 2 * j]
+            torque_j = kk * twist + cc * rate
+            loss += cc * rate * rate
+        net = upstream - torque_j
+        upstream = torque_j
+        if j < 2:  # the rotor (the motor's torque on it) and the flywheel
+            out[a] = y[a + 1]
+            out[a + 1] = (net + (tm if j == 0 else 0.0)) / p[o + j]
+            continue
+        k = NODE_THROW[j]
+        s, c = THROW_STATE[k], THROW_CRANK[k]
+        share = _inertia(y, p, k)
+        da = net / share[0]
+        _correct(y, p, out, k, share, da)
+        w = y[s + c + 1]
+        if not _is_link(k):  # (the joint's work integral holds the shaft's work on it)
+            out[s + I_WIN] += net * w
+        out[s + c + 1] += da
+        out[s + c + 2] = net * w
+    out[W_MOTOR] = tm * y[rotor + 1]
+    out[SHAFT_DAMPING] = loss
 
 
 @nb.njit(cache=True)
