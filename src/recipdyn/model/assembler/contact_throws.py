@@ -57,8 +57,14 @@ own slice's other line, and the volume's pressure rate from its stages' counters
 ``contact_throws``). A fed stage's throws take the interstage's values as their suction
 line's (`.assemble.throw_values`), which their slices keep (unread by the template).
 
-Not yet (refused in one line, `refusal`): a flexible shaft, a load of a user's file or a
-table, the guide's clearance on a frame or with an interstage, contact throws whose joints'
+On a flexible shaft (``[shaft.torsion]``, a motor) each throw's crank is its node: its module
+turns it on a torque of 0 (`throw_law`), the rotor's and flywheel's angles and speeds follow
+the throws' slices (part ``shaft.nodes``), the sections' slice and the nodes' phases are in
+the parameter vector (``shaft.torsion``, ``shaft.phases``), and the template's ``_torsion``
+gives each node its sections' torques.
+
+Not yet (refused in one line, `refusal`): a flexible shaft under a held rotor, a load of a
+user's file or a table, the guide's clearance on a frame or with an interstage, contact throws whose joints'
 configurations differ (`same_joints`), and the massless link (rc > 0) beside contact
 throws.
 
