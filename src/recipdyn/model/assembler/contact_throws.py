@@ -64,9 +64,9 @@ the parameter vector (``shaft.torsion``, ``shaft.phases``), and the template's `
 gives each node its sections' torques.
 
 Not yet (refused in one line, `refusal`): a flexible shaft under a held rotor, a load of a
-user's file or a table, the guide's clearance on a frame or with an interstage, contact throws whose joints'
-configurations differ (`same_joints`), and the massless link (rc > 0) beside contact
-throws.
+user's file or a table, the guide's clearance on a frame or with an interstage, contact
+throws whose joints' configurations differ (`same_joints`), and the massless link (rc > 0)
+beside contact throws.
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
