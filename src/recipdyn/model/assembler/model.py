@@ -1281,7 +1281,8 @@ def _torsion_crank(c: ContactConfiguration, y: np.ndarray, dy: np.ndarray,
         a, b = angles[j], angles[j + 1]
         twist = (y[:, a] - phases[j]) - (y[:, b] - phases[j + 1])
         torque = c.params[o + 2 + 2 * j] * twist + c.params[o + 3 + 2 * j] * (
-            y[:, a + 1] - y[:, b + 1])
+            y[:, a + 1] - y[:, b + 1]
+        )
         energy = energy + 0.5 * c.params[o + 2 + 2 * j] * twist**2
         sig[name + "twist"] = Signal(twist, "rad", "twist of the shaft's section: its driving "
                                      "end's angle less its driven end's")  # fmt: skip
