@@ -168,19 +168,20 @@ def test_throws_of_two_families_and_what_a_motor_does_not_take_are_refused_in_on
     """The massless link beside a contact pin, or beside an ideal crank pin with a worn
     crosshead pin (an ideal pin may stand there: tests/test_mixed_throws.py), the link with a
     worn crosshead pin, and contact throws whose
-    pins differ (a worn crosshead pin on one only); a flexible shaft with contact pins (the
-    held motor runs them: tests/test_mixed_throws.py), and on a motor a worn crank pin's
+    pins differ (a worn crosshead pin on one only); a flexible shaft under a held rotor with
+    contact pins (a flexible shaft on a motor: tests/test_contact_torsion.py; the held rotor
+    on a rigid shaft: tests/test_mixed_throws.py), and on a motor a worn crank pin's
     crank without an inertia of its own."""
     worn = Throw("throw2", crank_joint="ideal", crosshead_joint="contact")
     for throws, drive, words in (
         ((_throw("throw1"), Throw("throw2")), "prescribed", "throw2.crank_joint = 'link'"),
         ((Throw("throw1"), worn), "prescribed", "throw1.crank_joint = 'link'"),
         ((Throw("throw1", crosshead_joint="contact"),), "prescribed", "beside crank_joint"),
-        ((_throw("throw1"),), "torsion", "[shaft.torsion]"),
+        ((_throw("throw1"),), "torsion", "[shaft.torsion] under a held rotor"),
     ):
         with pytest.raises(ParameterError) as exc:
             if drive == "torsion":
-                _motor_machine(*throws, torsion=True)
+                _motor_machine(*throws, motor="held", torsion=True)
             else:
                 _machine(*throws, drive=drive)
         assert words in str(exc.value) and "\n" not in str(exc.value), str(exc.value)

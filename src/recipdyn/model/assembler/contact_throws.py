@@ -49,9 +49,24 @@ massless link at rc = 0 (given by the caller, ``link(throw)``: ``--model compres
 state, its kernels that model's generated module, which the template calls on the throw's
 views by its kind (``THROW_KIND``; docs/architecture.md, "A throw of another kind").
 
-Not yet (refused in one line, `refusal`): a flexible shaft, a load of a user's file or a
-table, a frame, an interstage volume, contact throws whose joints' configurations differ
-(`same_joints`), and the massless link (rc > 0) beside contact throws.
+Interstage volumes (``[[interstage]]``, `recipdyn.model.components.interstage`): each volume's
+slice (its volume, cooler's temperature and gas constant) and its pressure (a state,
+``interstage1.p``) follow the throws' (and the drive's and the frame's); the template writes
+again the load's derivatives of each throw joined to one between the volume's line and its
+own slice's other line, and the volume's pressure rate from its stages' counters (template
+``contact_throws``). A fed stage's throws take the interstage's values as their suction
+line's (`.assemble.throw_values`), which their slices keep (unread by the template).
+
+On a flexible shaft (``[shaft.torsion]``, a motor) each throw's crank is its node: its module
+turns it on a torque of 0 (`throw_law`), the rotor's and flywheel's angles and speeds follow
+the throws' slices (part ``shaft.nodes``), the sections' slice and the nodes' phases are in
+the parameter vector (``shaft.torsion``, ``shaft.phases``), and the template's ``_torsion``
+gives each node its sections' torques.
+
+Not yet (refused in one line, `refusal`): a flexible shaft under a held rotor, a load of a
+user's file or a table, the guide's clearance on a frame or with an interstage, contact
+throws whose joints' configurations differ (`same_joints`), and the massless link (rc > 0)
+beside contact throws.
 
 The model of such a machine is `recipdyn.model.assembler.model.ContactMachine` (each throw's
 signals and summary its one-throw model's, under its name); this module holds what it is
@@ -147,6 +162,10 @@ def contact_throw_params(throw: Throw, shaft: Shaft | None = None, frame: bool =
         out = [p for p in out if p.group != "cycle" and p.name != "gas"]
     if throw.load != "paper":
         out = [p for p in out if p.name not in ("load_amplitude", "load_sign")]
+    if shaft is not None and shaft.torsion:  # the crankshaft section that ends at its crank
+        from ..shaft.flexible import THROW_PARAMS
+
+        out += THROW_PARAMS
     return (*out, PHASE)
 
 
@@ -161,19 +180,21 @@ def is_contact(throw: Throw) -> bool:
 def refusal(machine: Machine) -> str | None:
     """Why a machine of contact throws cannot be assembled yet (one line), or None."""
     where = f"machine {machine.name!r}"
-    if machine.shaft.torsion:
-        return (f"{where}: a [shaft.torsion] with contact pins or the guide's clearance is not "
-                "modelled yet; allowed: a rigid shaft (no [shaft.torsion]), or crank_joint = "
-                "'link' | 'ideal' with ideal crosshead pins and guides")  # fmt: skip
+    if machine.shaft.torsion and machine.shaft.motor == "held":
+        return (f"{where}: a [shaft.torsion] under a held rotor (motor = 'held') with contact "
+                "pins or the guide's clearance is not modelled yet; allowed: a motor with a "
+                "torque law ('induction', ...), or a rigid shaft")  # fmt: skip
     if machine.frame is not None:
         for t in machine.throws:
             if t.guide == "clearance":
                 return (f"{where}: a [frame] with {t.name}.guide = 'clearance' is not modelled "
                         "yet; allowed on a frame: ideal guides (guide = 'ideal')")  # fmt: skip
     if machine.interstages:
-        return (f"{where}: an [[interstage]] with contact pins or the guide's clearance is "
-                "not modelled yet; allowed: crank_joint = 'link' | 'ideal', ideal crosshead "
-                "pins and guides")  # fmt: skip
+        for t in machine.throws:
+            if t.guide == "clearance":
+                return (f"{where}: an [[interstage]] with {t.name}.guide = 'clearance' is not "
+                        "modelled yet; allowed with an interstage: ideal guides (guide = "
+                        "'ideal')")  # fmt: skip
     for t in machine.throws:
         if not is_contact(t) and t.crank_joint != "ideal":
             return (f"{where}: {t.name}.crank_joint = {t.crank_joint!r} (the massless link) "
@@ -238,11 +259,21 @@ class ContactConfiguration:
             roles["torque"] = (law.module, law.kernel("torque"))
         link = self.link_module
         frame = self.machine.frame is not None
+        stages = bool(self.machine.interstages)
         for r in ("rhs", "jac", "event", "reset", "share", "crank"):
             on = link is not None and (r != "share" or shared(self.machine))
-            if r == "crank":  # (an ideal throw's crank angle on a frame, the crank prescribed)
-                on = link is not None and frame and not motor
+            if r == "crank":  # (an ideal throw's crank angle on a frame or an interstage's
+                # line, the crank prescribed)
+                on = link is not None and (frame or stages) and not motor
             roles[f"link_{r}"] = (link.__name__, r) if on else absent
+        roles.update(_interstage_roles(self.machine))
+        torsion = bool(self.machine.shaft.torsion)
+        roles["motor_torque"] = absent
+        if torsion:  # the rotor's torque law (each throw's module turns on a torque of 0)
+            from .assemble import motor_of
+
+            law = motor_of(self.machine)
+            roles["motor_torque"] = (law.module, law.kernel("torque"))
         kinds = [0 if is_contact(t) else 1 for t in throws]
         first = kinds.index(0)  # (a contact throw: the machine's family)
         phased = one_model(throws[first]).tracks_separations(self.locals[first])
@@ -250,8 +281,30 @@ class ContactConfiguration:
         crank = {0: int(m.M), 1: int(getattr(link, "CRANK", 0))}
         torque_at = {0: int(m.MO), 1: int(getattr(link, "MOTOR", 0))}
         end = slices[-1].stop
+        names = [i.name for i in self.machine.interstages]
+
+        def index(found) -> int:
+            return -1 if found is None else names.index(found.name)
+
+        def arr1(values) -> np.ndarray:  # (an empty array holds one unused -1)
+            return np.array(list(values) or [-1], dtype=np.int64)
+
+        def load_at(mod, g, a, o) -> np.ndarray:
+            return arr([int(g), int(a), int(o)]) if mod is not None else arr([0, 0, 0])
+
         constants = {
             "CFG": _literal(CFG[self.locals[first]["clearance_joints"]]),
+            "CONTACT_LOAD": load_at(m, getattr(m, "G", 0), getattr(m, "A", 0), getattr(m, "LO", 0)),
+            "INTERSTAGE": stages,
+            "IS_PARAM": arr1(pv.start(n) for n in names),
+            "IS_STATE": arr1(st[f"{n}.p"] for n in names),
+            "LINK_LOAD": load_at(
+                link, *(getattr(link, k, [0])[0] for k in ("LOAD_STATE", "LOAD_AUX", "THROW_LOAD"))
+            ),
+            "N_INTERSTAGES": len(names),
+            **_torsion_constants(self.machine, self.layout, crank, kinds),
+            "THROW_IN": arr1(index(self.machine.interstage_into(t.stage)) for t in throws),
+            "THROW_OUT": arr1(index(self.machine.interstage_from(t.stage)) for t in throws),
             "FRAME": frame,
             "FRAME_CRANKS": pv.start("frame.cranks") if frame else 0,
             "FRAME_PARAMS": pv.start("frame") if frame else 0,
@@ -287,6 +340,10 @@ class ContactConfiguration:
             stem += f"_motor_{self.machine.shaft.motor}".replace("-", "_")
         if frame:
             stem += "_frame"
+        if stages:
+            stem += f"_is{len(names)}"
+        if torsion:
+            stem += "_torsion"
         return "contact_throws", roles, constants, stem, ""
 
     @property
@@ -298,6 +355,47 @@ class ContactConfiguration:
             mod = generate.module(*self.bindings())
             object.__setattr__(self, "_kernels", mod)
         return mod
+
+
+def _torsion_constants(machine: Machine, layout: Layout, crank: Mapping[int, int],
+                       kinds: list[int]) -> dict[str, Any]:  # fmt: skip
+    """``TORSION``, the nodes' angles' states (the rotor's and flywheel's in the shaft's part,
+    then each throw's crank along the shaft, `recipdyn.model.shaft.flexible.order`), the
+    throw at each node, the slices of the sections and of the nodes' phases, the state of the
+    sections' dissipation (template ``contact_throws``)."""
+    st, pv = layout.state, layout.params
+    if not machine.shaft.torsion:
+        return {"TORSION": False, "N_NODES": 1, "NODE_ANGLE": np.zeros(1, dtype=np.int64),
+                "NODE_PHASES": 0, "NODE_THROW": np.full(1, -1, dtype=np.int64),
+                "SHAFT_DAMPING": 0, "TORSION_PARAMS": 0}  # fmt: skip
+    from ..shaft.flexible import order
+
+    along = order(machine)
+    nodes = st.start("shaft.nodes")
+    angles = [nodes, nodes + 2, *(st.start(f"{machine.throws[k].name}.mechanism")
+                                  + crank[kinds[k]] for k in along)]  # fmt: skip
+    return {"TORSION": True, "N_NODES": len(angles),
+            "NODE_ANGLE": np.array(angles, dtype=np.int64),
+            "NODE_PHASES": pv.start("shaft.phases"),
+            "NODE_THROW": np.array([-1, -1, *along], dtype=np.int64),
+            "SHAFT_DAMPING": st.start("shaft.work") + 1,
+            "TORSION_PARAMS": pv.start("shaft.torsion")}  # fmt: skip
+
+
+def _interstage_roles(machine: Machine) -> dict[str, tuple[str, str]]:
+    """The roles of the interstage volumes and of the loads between their lines (the dynamic
+    valves': `.assemble.load_of`), absent without an interstage."""
+    from ..components.interstage import INTERSTAGE
+    from ..components.load import VALVES
+
+    names = ("load_rhs_lines", "load_lines", "load_flows", "interstage_line", "interstage_rate")
+    if not machine.interstages:
+        return dict.fromkeys(names, ("recipdyn.model.assembler.generate", "absent"))
+    return {"load_rhs_lines": (VALVES.module, VALVES.kernel("state_rhs_lines")),
+            "load_lines": (VALVES.module, VALVES.kernel("lines")),
+            "load_flows": (VALVES.module, VALVES.kernel("flows")),
+            "interstage_line": (INTERSTAGE.module, INTERSTAGE.kernel("line")),
+            "interstage_rate": (INTERSTAGE.module, INTERSTAGE.kernel("rate"))}  # fmt: skip
 
 
 def _literal(k: int):
@@ -327,7 +425,7 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
         v["motor"] = machine.shaft.motor
         if shared(machine):  # its own crank; the drive's inertia is the machine's
             v["J_drive"] = 0.0
-        if held(machine):
+        if held(machine) or machine.shaft.torsion:  # (its node's torques: the template's)
             v.update(motor=throw_law(machine).name, motor_torque=0.0)
     if "load" in names:
         v["load"] = throw.load
@@ -345,7 +443,8 @@ def throw_contact_values(machine: Machine, throw: Throw, local: Mapping[str, Any
 def shared(machine: Machine) -> bool:
     """Whether the throws share a free crank's acceleration (a motor and several throws, or
     a held rotor: the template turns the crank, each throw's module its own crank alone)."""
-    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine))
+    return machine.shaft.drive == "motor" and (len(machine.throws) > 1 or held(machine)
+                                               or bool(machine.shaft.torsion))  # fmt: skip
 
 
 def held(machine: Machine) -> bool:
@@ -361,7 +460,7 @@ def throw_law(machine: Machine):
     from ..components.drive import CONSTANT_TORQUE
     from .assemble import motor_of
 
-    return CONSTANT_TORQUE if held(machine) else motor_of(machine)
+    return CONSTANT_TORQUE if held(machine) or machine.shaft.torsion else motor_of(machine)
 
 
 #: A free crank's state names in a throw's one-throw state, then in its slice of a machine's
@@ -434,7 +533,7 @@ def throw_link_values(machine: Machine, throw: Throw, local: Mapping[str, Any], 
         v["load"] = throw.load
     if shared(machine):
         v["J_drive"] = 0.0
-    if held(machine):
+    if held(machine) or machine.shaft.torsion:
         v.update(motor=throw_law(machine).name, motor_torque=0.0)
     return _validated(machine, throw, model, v)
 
@@ -456,7 +555,10 @@ def _validated(machine: Machine, throw: Throw, model, v: dict[str, Any]) -> dict
 
 
 def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0, link=None,
-                     frame: Mapping[str, Any] | None = None) -> ContactConfiguration:  # fmt: skip
+                     frame: Mapping[str, Any] | None = None,
+                     stages: Mapping[str, Mapping[str, Any]] | None = None,
+                     torsion: Mapping[str, Any] | None = None
+                     ) -> ContactConfiguration:  # fmt: skip
     """Resolve a machine of contact throws (and ideal ones): each throw's one-throw vector and
     state, one after another (module docstring); with a motor and several throws then the
     drive's slice (its inertia ``J_drive`` and the torque law's) and the machine's work of
@@ -464,7 +566,12 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
     values ``locals_``' entry, `throw_link_values`). On a ``[frame]`` (its values ``frame``,
     names inside ``frame.``) then the frame's slice (`recipdyn.model.frame.body.pack`), each
     throw's crank's static moment ``m1 rs`` (part ``frame.cranks``) and the difference steps'
-    scales, and the frame's states and work integrals last."""
+    scales, and the frame's states and work integrals; then per interstage volume its slice
+    (its values ``stages[name]``: ``volume``, ``cooler_temperature``; the gas constant its
+    upstream stage's) and its pressure (``interstage1.p``). On a flexible shaft (its values
+    ``torsion``: the machine's namespaced ones, `recipdyn.model.shaft.flexible.pack`) the
+    rotor's and flywheel's angles and speeds (part ``shaft.nodes``) before the motor's work,
+    the sections' dissipation after it, the sections' slice and the nodes' phases."""
     from ..components.contact_model import pack
 
     if len(locals_) > 1:  # (one throw: nothing to compare)
@@ -503,8 +610,28 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
                                 law.pack(_torque_values(machine, locals_, law))])  # fmt: skip
         chunks.append(drive)
         pv.reserve("shaft", drive.size)
-        sv.add("shaft.work", (("W_motor", "J"),))
-        scales.append(np.ones(1))
+        if machine.shaft.torsion:  # the rotor's and flywheel's angles and speeds; the
+            # sections' slice and the nodes' phases (a throw's: its crank's angle less its
+            # node's); the sections' dissipation after the motor's work
+            from ..shaft.flexible import order
+            from ..shaft.flexible import pack as torsion_pack
+
+            pre = machine.prefix("shaft")
+            sv.add("shaft.nodes", (("theta1", "rad"), ("omega1", "rad/s"),
+                                   (pre + "theta_flywheel", "rad"),
+                                   (pre + "omega_flywheel", "rad/s")))  # fmt: skip
+            scales.append(np.ones(4))
+            chunks.append(torsion_pack(machine, torsion or {})[0])
+            pv.reserve("shaft.torsion", chunks[-1].size)
+            theta0 = float(torsion["theta1_0"]) if torsion else 0.0
+            chunks.append(np.array([0.0, 0.0, *(float(locals_[k]["theta1_0"]) - theta0
+                                                for k in order(machine))]))  # fmt: skip
+            pv.reserve("shaft.phases", chunks[-1].size)
+        work = (("W_motor", "J"),)
+        if machine.shaft.torsion:
+            work += ((machine.prefix("shaft") + "W_shaft_damping", "J"),)
+        sv.add("shaft.work", work)
+        scales.append(np.ones(len(work)))
     if machine.frame is not None:  # (one-way: nothing before it reads it)
         from ..frame.body import STATES as FRAME_STATES
         from ..frame.body import WORK as FRAME_WORK
@@ -518,7 +645,17 @@ def assemble_contact(machine: Machine, locals_: list[dict], J_drive: float = 0.0
         sv.add("frame.work", ((f"frame.{s}", u) for s, u in FRAME_WORK))
         # the frame's displacements, rates and work integrals: linear in them, any step
         scales.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
-    if shared(machine) or machine.frame is not None:
+    for i in machine.interstages:  # its volume, cooler's temperature, gas constant; its p
+        from ..components.interstage import INTERSTAGE
+
+        upstream = next(v for t, v in zip(machine.throws, locals_, strict=True)
+                        if t.stage == i.upstream)  # fmt: skip
+        own = dict(stages or {}).get(i.name, {})
+        chunks.append(INTERSTAGE.pack({**own, "gas_constant": upstream["gas_constant"]}))
+        pv.reserve(i.name, chunks[-1].size)
+        sv.add(i.name, ((f"{i.name}.p", "Pa"),))
+        scales.append(np.array([1e3]))  # (a pressure: 1 kPa, at least, scales its step)
+    if shared(machine) or machine.frame is not None or machine.interstages:
         chunks.append(np.concatenate(scales))
         pv.reserve("jacobian", chunks[-1].size)
     layout = Layout(sv.build(), pv.build(), SlicesBuilder().build())
@@ -543,7 +680,13 @@ def contact_configuration(machine: Machine, items: tuple, link=None) -> ContactC
         from .assemble import frame_values
 
         frame = frame_values(values)
-    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame)
+    stages = {i.name: {k[len(i.name) + 1 :]: v for k, v in values.items()
+                       if k.startswith(f"{i.name}.")} for i in machine.interstages}  # fmt: skip
+    torsion = None
+    if machine.shaft.torsion:
+        torsion = {**values, "theta1_0": float(own[0]["theta1_0"])}
+    return assemble_contact(machine, locals_, float(own[0].get("J_drive", 0.0)), link, frame,
+                            stages, torsion)  # fmt: skip
 
 
 def one_throw_configuration(machine: Machine, local: Mapping[str, Any]) -> ContactConfiguration:

@@ -780,6 +780,18 @@ class ContactMachine(MachineModel):
                 "frame's states as passive components are checked for ideal throws only); "
                 "offered without the [frame], or with ideal throws"
             )
+        elif machine.shaft.torsion:
+            self.lyapunov_refusal = (
+                "Lyapunov exponents of contact throws on a flexible shaft ([shaft.torsion]) "
+                "are not offered yet (each throw's crank is its node: not checked); offered on "
+                "a rigid shaft with drive = 'prescribed'"
+            )
+        elif machine.interstages:
+            self.lyapunov_refusal = (
+                "Lyapunov exponents of contact throws joined by an [[interstage]] are not "
+                "offered yet (checked for the massless link's throws only); offered without "
+                "the interstage, or with ideal throws"
+            )
         elif len(machine.throws) > 1 and machine.shaft.drive == "motor":
             self.lyapunov_refusal = (
                 "each throw of a machine of several contact throws on a motor carries its own "
@@ -811,6 +823,11 @@ class ContactMachine(MachineModel):
                    else link(machine, t, v, _one_model(t))
                    for t, v in zip(machine.throws, self.throws(values), strict=True)]  # fmt: skip
         same_joints(machine, locals_)
+        if machine.shaft.torsion:
+            from ..shaft.flexible import check as torsion_check
+
+            torsion_check(machine, values)
+        self._check_interstages(machine, values)
 
     def has_dynamics(self, values: Mapping[str, Any]) -> bool:
         return True
@@ -825,7 +842,9 @@ class ContactMachine(MachineModel):
         crank or one throw, and no frame (`lyapunov_refusal`)."""
         machine = self.structure(values)
         several_on_motor = len(machine.throws) > 1 and machine.shaft.drive == "motor"
-        if machine.frame is not None or several_on_motor:
+        if machine.frame is not None or several_on_motor or machine.interstages:
+            return False
+        if machine.shaft.torsion:
             return False
         return all(_one_model(t).lyapunov_supported(v) for t, v in zip(
             machine.throws, self.contact_values(values), strict=True))  # fmt: skip
@@ -872,6 +891,8 @@ class ContactMachine(MachineModel):
         pre = [c.machine.prefix(t.name) for t in c.machine.throws]
         if shared(c.machine):  # the work integrals of the shaft on each crank and the motor's
             passive += [st[q + "W_crank"] for q in pre] + [st["W_motor"]]
+            if c.machine.shaft.torsion:  # (and the sections' dissipation)
+                passive.append(st.start("shaft.work") + 1)
             aux_states = 1
         if c.machine.frame is not None:  # its states and work integrals (one-way: passive)
             for part in ("frame", "frame.work"):
@@ -886,7 +907,8 @@ class ContactMachine(MachineModel):
                     recorded |= {s + i for i in (*range(one.dim - one.aux_states, one.dim),
                                                  *one.aux)}  # fmt: skip
             aux = tuple(sorted(recorded - set(passive)))
-            aux_states = 1 if shared(c.machine) and c.machine.frame is None else 0
+            last = c.machine.frame is None and not c.machine.interstages  # (W_motor last)
+            aux_states = 1 if shared(c.machine) and last else 0
         names, units = zip(*st.named(), strict=True)
         return AssembledSystem(
             rhs=c.kernels.rhs,
@@ -921,21 +943,35 @@ class ContactMachine(MachineModel):
                 sign = 1.0 if v["e0_ratio"] >= 1.0 else -1.0
                 y[8] = y[9] = sign * v["v_impact_min"]
             parts.append(y)
-        if "shaft.work" in c.layout.state.parts:  # the motor's work, the machine's last state
-            parts.append(np.zeros(1))
+        st = c.layout.state
+        if "shaft.nodes" in st.parts:  # the rotor and the flywheel at the shaft's start
+            th0, w0 = (float(self._shaft(values, k)) for k in ("theta1_0", "omega"))
+            parts.append(np.array([th0, w0, th0, w0]))
+        if "shaft.work" in st.parts:  # the motor's work (and the sections' dissipation)
+            parts.append(np.zeros(len(st.names[st.parts["shaft.work"]])))
         if c.machine.frame is not None:  # the frame at rest on its mounts, its works 0
             parts.append(np.zeros(8))
-        return np.concatenate(parts)
+        for i in c.machine.interstages:  # at the upstream stage's set discharge pressure
+            parts.append(np.array([float(values[f"{i.upstream}.discharge_pressure"])]))
+        y0 = np.concatenate(parts)
+        if "shaft.nodes" in st.parts:
+            y0 = _twisted(c, values, y0)
+        return y0
 
     def state_scale(self, values: Mapping[str, Any]) -> np.ndarray:
         """Each throw's one-throw scales (the gas states at their own size)."""
         c = self.contact(values)
         own = [_one_model(t).state_scale(v)
                for t, v in zip(c.machine.throws, c.locals, strict=True)]  # fmt: skip
+        if "shaft.nodes" in c.layout.state.parts:
+            own.append(np.ones(4))
         if "shaft.work" in c.layout.state.parts:
-            own.append(np.ones(1))
+            st = c.layout.state
+            own.append(np.ones(len(st.names[st.parts["shaft.work"]])))
         if c.machine.frame is not None:  # (its displacements at their own size: microns)
             own.append(np.array([1e-6] * 3 + [1e-4] * 3 + [1.0] * 2))
+        for i in c.machine.interstages:  # (a pressure: its own size)
+            own.append(np.array([float(values[f"{i.upstream}.discharge_pressure"])]))
         return np.concatenate(own)
 
     def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
@@ -950,14 +986,18 @@ class ContactMachine(MachineModel):
         out: dict[str, Signal] = {}
         dy = None
         frame = None
-        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None:
+        stages = bool(c.machine.interstages)
+        if (shared(c.machine) and c.link_module is not None) or c.machine.frame is not None \
+                or stages:  # fmt: skip
             dy = rhs_series(c.kernels.rhs, c.params, np.asarray(t, dtype=np.float64), y)
         if c.machine.frame is not None:
             frame = _FrameRecord(c, values, y, dy)
         for th, v in zip(c.machine.throws, c.locals, strict=True):
             part = c.layout.state.parts[f"{th.name}.mechanism"]
             yk = np.ascontiguousarray(y[:, part])
-            if is_contact(th):
+            if is_contact(th) and stages and th.load == "valves":  # its lines: the machine's
+                own = _one_model(th).outputs(v, t, yk, np.ascontiguousarray(dy[:, part]))
+            elif is_contact(th):
                 own = _one_model(th).outputs(v, t, yk)
             else:  # an ideal throw: its one-throw model's, at the shaft's acceleration
                 own = _one_model(th).outputs(v, t, yk, None if dy is None else dy[:, part])
@@ -979,6 +1019,8 @@ class ContactMachine(MachineModel):
                                     "shaking force on the frame along x: the sum over the "
                                     "throws of -(m1 a1 + m2 a2 + m3 a3)")  # fmt: skip
             out.update(frame.signals())
+        if stages:
+            out.update(_contact_interstage_outputs(c, y, dy))
         if shared(c.machine):
             crank = _shared_crank(c, values, t, y, out)
             for q in (c.machine.prefix(th.name) for th in c.machine.throws):
@@ -1088,6 +1130,63 @@ def _contact_shaking(c: ContactConfiguration, throw: Throw, local: Mapping[str, 
 _ONE_THROW_NAMES = {"W_crank": "W_motor", "W_crank_after": "W_motor_after"}
 
 
+def _twisted(c: ContactConfiguration, values: Mapping[str, Any], y: np.ndarray) -> np.ndarray:
+    """``y`` with the flexible shaft's nodes twisted as the rigid shaft's motion asks
+    (`recipdyn.model.shaft.flexible.twisted_start`), on the nodes' angles less their phases (a
+    throw's crank angle in its slice is its node's plus its phase)."""
+    from ..base import rhs_series
+    from ..shaft.flexible import stiffnesses, twisted_start
+
+    k = c.kernels
+    angles = [int(a) for a in k.NODE_ANGLE]
+    phases = c.params[int(k.NODE_PHASES) : int(k.NODE_PHASES) + len(angles)]
+    o = int(k.TORSION_PARAMS)
+
+    def shifted(z: np.ndarray, sign: float) -> np.ndarray:
+        z = np.array(z, dtype=np.float64)
+        z[angles] += sign * phases
+        return z
+
+    def rhs(z: np.ndarray) -> np.ndarray:
+        return rhs_series(k.rhs, c.params, np.zeros(1), shifted(z, 1.0)[None, :])[0]
+
+    z = twisted_start(rhs, shifted(y, -1.0), angles, (c.params[o], c.params[o + 1]),
+                      stiffnesses(c.machine, values))  # fmt: skip
+    return shifted(z, 1.0)
+
+
+def _contact_interstage_outputs(c: ContactConfiguration, y: np.ndarray, dy: np.ndarray
+                                ) -> dict[str, Signal]:  # fmt: skip
+    """`_interstage_outputs` of a machine of contact throws: each throw's mass counters at its
+    module's offset in its slice (a contact throw's ``A``, an ideal throw's ``LOAD_AUX``)."""
+    from ..base import Signal
+    from .contact_throws import is_contact
+
+    out: dict[str, Signal] = {}
+    st, pv = c.layout.state, c.layout.params
+    link = c.link_module
+    for i in c.machine.interstages:
+        pi = y[:, st[f"{i.name}.p"]]
+        vol, temp, gas_r = c.params[pv[i.name]]
+        flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
+        for t in c.machine.throws:
+            own = int(c.throw_module.A) if is_contact(t) else int(link.LOAD_AUX[0])
+            a = st.start(f"{t.name}.mechanism") + own
+            if t.stage == i.upstream:
+                flows["in"] += dy[:, a + 1] + dy[:, a + 3]
+            if t.stage == i.downstream:
+                flows["out"] += dy[:, a] + dy[:, a + 2]
+        out[f"{i.name}.p"] = Signal(pi, "Pa", f"interstage pressure: {i.upstream}'s discharge, "
+                                    f"{i.downstream}'s suction (absolute)")  # fmt: skip
+        out[f"{i.name}.mass"] = Signal(pi * vol / (gas_r * temp), "kg",
+                                       "gas mass in the interstage volume")  # fmt: skip
+        out[f"{i.name}.mdot_in"] = Signal(flows["in"], "kg/s", f"mass flow {i.upstream}'s "
+                                          "discharge valves deliver into the volume")  # fmt: skip
+        out[f"{i.name}.mdot_out"] = Signal(flows["out"], "kg/s", f"mass flow {i.downstream}'s "
+                                           "suction valves take from the volume")  # fmt: skip
+    return out
+
+
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
     """The machine's energy balance over the record, ``W_motor + sum_k W_gas,k = dE + sum_k
     W_loss,k``: its largest residual over the largest of the energy and the motor's work."""
@@ -1095,6 +1194,9 @@ def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
     E, Wm = ds["energy"].values, ds["W_motor"].values
     Wg = sum(ds[q + "W_gas"].values for q in pre)
     Wl = sum(ds[q + "W_loss"].values for q in pre if q + "W_loss" in ds)  # (ideal: none)
+    damping = c.machine.prefix("shaft") + "W_shaft_damping"
+    if damping in ds:  # (a flexible shaft's sections)
+        Wl = Wl + ds[damping].values
     bal = (Wm - Wm[0]) + (Wg - Wg[0]) - (E - E[0]) - (Wl - Wl[0])
     return float(np.abs(bal).max() / max(np.abs(E).max(), np.abs(Wm).max(), 1e-300))
 
@@ -1130,9 +1232,11 @@ def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndar
     pre = [machine.prefix(th.name) for th in machine.throws]
     dy = rhs_series(c.kernels.rhs, c.params, t, y)
     w = y[:, st[pre[0] + "omega1"]]
+    torsion = "shaft.nodes" in st.parts
     sig: dict[str, Signal] = {}
     for q in pre:
-        sig[q + "crank_torque"] = Signal(dy[:, st[q + "W_crank"]] / w, "N*m",
+        wk = y[:, st[q + "omega1"]]  # (its node's speed on a flexible shaft)
+        sig[q + "crank_torque"] = Signal(dy[:, st[q + "W_crank"]] / wk, "N*m",
                                          "torque of the shaft on the throw's crank")  # fmt: skip
         sig[q + "W_crank"] = Signal(y[:, st[q + "W_crank"]], "J", "work of the shaft on the "
                                     "throw's crank since t = 0")  # fmt: skip
@@ -1148,6 +1252,51 @@ def _shared_crank(c: ContactConfiguration, values: Mapping[str, Any], t: np.ndar
         "W_motor": Signal(y[:, st["W_motor"]], "J", "work done by the motor since t = 0"),
         "energy": Signal(energy, "J", "the machine's energy: the drive's kinetic energy and "
                          "each throw's (its crank, rod and crosshead, contact elastic)"),
+    })  # fmt: skip
+    if torsion:
+        sig.update(_torsion_crank(c, y, dy, out))
+    return sig
+
+
+def _torsion_crank(c: ContactConfiguration, y: np.ndarray, dy: np.ndarray,
+                   out: Mapping[str, Signal]) -> dict[str, Signal]:  # fmt: skip
+    """On a flexible shaft: the rotor's angle, speed and acceleration (the shaft's crank
+    signals), the motor's torque, each section's twist and torque, the sections' dissipation,
+    and the machine's energy (the rotor's, the flywheel's, each throw's, the sections'
+    elastic)."""
+    from ..base import Signal
+    from ..shaft.flexible import section_names
+
+    st, k = c.layout.state, c.kernels
+    pre = [c.machine.prefix(th.name) for th in c.machine.throws]
+    angles = [int(a) for a in k.NODE_ANGLE]
+    phases = c.params[int(k.NODE_PHASES) : int(k.NODE_PHASES) + len(angles)]
+    o = int(k.TORSION_PARAMS)
+    rotor = angles[0]
+    w0 = y[:, rotor + 1]
+    energy = (0.5 * c.params[o] * w0**2 + 0.5 * c.params[o + 1] * y[:, angles[1] + 1] ** 2
+              + sum(out[q + "energy"].values for q in pre))  # fmt: skip
+    sig: dict[str, Signal] = {}
+    for j, name in enumerate(section_names(c.machine)):
+        a, b = angles[j], angles[j + 1]
+        twist = (y[:, a] - phases[j]) - (y[:, b] - phases[j + 1])
+        torque = c.params[o + 2 + 2 * j] * twist + c.params[o + 3 + 2 * j] * (
+            y[:, a + 1] - y[:, b + 1]
+        )
+        energy = energy + 0.5 * c.params[o + 2 + 2 * j] * twist**2
+        sig[name + "twist"] = Signal(twist, "rad", "twist of the shaft's section: its driving "
+                                     "end's angle less its driven end's")  # fmt: skip
+        sig[name + "torque"] = Signal(torque, "N*m", "torque the section carries")
+    damping = st.start("shaft.work") + 1
+    sig.update({
+        "theta1": Signal(y[:, rotor], "rad", "angle of the motor's rotor"),
+        "omega1": Signal(w0, "rad/s", "speed of the motor's rotor"),
+        "alpha1": Signal(dy[:, rotor + 1], "rad/s**2", "acceleration of the motor's rotor"),
+        "motor_torque": Signal(dy[:, st["W_motor"]] / w0, "N*m", "motor torque on its rotor"),
+        st.names[damping]: Signal(y[:, damping], "J", "energy the shaft's sections dissipated "
+                                  "since t = 0"),
+        "energy": Signal(energy, "J", "the machine's energy: the rotor's and flywheel's kinetic "
+                         "energy, each throw's, the sections' elastic energy"),
     })  # fmt: skip
     return sig
 

@@ -167,15 +167,18 @@ class CompressorContactValves(cm.CompressorContact):
         g0, a0, _ = _layout(values)
         return va.gas_scale(values, y0, g0, a0, super().state_scale(values))
 
-    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray
-                ) -> dict[str, Signal]:  # fmt: skip
+    def outputs(self, values: Mapping[str, Any], t: np.ndarray, y: np.ndarray,
+                dy: np.ndarray | None = None) -> dict[str, Signal]:  # fmt: skip
         """The contact model's outputs (its gas force is the pressures'), then the chambers'
-        pressures, volumes (from the recorded crosshead), temperatures and mass flows."""
+        pressures, volumes (from the recorded crosshead), temperatures and mass flows. ``dy``:
+        the derivatives at ``y`` when they are not this model's own (a throw's slice of a
+        machine whose interstage volume is a line of its cylinder)."""
         from ..base import rhs_series
 
         sig = super().outputs(values, t, y)
         s = self.system(values)
-        dy = rhs_series(s.rhs, s.params, t, y)
+        if dy is None:
+            dy = rhs_series(s.rhs, s.params, t, y)
         g0, a0, lo = _layout(values)
         sig.update(va.gas_outputs(values, sig["x"].values, y, dy, g0, a0,
                                   s.params[lo:lo + cy.N_CYCLE]))  # fmt: skip

@@ -77,6 +77,36 @@ is taken by the frame (`recipdyn.model.frame.kernels`: ``throw_load``, ``frame_r
 throw reads the frame's states, so the throws' Jacobian is unchanged and the frame's rows are
 central differences of the whole right-hand side (`_frame_rows`). Without a frame the
 branches on ``FRAME`` are removed.
+
+Interstage volumes (``INTERSTAGE``; `recipdyn.model.components.interstage`): each throw's
+module runs its load between the set lines of its own slice; after every throw's call, a
+throw whose suction is fed by an interstage (``THROW_IN[k]``) or whose discharge delivers
+into one (``THROW_OUT[k]``) has its load's derivatives written again by ``load_rhs_lines``
+(the load's ``state_rhs_lines``) at the volume's pressure and the cooler's temperature
+(``interstage_line``), the other line its slice's (``load_lines``), its crosshead's place
+and speed from its states (a contact throw's pins' kinematics, an ideal throw's
+``link_crosshead``), its load's first state, first counter and slice at ``CONTACT_LOAD`` or
+``LINK_LOAD`` (offsets in its slice: its module's). Each volume's pressure rate then comes
+from its stages' counters' rates (``load_flows``, ``interstage_rate``), at ``IS_STATE[i]``,
+its slice at ``IS_PARAM[i]``. The gas force reads the chambers' states only, so the throws'
+mechanisms are as before; the volumes couple the throws, so the Jacobian is then the central
+differences of the whole right-hand side (`_fd_jac`, an interstage's pressure's scale its
+slice's at ``SCALE``). Without one the branches on ``INTERSTAGE`` are removed.
+
+A torsionally flexible shaft (``TORSION``; `recipdyn.model.shaft.flexible`): the crank is a
+chain of ``N_NODES`` nodes, the motor's rotor and the flywheel (states ``NODE_ANGLE[0]``,
+``NODE_ANGLE[1]``, in the shaft's part) and each throw's crank in the order along the shaft
+(``NODE_THROW[j]``: its crank's angle and speed in its slice, at ``THROW_CRANK``). Each
+throw's module turns its own crank on a torque of 0 (as under a held rotor), so its crank
+equation ``I_k alpha_k = tau_k`` gives its own acceleration; its node's equation adds the
+sections' torques, ``I_k alpha = tau_k + T_(j-1) - T_j``, so its crank turns ``(T_(j-1) -
+T_j) / I_k`` faster and its other accelerations are corrected as on the rigid shaft
+(`_correct`). A section's twist is its nodes' angles less their phases (``NODE_PHASES + j``:
+a throw's slice holds its own angle, its node's plus its phase); its torque ``k twist + c
+twist'`` (slice ``TORSION_PARAMS``: ``J_motor``, the flywheel's inertia, then per section
+``(k, c)``); the rotor turns under the motor's torque law (``motor_torque`` at ``SHAFT + 1``),
+the sections' dissipation is the state ``SHAFT_DAMPING``. Without it the branches on
+``TORSION`` are removed.
 """
 
 import math
@@ -89,24 +119,33 @@ from recipdyn.model.frame.kernels import frame_rhs, throw_load
 from recipdyn.model.joints.pins import (
     G_GUIDE,
     I_WIN,
+    P_L,
     P_OMEGA,
     P_R,
     P_TH10,
     _flip,
+    _kinematics_at,
     contact_factor,
     contact_shaking,
     ideal_share,
 )
+from recipdyn.model.mechanism.link_kernels import crosshead as link_crosshead
 from recipdyn.model.mechanism.link_kernels import shaking as link_shaking
 
 # isort: split
 # <bindings>
+from recipdyn.model.assembler.generate import absent as interstage_line
+from recipdyn.model.assembler.generate import absent as interstage_rate
 from recipdyn.model.assembler.generate import absent as link_crank
 from recipdyn.model.assembler.generate import absent as link_event
 from recipdyn.model.assembler.generate import absent as link_jac
 from recipdyn.model.assembler.generate import absent as link_reset
 from recipdyn.model.assembler.generate import absent as link_rhs
 from recipdyn.model.assembler.generate import absent as link_share
+from recipdyn.model.assembler.generate import absent as load_flows
+from recipdyn.model.assembler.generate import absent as load_lines
+from recipdyn.model.assembler.generate import absent as load_rhs_lines
+from recipdyn.model.assembler.generate import absent as motor_torque
 from recipdyn.model.assembler.generate import absent as torque
 from recipdyn.model.assembler.templates.contact import event as throw_event
 from recipdyn.model.assembler.templates.contact import jac as throw_jac
@@ -114,6 +153,7 @@ from recipdyn.model.assembler.templates.contact import reset as throw_reset
 from recipdyn.model.assembler.templates.contact import rhs as throw_rhs
 
 CFG = 0
+CONTACT_LOAD = np.array([12, 12, 31], dtype=np.int64)
 FRAME = False
 FRAME_CRANKS = np.int64(0)
 FRAME_PARAMS = np.int64(0)
@@ -122,24 +162,38 @@ FRAME_WORK = np.int64(0)
 HAS_GUIDE = False
 HAS_LINK = False
 HELD = False
+INTERSTAGE = False
+IS_PARAM = np.array([-1], dtype=np.int64)
+IS_STATE = np.array([-1], dtype=np.int64)
 LINK_EVENTS = False
+LINK_LOAD = np.array([0, 0, 0], dtype=np.int64)
 LINK_MECH = np.int64(0)
 LINK_PHASE = np.int64(0)
 LINK_SHAFT = np.int64(0)
 MOTOR = False
+N_INTERSTAGES = np.int64(0)
+N_NODES = np.int64(1)
+NODE_ANGLE = np.array([0], dtype=np.int64)
+NODE_PHASES = np.int64(0)
+NODE_THROW = np.array([-1], dtype=np.int64)
 N_THROWS = np.int64(1)
 OWN_EVENT = True
 SCALE = np.int64(33)
 SHAFT = np.int64(33)
+SHAFT_DAMPING = np.int64(0)
 SHARED = False
 THROW_CO = np.int64(31)
 THROW_CRANK = np.array([12], dtype=np.int64)
+THROW_IN = np.array([-1], dtype=np.int64)
 THROW_KIND = np.array([0], dtype=np.int64)
 THROW_N = np.array([12], dtype=np.int64)
 THROW_NP = np.array([33], dtype=np.int64)
+THROW_OUT = np.array([-1], dtype=np.int64)
 THROW_PARAMS = np.array([0], dtype=np.int64)
 THROW_STATE = np.array([0], dtype=np.int64)
 THROW_TORQUE = np.array([33], dtype=np.int64)
+TORSION = False
+TORSION_PARAMS = np.int64(0)
 W_MOTOR = np.int64(12)
 # </bindings>
 
@@ -251,10 +305,124 @@ def _rhs(t, y, p, out):
                 link_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
                 continue
         throw_rhs(t, y[s : s + n], p[o : o + m], out[s : s + n])
+    if INTERSTAGE:
+        _interstages(t, y, p, out)
     if SHARED:
-        _shaft(y, p, out)
+        if TORSION:
+            _torsion(y, p, out)
+        else:
+            _shaft(y, p, out)
     if FRAME:
         _frame(t, y, p, out)
+
+
+@nb.njit(cache=True)
+def _torsion(y, p, out):
+    """On a flexible shaft: each node's acceleration from its torques (module docstring);
+    ``out`` holds each throw's own derivatives at its own crank's acceleration under a torque
+    of 0 on entry."""
+    o = TORSION_PARAMS
+    rotor = NODE_ANGLE[0]
+    tm = motor_torque(y[rotor + 1], p, SHAFT + 1)
+    loss = 0.0
+    upstream = 0.0  # the torque of the section before node j
+    for j in range(N_NODES):
+        a = NODE_ANGLE[j]
+        torque_j = 0.0
+        if j < N_NODES - 1:
+            b = NODE_ANGLE[j + 1]
+            twist = (y[a] - p[NODE_PHASES + j]) - (y[b] - p[NODE_PHASES + j + 1])
+            rate = y[a + 1] - y[b + 1]
+            kk, cc = p[o + 2 + 2 * j], p[o + 3 + 2 * j]
+            torque_j = kk * twist + cc * rate
+            loss += cc * rate * rate
+        net = upstream - torque_j
+        upstream = torque_j
+        if j < 2:  # the rotor (the motor's torque on it) and the flywheel
+            out[a] = y[a + 1]
+            out[a + 1] = (net + (tm if j == 0 else 0.0)) / p[o + j]
+            continue
+        k = NODE_THROW[j]
+        s, c = THROW_STATE[k], THROW_CRANK[k]
+        share = _inertia(y, p, k)
+        da = net / share[0]
+        _correct(y, p, out, k, share, da)
+        w = y[s + c + 1]
+        if not _is_link(k):  # (the joint's work integral holds the shaft's work on it)
+            out[s + I_WIN] += net * w
+        out[s + c + 1] += da
+        out[s + c + 2] = net * w
+    out[W_MOTOR] = tm * y[rotor + 1]
+    out[SHAFT_DAMPING] = loss
+
+
+@nb.njit(cache=True)
+def _crank(t, y, p, k):
+    """Throw ``k``'s crank angle and speed: its slice's (a motor), an ideal throw's module's
+    (the shaft's: its phase is added by the caller), or a contact throw's prescribed ones."""
+    s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+    if MOTOR:
+        c = THROW_CRANK[k]
+        return y[s + c], y[s + c + 1]
+    if _is_link(k):
+        if HAS_LINK:
+            return link_crank(t, y[s : s + n], p[o : o + m], LINK_SHAFT)
+    w = p[o + P_OMEGA]
+    return p[o + P_TH10] + w * t, w
+
+
+@nb.njit(cache=True)
+def _crosshead(t, y, p, k):
+    """Throw ``k``'s crosshead's place and speed along its stroke, from its states: a contact
+    throw's big end moved by its crank pin's eccentricity and its small end by its crosshead
+    pin's (`recipdyn.model.joints.pins`; an ideal guide), an ideal throw's massless link's."""
+    s, o = THROW_STATE[k], THROW_PARAMS[k]
+    th, w = _crank(t, y, p, k)
+    if _is_link(k):
+        if HAS_LINK:
+            return link_crosshead(th + p[o + LINK_PHASE], y[s], w, y[s + 1], p, o + LINK_MECH)
+    _, c2, _, v3, _, _ = _kinematics_at(th, w, p[o:], y[s], y[s + 1], y[s + 4], y[s + 5],
+                                        y[s + 2], y[s + 3], y[s + 6], y[s + 7])  # fmt: skip
+    return p[o + P_R] * math.cos(th) + y[s] + p[o + P_L] * c2 - y[s + 2], v3
+
+
+@nb.njit(cache=True)
+def _load_offsets(k):
+    """Throw ``k``'s load's first state, first counter and slice (in its slice: its
+    module's)."""
+    if _is_link(k):
+        return LINK_LOAD[0], LINK_LOAD[1], LINK_LOAD[2]
+    return CONTACT_LOAD[0], CONTACT_LOAD[1], CONTACT_LOAD[2]
+
+
+@nb.njit(cache=True)
+def _interstages(t, y, p, out):
+    """Each throw joined to an interstage volume: its load's derivatives again between the
+    volume's line and its slice's other line; then each volume's pressure rate from its
+    stages' counters' rates (module docstring)."""
+    for k in range(N_THROWS):
+        i, j = THROW_IN[k], THROW_OUT[k]
+        if i < 0 and j < 0:
+            continue
+        s, n, o, m = THROW_STATE[k], THROW_N[k], THROW_PARAMS[k], THROW_NP[k]
+        g, a, lo = _load_offsets(k)
+        pk = p[o : o + m]
+        ps, ts, pd, td = load_lines(pk, lo)
+        if i >= 0:
+            ps, ts = interstage_line(y, IS_STATE[i], p, IS_PARAM[i])
+        if j >= 0:
+            pd, td = interstage_line(y, IS_STATE[j], p, IS_PARAM[j])
+        x, v = _crosshead(t, y, p, k)
+        load_rhs_lines(x, v, y[s : s + n], g, a, pk, lo, ps, ts, pd, td, out[s : s + n])
+    for i in range(N_INTERSTAGES):
+        mdot = 0.0
+        for k in range(N_THROWS):
+            a = THROW_STATE[k] + _load_offsets(k)[1]
+            if THROW_OUT[k] == i:
+                mdot += load_flows(out, a)[1]
+            if THROW_IN[k] == i:
+                mdot -= load_flows(out, a)[0]
+        out[IS_STATE[i]] = interstage_rate(mdot, p, IS_PARAM[i])
 
 
 @nb.njit(cache=True)
@@ -330,9 +498,9 @@ def _fd_jac(t, y, p, J):
 def jac(t, y, p, J):
     """Block-diagonal: each throw's own Jacobian (its module's ``jac``) on its states; the
     throws do not interact with the crank prescribed (or with one throw). With a motor and
-    several throws, which share the crank's acceleration: central differences of the whole
-    right-hand side (`_fd_jac`)."""
-    if SHARED:
+    several throws, which share the crank's acceleration, or with interstage volumes, which
+    join the throws' loads: central differences of the whole right-hand side (`_fd_jac`)."""
+    if SHARED or INTERSTAGE:
         _fd_jac(t, y, p, J)
         return
     for i in range(y.shape[0]):
