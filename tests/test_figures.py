@@ -519,28 +519,6 @@ def test_sweep_figures_have_no_layout_defects(store, tmp_path, monkeypatch):
     assert not any(found.values()), _report(found)
 
 
-@pytest.mark.slow
-def test_reproduction_figures_have_no_layout_defects(tmp_path):
-    """Every figure of the reproduction report, from the quick runs."""
-    from recipdyn.reproduce import CASES, VARIANTS
-    from recipdyn.reproduce.figures import FIGURES, fig02_load
-    from recipdyn.reproduce.runner import RunSpec, Settings, run_all
-
-    s = Settings().quick()
-    runs = run_all([RunSpec(c, v, s) for c in CASES for v in VARIANTS], tmp_path / "cache",
-                   jobs=1)  # fmt: skip
-    plt = _mpl()
-    found = {}
-    groups = [lambda: fig02_load(runs, None)]
-    groups += [lambda m=make, v=v: m(runs, v.id) for v in VARIANTS for make in FIGURES]
-    for group in groups:
-        for stem, fig in group().items():  # one group open at a time
-            found[stem] = layout_defects(fig)
-            plt.close(fig)
-    assert len(found) > 70
-    assert not any(found.values()), _report(found)
-
-
 def test_compare_spectra_on_a_log_frequency_axis(short_records, ringing_run, tmp_path,
                                                  monkeypatch):  # fmt: skip
     """The spectra panel of ``compare``: a log frequency axis whose range holds both the

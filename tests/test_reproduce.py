@@ -159,3 +159,32 @@ def test_every_reproduction_figure_is_labelled_and_finite(report_dir):
             checked += 1
             plt.close(fig)
     assert checked > 70
+
+
+@pytest.mark.slow
+def test_reproduction_figures_have_no_layout_defects(report_dir):
+    """Every figure of the reproduction report (rebuilt from the cached quick runs, as above:
+    the runs are computed once, by the module's reproduction) is free of the layout defects
+    of tests/test_figures.py's `layout_defects`."""
+    from recipdyn.plotting import _mpl
+    from recipdyn.reproduce.figures import FIGURES, fig02_load
+    from test_figures import _report, layout_defects
+
+    s = Settings().quick()
+    runs = run_all([RunSpec(c, v, s) for c in CASES for v in VARIANTS], report_dir / "cache",
+                   jobs=1, progress=lambda key, cached: assert_cached(key, cached))  # fmt: skip
+    plt = _mpl()
+    found = {}
+    groups = [lambda: fig02_load(runs, None)]
+    groups += [lambda m=make, v=v: m(runs, v.id) for v in VARIANTS for make in FIGURES]
+    for group in groups:
+        for stem, fig in group().items():  # one group open at a time
+            found[stem] = layout_defects(fig)
+            plt.close(fig)
+    assert len(found) > 70
+    assert not any(found.values()), _report(found)
+
+
+def assert_cached(key: str, cached: bool) -> None:
+    """The figures' checks read the reproduction's own runs, none computed again."""
+    assert cached, key
