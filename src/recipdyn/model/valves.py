@@ -422,7 +422,7 @@ def _area(lift, u, v):
     return v[V_CD] * v[V_AREA] * x / ymax
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _bilinear(tab, k, i, j, wx, wp):
     n = int(tab[rg.T_NP])
     o = rg.T_HEADER + k * int(tab[rg.T_NX]) * n + i * n + j
@@ -430,7 +430,7 @@ def _bilinear(tab, k, i, j, wx, wp):
             + wx * ((1.0 - wp) * tab[o + n] + wp * tab[o + n + 1]))  # fmt: skip
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def real_properties(p, rt, tab):
     """``(u - u0, (dp/drho)_u, (dp/du)_rho, T)`` of the real gas at pressure ``p`` and
     ``p/rho = rt``, bilinear on `recipdyn.model.realgas.chamber_table` (its scaled
@@ -489,7 +489,7 @@ def _chamber(V, dV, y, b, q, c, v, mr, hr, ps, ts, pd, td, out):
     return ms, md
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _gas_rt(p, m, V, v):
     """``p / rho`` and the specific enthalpy (real gas) or ``R T`` (ideal gas) of a chamber's
     gas, for the ring leak that leaves it."""
@@ -499,7 +499,7 @@ def _gas_rt(p, m, V, v):
     return rt, rt
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _ring(x, xdot, y, g, c, v):
     """Ring leak into the head-end chamber (kg/s, < 0: out of it) and into the crank-end
     chamber, each with the ``h`` or ``R T`` of its upstream gas: the nozzle equation between
@@ -544,9 +544,14 @@ def _volume(x, xdot, j, c):
             c[cy.C_ACE] * xdot)  # fmt: skip
 
 
-# real_properties, _chamber and gas_rhs are inlined into the models' rhs (a call between
-# numba functions passing arrays costs ~30 ns): 18 % less time per revolution with dynamic
-# valves, bit-identical results, ~4 s more compilation on first use (cached).
+# _chamber and gas_rhs are inlined into the load's compiled role (a call between numba
+# functions passing arrays costs ~30 ns): 18 % less time per revolution with dynamic valves,
+# bit-identical results. The paths a healthy cylinder of an ideal gas never takes (the ring
+# leak, the real gas's table: _ring, _gas_rt, real_properties, _bilinear) are called, not
+# inlined: inlined at numba's level they were typed again at each of their seven call sites,
+# and the load's role `valves_rhs` took 28 s of CPU to compile on first use; called, 8 s,
+# the time per right-hand side unchanged (171 against 169 ns, measured 2026-12-08, one
+# machine; issue 43, a configuration never run before).
 @nb.njit(cache=True, inline="always")
 def gas_rhs(x, xdot, y, g, a, c, v, out):
     """`gas_rhs_lines` between the cylinder's set line pressures and temperatures (``c``
