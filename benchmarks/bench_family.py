@@ -1,7 +1,6 @@
 """Benchmark: the one ``compressor`` model (its selectors describe the machine of one throw
-the assembler builds) against the model class the old name reached (for the contact routes
-the joints' configuration part, `OneContact.part`; for the link routes the machine itself),
-per revolution.
+the assembler builds) against that machine itself (`recipdyn.model.family.machine`: the
+one-throw machine of the route), per revolution.
 
 Each route runs ``recipdyn.simulate`` for one revolution (fs 2 kHz, default tolerances) with
 ``--model compressor --set SELECTORS`` and with that class directly, in alternating
@@ -49,7 +48,6 @@ def main(argv: list[str] | None = None) -> dict:
     rows = []
     for label, (selectors, route) in ROUTES.items():
         impl = family.machine(route)
-        impl = getattr(impl, "part", impl)  # (a contact route: the old class, its part now)
         sides = {"model": (model, selectors), "impl": (impl, {})}
         for m, p in sides.values():  # compile or load the cache
             recipdyn.simulate(model=m, params=p, revolutions=0.05, fs=2000.0)

@@ -56,17 +56,29 @@ def _simulate(**kw):
 @pytest.mark.parametrize("selectors,route,own", ROUTES, ids=[r[1] for r in ROUTES])
 def test_every_route_runs_its_implementation_to_the_bit(selectors, route, own):
     """The model delegates to the machine of one throw the assembler builds, and a contact
-    route's machine (`OneContact`: the assembled layout and parameter vector) runs what its
-    joints' configuration (the model class the old name reached, now its part) runs: the same
-    compiled kernels on the same parameter vector, so every recorded variable and the number
-    of right-hand-side calls equal exactly (no tolerance: the arithmetic is the same)."""
+    route's machine (`OneContact`: the assembled layout and parameter vector) holds what its
+    joints' configuration part (`ContactJoints`, no model: the joints' kernels on their own
+    packed values) holds: the same parameter vector, initial state and right-hand side at a
+    perturbed state, to the bit. The model's run and the machine's (asked for directly, under
+    the old class's values) record every variable and right-hand-side call the same (no
+    tolerance: the arithmetic is the same)."""
+    from recipdyn.model.base import rhs_series
+
     m = get_model("compressor")
     values = m.parameters(selectors)
     assert m.route(values)[0] == route
     impl = family.machine(route)
     assert m.route(values)[1] is impl
-    impl = getattr(impl, "part", impl)  # (the contact routes: the old class, a part now)
-    assert np.array_equal(m.system(values).params, impl.system(impl.parameters(own)).params)
+    part = getattr(impl, "part", impl)  # (the contact routes: the joints' part)
+    pv = part.parameters(own)
+    sm, sp = m.system(values), part.system(pv)
+    assert np.array_equal(sm.params, sp.params)
+    y0 = m.initial_state(values)
+    assert np.array_equal(y0, part.initial_state(pv))
+    y = y0 + 1e-3 * np.random.default_rng(43).standard_normal(y0.size) * m.state_scale(values)
+    t = np.array([0.01])
+    assert np.array_equal(rhs_series(sm.rhs, sm.params, t, y[None]),
+                          rhs_series(sp.rhs, sp.params, t, y[None]))  # fmt: skip
     kw = dict(revolutions=0.25, fs=2000.0)
     a = _simulate(model=m, params=selectors, **kw)
     b = _simulate(model=impl, params=own, **kw)
@@ -116,15 +128,15 @@ SAME_IMPLEMENTATION = sorted(set(family.PRESETS) - {"compressor-guide"})
 def test_presets_keep_the_values_and_sweep_digests_of_the_old_names(name):
     """A preset at its defaults validates to exactly the values its implementation gives
     (no selector added), so a sweep store made before the presets keeps its digest: the
-    spec's digest with the preset equals the one with the implementation registered under
-    the name (the code that made the old stores)."""
+    spec's digest with the preset equals the one with the one-throw machine registered under
+    the name, and both the pinned digest of the code that made the old stores."""
     from recipdyn.model import registry
     from recipdyn.sweep import SweepSpec, parse_axis
 
     preset = get_model(name)
-    impl = preset.route(family.PRESETS[name])[1]
-    impl = getattr(impl, "part", impl)  # (a contact route: its joints' configuration)
+    impl = preset.route(family.PRESETS[name])[1]  # (the machine of one throw, a model)
     assert preset.parameters() == impl.parameters()
+    assert preset.parameters() == getattr(impl, "part", impl).parameters()  # (its joints')
     assert preset.schema is impl.schema and preset.state_names == impl.state_names
     axis = parse_axis("omega=19:21:2", name)
     digest = SweepSpec(axes=(axis,), measures=("peak",), model=name).digest

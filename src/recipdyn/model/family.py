@@ -268,13 +268,6 @@ class Compressor(Model):
             if hasattr(impl, k):
                 setattr(self, k, getattr(impl, k))
 
-    def __getattr__(self, name: str) -> Any:
-        # what an implementation offers beyond the protocol (the contact joints' kernels):
-        # the default configuration's
-        if name.startswith("_"):
-            raise AttributeError(name)
-        return getattr(machine(self._route0()), name)
-
     def _route0(self, s: Mapping[str, Any] | None = None) -> str:
         """The route at the selector values ``s`` (default: this preset's)."""
         return route(self._selectors if s is None else s)
@@ -486,6 +479,19 @@ class Compressor(Model):
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
         impl, own = self._split(values)
         return impl.run_summary(own, ds)
+
+    # -- beyond the protocol: the contact joints' compiled module and load ----------------
+    def kernels(self, values: Mapping[str, Any]):
+        """The compiled kernels of the configuration at validated ``values`` (a contact
+        route's: its throw's module, with ``fd_jac`` and ``observe``)."""
+        impl, own = self._split(values)
+        return impl.kernels(own)
+
+    def load_part(self, values: Mapping[str, Any]):
+        """The load component of the configuration at validated ``values`` (a contact
+        route's)."""
+        impl, own = self._split(values)
+        return impl.load_part(own)
 
     def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
                      ) -> dict[str, Any]:  # fmt: skip

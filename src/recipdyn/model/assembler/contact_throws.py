@@ -121,10 +121,10 @@ def joints_part(valves: bool = False):
 def _models():
     """The contact model and the contact model with the dynamic valves (the parts' classes,
     one instance each: no model module imports another's, tests/test_layers.py)."""
-    from ..components.contact_model import CompressorContact
-    from ..components.contact_valves_model import CompressorContactValves
+    from ..components.contact_model import ContactJoints
+    from ..components.contact_valves_model import ContactJointsValves
 
-    return CompressorContact(), CompressorContactValves()
+    return ContactJoints(), ContactJointsValves()
 
 
 #: A free crank's own parameters (its mass, centroid and inertia), a throw's with a motor.
@@ -492,7 +492,7 @@ def fd_scales(local: Mapping[str, Any], n: int) -> np.ndarray:
 
 
 def joints_key(throw: Throw, local: Mapping[str, Any]) -> tuple:
-    """What chooses a contact throw's kernels module (`CompressorContact.kernels`): which
+    """What chooses a contact throw's kernels module (`ContactJoints.kernels`): which
     pins are worn, the load, the guide, the contact law of a user's file, the friction laws;
     throws of one machine share it (`same_joints`)."""
     from ..components import contact_model as cm

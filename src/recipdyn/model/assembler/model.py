@@ -930,7 +930,7 @@ class ContactMachine(MachineModel):
 
     def initial_state(self, values: Mapping[str, Any]) -> np.ndarray:
         """Each throw's one-throw initial state (the pin along its rod load at its own crank
-        angle, `CompressorContact.initial_state`); with several throws each recorded approach
+        angle, `ContactJoints.initial_state`); with several throws each recorded approach
         velocity carries its pin's phase (+ in contact, - in free flight)."""
         from .contact_throws import is_contact
 
@@ -1038,7 +1038,7 @@ class ContactMachine(MachineModel):
         return out
 
     def run_summary(self, values: Mapping[str, Any], ds: Any) -> dict[str, Any]:
-        """Each throw's figures (`CompressorContact.run_summary` of its signals and of the
+        """Each throw's figures (`ContactJoints.run_summary` of its signals and of the
         events at which its own pin changed phase), under its name."""
         from .contact_throws import is_contact
 
@@ -1774,13 +1774,13 @@ class OneContact(ContactMachine):
         return self.part.period(values)
 
     def section_angle(self, values: Mapping[str, Any]) -> str | None:
-        return self.part.section_angle(values)
-
-    def has_dynamics(self, values: Mapping[str, Any]) -> bool:
-        return self.part.has_dynamics(values)
+        """None: the family (`recipdyn.model.family.Compressor.section_angle`) says where a
+        one-throw record's section is taken, as before."""
+        return None
 
     def validity_applies(self, values: Mapping[str, Any]) -> bool:
-        return self.part.validity_applies(values)
+        """True (the protocol's default; the joints have no bounds of their own)."""
+        return True
 
     def lyapunov_supported(self, values: Mapping[str, Any]) -> bool:
         return self.part.lyapunov_supported(values)
@@ -1806,10 +1806,23 @@ class OneContact(ContactMachine):
 
     def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
                      ) -> dict[str, Any]:  # fmt: skip
-        return self.part.record_attrs(values, y0)
+        """The protocol's record attributes (`Model.record_attrs`: the joints' schema, not the
+        machine's), with a table load's rows (``param_load_table_deg_N``: it has no schema
+        row)."""
+        out = Model.record_attrs(self, values, y0)
+        if values.get("load_table") is not None:
+            out["param_load_table_deg_N"] = [float(x) for row in values["load_table"] for x in row]
+        return out
 
     def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
-        return self.part.values_from_record(attrs)
+        """`Model.values_from_record` (the joints' schema and checks), the table load's rows
+        included."""
+        values = Model.values_from_record(self, attrs)
+        flat = attrs.get("param_load_table_deg_N")
+        if flat is not None:
+            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
+            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
+        return values
 
     # -- what the joints' kernels offer beyond the protocol ---------------------------
     def kernels(self, values: Mapping[str, Any]):

@@ -1,7 +1,7 @@
 r"""The contact-impact joints at the pins: the joints' configuration part of a throw.
 
 A throw with a contact or lubricated pin, or the guide's clearance, is one configuration of
-these joints: `CompressorContact` holds what its values mean (schema, checks, packing,
+these joints: `ContactJoints` holds what its values mean (schema, checks, packing,
 states, the generated glue's bindings, outputs, summaries) and `.contact_valves_model`
 overrides what the dynamic valves' states change. The one assembler builds the machines from
 them: the family's one-throw machine (``compressor-contact``, ``compressor-contact-valves``,
@@ -47,11 +47,11 @@ from ..joints.pins import (
 from ..load import CYCLE_PARAMS
 from ..parameters import SCHEMA as LINK_SCHEMA
 from ..parameters import check_reach
-from ..protocol import Model, Param, Schema
+from ..protocol import Param, Schema
 from .guide import GUIDE_PARAMS, GUIDES
 from .load import cycle_outputs, cycle_summary
 
-__all__ = ["CompressorContact", "energy", "overlap_half_angle", "pack", "stiffness"]
+__all__ = ["ContactJoints", "energy", "overlap_half_angle", "pack", "stiffness"]
 
 _INF = math.inf
 
@@ -696,9 +696,16 @@ def _plugged_schema(schema: Schema, law: str | None, load: str | None) -> Schema
     return hit[1]
 
 
-class CompressorContact(Model):
-    """The compressor with contact-impact (dry or lubricated) clearance joints at the crank
-    pin, the crosshead pin, or both."""
+class ContactJoints:
+    """The joints' configuration part of a throw with contact-impact (dry or lubricated)
+    clearance joints at the crank pin, the crosshead pin, or both, or the guide's clearance:
+    what its values mean (schema, checks, packing, states, the generated glue's kernels,
+    events, signals, summary of one throw's slice). Not a model: the one-throw machine
+    (`recipdyn.model.assembler.model.OneContact`) and a machine's contact throws
+    (`recipdyn.model.assembler.contact_throws`) take it as a part."""
+
+    #: (a contact throw's bounds are its machine's: none of its own)
+    validity_bounds: tuple = ()
 
     mean_signals = (
         ("contact", "contact_fraction", "1"),
@@ -803,24 +810,6 @@ class CompressorContact(Model):
         if tab is not None:
             out["load_table"] = tab
         return out
-
-    def record_attrs(self, values: Mapping[str, Any], y0: np.ndarray | None = None
-                     ) -> dict[str, Any]:  # fmt: skip
-        """`Model.record_attrs`, with a table load's rows (``param_load_table_deg_N``: it has
-        no schema row)."""
-        out = super().record_attrs(values, y0)
-        if values.get("load_table") is not None:
-            out["param_load_table_deg_N"] = [float(x) for row in values["load_table"] for x in row]
-        return out
-
-    def values_from_record(self, attrs: Mapping[str, Any]) -> dict[str, Any]:
-        """`Model.values_from_record`, the table load's rows included."""
-        values = super().values_from_record(attrs)
-        flat = attrs.get("param_load_table_deg_N")
-        if flat is not None:
-            rows = np.asarray(flat, dtype=float).reshape(-1, 2)
-            values["load_table"] = tuple((float(a), float(b)) for a, b in rows)
-        return values
 
     @staticmethod
     def _table(values: Mapping[str, Any], table: Any, ptab: Any) -> Any:

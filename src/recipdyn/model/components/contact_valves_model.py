@@ -45,7 +45,7 @@ from ..protocol import Schema
 from . import contact_model as cm
 from .load import VALVES
 
-__all__ = ["CompressorContactValves", "SCHEMA", "STATE_NAMES", "STATE_UNITS", "P_VALVE", "pack"]
+__all__ = ["ContactJointsValves", "SCHEMA", "STATE_NAMES", "STATE_UNITS", "P_VALVE", "pack"]
 
 G0, A0 = pins.G_GAS, pins.G_AUX
 STATE_NAMES = (*pins.STATE_NAMES, *va.GAS_STATE_NAMES, *va.AUX_STATE_NAMES)
@@ -81,8 +81,9 @@ def pack(values: Mapping[str, Any]) -> np.ndarray:
     return cm.pack(values, load=VALVES)
 
 
-class CompressorContactValves(cm.CompressorContact):
-    """The contact-impact joint with the cylinder gas and dynamic valves (module docstring)."""
+class ContactJointsValves(cm.ContactJoints):
+    """The contact joints' configuration part with the cylinder gas and dynamic valves
+    (module docstring)."""
 
     name = "compressor-contact-valves"
     description = ("compressor with contact-impact clearance joints driven by the compression "
