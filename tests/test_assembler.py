@@ -100,8 +100,8 @@ def test_a_templates_own_block_binds_its_reference_configuration(drive):
     from recipdyn.model.registry import get_model
 
     m = get_model("compressor")
-    v = m.parameters({"drive": drive})
-    template, roles, constants, _, _ = m.configuration(v).bindings()
+    impl, own = m._split(m.parameters({"drive": drive}))  # (its route's machine)
+    template, roles, constants, _, _ = impl.configuration(own).bindings()
     got_roles, got_consts = _block(template)
     assert got_roles == roles
     _same_constants(got_consts, constants)

@@ -1159,32 +1159,15 @@ def _contact_interstage_outputs(c: ContactConfiguration, y: np.ndarray, dy: np.n
                                 ) -> dict[str, Signal]:  # fmt: skip
     """`_interstage_outputs` of a machine of contact throws: each throw's mass counters at its
     module's offset in its slice (a contact throw's ``A``, an ideal throw's ``LOAD_AUX``)."""
-    from ..base import Signal
     from .contact_throws import is_contact
 
-    out: dict[str, Signal] = {}
     st, pv = c.layout.state, c.layout.params
     link = c.link_module
-    for i in c.machine.interstages:
-        pi = y[:, st[f"{i.name}.p"]]
-        vol, temp, gas_r = c.params[pv[i.name]]
-        flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
-        for t in c.machine.throws:
-            own = int(c.throw_module.A) if is_contact(t) else int(link.LOAD_AUX[0])
-            a = st.start(f"{t.name}.mechanism") + own
-            if t.stage == i.upstream:
-                flows["in"] += dy[:, a + 1] + dy[:, a + 3]
-            if t.stage == i.downstream:
-                flows["out"] += dy[:, a] + dy[:, a + 2]
-        out[f"{i.name}.p"] = Signal(pi, "Pa", f"interstage pressure: {i.upstream}'s discharge, "
-                                    f"{i.downstream}'s suction (absolute)")  # fmt: skip
-        out[f"{i.name}.mass"] = Signal(pi * vol / (gas_r * temp), "kg",
-                                       "gas mass in the interstage volume")  # fmt: skip
-        out[f"{i.name}.mdot_in"] = Signal(flows["in"], "kg/s", f"mass flow {i.upstream}'s "
-                                          "discharge valves deliver into the volume")  # fmt: skip
-        out[f"{i.name}.mdot_out"] = Signal(flows["out"], "kg/s", f"mass flow {i.downstream}'s "
-                                           "suction valves take from the volume")  # fmt: skip
-    return out
+    counters = {t.name: st.start(f"{t.name}.mechanism")
+                + (int(c.throw_module.A) if is_contact(t) else int(link.LOAD_AUX[0]))
+                for t in c.machine.throws}  # fmt: skip
+    gas = {i.name: tuple(c.params[pv[i.name]]) for i in c.machine.interstages}
+    return _interstage_signals(c.machine, st, y, dy, counters, gas)
 
 
 def _energy_residual(c: ContactConfiguration, ds: Any) -> float:
@@ -1456,17 +1439,29 @@ def _interstage_outputs(c: Configuration, y: np.ndarray, dy: np.ndarray) -> dict
     """Per interstage volume: its pressure (a state), its gas's mass, and the mass flows its
     upstream stage delivers into it and its downstream stage takes from it (the cylinders'
     counters' rates: the flows that were integrated)."""
+    st, pv = c.layout.state, c.layout.params
+    counters = {t.name: st.start(f"{t.name}.load_aux") for t in c.machine.throws}
+    gas = {i.name: tuple(c.params[pv[f"{i.name}.{k}"]]
+                         for k in ("volume", "cooler_temperature", "gas_constant"))
+           for i in c.machine.interstages}  # fmt: skip
+    return _interstage_signals(c.machine, st, y, dy, counters, gas)
+
+
+def _interstage_signals(machine: Machine, st: Any, y: np.ndarray, dy: np.ndarray,
+                        counters: Mapping[str, int], gas: Mapping[str, tuple]
+                        ) -> dict[str, Signal]:  # fmt: skip
+    """The interstage signals of `_interstage_outputs`, from each throw's first mass counter's
+    index (``counters``: suction head, discharge head, suction crank, discharge crank) and
+    each volume's ``(volume, cooler temperature, gas constant)``."""
     from ..base import Signal
 
     out: dict[str, Signal] = {}
-    st, pv = c.layout.state, c.layout.params
-    for i in c.machine.interstages:
+    for i in machine.interstages:
         pi = y[:, st[f"{i.name}.p"]]
-        vol, temp, gas_r = (c.params[pv[f"{i.name}.{k}"]]
-                            for k in ("volume", "cooler_temperature", "gas_constant"))  # fmt: skip
+        vol, temp, gas_r = gas[i.name]
         flows = {"in": np.zeros(y.shape[0]), "out": np.zeros(y.shape[0])}
-        for t in c.machine.throws:
-            a = st.start(f"{t.name}.load_aux")
+        for t in machine.throws:
+            a = counters[t.name]
             if t.stage == i.upstream:
                 flows["in"] += dy[:, a + 1] + dy[:, a + 3]
             if t.stage == i.downstream:

@@ -481,6 +481,13 @@ def rhs(t, y, p, out):
 def _fd_jac(t, y, p, J):
     """Fourth-order central differences of the whole right-hand side (truncation O(h^4)),
     steps ``1e-5 max(|y_i|, s_i)`` (the scales at ``SCALE``: each throw's own module's)."""
+    _fd_rows(t, y, p, J, np.arange(y.shape[0]))
+
+
+@nb.njit(cache=True)
+def _fd_rows(t, y, p, J, rows):
+    """The ``rows`` of ``J`` by the central differences of `_fd_jac`, the rest left as it
+    is."""
     n = y.shape[0]
     yp = y.copy()
     f = np.empty((4, n))
@@ -490,7 +497,7 @@ def _fd_jac(t, y, p, J):
             yp[k] = y[k] + step
             _rhs(t, yp, p, f[m])
         yp[k] = y[k]
-        for i in range(n):
+        for i in rows:
             J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
 
 
@@ -525,19 +532,9 @@ def jac(t, y, p, J):
 def _frame_rows(t, y, p, J):
     """The frame's rows (its states and work integrals) by the fourth-order central
     differences of `_fd_jac` (its steps), the rest of ``J`` left as it is."""
-    n = y.shape[0]
-    yp = y.copy()
-    f = np.empty((4, n))
     rows = np.concatenate((np.arange(FRAME_STATE, FRAME_STATE + 6),
                            np.arange(FRAME_WORK, FRAME_WORK + 2)))  # fmt: skip
-    for k in range(n):
-        h = 1e-5 * max(abs(y[k]), p[SCALE + k])
-        for m, step in enumerate((h, -h, 2.0 * h, -2.0 * h)):
-            yp[k] = y[k] + step
-            _rhs(t, yp, p, f[m])
-        yp[k] = y[k]
-        for i in rows:
-            J[i, k] = (8.0 * (f[0, i] - f[1, i]) - (f[2, i] - f[3, i])) / (12.0 * h)
+    _fd_rows(t, y, p, J, rows)
 
 
 @nb.njit(cache=True)
