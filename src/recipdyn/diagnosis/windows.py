@@ -58,10 +58,10 @@ def window_slices(revs, revolutions: float) -> list[slice]:
     L = float(revolutions)
     if r.size < 2 or not (L >= 1 and L == math.floor(L)) or not np.isfinite(r).all():
         return []
+    from .evidence import _whole_revs
+
+    _, whole, start = _whole_revs(r)  # the whole revolutions the features count
     step = abs(r[1] - r[0])
-    tol = 2.0 * step  # a sample or two short still covers a revolution (as the features)
-    start = math.ceil(r[0] - tol)
-    whole = math.floor(r[-1] + tol) - start
     k = int(whole - L) + 1
     if k < WINDOWS_MIN:
         return []
